@@ -1,0 +1,41 @@
+//! Sylva's shared vocabulary.
+//!
+//! Every model grows a [`Plant`]; fitness terms, meshing and pictures read only a `Plant`.
+//!
+//! - [`turtle`]: the HLU [`Frame`] and [`Turtle`] of *The Algorithmic Beauty of Plants*.
+//! - [`plant`]: [`Plant`], its [`Segment`]s, [`Organ`]s and [`Material`]s, with typed ids.
+//! - [`measures`]: tips, height, bounds, surface area and volume.
+//! - [`hash`]: a stable hash for genome fingerprints.
+//! - [`io`]: atomic file writes.
+//!
+//! Conventions: Y is up, right-handed, metres; angles are radians in code.
+//!
+//! ```
+//! use sylva_core::{Plant, PlantMeta, Turtle, glam::Vec3};
+//!
+//! let mut plant = Plant::new(PlantMeta::default());
+//! let mut turtle = Turtle::default();
+//! let base = turtle.position;
+//! let top = turtle.forward(2.0);
+//! let trunk = plant.add_segment(base, top, (0.2, 0.1), None, false, Plant::BARK)?;
+//! turtle.frame.rotate_l(0.6);
+//! let tip = turtle.forward(1.0);
+//! plant.add_segment(top, tip, (0.1, 0.05), Some(trunk), true, Plant::BARK)?;
+//! assert_eq!(plant.tips().count(), 1);
+//! assert!(plant.height() > 2.0);
+//! # Ok::<(), sylva_core::PlantError>(())
+//! ```
+
+pub mod hash;
+pub mod io;
+pub mod measures;
+pub mod plant;
+pub mod turtle;
+
+pub use glam;
+pub use measures::Aabb;
+pub use plant::{
+    Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantError, PlantMeta, Segment,
+    SegmentId,
+};
+pub use turtle::{Frame, Turtle};

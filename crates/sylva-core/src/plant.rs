@@ -1,0 +1,427 @@
+//! The one plant type every model grows and every later stage reads.
+//!
+//! A [`Plant`] is a skeleton of [`Segment`]s (tapered cylinders, each with a parent), a list of
+//! [`Organ`]s (leaves, flowers, root tips), the [`Material`]s they use, and [`PlantMeta`]
+//! saying where it came from. Segments are stored parents-first: a segment's parent always has
+//! a smaller [`SegmentId`], so one forward pass sees every parent before its children.
+//!
+//! An *axis* is a chain of segments that continue one another (`lateral == false`); a lateral
+//! segment starts a new axis (a branch) from its parent. Meshing joins the segments of an
+//! axis into one tube.
+//!
+//! Units are metres; Y is up.
+
+use glam::{Quat, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Index of a segment in [`Plant::segments`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct SegmentId(pub u32);
+
+impl SegmentId {
+    /// The index as `usize`.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Index of a material in [`Plant::materials`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct MaterialId(pub u16);
+
+impl MaterialId {
+    /// The index as `usize`.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A tapered cylinder of the skeleton.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// Centre of the base, metres.
+    pub start: Vec3,
+    /// Centre of the tip, metres.
+    pub end: Vec3,
+    /// Radius at `start`, metres.
+    pub start_radius: f32,
+    /// Radius at `end`, metres.
+    pub end_radius: f32,
+    /// Branch order: 0 for the trunk's axis, parent's order + 1 for a lateral branch.
+    pub order: u16,
+    /// The segment this one grows from; `None` for a root of the skeleton.
+    pub parent: Option<SegmentId>,
+    /// `true` when this segment starts a new axis (a branch) from its parent, `false` when it
+    /// continues its parent's axis.
+    pub lateral: bool,
+    /// Bark (or root) material.
+    pub material: MaterialId,
+}
+
+impl Segment {
+    /// `end - start`.
+    #[inline]
+    pub fn vector(&self) -> Vec3 {
+        self.end - self.start
+    }
+
+    /// Length in metres.
+    #[inline]
+    pub fn length(&self) -> f32 {
+        self.vector().length()
+    }
+}
+
+/// What an organ is; decides its outline when meshed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrganKind {
+    /// A flat blade.
+    Leaf,
+    /// A star of petals.
+    Flower,
+    /// The absorbing tip of a fine root.
+    RootTip,
+}
+
+/// A leaf, flower or root tip attached to the skeleton.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Organ {
+    /// What it is.
+    pub kind: OrganKind,
+    /// Where its base is attached, metres.
+    pub position: Vec3,
+    /// Local to world: local +Y runs from base to tip along the blade, local +Z is the blade's
+    /// face normal.
+    pub orientation: Quat,
+    /// Length (along local Y) and width (along local X), metres.
+    pub size: Vec2,
+    /// Its material.
+    pub material: MaterialId,
+    /// The segment it grows on, if any.
+    pub parent: Option<SegmentId>,
+}
+
+/// The broad kind of a material; exporters and renderers may treat kinds differently
+/// (leaves and petals are double-sided).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialKind {
+    /// Stems, trunks and branches.
+    Bark,
+    /// Leaf blades.
+    Leaf,
+    /// Petals.
+    Flower,
+    /// Roots below ground.
+    Root,
+}
+
+impl MaterialKind {
+    /// Lower-case name, used for material names in exports.
+    pub fn name(self) -> &'static str {
+        match self {
+            MaterialKind::Bark => "bark",
+            MaterialKind::Leaf => "leaf",
+            MaterialKind::Flower => "flower",
+            MaterialKind::Root => "root",
+        }
+    }
+
+    /// Sylva's default colour for this kind (linear RGB).
+    pub fn default_color(self) -> [f32; 3] {
+        match self {
+            MaterialKind::Bark => [0.20, 0.11, 0.05],
+            MaterialKind::Leaf => [0.10, 0.35, 0.06],
+            MaterialKind::Flower => [0.85, 0.25, 0.45],
+            MaterialKind::Root => [0.45, 0.32, 0.18],
+        }
+    }
+}
+
+/// A surface look: kind, colour and an optional texture id (a model decides what ids mean).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    /// Unique within the plant; used as the exported material name.
+    pub name: String,
+    /// What the material is for.
+    pub kind: MaterialKind,
+    /// Linear RGB in 0..=1.
+    pub color: [f32; 3],
+    /// Texture id, if the model uses textures.
+    pub texture: Option<u16>,
+}
+
+impl Material {
+    /// The default material of a kind, named after it.
+    pub fn of_kind(kind: MaterialKind) -> Self {
+        Material {
+            name: kind.name().to_owned(),
+            kind,
+            color: kind.default_color(),
+            texture: None,
+        }
+    }
+}
+
+/// Where a plant came from: enough to grow it again.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlantMeta {
+    /// Model name (`"bintree"`, `"automata"`, `"plantmaker"`, `"lsystem"`).
+    pub model: String,
+    /// Stable hash of the genome's canonical JSON (see [`crate::hash`]).
+    pub genome_hash: u64,
+    /// The seed the plant was grown with.
+    pub seed: u64,
+}
+
+/// Why a segment or organ was refused.
+#[derive(Debug, Error, PartialEq)]
+pub enum PlantError {
+    /// A coordinate, radius or size is NaN or infinite.
+    #[error("{what} is not finite")]
+    NotFinite {
+        /// Which value.
+        what: &'static str,
+    },
+    /// A radius or size is negative.
+    #[error("{what} is negative ({value})")]
+    Negative {
+        /// Which value.
+        what: &'static str,
+        /// The value given.
+        value: f32,
+    },
+    /// The parent does not exist yet.
+    #[error("parent segment {parent} does not exist (the plant has {len} segments)")]
+    NoSuchParent {
+        /// The parent asked for.
+        parent: u32,
+        /// Segments so far.
+        len: usize,
+    },
+    /// The material does not exist.
+    #[error("material {0} does not exist")]
+    NoSuchMaterial(u16),
+    /// More segments than a `SegmentId` can index.
+    #[error("too many segments")]
+    TooManySegments,
+    /// More materials than a `MaterialId` can index.
+    #[error("too many materials")]
+    TooManyMaterials,
+}
+
+/// A grown plant: skeleton, organs, materials and origin.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Plant {
+    /// The skeleton, parents first.
+    pub segments: Vec<Segment>,
+    /// Leaves, flowers and root tips.
+    pub organs: Vec<Organ>,
+    /// Materials referenced by segments and organs.
+    pub materials: Vec<Material>,
+    /// Origin.
+    pub meta: PlantMeta,
+}
+
+fn finite3(v: Vec3, what: &'static str) -> Result<(), PlantError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(PlantError::NotFinite { what })
+    }
+}
+
+fn non_negative(value: f32, what: &'static str) -> Result<(), PlantError> {
+    if !value.is_finite() {
+        Err(PlantError::NotFinite { what })
+    } else if value < 0.0 {
+        Err(PlantError::Negative { what, value })
+    } else {
+        Ok(())
+    }
+}
+
+impl Plant {
+    /// An empty plant with the given metadata and the three default materials
+    /// (bark, leaf, flower), returned as ids in that order by [`Plant::BARK`] and friends.
+    pub fn new(meta: PlantMeta) -> Self {
+        Plant {
+            segments: Vec::new(),
+            organs: Vec::new(),
+            materials: vec![
+                Material::of_kind(MaterialKind::Bark),
+                Material::of_kind(MaterialKind::Leaf),
+                Material::of_kind(MaterialKind::Flower),
+            ],
+            meta,
+        }
+    }
+
+    /// The default bark material of [`Plant::new`].
+    pub const BARK: MaterialId = MaterialId(0);
+    /// The default leaf material of [`Plant::new`].
+    pub const LEAF: MaterialId = MaterialId(1);
+    /// The default flower material of [`Plant::new`].
+    pub const FLOWER: MaterialId = MaterialId(2);
+
+    /// Adds a material and returns its id.
+    pub fn add_material(&mut self, material: Material) -> Result<MaterialId, PlantError> {
+        let id = u16::try_from(self.materials.len()).map_err(|_| PlantError::TooManyMaterials)?;
+        self.materials.push(material);
+        Ok(MaterialId(id))
+    }
+
+    /// Adds a segment after checking it: finite, non-negative radii, an existing parent and
+    /// material. Order is derived: the parent's order, plus one when `lateral`.
+    pub fn add_segment(
+        &mut self,
+        start: Vec3,
+        end: Vec3,
+        radii: (f32, f32),
+        parent: Option<SegmentId>,
+        lateral: bool,
+        material: MaterialId,
+    ) -> Result<SegmentId, PlantError> {
+        finite3(start, "segment start")?;
+        finite3(end, "segment end")?;
+        non_negative(radii.0, "segment start radius")?;
+        non_negative(radii.1, "segment end radius")?;
+        if material.index() >= self.materials.len() {
+            return Err(PlantError::NoSuchMaterial(material.0));
+        }
+        let order = match parent {
+            None => 0,
+            Some(p) => {
+                let parent = self
+                    .segments
+                    .get(p.index())
+                    .ok_or(PlantError::NoSuchParent {
+                        parent: p.0,
+                        len: self.segments.len(),
+                    })?;
+                parent.order.saturating_add(u16::from(lateral))
+            }
+        };
+        let id = u32::try_from(self.segments.len()).map_err(|_| PlantError::TooManySegments)?;
+        self.segments.push(Segment {
+            start,
+            end,
+            start_radius: radii.0,
+            end_radius: radii.1,
+            order,
+            parent,
+            lateral: lateral && parent.is_some(),
+            material,
+        });
+        Ok(SegmentId(id))
+    }
+
+    /// Adds an organ after checking it is finite with a non-negative size.
+    pub fn add_organ(&mut self, organ: Organ) -> Result<(), PlantError> {
+        finite3(organ.position, "organ position")?;
+        if !organ.orientation.is_finite() || !organ.orientation.is_normalized() {
+            return Err(PlantError::NotFinite {
+                what: "organ orientation",
+            });
+        }
+        non_negative(organ.size.x, "organ length")?;
+        non_negative(organ.size.y, "organ width")?;
+        if material_missing(organ.material, &self.materials) {
+            return Err(PlantError::NoSuchMaterial(organ.material.0));
+        }
+        if let Some(p) = organ.parent
+            && p.index() >= self.segments.len()
+        {
+            return Err(PlantError::NoSuchParent {
+                parent: p.0,
+                len: self.segments.len(),
+            });
+        }
+        self.organs.push(organ);
+        Ok(())
+    }
+
+    /// A segment by id.
+    #[inline]
+    pub fn segment(&self, id: SegmentId) -> &Segment {
+        &self.segments[id.index()]
+    }
+
+    /// How many children each segment has, indexed like `segments`.
+    pub fn child_counts(&self) -> Vec<u32> {
+        let mut counts = vec![0u32; self.segments.len()];
+        for s in &self.segments {
+            if let Some(p) = s.parent {
+                counts[p.index()] += 1;
+            }
+        }
+        counts
+    }
+}
+
+fn material_missing(id: MaterialId, materials: &[Material]) -> bool {
+    id.index() >= materials.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orders_follow_laterals() {
+        let mut p = Plant::new(PlantMeta::default());
+        let a = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        let b = p
+            .add_segment(
+                Vec3::Y,
+                Vec3::Y * 2.0,
+                (0.1, 0.1),
+                Some(a),
+                false,
+                Plant::BARK,
+            )
+            .unwrap();
+        let c = p
+            .add_segment(Vec3::Y, Vec3::X, (0.1, 0.1), Some(a), true, Plant::BARK)
+            .unwrap();
+        assert_eq!(p.segment(b).order, 0);
+        assert_eq!(p.segment(c).order, 1);
+        assert_eq!(p.child_counts(), vec![2, 0, 0]);
+    }
+
+    #[test]
+    fn refuses_bad_segments() {
+        let mut p = Plant::new(PlantMeta::default());
+        let nan = Vec3::new(f32::NAN, 0.0, 0.0);
+        assert!(matches!(
+            p.add_segment(nan, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK),
+            Err(PlantError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            p.add_segment(Vec3::ZERO, Vec3::Y, (-0.1, 0.1), None, false, Plant::BARK),
+            Err(PlantError::Negative { .. })
+        ));
+        assert!(matches!(
+            p.add_segment(
+                Vec3::ZERO,
+                Vec3::Y,
+                (0.1, 0.1),
+                Some(SegmentId(3)),
+                false,
+                Plant::BARK
+            ),
+            Err(PlantError::NoSuchParent { .. })
+        ));
+        assert!(matches!(
+            p.add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, MaterialId(9)),
+            Err(PlantError::NoSuchMaterial(9))
+        ));
+        assert!(p.segments.is_empty());
+    }
+}

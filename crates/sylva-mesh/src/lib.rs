@@ -1,0 +1,19 @@
+//! From a [`Plant`](sylva_core::Plant) to triangles, files and pictures.
+//!
+//! - [`mesh`]: the [`Mesh`] type (shared vertices, one primitive per material).
+//! - [`mesher`]: [`Mesher`] turns a plant into a mesh (generalised cylinders along each axis,
+//!   parallel-transport frames, shared rings, caps, leaves and flowers).
+//! - [`scene`]: [`Scene`], meshes placed in the world with their origin data.
+//! - [`export`]: GLB (glTF 2.0 binary), OBJ with MTL, VRML97.
+//! - [`render`]: a software z-buffer renderer writing PNG, and contact sheets.
+//!
+//! A mesh never knows which model made the plant.
+
+pub mod export;
+pub mod mesh;
+pub mod mesher;
+pub mod render;
+pub mod scene;
+
+pub use mesh::{Mesh, Primitive};
+pub use scene::{Scene, SceneNode};

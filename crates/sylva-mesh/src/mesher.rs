@@ -1,0 +1,1 @@
+//! Plant to mesh. (being written)

@@ -1,0 +1,1 @@
+//! Software renderer. (being written)
