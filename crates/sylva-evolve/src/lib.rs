@@ -1,1 +1,63 @@
-//! TODO
+//! Sylva's generic evolution engine. It knows genomes and fitness, never plants.
+//!
+//! - [`Problem`]: a genome type, random genomes, and a fitness ([`Fitness`]: a total and
+//!   named terms; higher is better).
+//! - [`Mutate`] and [`Crossover`]: variation operators, one method each, randomness passed in.
+//! - [`Strategy`]: how one generation becomes the next; [`MeanReplacement`] is Susinno's.
+//! - [`Evaluator`]: the one seam where work goes parallel (rayon), results kept in order.
+//! - [`Run`]: generations, batches, statistics, a [`Browser`] over the family, and
+//!   [`Checkpoint`]s that resume exactly.
+//! - [`bits`]: fixed-length bit strings with bit-flip mutation and crossovers.
+//! - [`rng`]: ChaCha8 streams keyed by `(seed, generation, slot)`.
+//!
+//! Determinism: the same problem, settings and seed give the same populations and
+//! statistics (less wall time) for any number of threads.
+//!
+//! ```
+//! use sylva_evolve::{
+//!     Evaluator, Fitness, MeanReplacement, Problem, Run, RunSettings,
+//!     bits::{BitFlip, BitString, OnePoint},
+//! };
+//!
+//! /// Count the ones.
+//! struct OneMax;
+//! impl Problem for OneMax {
+//!     type Genome = BitString<1>;
+//!     fn term_names(&self) -> Vec<String> { vec!["ones".into()] }
+//!     fn evaluate(&self, g: &Self::Genome) -> Fitness {
+//!         let ones = (0..g.len()).filter(|&i| g.get(i)).count() as f64;
+//!         Fitness::new(ones, &[ones])
+//!     }
+//!     fn random_genome<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Self::Genome {
+//!         BitString::random(40, rng).expect("40 bits fit in one word")
+//!     }
+//! }
+//!
+//! let strategy = MeanReplacement {
+//!     crossover: OnePoint,
+//!     mutation: BitFlip { rate: 0.02 },
+//!     cull_clones: true,
+//! };
+//! let settings = RunSettings { seed: 1, population: 60, keep_history: 0 };
+//! let mut run = Run::new(OneMax, strategy, Evaluator::Serial, settings)?;
+//! let first = run.stats()[0].best;
+//! run.run_batch(40, |_| {});
+//! assert!(run.best().total() > first);
+//! # Ok::<(), sylva_evolve::EvolveError>(())
+//! ```
+
+pub mod bits;
+pub mod fitness;
+pub mod individual;
+pub mod problem;
+pub mod rng;
+pub mod run;
+pub mod strategy;
+pub mod variation;
+
+pub use fitness::{Fitness, MAX_TERMS};
+pub use individual::{Individual, IndividualId, Origin};
+pub use problem::{Evaluator, Problem};
+pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};
+pub use strategy::{Breeding, MeanReplacement, Strategy};
+pub use variation::{Crossover, Mutate};
