@@ -4,9 +4,11 @@
 //!
 //! - [`turtle`]: the HLU [`Frame`] and [`Turtle`] of *The Algorithmic Beauty of Plants*.
 //! - [`plant`]: [`Plant`], its [`Segment`]s, [`Organ`]s and [`Material`]s, with typed ids.
-//! - [`measures`]: tips, height, bounds, surface area and volume.
+//! - [`measures`]: tips, height, bounds, surface area, volume, and Susinno's
+//!   [`TreeMeasures`].
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
+//! - [`ranged`]: range-checked fields for genome and config files.
 //!
 //! Conventions: Y is up, right-handed, metres; angles are radians in code.
 //!
@@ -30,10 +32,11 @@ pub mod hash;
 pub mod io;
 pub mod measures;
 pub mod plant;
+pub mod ranged;
 pub mod turtle;
 
 pub use glam;
-pub use measures::Aabb;
+pub use measures::{Aabb, TreeMeasures};
 pub use plant::{
     Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantError, PlantMeta, Segment,
     SegmentId,

@@ -1,1 +1,20 @@
-//! TODO
+//! Fitness terms over a [`Plant`](sylva_core::Plant), shared by every model.
+//!
+//! - [`tree`]: Susinno's six tree measures ([`TreeMeasures`], with two of Sylva's) read
+//!   from any plant, and his weighted fitness ([`SusinnoWeights`]), reported term by term.
+//!
+//! ```
+//! use sylva_fitness::{SusinnoWeights, TreeMeasures};
+//! use sylva_models::bintree::BinTree;
+//!
+//! let plant = BinTree::default().develop(0)?;
+//! let measures = TreeMeasures::of_plant(&plant);
+//! let score = SusinnoWeights::default().score(&measures);
+//! assert_eq!(score.terms.len(), 8);
+//! assert!((score.terms.iter().sum::<f64>() - score.total).abs() < 1e-9);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod tree;
+
+pub use tree::{SusinnoScore, SusinnoWeights, TreeMeasures};
