@@ -1,1 +1,510 @@
-//! Exporters. (being written)
+//! Writing a [`Scene`] to files: GLB (glTF 2.0 binary), OBJ with MTL, and VRML97.
+//!
+//! - [`to_glb`]: one glTF node per [`SceneNode`](crate::SceneNode), one glTF mesh per distinct
+//!   [`Mesh`] (nodes borrowing the same mesh share it), the node's extras kept as glTF
+//!   `extras`. Checked by the Khronos validator in the tests.
+//! - [`to_obj`]: world-space vertices, one object per node, one `usemtl` per primitive.
+//! - [`to_vrml`]: one `Transform` per node, one `Shape` per primitive.
+//! - [`write_scene`]: picks the format from the file extension ([`Format::from_path`]) and
+//!   writes atomically, so a reader never sees half a file.
+//!
+//! Every exporter is deterministic: the same scene gives the same bytes.
+//!
+//! ```no_run
+//! use sylva_core::{Plant, PlantMeta, glam::Vec3};
+//! use sylva_mesh::{Scene, SceneNode, export, mesher::{MeshOptions, mesh_plant}};
+//!
+//! let mut plant = Plant::new(PlantMeta::default());
+//! plant.add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.05), None, false, Plant::BARK)?;
+//! let mesh = mesh_plant(&plant, &MeshOptions::default())?;
+//! let scene = Scene::single(SceneNode::new("plant", &mesh));
+//! export::write_scene("plant.glb".as_ref(), &scene)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod glb;
+mod obj;
+mod vrml;
+
+use std::fmt::Write as _;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+pub use glb::to_glb;
+pub use obj::to_obj;
+pub use vrml::to_vrml;
+
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
+/// Why a scene could not be exported.
+#[derive(Debug, Error)]
+pub enum ExportError {
+    /// The file extension names no format this crate writes.
+    #[error("unknown export format \".{extension}\" (expected .glb, .obj or .wrl)")]
+    UnknownExtension {
+        /// The extension found.
+        extension: String,
+    },
+    /// The path has no extension to pick a format by.
+    #[error("{path:?} has no file extension (expected .glb, .obj or .wrl)")]
+    NoExtension {
+        /// The path given.
+        path: PathBuf,
+    },
+    /// Writing a file failed.
+    #[error("cannot write {path:?}: {source}")]
+    Io {
+        /// The file being written.
+        path: PathBuf,
+        /// What went wrong.
+        #[source]
+        source: io::Error,
+    },
+    /// A position, normal, colour or transform is NaN or infinite.
+    #[error("node {node}: {what} is not finite")]
+    NotFinite {
+        /// The scene node.
+        node: usize,
+        /// Which value.
+        what: &'static str,
+    },
+    /// A node's rotation is a zero quaternion.
+    #[error("node {node}: rotation is a zero quaternion")]
+    ZeroRotation {
+        /// The scene node.
+        node: usize,
+    },
+    /// A mesh has a different number of normals than positions.
+    #[error("node {node}: {positions} positions but {normals} normals")]
+    NormalCount {
+        /// The scene node.
+        node: usize,
+        /// Positions in its mesh.
+        positions: usize,
+        /// Normals in its mesh.
+        normals: usize,
+    },
+    /// A primitive's index count is not a multiple of three.
+    #[error("node {node}, primitive {primitive}: {len} indices is not whole triangles")]
+    PartialTriangle {
+        /// The scene node.
+        node: usize,
+        /// The primitive.
+        primitive: usize,
+        /// Its index count.
+        len: usize,
+    },
+    /// A primitive refers to a vertex the mesh does not have.
+    #[error("node {node}, primitive {primitive}: index {index} but only {vertices} vertices")]
+    IndexOutOfRange {
+        /// The scene node.
+        node: usize,
+        /// The primitive.
+        primitive: usize,
+        /// The bad index.
+        index: u32,
+        /// Vertices in the mesh.
+        vertices: usize,
+    },
+    /// A primitive refers to a material the mesh does not have.
+    #[error("node {node}, primitive {primitive}: material {material} but only {len} materials")]
+    NoSuchMaterial {
+        /// The scene node.
+        node: usize,
+        /// The primitive.
+        primitive: usize,
+        /// The material asked for.
+        material: usize,
+        /// Materials in the mesh.
+        len: usize,
+    },
+    /// The GLB would exceed the 4 GiB a GLB header can describe.
+    #[error("the GLB would be {bytes} bytes, more than a GLB can hold")]
+    TooLarge {
+        /// The size it would have.
+        bytes: u64,
+    },
+    /// The glTF JSON could not be written.
+    #[error("cannot write the glTF JSON: {0}")]
+    Json(#[from] serde_json::Error),
+}
+
+/// A file format [`write_scene`] can write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// glTF 2.0 binary, `.glb`.
+    Glb,
+    /// Wavefront OBJ with an MTL file, `.obj`.
+    Obj,
+    /// VRML97, `.wrl`.
+    Vrml,
+}
+
+impl Format {
+    /// The format named by a path's extension (`glb`, `obj` or `wrl`, in any case).
+    pub fn from_path(path: &Path) -> Result<Format, ExportError> {
+        let Some(extension) = path.extension() else {
+            return Err(ExportError::NoExtension {
+                path: path.to_owned(),
+            });
+        };
+        let extension = extension.to_string_lossy();
+        match extension.to_ascii_lowercase().as_str() {
+            "glb" => Ok(Format::Glb),
+            "obj" => Ok(Format::Obj),
+            "wrl" => Ok(Format::Vrml),
+            _ => Err(ExportError::UnknownExtension {
+                extension: extension.into_owned(),
+            }),
+        }
+    }
+
+    /// The usual file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Glb => "glb",
+            Format::Obj => "obj",
+            Format::Vrml => "wrl",
+        }
+    }
+}
+
+/// Writes `scene` to `path` in the format its extension names, atomically. An OBJ also gets
+/// its MTL file next to it, with the same stem (written first, so the OBJ never refers to a
+/// missing MTL). The scene is checked first ([`check_scene`]), so no malformed file is
+/// written.
+pub fn write_scene(path: &Path, scene: &Scene) -> Result<(), ExportError> {
+    let format = Format::from_path(path)?;
+    check_scene(scene)?;
+    let write = |path: &Path, bytes: &[u8]| {
+        sylva_core::io::write_atomic(path, bytes).map_err(|source| ExportError::Io {
+            path: path.to_owned(),
+            source,
+        })
+    };
+    match format {
+        Format::Glb => write(path, &to_glb(scene)?),
+        Format::Vrml => write(path, to_vrml(scene).as_bytes()),
+        Format::Obj => {
+            let mtl_path = path.with_extension("mtl");
+            let mtl_name = mtl_path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene.mtl".to_owned());
+            let (obj, mtl) = to_obj(scene, &mtl_name);
+            write(&mtl_path, mtl.as_bytes())?;
+            write(path, obj.as_bytes())
+        }
+    }
+}
+
+/// Checks that every node can be exported faithfully: finite transforms, positions, normals
+/// and colours; as many normals as positions; whole triangles; indices and materials in range.
+/// [`to_glb`] and [`write_scene`] call it; [`to_obj`] and [`to_vrml`] instead skip or replace
+/// what is broken, so they never fail.
+pub fn check_scene(scene: &Scene) -> Result<(), ExportError> {
+    for (node, n) in scene.nodes.iter().enumerate() {
+        if !n.translation.is_finite() {
+            return Err(ExportError::NotFinite {
+                node,
+                what: "translation",
+            });
+        }
+        if !n.rotation.is_finite() {
+            return Err(ExportError::NotFinite {
+                node,
+                what: "rotation",
+            });
+        }
+        if n.rotation.length_squared() < 1e-12 {
+            return Err(ExportError::ZeroRotation { node });
+        }
+        check_mesh(node, n.mesh)?;
+    }
+    Ok(())
+}
+
+fn check_mesh(node: usize, mesh: &Mesh) -> Result<(), ExportError> {
+    let finite = |v: &[[f32; 3]]| v.iter().flatten().all(|c| c.is_finite());
+    if mesh.normals.len() != mesh.positions.len() {
+        return Err(ExportError::NormalCount {
+            node,
+            positions: mesh.positions.len(),
+            normals: mesh.normals.len(),
+        });
+    }
+    if !finite(&mesh.positions) {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "a vertex position",
+        });
+    }
+    if !finite(&mesh.normals) {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "a vertex normal",
+        });
+    }
+    if mesh
+        .materials
+        .iter()
+        .flat_map(|m| m.color)
+        .any(|c| !c.is_finite())
+    {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "a material colour",
+        });
+    }
+    let vertices = mesh.positions.len();
+    for (primitive, p) in mesh.primitives.iter().enumerate() {
+        if !p.indices.len().is_multiple_of(3) {
+            return Err(ExportError::PartialTriangle {
+                node,
+                primitive,
+                len: p.indices.len(),
+            });
+        }
+        if p.material >= mesh.materials.len() {
+            return Err(ExportError::NoSuchMaterial {
+                node,
+                primitive,
+                material: p.material,
+                len: mesh.materials.len(),
+            });
+        }
+        if let Some(&index) = p.indices.iter().find(|&&i| i as usize >= vertices) {
+            return Err(ExportError::IndexOutOfRange {
+                node,
+                primitive,
+                index,
+                vertices,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Triangles of a primitive whose three indices address existing vertices; what the text
+/// exporters write (a checked scene loses nothing).
+fn valid_triangles(indices: &[u32], vertices: usize) -> impl Iterator<Item = [u32; 3]> + '_ {
+    indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .filter(move |t| t.iter().all(|&i| (i as usize) < vertices))
+}
+
+/// Appends `x` in the shortest form that reads back as the same `f32`; NaN and infinities,
+/// which text formats cannot hold, are written as 0.
+fn push_float(out: &mut String, x: f32) {
+    let x = if x.is_finite() { x } else { 0.0 };
+    // -0 reads as 0 everywhere; writing it plainly keeps outputs tidy.
+    let x = if x == 0.0 { 0.0 } else { x };
+    let _ = write!(out, "{x}");
+}
+
+/// Appends three floats separated by spaces.
+fn push_vec3(out: &mut String, v: [f32; 3]) {
+    push_float(out, v[0]);
+    out.push(' ');
+    push_float(out, v[1]);
+    out.push(' ');
+    push_float(out, v[2]);
+}
+
+/// A name safe as one token (OBJ names, VRML identifiers): letters, digits, `_` and `-` kept,
+/// everything else turned into `_`; never empty.
+fn token(name: &str) -> String {
+    let mut t: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if t.is_empty() {
+        t.push('_');
+    }
+    t
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::mesher::{MeshOptions, mesh_plant};
+    use crate::scene::SceneNode;
+    use sylva_core::glam::{Quat, Vec2, Vec3};
+    use sylva_core::{Organ, OrganKind, Plant, PlantMeta};
+
+    /// A small plant with a trunk, a branch, a leaf and a flower.
+    pub(crate) fn small_plant() -> Plant {
+        let mut p = Plant::new(PlantMeta::default());
+        let a = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.08), None, false, Plant::BARK)
+            .unwrap();
+        let b = p
+            .add_segment(
+                Vec3::Y,
+                Vec3::new(0.5, 1.6, 0.0),
+                (0.05, 0.03),
+                Some(a),
+                true,
+                Plant::BARK,
+            )
+            .unwrap();
+        p.add_organ(Organ {
+            kind: OrganKind::Leaf,
+            position: Vec3::new(0.5, 1.6, 0.0),
+            orientation: Quat::from_rotation_z(-0.5),
+            size: Vec2::new(0.3, 0.1),
+            material: Plant::LEAF,
+            parent: Some(b),
+        })
+        .unwrap();
+        p.add_organ(Organ {
+            kind: OrganKind::Flower,
+            position: Vec3::Y,
+            orientation: Quat::IDENTITY,
+            size: Vec2::new(0.2, 0.05),
+            material: Plant::FLOWER,
+            parent: Some(a),
+        })
+        .unwrap();
+        p
+    }
+
+    pub(crate) fn small_mesh() -> Mesh {
+        mesh_plant(&small_plant(), &MeshOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn format_from_extension() {
+        assert_eq!(
+            Format::from_path(Path::new("a/b.GLB")).unwrap(),
+            Format::Glb
+        );
+        assert_eq!(Format::from_path(Path::new("b.obj")).unwrap(), Format::Obj);
+        assert_eq!(Format::from_path(Path::new("b.Wrl")).unwrap(), Format::Vrml);
+        let e = Format::from_path(Path::new("b.stl")).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains(".stl") && msg.contains(".glb") && msg.contains(".wrl"),
+            "{msg}"
+        );
+        assert!(matches!(
+            Format::from_path(Path::new("noext")),
+            Err(ExportError::NoExtension { .. })
+        ));
+    }
+
+    #[test]
+    fn write_scene_writes_each_format_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let mesh = small_mesh();
+        let scene = Scene::single(SceneNode::new("plant", &mesh));
+        for name in ["p.glb", "p.obj", "p.wrl"] {
+            write_scene(&dir.path().join(name), &scene).unwrap();
+        }
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["p.glb", "p.mtl", "p.obj", "p.wrl"],
+            "no temporary files left"
+        );
+        let obj = std::fs::read_to_string(dir.path().join("p.obj")).unwrap();
+        assert!(obj.contains("mtllib p.mtl"));
+        assert_eq!(
+            std::fs::read(dir.path().join("p.glb")).unwrap(),
+            to_glb(&scene).unwrap()
+        );
+    }
+
+    #[test]
+    fn write_scene_refuses_bad_extensions_and_bad_meshes_without_writing() {
+        let dir = tempfile::tempdir().unwrap();
+        let mesh = small_mesh();
+        let scene = Scene::single(SceneNode::new("plant", &mesh));
+        let e = write_scene(&dir.path().join("p.stl"), &scene).unwrap_err();
+        assert!(matches!(e, ExportError::UnknownExtension { ref extension } if extension == "stl"));
+
+        let mut broken = small_mesh();
+        broken.primitives[0].indices[0] = 1_000_000;
+        let scene = Scene::single(SceneNode::new("plant", &broken));
+        let e = write_scene(&dir.path().join("p.glb"), &scene).unwrap_err();
+        assert!(matches!(e, ExportError::IndexOutOfRange { .. }), "{e}");
+        let mut nan = small_mesh();
+        nan.positions[3][1] = f32::NAN;
+        let scene = Scene::single(SceneNode::new("plant", &nan));
+        let e = write_scene(&dir.path().join("p.obj"), &scene).unwrap_err();
+        assert!(matches!(e, ExportError::NotFinite { .. }), "{e}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+
+        // A directory that does not exist is an I/O error naming the path.
+        let e = write_scene(&dir.path().join("no/such/p.glb"), &Scene::default()).unwrap_err();
+        assert!(matches!(e, ExportError::Io { .. }), "{e}");
+    }
+
+    #[test]
+    fn a_failed_write_leaves_no_partial_file() {
+        // The target is a directory, so the final rename fails after the data was written.
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("p.glb");
+        std::fs::create_dir(&target).unwrap();
+        let mesh = small_mesh();
+        let e = write_scene(&target, &Scene::single(SceneNode::new("plant", &mesh))).unwrap_err();
+        assert!(
+            matches!(e, ExportError::Io { ref path, .. } if path == &target),
+            "{e}"
+        );
+        assert!(target.is_dir());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary file left"
+        );
+    }
+
+    #[test]
+    fn write_scene_replaces_an_existing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.wrl");
+        std::fs::write(&path, "old").unwrap();
+        let mesh = small_mesh();
+        write_scene(&path, &Scene::single(SceneNode::new("plant", &mesh))).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("#VRML V2.0 utf8"));
+    }
+
+    #[test]
+    fn floats_are_short_and_round_trip() {
+        let mut s = String::new();
+        for x in [0.1f32, -0.0, 1e-7, 3.0, f32::NAN, 123456.79, -2.5e-3] {
+            s.clear();
+            push_float(&mut s, x);
+            let back: f32 = s.parse().unwrap();
+            if x.is_finite() {
+                assert_eq!(back, x, "{s}");
+            } else {
+                assert_eq!(back, 0.0);
+            }
+            assert!(!s.contains('e'), "{s}");
+        }
+    }
+
+    #[test]
+    fn tokens_are_single_words() {
+        assert_eq!(token("a b\tc"), "a_b_c");
+        assert_eq!(token(""), "_");
+        assert_eq!(token("bark-2"), "bark-2");
+    }
+}

@@ -1,0 +1,56 @@
+//! Meshing and GLB export throughput on a tree of over a million triangles.
+//!
+//! Run with `cargo bench -p sylva-mesh --bench mesh`; throughput is in triangles (elements).
+#![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sylva_mesh::mesher::{MeshOptions, Mesher};
+use sylva_mesh::{Mesh, Scene, SceneNode, export};
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+fn mesh_tree(c: &mut Criterion) {
+    let plant = common::bench_tree();
+    let mut mesher = Mesher::new(MeshOptions::default()).expect("default options are legal");
+    let mut mesh = Mesh::default();
+    let stats = mesher
+        .mesh_into(&plant, &mut mesh)
+        .expect("the bench tree meshes");
+    eprintln!(
+        "bench tree: {} segments, {} organs, {} vertices, {} triangles",
+        plant.segments.len(),
+        plant.organs.len(),
+        stats.vertices,
+        stats.triangles
+    );
+
+    let mut group = c.benchmark_group("mesh");
+    group.throughput(Throughput::Elements(stats.triangles as u64));
+    group.sample_size(20);
+    group.bench_function("mesh_into_reused", |b| {
+        b.iter(|| {
+            mesher
+                .mesh_into(black_box(&plant), &mut mesh)
+                .expect("the bench tree meshes")
+        })
+    });
+    group.bench_function("mesh_fresh", |b| {
+        b.iter(|| {
+            mesher
+                .mesh(black_box(&plant))
+                .expect("the bench tree meshes")
+        })
+    });
+    let scene = Scene::single(SceneNode::new("tree", &mesh));
+    group.sample_size(10);
+    group.bench_function("to_glb", |b| {
+        b.iter(|| export::to_glb(black_box(&scene)).expect("the bench mesh exports"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, mesh_tree);
+criterion_main!(benches);

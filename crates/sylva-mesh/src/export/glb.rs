@@ -1,0 +1,427 @@
+//! glTF 2.0 binary (GLB) writer.
+//!
+//! Layout: one glTF node per scene node, all at the root of one scene; one glTF mesh per
+//! distinct [`Mesh`] (nodes that borrow the same mesh, compared by address, share it); one
+//! primitive per [`Primitive`](crate::Primitive), all sharing the mesh's POSITION and NORMAL
+//! accessors. Indices are `u16` when the mesh has at most 65 535 vertices (65 535 itself is
+//! the primitive-restart value glTF forbids), `u32` otherwise. Materials are metallic-roughness
+//! with the plant colour as base colour, not metallic and rough (0.9); identical materials
+//! are written once. They are not `doubleSided`: leaves and petals already carry a back face,
+//! and a double-sided material would draw both coincident faces from either side.
+//!
+//! Each buffer view holds one tightly packed accessor (no `byteStride`), starts on a 4-byte
+//! boundary and has its `target` set. The JSON chunk is padded with spaces and the BIN chunk
+//! with zeros to 4 bytes. A mesh with no triangles gives a node without a mesh. The JSON is
+//! built with `serde_json`, whose maps keep a fixed key order, so output is deterministic.
+
+use std::collections::HashMap;
+
+use serde_json::{Map, Value, json};
+use sylva_core::glam::{Quat, Vec3};
+
+use super::{ExportError, check_scene};
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
+const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
+const GLB_VERSION: u32 = 2;
+const CHUNK_JSON: u32 = 0x4E4F_534A; // "JSON"
+const CHUNK_BIN: u32 = 0x004E_4942; // "BIN\0"
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+/// Most vertices that `u16` indices can address (65 535 is reserved for primitive restart).
+const U16_VERTICES: usize = 65_535;
+/// Roughness of every material: plants are matte.
+const ROUGHNESS: f64 = 0.9;
+
+/// Encodes `scene` as a GLB file. Fails only on a scene [`check_scene`] refuses or one too
+/// large for a GLB's 32-bit lengths.
+pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
+    check_scene(scene)?;
+    let mut w = Writer::default();
+    let mut mesh_of: HashMap<*const Mesh, Option<usize>> = HashMap::new();
+    let mut nodes = Vec::with_capacity(scene.nodes.len());
+    for node in &scene.nodes {
+        // Addresses only find a mesh already written; indices follow first appearance.
+        let key: *const Mesh = node.mesh;
+        let mesh = match mesh_of.get(&key) {
+            Some(&m) => m,
+            None => {
+                let m = w.mesh(node.mesh, &node.name);
+                mesh_of.insert(key, m);
+                m
+            }
+        };
+        let mut n = Map::new();
+        n.insert("name".into(), json!(node.name));
+        if let Some(m) = mesh {
+            n.insert("mesh".into(), json!(m));
+        }
+        if node.translation != Vec3::ZERO {
+            n.insert(
+                "translation".into(),
+                json!(node.translation.to_array().map(short)),
+            );
+        }
+        let rotation = node.rotation.normalize();
+        if rotation != Quat::IDENTITY {
+            n.insert("rotation".into(), json!(rotation.to_array().map(short)));
+        }
+        if let Some(extras) = &node.extras {
+            n.insert("extras".into(), extras.clone());
+        }
+        nodes.push(Value::Object(n));
+    }
+
+    let mut root = Map::new();
+    root.insert(
+        "asset".into(),
+        json!({ "version": "2.0", "generator": concat!("Sylva ", env!("CARGO_PKG_VERSION")) }),
+    );
+    root.insert("scene".into(), json!(0));
+    let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
+    root.insert(
+        "scenes".into(),
+        if scene_nodes.is_empty() {
+            json!([{}])
+        } else {
+            json!([{ "nodes": scene_nodes }])
+        },
+    );
+    pad4(&mut w.bin, 0);
+    let bin_len = w.bin.len();
+    let arrays = [
+        ("nodes", nodes),
+        ("meshes", w.meshes),
+        ("materials", w.materials),
+        ("accessors", w.accessors),
+        ("bufferViews", w.views),
+        (
+            "buffers",
+            if bin_len > 0 {
+                vec![json!({ "byteLength": bin_len })]
+            } else {
+                Vec::new()
+            },
+        ),
+    ];
+    // glTF forbids empty arrays at the root: leave them out.
+    for (name, items) in arrays {
+        if !items.is_empty() {
+            root.insert(name.into(), Value::Array(items));
+        }
+    }
+    let mut json = serde_json::to_vec(&Value::Object(root))?;
+    pad4(&mut json, b' ');
+
+    let total = 12 + 8 + json.len() as u64 + if bin_len > 0 { 8 + bin_len as u64 } else { 0 };
+    let too_large = || ExportError::TooLarge { bytes: total };
+    let total32 = u32::try_from(total).map_err(|_| too_large())?;
+    let mut out = Vec::with_capacity(total as usize);
+    for word in [
+        GLB_MAGIC,
+        GLB_VERSION,
+        total32,
+        json.len() as u32,
+        CHUNK_JSON,
+    ] {
+        out.extend_from_slice(&word.to_le_bytes());
+    }
+    out.extend_from_slice(&json);
+    if bin_len > 0 {
+        out.extend_from_slice(&(bin_len as u32).to_le_bytes());
+        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+        out.extend_from_slice(&w.bin);
+    }
+    Ok(out)
+}
+
+/// The parts of the glTF document built while walking the scene.
+#[derive(Default)]
+struct Writer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+    /// (name, colour bits) to material index, to write identical materials once.
+    material_of: HashMap<(String, [u32; 3]), usize>,
+}
+
+impl Writer {
+    /// Writes a mesh's data and returns its glTF mesh index; `None` when it has no triangles.
+    fn mesh(&mut self, mesh: &Mesh, name: &str) -> Option<usize> {
+        if mesh.primitives.iter().all(|p| p.indices.is_empty()) {
+            return None;
+        }
+        let count = mesh.positions.len();
+        let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let start = self.bin.len();
+        let index_count: usize = mesh.primitives.iter().map(|p| p.indices.len() + 2).sum();
+        self.bin.reserve(24 * count + 4 * index_count);
+        for p in &mesh.positions {
+            let p = Vec3::from_array(*p);
+            (min, max) = (min.min(p), max.max(p));
+            push_vec3(&mut self.bin, p);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let position = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
+            // Exact f32 values written as f64: the validator compares them exactly.
+            "min": min.to_array(), "max": max.to_array(),
+        }));
+        let start = self.bin.len();
+        for n in &mesh.normals {
+            // Renormalise: glTF requires unit normals, and a zero normal gets +Y.
+            push_vec3(&mut self.bin, Vec3::from_array(*n).normalize_or(Vec3::Y));
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let normal = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
+        }));
+
+        let wide = count > U16_VERTICES;
+        let mut primitives = Vec::new();
+        for p in mesh.primitives.iter().filter(|p| !p.indices.is_empty()) {
+            let start = self.bin.len();
+            if wide {
+                for i in &p.indices {
+                    self.bin.extend_from_slice(&i.to_le_bytes());
+                }
+            } else {
+                // check_scene put every index below count <= 65 535.
+                for &i in &p.indices {
+                    self.bin.extend_from_slice(&(i as u16).to_le_bytes());
+                }
+            }
+            pad4(&mut self.bin, 0);
+            let view = self.view(start, ELEMENT_ARRAY_BUFFER);
+            let indices = self.accessor(json!({
+                "bufferView": view,
+                "componentType": if wide { UNSIGNED_INT } else { UNSIGNED_SHORT },
+                "count": p.indices.len(),
+                "type": "SCALAR",
+            }));
+            let material = self.material(&mesh.materials[p.material]);
+            primitives.push(json!({
+                "attributes": { "POSITION": position, "NORMAL": normal },
+                "indices": indices,
+                "material": material,
+            }));
+        }
+        self.meshes
+            .push(json!({ "name": name, "primitives": primitives }));
+        Some(self.meshes.len() - 1)
+    }
+
+    /// A buffer view over `bin[start..]`, which starts on a 4-byte boundary.
+    fn view(&mut self, start: usize, target: u32) -> usize {
+        debug_assert_eq!(start % 4, 0);
+        let length = self.bin.len() - start;
+        self.views.push(json!({
+            "buffer": 0, "byteOffset": start, "byteLength": length, "target": target,
+        }));
+        self.views.len() - 1
+    }
+
+    fn accessor(&mut self, accessor: Value) -> usize {
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn material(&mut self, m: &sylva_core::Material) -> usize {
+        let key = (m.name.clone(), m.color.map(f32::to_bits));
+        if let Some(&i) = self.material_of.get(&key) {
+            return i;
+        }
+        let [r, g, b] = m.color.map(|c| short(c.clamp(0.0, 1.0)));
+        self.materials.push(json!({
+            "name": m.name,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [r, g, b, 1.0],
+                "metallicFactor": 0.0,
+                "roughnessFactor": ROUGHNESS,
+            },
+        }));
+        self.material_of.insert(key, self.materials.len() - 1);
+        self.materials.len() - 1
+    }
+}
+
+fn push_vec3(bin: &mut Vec<u8>, v: Vec3) {
+    for c in v.to_array() {
+        bin.extend_from_slice(&c.to_le_bytes());
+    }
+}
+
+fn pad4(bytes: &mut Vec<u8>, fill: u8) {
+    while !bytes.len().is_multiple_of(4) {
+        bytes.push(fill);
+    }
+}
+
+/// The `f64` nearest the shortest decimal that reads back as `x`: `0.85f32` is written as
+/// `0.85`, not `0.8500000238418579`. For values that are not compared bit for bit.
+fn short(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::tests::small_mesh;
+    use crate::scene::SceneNode;
+
+    fn u32_at(b: &[u8], at: usize) -> u32 {
+        u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+    }
+
+    /// Splits a GLB into its JSON and BIN chunks, checking header and alignment.
+    pub(crate) fn chunks(glb: &[u8]) -> (Value, Option<&[u8]>) {
+        assert_eq!(u32_at(glb, 0), GLB_MAGIC);
+        assert_eq!(u32_at(glb, 4), 2);
+        assert_eq!(u32_at(glb, 8) as usize, glb.len());
+        assert_eq!(glb.len() % 4, 0);
+        let json_len = u32_at(glb, 12) as usize;
+        assert_eq!(json_len % 4, 0, "JSON chunk is padded to 4 bytes");
+        assert_eq!(u32_at(glb, 16), CHUNK_JSON);
+        let json_bytes = &glb[20..20 + json_len];
+        let json: Value = serde_json::from_slice(json_bytes).unwrap();
+        let rest = &glb[20 + json_len..];
+        if rest.is_empty() {
+            return (json, None);
+        }
+        let bin_len = u32_at(rest, 0) as usize;
+        assert_eq!(bin_len % 4, 0, "BIN chunk is padded to 4 bytes");
+        assert_eq!(u32_at(rest, 4), CHUNK_BIN);
+        assert_eq!(rest.len(), 8 + bin_len);
+        (json, Some(&rest[8..]))
+    }
+
+    #[test]
+    fn header_chunks_and_alignment() {
+        let mesh = small_mesh();
+        let mut node = SceneNode::new("plant", &mesh);
+        node.translation = Vec3::new(1.0, 0.0, 2.0);
+        node.extras = Some(json!({ "seed": 7, "genome": { "model": "bintree", "bits": [1, 0] } }));
+        let glb = to_glb(&Scene::single(node)).unwrap();
+        let (json, bin) = chunks(&glb);
+        let bin = bin.unwrap();
+        assert_eq!(
+            json["buffers"][0]["byteLength"].as_u64().unwrap() as usize,
+            bin.len()
+        );
+        for view in json["bufferViews"].as_array().unwrap() {
+            assert_eq!(view["byteOffset"].as_u64().unwrap() % 4, 0);
+            assert!(view.get("byteStride").is_none());
+            assert!(view["target"].is_u64());
+        }
+        assert_eq!(
+            json["asset"]["generator"],
+            concat!("Sylva ", env!("CARGO_PKG_VERSION"))
+        );
+        assert_eq!(json["nodes"][0]["extras"]["genome"]["model"], "bintree");
+        assert_eq!(json["nodes"][0]["translation"], json!([1.0, 0.0, 2.0]));
+        assert_eq!(
+            json["meshes"][0]["primitives"].as_array().unwrap().len(),
+            mesh.primitives.len()
+        );
+        assert_eq!(json["accessors"][2]["componentType"], UNSIGNED_SHORT);
+        let pos = &json["accessors"][0];
+        let b = mesh.bounds();
+        assert_eq!(pos["min"], json!(b.min.to_array()));
+        assert_eq!(pos["max"], json!(b.max.to_array()));
+    }
+
+    #[test]
+    fn shared_meshes_are_written_once() {
+        let a = small_mesh();
+        let b = small_mesh();
+        let scene = Scene {
+            nodes: vec![
+                SceneNode::new("a1", &a),
+                SceneNode::new("b", &b),
+                SceneNode::new("a2", &a),
+            ],
+        };
+        let (json, _) = chunks(&to_glb(&scene).unwrap());
+        assert_eq!(json["meshes"].as_array().unwrap().len(), 2);
+        assert_eq!(json["nodes"][0]["mesh"], 0);
+        assert_eq!(json["nodes"][1]["mesh"], 1);
+        assert_eq!(json["nodes"][2]["mesh"], 0);
+        // Identical materials are shared too.
+        assert_eq!(json["materials"].as_array().unwrap().len(), 3);
+    }
+
+    #[test]
+    fn empty_scene_and_empty_mesh_are_valid() {
+        let glb = to_glb(&Scene::default()).unwrap();
+        let (json, bin) = chunks(&glb);
+        assert!(bin.is_none());
+        assert!(json.get("nodes").is_none() && json.get("buffers").is_none());
+        let empty = Mesh::default();
+        let glb = to_glb(&Scene::single(SceneNode::new("e", &empty))).unwrap();
+        let (json, bin) = chunks(&glb);
+        assert!(bin.is_none());
+        assert!(json["nodes"][0].get("mesh").is_none());
+        assert_eq!(json["scenes"][0]["nodes"], json!([0]));
+    }
+
+    #[test]
+    fn same_scene_same_bytes() {
+        let mesh = small_mesh();
+        let mut node = SceneNode::new("plant", &mesh);
+        node.rotation = Quat::from_rotation_y(0.3);
+        node.extras = Some(json!({ "z": 1, "a": [1.5, 2.5], "m": { "y": null, "b": true } }));
+        let scene = Scene::single(node);
+        assert_eq!(to_glb(&scene).unwrap(), to_glb(&scene).unwrap());
+        let again = small_mesh();
+        let mut node = SceneNode::new("plant", &again);
+        node.rotation = Quat::from_rotation_y(0.3);
+        node.extras = Some(json!({ "a": [1.5, 2.5], "m": { "b": true, "y": null }, "z": 1 }));
+        assert_eq!(
+            to_glb(&scene).unwrap(),
+            to_glb(&Scene::single(node)).unwrap()
+        );
+    }
+
+    #[test]
+    fn wide_indices_past_65535_vertices() {
+        let mut mesh = Mesh {
+            materials: vec![sylva_core::Material::of_kind(
+                sylva_core::MaterialKind::Bark,
+            )],
+            ..Mesh::default()
+        };
+        for i in 0..70_000u32 {
+            mesh.positions.push([i as f32, (i % 3) as f32, 0.0]);
+            mesh.normals.push([0.0, 0.0, 1.0]);
+        }
+        mesh.primitives.push(crate::Primitive {
+            material: 0,
+            indices: vec![0, 1, 2, 69_997, 69_998, 69_999],
+        });
+        let (json, _) = chunks(&to_glb(&Scene::single(SceneNode::new("w", &mesh))).unwrap());
+        assert_eq!(json["accessors"][2]["componentType"], UNSIGNED_INT);
+    }
+
+    #[test]
+    fn refuses_broken_meshes() {
+        let mut mesh = small_mesh();
+        mesh.normals.pop();
+        let e = to_glb(&Scene::single(SceneNode::new("x", &mesh))).unwrap_err();
+        assert!(matches!(e, ExportError::NormalCount { .. }), "{e}");
+        let mut mesh = small_mesh();
+        mesh.primitives[0].indices.pop();
+        let e = to_glb(&Scene::single(SceneNode::new("x", &mesh))).unwrap_err();
+        assert!(matches!(e, ExportError::PartialTriangle { .. }), "{e}");
+        let mesh = small_mesh();
+        let mut node = SceneNode::new("x", &mesh);
+        node.rotation = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+        let e = to_glb(&Scene::single(node)).unwrap_err();
+        assert!(matches!(e, ExportError::ZeroRotation { .. }), "{e}");
+    }
+}

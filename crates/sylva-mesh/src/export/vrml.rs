@@ -1,0 +1,195 @@
+//! VRML97 writer.
+//!
+//! One `Transform` per node (translation, and rotation as axis and angle), named with `DEF`
+//! after the node; inside it one `Shape` per primitive: an `Appearance` whose `Material` has
+//! the plant colour as `diffuseColor`, and an `IndexedFaceSet` with per-vertex normals,
+//! `solid FALSE` and `ccw TRUE`. A mesh's `Coordinate` and `Normal` nodes are written once,
+//! with `DEF`, the first time it appears, and re-used with `USE` by its other primitives and
+//! by every other node that borrows the same mesh. Numbers are written in the shortest form
+//! that reads back as the same `f32`.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+
+use sylva_core::glam::Vec3;
+
+use super::{push_float, push_vec3, token, valid_triangles};
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
+/// Encodes `scene` as a VRML97 (`.wrl`) file. Never fails: indices out of range are dropped
+/// and non-finite numbers written as 0 (use [`super::check_scene`] to refuse such scenes).
+pub fn to_vrml(scene: &Scene) -> String {
+    let vertices: usize = scene.nodes.iter().map(|n| n.mesh.positions.len()).sum();
+    let mut out = String::with_capacity(64 * vertices + 256);
+    let _ = writeln!(
+        out,
+        "#VRML V2.0 utf8\n# Sylva {}; Y up, metres\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    let mut mesh_ids: HashMap<*const Mesh, usize> = HashMap::new();
+    for (index, node) in scene.nodes.iter().enumerate() {
+        let key: *const Mesh = node.mesh;
+        let fresh = !mesh_ids.contains_key(&key);
+        let next_id = mesh_ids.len();
+        let id = *mesh_ids.entry(key).or_insert(next_id);
+
+        let _ = writeln!(out, "DEF N{index}_{} Transform {{", token(&node.name));
+        out.push_str("  translation ");
+        push_vec3(&mut out, node.translation.to_array());
+        let (axis, angle) = node.rotation.normalize().to_axis_angle();
+        let (axis, angle) = if axis.is_finite() && angle.is_finite() {
+            (axis, angle)
+        } else {
+            (Vec3::X, 0.0)
+        };
+        out.push_str("\n  rotation ");
+        push_vec3(&mut out, axis.to_array());
+        out.push(' ');
+        push_float(&mut out, angle);
+        out.push_str("\n  children [\n");
+        shapes(&mut out, node.mesh, id, fresh);
+        out.push_str("  ]\n}\n");
+    }
+    out
+}
+
+/// Writes one `Shape` per primitive of `mesh`; the first defines the mesh's coordinates and
+/// normals when `fresh`, every other one uses them.
+fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool) {
+    let count = mesh.positions.len();
+    for p in &mesh.primitives {
+        let mut triangles = valid_triangles(&p.indices, count).peekable();
+        if triangles.peek().is_none() {
+            continue;
+        }
+        let color = mesh
+            .materials
+            .get(p.material)
+            .map_or([0.8; 3], |m| m.color)
+            .map(|c| c.clamp(0.0, 1.0));
+        out.push_str(
+            "    Shape {\n      appearance Appearance {\n        material Material { diffuseColor ",
+        );
+        push_vec3(out, color);
+        out.push_str(" }\n      }\n      geometry IndexedFaceSet {\n");
+        if fresh {
+            let _ = writeln!(out, "        coord DEF M{id}_P Coordinate {{ point [");
+            for v in &mesh.positions {
+                out.push_str("          ");
+                push_vec3(out, *v);
+                out.push_str(",\n");
+            }
+            let _ = writeln!(
+                out,
+                "        ] }}\n        normal DEF M{id}_N Normal {{ vector ["
+            );
+            for i in 0..count {
+                let n = mesh.normals.get(i).copied().unwrap_or([0.0, 1.0, 0.0]);
+                out.push_str("          ");
+                push_vec3(out, Vec3::from_array(n).normalize_or(Vec3::Y).to_array());
+                out.push_str(",\n");
+            }
+            out.push_str("        ] }\n");
+            fresh = false;
+        } else {
+            let _ = writeln!(out, "        coord USE M{id}_P\n        normal USE M{id}_N");
+        }
+        out.push_str("        coordIndex [\n");
+        for [a, b, c] in triangles {
+            let _ = writeln!(out, "          {a}, {b}, {c}, -1,");
+        }
+        out.push_str(
+            "        ]\n        normalPerVertex TRUE\n        solid FALSE\n        ccw TRUE\n      }\n    }\n",
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::tests::small_mesh;
+    use crate::scene::SceneNode;
+    use sylva_core::glam::Quat;
+
+    fn balanced(text: &str) -> bool {
+        let mut stack = Vec::new();
+        for c in text
+            .lines()
+            .filter(|l| !l.trim_start().starts_with('#'))
+            .flat_map(str::chars)
+        {
+            let open = match c {
+                '[' | '{' => {
+                    stack.push(c);
+                    continue;
+                }
+                ']' => '[',
+                '}' => '{',
+                _ => continue,
+            };
+            if stack.pop() != Some(open) {
+                return false;
+            }
+        }
+        stack.is_empty()
+    }
+
+    #[test]
+    fn structure() {
+        let mesh = small_mesh();
+        let other = small_mesh();
+        let mut turned = SceneNode::new("turned one", &mesh);
+        turned.rotation = Quat::from_rotation_x(0.5);
+        turned.translation = Vec3::new(0.0, 0.0, -2.0);
+        let scene = Scene {
+            nodes: vec![
+                SceneNode::new("a", &mesh),
+                SceneNode::new("b", &other),
+                turned,
+            ],
+        };
+        let text = to_vrml(&scene);
+        assert!(text.starts_with("#VRML V2.0 utf8\n"));
+        assert!(balanced(&text));
+        assert_eq!(text.matches("Transform {").count(), 3);
+        assert_eq!(text.matches("Shape {").count(), 3 * mesh.primitives.len());
+        // Two distinct meshes: two DEFs each of coordinates and normals, USEd elsewhere.
+        assert_eq!(text.matches("Coordinate {").count(), 2);
+        assert_eq!(
+            text.matches("coord USE M0_P").count(),
+            2 * mesh.primitives.len() - 1
+        );
+        assert_eq!(text.matches(", -1,").count(), 3 * mesh.triangle_count());
+        assert!(text.contains("DEF N2_turned_one Transform {"));
+        assert!(text.contains("rotation 1 0 0 0.5"));
+        assert!(text.contains("translation 0 0 -2"));
+        assert_eq!(
+            text.matches("solid FALSE").count(),
+            3 * mesh.primitives.len()
+        );
+    }
+
+    #[test]
+    fn empty_and_broken_meshes() {
+        let empty = Mesh::default();
+        let text = to_vrml(&Scene::single(SceneNode::new("e", &empty)));
+        assert!(balanced(&text));
+        assert!(!text.contains("Shape"));
+        let mut broken = small_mesh();
+        broken.positions[0][0] = f32::NAN;
+        broken.primitives[0].indices[0] = 1 << 30;
+        let mut node = SceneNode::new("b", &broken);
+        node.rotation = Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0);
+        let text = to_vrml(&Scene::single(node));
+        assert!(balanced(&text));
+        assert!(!text.contains("NaN"));
+    }
+
+    #[test]
+    fn same_scene_same_text() {
+        let mesh = small_mesh();
+        let scene = Scene::single(SceneNode::new("p", &mesh));
+        assert_eq!(to_vrml(&scene), to_vrml(&scene));
+    }
+}

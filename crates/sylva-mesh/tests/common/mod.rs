@@ -1,0 +1,113 @@
+//! Test plants shared by the integration tests and the benchmarks (which include this file
+//! with `#[path]`).
+#![allow(dead_code)]
+
+use sylva_core::glam::{Quat, Vec2};
+use sylva_core::{Organ, OrganKind, Plant, PlantMeta, SegmentId, Turtle};
+
+/// A deterministic recursive binary tree grown with the turtle: `2^(depth+1) - 1` axes of
+/// `segments_per_axis` gently spiralling, tapering segments each; every tip carries a leaf and
+/// every third tip also a flower.
+pub fn binary_tree(depth: u32, segments_per_axis: u32) -> Plant {
+    let mut plant = Plant::new(PlantMeta {
+        model: "test-binary-tree".into(),
+        genome_hash: 0,
+        seed: u64::from(depth),
+    });
+    let mut turtle = Turtle::default();
+    let mut tips = 0;
+    grow_axis(
+        &mut plant,
+        &mut turtle,
+        None,
+        Axis {
+            level: 0,
+            depth,
+            segments: segments_per_axis.max(1),
+            length: 4.0,
+            radius: 0.25,
+        },
+        &mut tips,
+    );
+    plant
+}
+
+/// The benchmark tree: depth 10, 24 segments per axis, 1.25 million triangles with the
+/// default mesh options.
+pub fn bench_tree() -> Plant {
+    binary_tree(10, 24)
+}
+
+struct Axis {
+    level: u32,
+    depth: u32,
+    segments: u32,
+    length: f32,
+    radius: f32,
+}
+
+fn grow_axis(
+    plant: &mut Plant,
+    turtle: &mut Turtle,
+    parent: Option<SegmentId>,
+    axis: Axis,
+    tips: &mut u32,
+) {
+    let n = axis.segments;
+    let step = axis.length / n as f32;
+    let (mut parent, mut lateral) = (parent, parent.is_some());
+    for i in 0..n {
+        // Roll a little and pitch a little: a gentle spiral, so frames must not twist.
+        turtle.frame.rotate_h(0.15);
+        turtle.frame.rotate_l(0.03);
+        let r0 = axis.radius * (1.0 - 0.5 * i as f32 / n as f32);
+        let r1 = axis.radius * (1.0 - 0.5 * (i + 1) as f32 / n as f32);
+        let start = turtle.position;
+        let end = turtle.forward(step);
+        let id = plant
+            .add_segment(start, end, (r0, r1), parent, lateral, Plant::BARK)
+            .expect("the test tree is well formed");
+        (parent, lateral) = (Some(id), false);
+    }
+    if axis.level == axis.depth {
+        let leaf = Organ {
+            kind: OrganKind::Leaf,
+            position: turtle.position,
+            orientation: turtle.frame.rotation() * Quat::from_rotation_x(-0.4),
+            size: Vec2::new(0.3, 0.1),
+            material: Plant::LEAF,
+            parent,
+        };
+        plant.add_organ(leaf).expect("the leaf is well formed");
+        if tips.is_multiple_of(3) {
+            let flower = Organ {
+                kind: OrganKind::Flower,
+                size: Vec2::new(0.12, 0.04),
+                material: Plant::FLOWER,
+                orientation: turtle.frame.rotation(),
+                ..leaf
+            };
+            plant.add_organ(flower).expect("the flower is well formed");
+        }
+        *tips += 1;
+        return;
+    }
+    for side in [1.0f32, -1.0] {
+        turtle.push();
+        turtle.frame.rotate_h(0.9 * side);
+        turtle.frame.rotate_u(0.55 * side);
+        grow_axis(
+            plant,
+            turtle,
+            parent,
+            Axis {
+                level: axis.level + 1,
+                length: axis.length * 0.78,
+                radius: axis.radius * 0.5 * 0.8,
+                ..axis
+            },
+            tips,
+        );
+        turtle.pop();
+    }
+}
