@@ -1,1 +1,144 @@
-fn main() {}
+//! `sylva`: grow and evolve 3D plants from the command line.
+//!
+//! Exit codes: 0 success, 1 failure, 2 bad input (a malformed genome, config or flag).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use sylva::commands::{self, EvolveArgs, GrowArgs, RenderArgs};
+use sylva::error::InputError;
+use sylva_mesh::render::View;
+
+#[derive(Parser)]
+#[command(
+    name = "sylva",
+    version,
+    about = "Grow and evolve 3D plants from genomes",
+    long_about = "Sylva grows plants from genomes and evolves the genomes towards goals, \
+                  then exports them as 3D assets (GLB, OBJ, VRML97) and pictures (PNG)."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Evolve plants; writes stats.csv, best.json, best.glb, best.png, fitness.svg,
+    /// population.png and a checkpoint into the run directory.
+    Evolve {
+        /// TOML config; without one, the built-in default run (binary trees).
+        config: Option<PathBuf>,
+        /// Run directory [default: runs/<model>-seed<seed>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Generations to breed after the random first one (overrides the config).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+        generations: Option<u32>,
+        /// Individuals per generation (overrides the config).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+        population: Option<u32>,
+        /// Seed of every random choice (overrides the config).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Worker threads; 0 means one per core. Results do not depend on it.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1024))]
+        threads: Option<u32>,
+        /// Continue the run saved in the run directory's checkpoint.
+        #[arg(long)]
+        resume: bool,
+    },
+    /// Grow one genome into a 3D asset (format from the extension: .glb, .obj, .wrl).
+    Grow {
+        /// Genome JSON.
+        genome: PathBuf,
+        /// Output asset.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also render a picture.
+        #[arg(long)]
+        png: Option<PathBuf>,
+        /// Seed for the model's random choices.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+    /// Render a genome (.json) or a GLB (.glb) to a PNG picture.
+    Render {
+        /// Genome JSON or GLB.
+        file: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Camera.
+        #[arg(long, default_value = "iso")]
+        view: View,
+        /// Picture size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "800x800", value_parser = commands::parse_size)]
+        size: (u32, u32),
+        /// Seed for the model's random choices (genomes only).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Evolve {
+            config,
+            out,
+            generations,
+            population,
+            seed,
+            threads,
+            resume,
+        } => commands::evolve(&EvolveArgs {
+            config,
+            out,
+            generations,
+            population,
+            seed,
+            threads,
+            resume,
+        }),
+        Command::Grow {
+            genome,
+            output,
+            png,
+            seed,
+        } => commands::grow(&GrowArgs {
+            genome,
+            output,
+            png,
+            seed,
+        }),
+        Command::Render {
+            file,
+            output,
+            view,
+            size,
+            seed,
+        } => commands::render(&RenderArgs {
+            file,
+            output,
+            view,
+            size,
+            seed,
+        }),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => match e.downcast::<InputError>() {
+            Ok(input) => {
+                eprintln!("error: {input}");
+                eprintln!("{:?}", miette::Report::new(input));
+                ExitCode::from(2)
+            }
+            Err(other) => {
+                eprintln!("error: {other:#}");
+                ExitCode::from(1)
+            }
+        },
+    }
+}

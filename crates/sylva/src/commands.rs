@@ -1,0 +1,321 @@
+//! The commands behind `sylva evolve`, `sylva grow` and `sylva render`.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
+use sylva_core::io::write_atomic;
+use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings};
+use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
+use sylva_models::Genome;
+use sylva_models::bintree::Bits;
+
+use crate::assets::{Grown, asset_format, check_png, load_genome};
+use crate::config::{EvolveConfig, ModelName, read_text};
+use crate::error::InputError;
+use crate::problem::{BinTreeProblem, BinTreeStrategy, strategy};
+use crate::report::{fitness_svg, stats_csv};
+
+/// Arguments of `sylva evolve`; `None` keeps the config's value.
+#[derive(Clone, Debug, Default)]
+pub struct EvolveArgs {
+    /// Config file; `None` runs the built-in default.
+    pub config: Option<PathBuf>,
+    /// Run directory; `None` is `runs/<model>-seed<seed>`.
+    pub out: Option<PathBuf>,
+    /// Overrides `run.generations`.
+    pub generations: Option<u32>,
+    /// Overrides `run.population`.
+    pub population: Option<u32>,
+    /// Overrides `run.seed`.
+    pub seed: Option<u64>,
+    /// Overrides `run.threads`.
+    pub threads: Option<u32>,
+    /// Continue from the run directory's checkpoint.
+    pub resume: bool,
+}
+
+/// The checkpoint file: the effective config and the engine's checkpoint.
+#[derive(Serialize, Deserialize)]
+struct SavedRun {
+    config: EvolveConfig,
+    checkpoint: Checkpoint<Bits>,
+}
+
+const CHECKPOINT: &str = "checkpoint.json";
+/// Checkpoints are written at most this often (and always at the end).
+const CHECKPOINT_EVERY: Duration = Duration::from_secs(2);
+
+/// `sylva evolve`.
+pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
+    let mut config = match &args.config {
+        Some(path) => EvolveConfig::load(path)?,
+        None => EvolveConfig::default(),
+    };
+    let run = &mut config.run;
+    run.generations = args.generations.unwrap_or(run.generations);
+    run.population = args.population.unwrap_or(run.population);
+    run.seed = args.seed.unwrap_or(run.seed);
+    run.threads = args.threads.unwrap_or(run.threads);
+    let out = args.out.clone().unwrap_or_else(|| {
+        let model = match config.model {
+            ModelName::BinTree => "bintree",
+        };
+        PathBuf::from(format!("runs/{model}-seed{}", config.run.seed))
+    });
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    match config.model {
+        ModelName::BinTree => evolve_bintree(&config, &out, args.resume),
+    }
+}
+
+/// The parts of a config that must match for a run to resume (everything but the length of
+/// the run and the thread count).
+fn resumable(config: &EvolveConfig) -> EvolveConfig {
+    let mut c = config.clone();
+    c.run.generations = 0;
+    c.run.threads = 0;
+    c
+}
+
+fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Result<()> {
+    let problem = BinTreeProblem::new(&config.bintree);
+    let evaluator = Evaluator::with_threads(config.run.threads as usize)
+        .context("starting the worker threads")?;
+    let checkpoint_path = out.join(CHECKPOINT);
+    let mut run: Run<BinTreeProblem, BinTreeStrategy> = if resume {
+        let text = read_text(&checkpoint_path)?;
+        let saved: SavedRun = serde_json::from_str(&text).map_err(|e| {
+            InputError::at(&checkpoint_path, &text, e.line(), e.column(), e.to_string())
+        })?;
+        if resumable(&saved.config) != resumable(config) {
+            return Err(InputError::new(
+                checkpoint_path.display().to_string(),
+                "the checkpoint was written by a different config (only `generations` and \
+                 `threads` may change when resuming)",
+            )
+            .into());
+        }
+        Run::resume(
+            problem.clone(),
+            strategy(&config.bintree),
+            evaluator,
+            saved.checkpoint,
+        )
+        .map_err(|e| InputError::new(checkpoint_path.display().to_string(), e.to_string()))?
+    } else {
+        let settings = RunSettings {
+            seed: config.run.seed,
+            population: config.run.population as usize,
+            keep_history: 0,
+        };
+        Run::new(
+            problem.clone(),
+            strategy(&config.bintree),
+            evaluator,
+            settings,
+        )?
+    };
+
+    let target = config.run.generations;
+    let bar = ProgressBar::new(u64::from(target)).with_style(
+        ProgressStyle::with_template(
+            "{spinner} generation {pos}/{len} {bar:30} best {msg} ({per_sec}, eta {eta})",
+        )
+        .expect("the template is valid"),
+    );
+    bar.set_position(u64::from(run.generation().min(target)));
+    let save = |run: &Run<BinTreeProblem, BinTreeStrategy>| -> anyhow::Result<()> {
+        let saved = SavedRun {
+            config: config.clone(),
+            checkpoint: run.checkpoint(),
+        };
+        write_atomic(&checkpoint_path, &serde_json::to_vec(&saved)?)
+            .with_context(|| format!("writing {}", checkpoint_path.display()))
+    };
+    let mut last_save = Instant::now();
+    while run.generation() < target {
+        let stats = run.step();
+        bar.set_message(format!("{:.4}", stats.best));
+        bar.set_position(u64::from(run.generation()));
+        if last_save.elapsed() >= CHECKPOINT_EVERY {
+            save(&run)?;
+            last_save = Instant::now();
+        }
+    }
+    save(&run)?;
+    bar.finish_and_clear();
+
+    // Results.
+    let write = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
+        let path = out.join(name);
+        write_atomic(&path, bytes).with_context(|| format!("writing {}", path.display()))
+    };
+    write("config.toml", config.to_toml().as_bytes())?;
+    write(
+        "stats.csv",
+        stats_csv(run.term_names(), run.stats()).as_bytes(),
+    )?;
+    let title = format!("Binary trees, seed {}", config.run.seed);
+    write("fitness.svg", fitness_svg(run.stats(), &title)?.as_bytes())?;
+    let best = run.best();
+    let genome = Genome::BinTree(problem.decode(&best.genome));
+    write("best.json", genome.to_json().as_bytes())?;
+    let grown = Grown::new(genome, 0)?;
+    grown.export(&out.join("best.glb"))?;
+    let size = config.output.image_size;
+    grown.picture(&out.join("best.png"), config.output.view, (size, size))?;
+    population_sheet(
+        &run,
+        &problem,
+        config.output.sheet_size as usize,
+        &out.join("population.png"),
+    )?;
+
+    let last = run.stats().last().expect("a run has statistics");
+    let total_evals: u64 = run.stats().iter().map(|s| s.evaluations).sum();
+    let seconds: f64 = run.stats().iter().map(|s| s.seconds).sum();
+    println!(
+        "generation {}: best fitness {:.4} (individual #{}), mean {:.4}; {} evaluations, {:.0}/s",
+        last.generation,
+        last.best,
+        last.best_id.0,
+        last.mean,
+        total_evals,
+        total_evals as f64 / seconds.max(1e-9),
+    );
+    println!(
+        "best tree: {} cylinders, {} triangles; wrote {}/{{stats.csv, best.json, best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
+        grown.plant.segments.len(),
+        grown.mesh.triangle_count(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// A contact sheet of the best `count` members of the current population.
+fn population_sheet(
+    run: &Run<BinTreeProblem, BinTreeStrategy>,
+    problem: &BinTreeProblem,
+    count: usize,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let mut order: Vec<usize> = (0..run.population().len()).collect();
+    let pop = run.population();
+    order.sort_by(|&a, &b| pop[b].total().total_cmp(&pop[a].total()).then(a.cmp(&b)));
+    order.truncate(count);
+    let grown = order
+        .iter()
+        .map(|&i| Grown::new(Genome::BinTree(problem.decode(&pop[i].genome)), 0))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let cells: Vec<SheetCell> = order
+        .iter()
+        .zip(&grown)
+        .map(|(&i, g)| SheetCell {
+            scene: g.scene(),
+            caption: format!("#{} {:.3}", pop[i].id.0, pop[i].total()),
+        })
+        .collect();
+    let options = SheetOptions {
+        title: Some(format!(
+            "Generation {}: best {} of {}",
+            run.generation(),
+            cells.len(),
+            pop.len()
+        )),
+        ..SheetOptions::default()
+    };
+    let image = render::contact_sheet(&cells, &options).context("drawing the contact sheet")?;
+    render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Arguments of `sylva grow`.
+#[derive(Clone, Debug)]
+pub struct GrowArgs {
+    /// Genome JSON.
+    pub genome: PathBuf,
+    /// Asset to write (.glb, .obj or .wrl).
+    pub output: PathBuf,
+    /// Optional picture.
+    pub png: Option<PathBuf>,
+    /// Seed of the model's random choices.
+    pub seed: u64,
+}
+
+/// `sylva grow`.
+pub fn grow(args: &GrowArgs) -> anyhow::Result<()> {
+    asset_format(&args.output)?;
+    if let Some(png) = &args.png {
+        check_png(png)?;
+    }
+    let genome = load_genome(&args.genome)?;
+    let grown = Grown::new(genome, args.seed)?;
+    grown.export(&args.output)?;
+    if let Some(png) = &args.png {
+        grown.picture(png, View::Iso, (800, 800))?;
+    }
+    println!(
+        "wrote {}: {} segments, {} organs, {} vertices, {} triangles",
+        args.output.display(),
+        grown.plant.segments.len(),
+        grown.plant.organs.len(),
+        grown.mesh.vertex_count(),
+        grown.mesh.triangle_count()
+    );
+    Ok(())
+}
+
+/// Arguments of `sylva render`.
+#[derive(Clone, Debug)]
+pub struct RenderArgs {
+    /// Genome JSON or GLB.
+    pub file: PathBuf,
+    /// PNG to write.
+    pub output: PathBuf,
+    /// Camera.
+    pub view: View,
+    /// Width and height.
+    pub size: (u32, u32),
+    /// Seed for genomes.
+    pub seed: u64,
+}
+
+/// `sylva render`.
+pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
+    check_png(&args.output)?;
+    let genome = load_genome(&args.file)?;
+    let grown = Grown::new(genome, args.seed)?;
+    grown.picture(&args.output, args.view, args.size)?;
+    println!("wrote {}", args.output.display());
+    Ok(())
+}
+
+/// Parses `WIDTHxHEIGHT`, each 16 to 8192 pixels.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let bad =
+        || format!("expected WIDTHxHEIGHT with each from 16 to 8192, like 800x600; got {text:?}");
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if (16..=8192).contains(&w) && (16..=8192).contains(&h) {
+        Ok((w, h))
+    } else {
+        Err(bad())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("800x600"), Ok((800, 600)));
+        assert_eq!(parse_size("64X64"), Ok((64, 64)));
+        for bad in ["", "800", "x600", "0x10", "800x99999", "-5x10", "axb"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+    }
+}

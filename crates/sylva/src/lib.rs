@@ -1,0 +1,15 @@
+//! The runs behind the `sylva` command line.
+//!
+//! - [`config`]: the TOML config of `sylva evolve`, with documented defaults.
+//! - [`problem`]: the binary tree as an evolution problem (Susinno's GA).
+//! - [`commands`]: `evolve`, `grow` and `render`.
+//! - [`assets`]: a genome grown, meshed, exported and pictured.
+//! - [`report`]: `stats.csv` and `fitness.svg`.
+//! - [`error`]: bad-input errors that point at file, line and column (exit code 2).
+
+pub mod assets;
+pub mod commands;
+pub mod config;
+pub mod error;
+pub mod problem;
+pub mod report;

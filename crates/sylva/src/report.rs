@@ -1,0 +1,142 @@
+//! Run reports people read: the statistics table (CSV) and the fitness plot (SVG).
+
+use std::fmt::Write as _;
+
+use plotters::prelude::*;
+use sylva_evolve::GenerationStats;
+
+/// `stats.csv`: `generation,best,mean,<term...>,evals_per_s`, one row per generation.
+/// Numbers are written in Rust's shortest round-trip form, so equal runs give equal bytes
+/// (except `evals_per_s`, which is wall-clock).
+pub fn stats_csv(term_names: &[String], stats: &[GenerationStats]) -> String {
+    let mut out = String::from("generation,best,mean");
+    for name in term_names {
+        out.push(',');
+        out.push_str(name);
+    }
+    out.push_str(",evals_per_s\n");
+    for s in stats {
+        let _ = write!(out, "{},{},{}", s.generation, s.best, s.mean);
+        for t in &s.best_terms {
+            let _ = write!(out, ",{t}");
+        }
+        let _ = writeln!(out, ",{:.0}", s.evals_per_second());
+    }
+    out
+}
+
+/// Why a plot could not be drawn.
+#[derive(Debug, thiserror::Error)]
+#[error("could not draw the fitness plot: {0}")]
+pub struct PlotError(String);
+
+/// `fitness.svg`: best and mean fitness per generation.
+pub fn fitness_svg(stats: &[GenerationStats], title: &str) -> Result<String, PlotError> {
+    let err = |e: &dyn std::fmt::Display| PlotError(e.to_string());
+    let finite = |v: f64| v.is_finite().then_some(v);
+    let values: Vec<f64> = stats
+        .iter()
+        .flat_map(|s| [finite(s.best), finite(s.mean)])
+        .flatten()
+        .collect();
+    let (mut lo, mut hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !(lo.is_finite() && hi.is_finite()) {
+        (lo, hi) = (0.0, 1.0);
+    }
+    if hi - lo < 1e-9 {
+        hi = lo + 1.0;
+    }
+    let pad = 0.05 * (hi - lo);
+    let last = stats.last().map_or(1, |s| s.generation.max(1));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 480)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d(0u32..last, (lo - pad)..(hi + pad))
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("generation")
+            .y_desc("fitness")
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(|e| err(&e))?;
+        let series = [
+            ("best", RGBColor(34, 120, 50), true),
+            ("mean", RGBColor(200, 110, 30), false),
+        ];
+        for (name, color, is_best) in series {
+            let points = stats.iter().filter_map(move |s| {
+                let v = if is_best { s.best } else { s.mean };
+                v.is_finite().then_some((s.generation, v))
+            });
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)))
+                .map_err(|e| err(&e))?
+                .label(name)
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK.mix(0.3))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sylva_evolve::IndividualId;
+
+    fn row(generation: u32, best: f64, mean: f64) -> GenerationStats {
+        GenerationStats {
+            generation,
+            best,
+            mean,
+            best_id: IndividualId(0),
+            best_terms: vec![best / 2.0, best / 2.0],
+            evaluations: 10,
+            seconds: 0.5,
+        }
+    }
+
+    #[test]
+    fn csv_has_header_and_rows() {
+        let csv = stats_csv(
+            &["a".into(), "b".into()],
+            &[row(0, 1.5, 1.0), row(1, 2.0, 1.25)],
+        );
+        assert_eq!(
+            csv,
+            "generation,best,mean,a,b,evals_per_s\n0,1.5,1,0.75,0.75,20\n1,2,1.25,1,1,20\n"
+        );
+    }
+
+    #[test]
+    fn svg_plots_both_lines() {
+        let svg =
+            fitness_svg(&[row(0, 1.0, 0.5), row(1, 2.0, 1.0), row(2, 2.5, 2.0)], "t").unwrap();
+        assert!(svg.starts_with("<svg"));
+        assert!(svg.contains("best") && svg.contains("mean"));
+        assert!(svg.matches("<polyline").count() >= 2, "two lines");
+        // Degenerate inputs still give a picture.
+        assert!(fitness_svg(&[], "empty").is_ok());
+        assert!(fitness_svg(&[row(0, f64::NEG_INFINITY, f64::NEG_INFINITY)], "x").is_ok());
+    }
+}
