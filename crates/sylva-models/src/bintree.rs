@@ -94,10 +94,10 @@ pub struct BinTree {
     #[serde(deserialize_with = "depth")]
     pub depth: u32,
     /// Radius at the foot of the trunk, metres.
-    #[serde(deserialize_with = "radius")]
+    #[serde(deserialize_with = "lower_radius")]
     pub lower_radius: f64,
     /// Radius at the top of the trunk, metres; `upper / lower` is the taper of every level.
-    #[serde(deserialize_with = "radius")]
+    #[serde(deserialize_with = "upper_radius")]
     pub upper_radius: f64,
     /// Trunk length, metres.
     #[serde(deserialize_with = "length")]
@@ -114,30 +114,51 @@ pub struct BinTree {
     pub min_radius: f64,
 }
 
-ranged_number!(radius, "radius", 0.001, 5.0, " m");
+ranged_number!(lower_radius, "lower_radius", 0.001, 5.0, " m");
+ranged_number!(upper_radius, "upper_radius", 0.001, 5.0, " m");
 ranged_number!(length, "length", 0.01, 50.0, " m");
 ranged_number!(length_ratio, "length_ratio", 0.1, 1.5, "");
 ranged_number!(min_radius, "min_radius", 0.001, 1.0, " m");
-ranged_number!(angle, "angle", -360.0, 360.0, " degrees");
+ranged_number!(angle, "rotation angle", -360.0, 360.0, " degrees");
 
 fn depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     sylva_core::ranged::integer(d, "depth", 1, MAX_DEPTH)
 }
 
+/// Reads an axis inside the array's own visitor, so an error points at the array (checks
+/// made after the array is read would point at the end of the enclosing object).
 fn axis<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
-    use serde::de::Error;
-    let v = <[f64; 3]>::deserialize(d)?;
-    if v.iter().any(|c| !c.is_finite() || c.abs() > 1.0) {
-        return Err(D::Error::custom(format!(
-            "`axis` components must be numbers from -1 to 1, got {v:?}"
-        )));
+    struct AxisVisitor;
+    impl<'de> serde::de::Visitor<'de> for AxisVisitor {
+        type Value = [f64; 3];
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an axis: three numbers from -1 to 1, not all zero")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<[f64; 3], A::Error> {
+            use serde::de::Error;
+            let mut v = [0.0f64; 3];
+            for (i, c) in v.iter_mut().enumerate() {
+                *c = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(i, &self))?;
+            }
+            if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                return Err(A::Error::invalid_length(4, &self));
+            }
+            if v.iter().any(|c| !c.is_finite() || c.abs() > 1.0) {
+                return Err(A::Error::custom(format!(
+                    "`axis` components must be numbers from -1 to 1, got {v:?}"
+                )));
+            }
+            if DVec3::from_array(v).length() < 1e-6 {
+                return Err(A::Error::custom(
+                    "`axis` must not be the zero vector (a rotation needs a direction)",
+                ));
+            }
+            Ok(v)
+        }
     }
-    if DVec3::from_array(v).length() < 1e-6 {
-        return Err(D::Error::custom(
-            "`axis` must not be the zero vector (a rotation needs a direction)",
-        ));
-    }
-    Ok(v)
+    d.deserialize_seq(AxisVisitor)
 }
 
 /// One GA field: its name, width and range.

@@ -45,8 +45,6 @@ struct SavedRun {
 }
 
 const CHECKPOINT: &str = "checkpoint.json";
-/// Checkpoints are written at most this often (and always at the end).
-const CHECKPOINT_EVERY: Duration = Duration::from_secs(2);
 
 /// `sylva evolve`.
 pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
@@ -72,11 +70,12 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
 }
 
 /// The parts of a config that must match for a run to resume (everything but the length of
-/// the run and the thread count).
+/// the run, the thread count and the checkpoint interval).
 fn resumable(config: &EvolveConfig) -> EvolveConfig {
     let mut c = config.clone();
     c.run.generations = 0;
     c.run.threads = 0;
+    c.run.checkpoint_seconds = 0.0;
     c
 }
 
@@ -93,8 +92,8 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
         if resumable(&saved.config) != resumable(config) {
             return Err(InputError::new(
                 checkpoint_path.display().to_string(),
-                "the checkpoint was written by a different config (only `generations` and \
-                 `threads` may change when resuming)",
+                "the checkpoint was written by a different config (only `generations`, `threads` and \
+                 `checkpoint_seconds` may change when resuming)",
             )
             .into());
         }
@@ -135,12 +134,13 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
         write_atomic(&checkpoint_path, &serde_json::to_vec(&saved)?)
             .with_context(|| format!("writing {}", checkpoint_path.display()))
     };
+    let checkpoint_every = Duration::from_secs_f64(config.run.checkpoint_seconds);
     let mut last_save = Instant::now();
     while run.generation() < target {
         let stats = run.step();
         bar.set_message(format!("{:.4}", stats.best));
         bar.set_position(u64::from(run.generation()));
-        if last_save.elapsed() >= CHECKPOINT_EVERY {
+        if last_save.elapsed() >= checkpoint_every {
             save(&run)?;
             last_save = Instant::now();
         }

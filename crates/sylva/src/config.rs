@@ -12,6 +12,7 @@
 //! population = 400           # individuals per generation
 //! seed = 1                   # seed of every random choice
 //! threads = 0                # 0: one per core; results do not depend on it
+//! checkpoint_seconds = 2     # 0: checkpoint every generation
 //!
 //! [bintree]
 //! min_radius = 0.02          # metres; no cylinder is thinner
@@ -94,6 +95,10 @@ pub struct RunConfig {
     /// Worker threads, 0 (one per core) to 1024. Default 0. Results do not depend on it.
     #[serde(deserialize_with = "threads")]
     pub threads: u32,
+    /// Seconds between checkpoints, 0 (every generation) to 3600. Default 2. A run also
+    /// checkpoints when it ends.
+    #[serde(deserialize_with = "checkpoint_seconds")]
+    pub checkpoint_seconds: f64,
 }
 
 impl Default for RunConfig {
@@ -103,6 +108,7 @@ impl Default for RunConfig {
             population: 400,
             seed: 1,
             threads: 0,
+            checkpoint_seconds: 2.0,
         }
     }
 }
@@ -159,6 +165,7 @@ impl Default for BinTreeConfig {
     }
 }
 
+sylva_core::ranged_number!(checkpoint_seconds, "checkpoint_seconds", 0.0, 3600.0, " s");
 sylva_core::ranged_number!(min_radius, "min_radius", 0.001, 1.0, " m");
 sylva_core::ranged_number!(mutation_rate, "mutation_rate", 0.0, 1.0, "");
 
@@ -267,6 +274,15 @@ mod tests {
     #[test]
     fn empty_is_default() {
         assert_eq!(parse("").unwrap(), EvolveConfig::default());
+    }
+
+    #[test]
+    fn the_written_out_default_is_the_default() {
+        let text = include_str!("../../../examples/bintree/default.toml");
+        assert_eq!(parse(text).unwrap(), EvolveConfig::default());
+        let paper = parse(include_str!("../../../examples/bintree/paper.toml")).unwrap();
+        assert_eq!(paper.bintree.weights.pipe_model, 0.0);
+        assert!(!paper.bintree.cull_clones);
     }
 
     #[test]

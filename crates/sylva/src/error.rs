@@ -44,10 +44,13 @@ impl InputError {
         }
     }
 
-    /// An error at 1-based `line` and `column` of `text`, read from `path`.
+    /// An error at 1-based `line` and `column` of `text`, read from `path`. Parsers such as
+    /// serde_json report the position just past the offending token; the error is moved back
+    /// to the token's start and spans it.
     pub fn at(path: &Path, text: &str, line: usize, column: usize, message: String) -> Self {
-        let offset = offset_of(text, line, column);
-        Self::spanned(path, text, offset..offset, message)
+        let end = offset_of(text, line, column);
+        let start = token_start(text, end);
+        Self::spanned(path, text, start..end, message)
     }
 
     /// An error over a byte range of `text`, read from `path`.
@@ -87,6 +90,18 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
     text.len()
 }
 
+/// Start of the token that ends at `end` (JSON and TOML tokens end at white space or
+/// punctuation).
+fn token_start(text: &str, end: usize) -> usize {
+    let end = text.floor_char_boundary(end);
+    text[..end]
+        .char_indices()
+        .rev()
+        .take_while(|(_, c)| !c.is_whitespace() && !matches!(c, ':' | ',' | '[' | '{' | '='))
+        .last()
+        .map_or(end, |(i, _)| i)
+}
+
 /// 1-based line and column of a byte offset.
 fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..text.floor_char_boundary(offset)];
@@ -109,8 +124,16 @@ mod tests {
     }
 
     #[test]
+    fn positions_move_to_the_token_start() {
+        let text = "{\n  \"a\": -0.5,\n}";
+        let e = InputError::at(Path::new("g.json"), text, 2, 12, "bad".into());
+        assert_eq!(e.location, "g.json:2:8");
+        assert_eq!(token_start("x", 0), 0);
+    }
+
+    #[test]
     fn location_names_file_line_column() {
-        let e = InputError::at(Path::new("x.toml"), "a\nbb\n", 2, 2, "bad".into());
+        let e = InputError::spanned(Path::new("x.toml"), "a\nbb\n", 3..4, "bad".into());
         assert_eq!(e.to_string(), "x.toml:2:2: bad");
     }
 }

@@ -83,6 +83,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Long messages stay on one line, so they can be searched for and copied whole.
+    let _ = miette::set_hook(Box::new(|_| {
+        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Evolve {
@@ -131,7 +135,6 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => match e.downcast::<InputError>() {
             Ok(input) => {
-                eprintln!("error: {input}");
                 eprintln!("{:?}", miette::Report::new(input));
                 ExitCode::from(2)
             }

@@ -1,0 +1,53 @@
+//! Rendering throughput: the evolved default oak (36,840 triangles) and a 202k-triangle
+//! test tree at 800 x 800 with 2x supersampling, with and without ground and shadows.
+//!
+//! Run with `cargo bench -p sylva-mesh --bench render`.
+#![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use sylva_mesh::mesher::{MeshOptions, mesh_plant};
+use sylva_mesh::render::{RenderOptions, Renderer};
+use sylva_mesh::{Scene, SceneNode};
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+fn render(c: &mut Criterion) {
+    let plant = common::binary_tree(9, 8);
+    let mesh = mesh_plant(&plant, &MeshOptions::default()).unwrap();
+    eprintln!("render tree: {} triangles", mesh.triangle_count());
+    let scene = Scene::single(SceneNode::new("tree", &mesh));
+    let mut group = c.benchmark_group("render_800x800_ss2");
+    group.sample_size(10);
+    let base = RenderOptions::default();
+    let variants = [
+        ("ground_and_shadows", base.clone()),
+        (
+            "no_shadows",
+            RenderOptions {
+                shadows: false,
+                ..base.clone()
+            },
+        ),
+        (
+            "plant_only",
+            RenderOptions {
+                ground: false,
+                shadows: false,
+                ..base
+            },
+        ),
+    ];
+    let mut renderer = Renderer::new();
+    for (name, options) in variants {
+        group.bench_function(name, |b| {
+            b.iter(|| renderer.render(black_box(&scene), &options).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, render);
+criterion_main!(benches);

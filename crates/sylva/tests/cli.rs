@@ -1,0 +1,438 @@
+//! The command line as a user drives it: runs write every file, results are deterministic
+//! whatever the thread count, runs resume after a kill, and bad input gets exit code 2 with
+//! an error that names the file, line, column and field, leaving no output behind.
+#![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sylva_core::hash::stable_hash;
+
+fn sylva(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(args)
+        .output()
+        .expect("the sylva binary runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sylva-cli-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn ok(output: &Output) {
+    assert!(
+        output.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// Runs the Khronos glTF validator; every GLB must have zero errors and zero warnings.
+fn validate(glbs: &[PathBuf]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let script = root.join("tools/gltf-validator/validate.mjs");
+    assert!(
+        root.join("tools/gltf-validator/node_modules/gltf-validator")
+            .exists(),
+        "the validator is not installed: run `npm ci --prefix tools/gltf-validator`"
+    );
+    let out = Command::new("node")
+        .arg(&script)
+        .args(glbs)
+        .output()
+        .expect("node runs (install Node.js)");
+    assert!(
+        out.status.success(),
+        "validator: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A small, quick config.
+const SMALL: &str = "[run]\ngenerations = 12\npopulation = 40\nseed = 7\n\n[output]\nimage_size = 96\nsheet_size = 6\n";
+
+/// `stats.csv` without its wall-clock column.
+fn stats_without_timing(dir: &Path) -> String {
+    fs::read_to_string(dir.join("stats.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_owned() + "\n")
+        .collect()
+}
+
+#[test]
+fn evolve_writes_every_file_and_grow_reproduces_the_glb() {
+    let dir = temp_dir("files");
+    let config = dir.join("small.toml");
+    fs::write(&config, SMALL).unwrap();
+    let out = dir.join("run");
+    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    for file in [
+        "stats.csv",
+        "best.json",
+        "best.glb",
+        "best.png",
+        "fitness.svg",
+        "population.png",
+        "config.toml",
+        "checkpoint.json",
+    ] {
+        let len = fs::metadata(out.join(file)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 0, "{file} written");
+    }
+    let stats = fs::read_to_string(out.join("stats.csv")).unwrap();
+    let mut lines = stats.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "generation,best,mean,surface_to_volume,symmetry,radius_to_length,volume,height,\
+         straightness,pipe_model,roundness,evals_per_s"
+    );
+    assert_eq!(lines.count(), 13, "generations 0 to 12");
+    // No temporary files are left behind.
+    for entry in fs::read_dir(&out).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(!name.ends_with(".tmp"), "{name}");
+    }
+
+    let regrown = dir.join("regrown.glb");
+    ok(&sylva(&[
+        "grow",
+        s(&out.join("best.json")),
+        "-o",
+        s(&regrown),
+    ]));
+    assert_eq!(
+        fs::read(&regrown).unwrap(),
+        fs::read(out.join("best.glb")).unwrap(),
+        "sylva grow best.json gives the bytes the run wrote"
+    );
+    validate(&[out.join("best.glb"), regrown]);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn same_results_on_one_or_two_threads_and_golden() {
+    let dir = temp_dir("threads");
+    let config = dir.join("small.toml");
+    fs::write(&config, SMALL).unwrap();
+    let runs: Vec<PathBuf> = ["1", "2"]
+        .iter()
+        .map(|threads| {
+            let out = dir.join(format!("t{threads}"));
+            ok(&sylva(&[
+                "evolve",
+                s(&config),
+                "--out",
+                s(&out),
+                "--threads",
+                threads,
+            ]));
+            out
+        })
+        .collect();
+    assert_eq!(
+        stats_without_timing(&runs[0]),
+        stats_without_timing(&runs[1])
+    );
+    for file in ["best.json", "best.glb", "best.png"] {
+        assert_eq!(
+            fs::read(runs[0].join(file)).unwrap(),
+            fs::read(runs[1].join(file)).unwrap(),
+            "{file}"
+        );
+    }
+    // Golden values: any change to the model, the engine, the mesher or the exporter that
+    // changes results shows here. Update them only for an intended change.
+    let hash = |name: &str| stable_hash(&fs::read(runs[0].join(name)).unwrap());
+    let stats_hash = stable_hash(stats_without_timing(&runs[0]).as_bytes());
+    validate(&[runs[0].join("best.glb")]);
+    let golden = (stats_hash, hash("best.json"), hash("best.glb"));
+    assert_eq!(golden, GOLDEN, "{golden:#x?}");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+const GOLDEN: (u64, u64, u64) = (
+    0x629d_55af_3752_0bb2,
+    0x2810_836f_7727_2b53,
+    0x2408_0960_4e24_374d,
+);
+
+#[test]
+fn a_killed_run_resumes_exactly() {
+    let dir = temp_dir("resume");
+    let config = dir.join("c.toml");
+    fs::write(
+        &config,
+        "[run]\ngenerations = 100000\npopulation = 30\nseed = 3\ncheckpoint_seconds = 0\n\
+         [output]\nimage_size = 64\nsheet_size = 2\n",
+    )
+    .unwrap();
+    // Start a long run and kill it once it has checkpointed a few generations.
+    let out = dir.join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(["evolve", s(&config), "--out", s(&out)])
+        .spawn()
+        .unwrap();
+    let checkpoint = out.join("checkpoint.json");
+    let generation_saved = |path: &Path| -> Option<u64> {
+        let text = fs::read_to_string(path).ok()?;
+        let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+        v["checkpoint"]["generation"].as_u64()
+    };
+    let start = std::time::Instant::now();
+    while generation_saved(&checkpoint).unwrap_or(0) < 5 {
+        assert!(start.elapsed().as_secs() < 60, "the run checkpoints");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let saved = generation_saved(&checkpoint).unwrap();
+    let target = (saved + 10).to_string();
+
+    // Resume to a target, and compare with a run that was never interrupted.
+    ok(&sylva(&[
+        "evolve",
+        s(&config),
+        "--out",
+        s(&out),
+        "--resume",
+        "--generations",
+        &target,
+    ]));
+    let straight = dir.join("straight");
+    ok(&sylva(&[
+        "evolve",
+        s(&config),
+        "--out",
+        s(&straight),
+        "--generations",
+        &target,
+    ]));
+    assert_eq!(stats_without_timing(&out), stats_without_timing(&straight));
+    assert_eq!(
+        fs::read(out.join("best.json")).unwrap(),
+        fs::read(straight.join("best.json")).unwrap()
+    );
+    validate(&[out.join("best.glb"), straight.join("best.glb")]);
+
+    // A different config refuses to resume.
+    let other = dir.join("other.toml");
+    fs::write(&other, "[run]\npopulation = 31\nseed = 3\n").unwrap();
+    let refused = sylva(&["evolve", s(&other), "--out", s(&out), "--resume"]);
+    assert_eq!(refused.status.code(), Some(2));
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn grow_writes_obj_mtl_vrml_and_png() {
+    let dir = temp_dir("formats");
+    let genome = dir.join("tree.json");
+    fs::write(&genome, include_str!("../../../examples/bintree/oak.json")).unwrap();
+    ok(&sylva(&[
+        "grow",
+        s(&genome),
+        "-o",
+        s(&dir.join("t.obj")),
+        "--png",
+        s(&dir.join("t.png")),
+    ]));
+    let obj = fs::read_to_string(dir.join("t.obj")).unwrap();
+    assert!(obj.contains("mtllib t.mtl"));
+    assert!(
+        fs::read_to_string(dir.join("t.mtl"))
+            .unwrap()
+            .contains("newmtl")
+    );
+    assert!(fs::metadata(dir.join("t.png")).unwrap().len() > 1000);
+    ok(&sylva(&["grow", s(&genome), "-o", s(&dir.join("t.wrl"))]));
+    assert!(
+        fs::read_to_string(dir.join("t.wrl"))
+            .unwrap()
+            .starts_with("#VRML V2.0 utf8")
+    );
+    for view in ["front", "side", "top", "iso"] {
+        let png = dir.join(format!("{view}.png"));
+        ok(&sylva(&[
+            "render",
+            s(&genome),
+            "-o",
+            s(&png),
+            "--view",
+            view,
+            "--size",
+            "120x90",
+        ]));
+        let bytes = fs::read(&png).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+        // Width and height sit in the IHDR chunk.
+        assert_eq!(u32::from_be_bytes(bytes[16..20].try_into().unwrap()), 120);
+        assert_eq!(u32::from_be_bytes(bytes[20..24].try_into().unwrap()), 90);
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs `sylva grow` on a genome text; expects exit code 2, an error naming `location` and
+/// mentioning `what`, and no output file.
+fn bad_genome(text: &str, location: &str, what: &str) {
+    let dir = temp_dir("bad-genome");
+    let genome = dir.join("g.json");
+    fs::write(&genome, text).unwrap();
+    let glb = dir.join("out.glb");
+    let out = sylva(&["grow", s(&genome), "-o", s(&glb)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{text}\n{stderr}");
+    let expected = format!("{}:{location}", genome.display());
+    assert!(
+        stderr.contains(&expected),
+        "{text}\nexpected {expected} in\n{stderr}"
+    );
+    assert!(names_line_and_column(&stderr, &genome), "{stderr}");
+    assert!(
+        stderr.contains(what),
+        "{text}\nexpected {what:?} in\n{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!glb.exists(), "no output is written");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// True when the error names `path:LINE:COLUMN:`.
+fn names_line_and_column(stderr: &str, path: &Path) -> bool {
+    let prefix = format!("{}:", path.display());
+    stderr.split(&prefix).skip(1).any(|rest| {
+        let mut parts = rest.splitn(3, ':');
+        let line = parts.next().unwrap_or("");
+        let column = parts.next().unwrap_or("");
+        !line.is_empty()
+            && !column.is_empty()
+            && line.chars().all(|c| c.is_ascii_digit())
+            && column.chars().all(|c| c.is_ascii_digit())
+    })
+}
+
+const GOOD: &str = include_str!("../../../examples/bintree/oak.json");
+
+#[test]
+fn bad_genomes_are_refused_with_position_and_field() {
+    let field = |name: &str, value: &str| {
+        let mut done = false;
+        GOOD.lines()
+            .map(|l| {
+                if !done && l.trim_start().starts_with(&format!("\"{name}\"")) {
+                    done = true;
+                    let indent = &l[..l.len() - l.trim_start().len()];
+                    let comma = if l.trim_end().ends_with(',') { "," } else { "" };
+                    format!("{indent}\"{name}\": {value}{comma}\n")
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect::<String>()
+    };
+    let line_of = |name: &str| {
+        GOOD.lines()
+            .position(|l| l.trim_start().starts_with(&format!("\"{name}\"")))
+            .unwrap()
+            + 1
+    };
+    let depth = line_of("depth");
+    let radius = line_of("lower_radius");
+    bad_genome(
+        &field("lower_radius", "-0.3"),
+        &format!("{radius}:"),
+        "lower_radius",
+    );
+    bad_genome(&field("lower_radius", "1e999"), &format!("{radius}:"), "");
+    bad_genome(&field("depth", "100"), &format!("{depth}:"), "depth");
+    bad_genome(&field("depth", "2.5"), &format!("{depth}:"), "");
+    bad_genome(&field("depth", "\"deep\""), &format!("{depth}:"), "");
+    bad_genome(
+        &field("length", "0"),
+        &format!("{}:", line_of("length")),
+        "length",
+    );
+    bad_genome(
+        &GOOD.replacen("\"depth\"", "\"dept\"", 1),
+        &format!("{depth}:"),
+        "unknown field `dept`",
+    );
+    bad_genome(
+        &GOOD.replacen("\"bintree\"", "\"oak\"", 1),
+        "2:",
+        "unknown model `oak`",
+    );
+    bad_genome(
+        &GOOD.replacen("\"format\": 1", "\"format\": 2", 1),
+        "3:",
+        "format",
+    );
+    bad_genome(&GOOD[..GOOD.len() / 2], "", "EOF");
+    bad_genome("", "1:", "EOF");
+    bad_genome("[1, 2]", "1:", "");
+    let zero_axis = GOOD.replacen(
+        &GOOD[GOOD.find("\"axis\"").unwrap()..GOOD.find(']').unwrap() + 1],
+        "\"axis\": [0, 0, 0]",
+        1,
+    );
+    bad_genome(&zero_axis, "", "zero vector");
+}
+
+#[test]
+fn bad_configs_and_flags_are_refused() {
+    let dir = temp_dir("bad-config");
+    let config = dir.join("c.toml");
+    let out = dir.join("run");
+    for (text, location, what) in [
+        ("[run]\npopulation = -3\n", "2:14", "population"),
+        ("[bintree.weights]\nvolume = nan\n", "2:10", "weight"),
+        (
+            "[run]\npopulaton = 10\n",
+            "2:1",
+            "unknown field `populaton`",
+        ),
+        ("[output]\nview = \"back\"\n", "2:8", "iso"),
+        ("[run\n", "1:", ""),
+    ] {
+        fs::write(&config, text).unwrap();
+        let o = sylva(&["evolve", s(&config), "--out", s(&out)]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{text}\n{stderr}");
+        let expected = format!("{}:{location}", config.display());
+        assert!(
+            stderr.contains(&expected),
+            "{text}\nexpected {expected} in\n{stderr}"
+        );
+        assert!(names_line_and_column(&stderr, &config), "{stderr}");
+        assert!(stderr.contains(what), "{text}\n{stderr}");
+        assert!(!out.join("stats.csv").exists());
+    }
+    let missing = sylva(&["evolve", s(&dir.join("none.toml"))]);
+    assert_eq!(missing.status.code(), Some(2));
+    for args in [
+        vec!["evolve", "--population", "0"],
+        vec!["evolve", "--generations", "-1"],
+        vec!["evolve", "--threads", "lots"],
+        vec!["render", "x.json", "-o", "x.png", "--size", "0x10"],
+        vec!["render", "x.json", "-o", "x.png", "--view", "back"],
+        vec!["frobnicate"],
+    ] {
+        assert_eq!(sylva(&args).status.code(), Some(2), "{args:?}");
+    }
+    let genome = dir.join("g.json");
+    fs::write(&genome, GOOD).unwrap();
+    let wrong_ext = sylva(&["grow", s(&genome), "-o", s(&dir.join("tree.fbx"))]);
+    assert_eq!(wrong_ext.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&wrong_ext.stderr).contains("fbx"));
+    fs::remove_dir_all(&dir).unwrap();
+}
