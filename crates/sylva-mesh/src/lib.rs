@@ -5,11 +5,13 @@
 //!   parallel-transport frames, shared rings, caps, leaves and flowers).
 //! - [`scene`]: [`Scene`], meshes placed in the world with their origin data.
 //! - [`export`]: GLB (glTF 2.0 binary), OBJ with MTL, VRML97.
+//! - [`import`]: GLB files read back, for pictures of any GLB.
 //! - [`render`]: a software z-buffer renderer writing PNG, and contact sheets.
 //!
 //! A mesh never knows which model made the plant.
 
 pub mod export;
+pub mod import;
 pub mod mesh;
 pub mod mesher;
 pub mod render;

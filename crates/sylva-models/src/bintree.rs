@@ -217,10 +217,13 @@ fn axis_from_angles(azimuth: f64, elevation: f64) -> [f64; 3] {
     [e.cos() * a.cos(), e.sin(), e.cos() * a.sin()]
 }
 
-/// Azimuth (0 to 360) and elevation (-90 to 90) of an axis, degrees.
+/// Azimuth and elevation (-90 to 90) of an axis, degrees. The azimuth runs from minus half
+/// an azimuth code step to 360 less that, so an axis near 360° encodes as 0°, not as the
+/// largest code.
 fn angles_of_axis(axis: [f64; 3]) -> (f64, f64) {
     let v = DVec3::from_array(axis).try_normalize().unwrap_or(DVec3::X);
-    let azimuth = v.z.atan2(v.x).to_degrees().rem_euclid(360.0);
+    let half_step = 0.5 * LAYOUT[6].code.step();
+    let azimuth = (v.z.atan2(v.x).to_degrees() + half_step).rem_euclid(360.0) - half_step;
     (azimuth, v.y.clamp(-1.0, 1.0).asin().to_degrees())
 }
 

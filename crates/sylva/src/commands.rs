@@ -282,12 +282,33 @@ pub struct RenderArgs {
     pub seed: u64,
 }
 
-/// `sylva render`.
+/// `sylva render`: a genome is grown and pictured; a GLB is read and pictured as it is.
 pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     check_png(&args.output)?;
-    let genome = load_genome(&args.file)?;
-    let grown = Grown::new(genome, args.seed)?;
-    grown.picture(&args.output, args.view, args.size)?;
+    let is_glb = args
+        .file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if is_glb {
+        let shown = args.file.display().to_string();
+        let bytes = std::fs::read(&args.file)
+            .map_err(|e| InputError::new(&shown, format!("cannot read: {e}")))?;
+        let imported = sylva_mesh::import::read_glb(&bytes)
+            .map_err(|e| InputError::new(&shown, e.to_string()))?;
+        let options = render::RenderOptions {
+            width: args.size.0,
+            height: args.size.1,
+            view: args.view,
+            ..render::RenderOptions::default()
+        };
+        let image = render::render(&imported.scene(), &options).context("rendering")?;
+        render::write_png(&args.output, &image)
+            .with_context(|| format!("writing {}", args.output.display()))?;
+    } else {
+        let genome = load_genome(&args.file)?;
+        let grown = Grown::new(genome, args.seed)?;
+        grown.picture(&args.output, args.view, args.size)?;
+    }
     println!("wrote {}", args.output.display());
     Ok(())
 }

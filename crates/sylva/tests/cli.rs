@@ -117,7 +117,32 @@ fn evolve_writes_every_file_and_grow_reproduces_the_glb() {
         fs::read(out.join("best.glb")).unwrap(),
         "sylva grow best.json gives the bytes the run wrote"
     );
-    validate(&[out.join("best.glb"), regrown]);
+    validate(&[out.join("best.glb"), regrown.clone()]);
+
+    // A GLB renders as it is, and like the genome it came from.
+    let from_glb = dir.join("from-glb.png");
+    let from_json = dir.join("from-json.png");
+    ok(&sylva(&[
+        "render",
+        s(&regrown),
+        "-o",
+        s(&from_glb),
+        "--size",
+        "96x96",
+    ]));
+    ok(&sylva(&[
+        "render",
+        s(&out.join("best.json")),
+        "-o",
+        s(&from_json),
+        "--size",
+        "96x96",
+    ]));
+    assert_eq!(fs::read(&from_glb).unwrap(), fs::read(&from_json).unwrap());
+    let broken = dir.join("broken.glb");
+    fs::write(&broken, &fs::read(&regrown).unwrap()[..100]).unwrap();
+    let refused = sylva(&["render", s(&broken), "-o", s(&dir.join("b.png"))]);
+    assert_eq!(refused.status.code(), Some(2));
     fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,0 +1,408 @@
+//! Reading GLB files back, so `sylva render` can show any GLB: the ones Sylva writes, and
+//! simple ones from elsewhere.
+//!
+//! What is read: the default scene's node tree (translation, rotation, scale or matrix,
+//! composed down the hierarchy), triangle primitives with `FLOAT` `VEC3` positions and
+//! optional normals (flat normals are computed when missing), `UNSIGNED_BYTE`, `SHORT` or `INT`
+//! indices (or none), and each material's base colour. Textures, skins, morph targets,
+//! sparse accessors and non-triangle modes are ignored. Every node's transform is baked into
+//! a world-space copy of its mesh. Every offset and count is checked, so a truncated or
+//! hostile file is an error, never a panic.
+
+use serde_json::Value;
+use sylva_core::glam::{Mat3, Mat4, Quat, Vec3};
+use sylva_core::{Material, MaterialKind};
+
+use crate::mesh::{Mesh, Primitive};
+use crate::scene::{Scene, SceneNode};
+
+/// Why a GLB could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    /// Not a GLB (bad magic or version).
+    #[error("not a GLB file (glTF 2.0 binary): {0}")]
+    NotGlb(&'static str),
+    /// A length or offset points past the data.
+    #[error("truncated or inconsistent GLB: {0}")]
+    Truncated(String),
+    /// The JSON chunk is not valid JSON.
+    #[error("the GLB's JSON chunk is invalid: {0}")]
+    Json(#[from] serde_json::Error),
+    /// A value has the wrong type or is out of range.
+    #[error("invalid glTF: {0}")]
+    Invalid(String),
+    /// More geometry than the limit.
+    #[error("the GLB holds more than {limit} triangles")]
+    TooLarge {
+        /// The limit.
+        limit: usize,
+    },
+}
+
+/// Meshes read from a GLB, each already placed in world space.
+#[derive(Clone, Debug, Default)]
+pub struct ImportedScene {
+    /// One mesh per node that has one, with its transform baked in.
+    pub meshes: Vec<(String, Mesh)>,
+}
+
+impl ImportedScene {
+    /// A scene borrowing the meshes (each at the origin, as transforms are baked in).
+    pub fn scene(&self) -> Scene<'_> {
+        Scene {
+            nodes: self
+                .meshes
+                .iter()
+                .map(|(name, mesh)| SceneNode::new(name.clone(), mesh))
+                .collect(),
+        }
+    }
+}
+
+/// Most triangles read from one file.
+const MAX_TRIANGLES: usize = 100_000_000;
+/// Deepest node hierarchy followed (deeper nodes, or cycles, are an error).
+const MAX_DEPTH: usize = 64;
+
+fn invalid(what: impl Into<String>) -> ImportError {
+    ImportError::Invalid(what.into())
+}
+
+fn u32_at(bytes: &[u8], at: usize) -> Result<u32, ImportError> {
+    bytes
+        .get(at..at + 4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .ok_or_else(|| ImportError::Truncated(format!("no 4 bytes at offset {at}")))
+}
+
+/// Reads a GLB.
+pub fn read_glb(bytes: &[u8]) -> Result<ImportedScene, ImportError> {
+    if bytes.len() < 12 || u32_at(bytes, 0)? != 0x4654_6C67 {
+        return Err(ImportError::NotGlb("it does not start with \"glTF\""));
+    }
+    if u32_at(bytes, 4)? != 2 {
+        return Err(ImportError::NotGlb("only version 2 is read"));
+    }
+    let total = (u32_at(bytes, 8)? as usize).min(bytes.len());
+    let (mut json, mut bin): (Option<&[u8]>, &[u8]) = (None, &[]);
+    let mut at = 12;
+    while at + 8 <= total {
+        let len = u32_at(bytes, at)? as usize;
+        let kind = u32_at(bytes, at + 4)?;
+        let data = bytes
+            .get(at + 8..at + 8 + len)
+            .ok_or_else(|| ImportError::Truncated(format!("chunk at {at} runs past the end")))?;
+        match kind {
+            0x4E4F_534A if json.is_none() => json = Some(data),
+            0x004E_4942 if bin.is_empty() => bin = data,
+            _ => {}
+        }
+        at += 8 + len.next_multiple_of(4);
+    }
+    let root: Value = serde_json::from_slice(json.ok_or(ImportError::NotGlb("no JSON chunk"))?)?;
+    Reader { root: &root, bin }.scene()
+}
+
+struct Reader<'a> {
+    root: &'a Value,
+    bin: &'a [u8],
+}
+
+impl Reader<'_> {
+    fn list(&self, name: &str) -> &[Value] {
+        self.root[name].as_array().map_or(&[], Vec::as_slice)
+    }
+
+    fn item(&self, list: &str, index: &Value) -> Result<&Value, ImportError> {
+        let i = index
+            .as_u64()
+            .ok_or_else(|| invalid(format!("{list} index is not a whole number")))?;
+        self.list(list)
+            .get(i as usize)
+            .ok_or_else(|| invalid(format!("{list}[{i}] does not exist")))
+    }
+
+    fn scene(&self) -> Result<ImportedScene, ImportError> {
+        let roots: Vec<Value> = match self
+            .list("scenes")
+            .get(self.root["scene"].as_u64().unwrap_or(0) as usize)
+        {
+            Some(scene) => scene["nodes"].as_array().cloned().unwrap_or_default(),
+            // No scene: every node that is nobody's child is a root.
+            None => {
+                let children: Vec<u64> = self
+                    .list("nodes")
+                    .iter()
+                    .flat_map(|n| n["children"].as_array().cloned().unwrap_or_default())
+                    .filter_map(|c| c.as_u64())
+                    .collect();
+                (0..self.list("nodes").len() as u64)
+                    .filter(|i| !children.contains(i))
+                    .map(Value::from)
+                    .collect()
+            }
+        };
+        let mut out = ImportedScene::default();
+        let mut triangles = 0;
+        for r in &roots {
+            self.node(r, Mat4::IDENTITY, 0, &mut out, &mut triangles)?;
+        }
+        Ok(out)
+    }
+
+    fn node(
+        &self,
+        index: &Value,
+        parent: Mat4,
+        depth: usize,
+        out: &mut ImportedScene,
+        triangles: &mut usize,
+    ) -> Result<(), ImportError> {
+        if depth > MAX_DEPTH {
+            return Err(invalid("node hierarchy is deeper than 64 (or has a cycle)"));
+        }
+        let node = self.item("nodes", index)?;
+        let world = parent * local_transform(node)?;
+        if let Some(mesh) = node.get("mesh") {
+            let name = node["name"].as_str().unwrap_or("node").to_owned();
+            let mesh = self.mesh(self.item("meshes", mesh)?, world, triangles)?;
+            out.meshes.push((name, mesh));
+        }
+        for child in node["children"].as_array().map_or(&[][..], Vec::as_slice) {
+            self.node(child, world, depth + 1, out, triangles)?;
+        }
+        Ok(())
+    }
+
+    fn mesh(&self, mesh: &Value, world: Mat4, triangles: &mut usize) -> Result<Mesh, ImportError> {
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        let mut out = Mesh::default();
+        for prim in mesh["primitives"].as_array().map_or(&[][..], Vec::as_slice) {
+            if prim["mode"].as_u64().unwrap_or(4) != 4 {
+                continue;
+            }
+            let positions = self.vec3s(self.item("accessors", &prim["attributes"]["POSITION"])?)?;
+            let base =
+                u32::try_from(out.positions.len()).map_err(|_| invalid("too many vertices"))?;
+            let indices: Vec<u32> = match prim.get("indices") {
+                Some(i) => self.indices(self.item("accessors", i)?)?,
+                None => (0..positions.len() as u32).collect(),
+            };
+            let usable = indices.len() / 3 * 3;
+            *triangles += usable / 3;
+            if *triangles > MAX_TRIANGLES {
+                return Err(ImportError::TooLarge {
+                    limit: MAX_TRIANGLES,
+                });
+            }
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(invalid(format!(
+                    "index {bad} is past the {} vertices of its primitive",
+                    positions.len()
+                )));
+            }
+            let normals = match prim["attributes"].get("NORMAL") {
+                Some(n) => self.vec3s(self.item("accessors", n)?)?,
+                None => flat_normals(&positions, &indices[..usable]),
+            };
+            if normals.len() != positions.len() {
+                return Err(invalid("NORMAL and POSITION counts differ"));
+            }
+            for (p, n) in positions.iter().zip(&normals) {
+                out.positions.push(world.transform_point3(*p).to_array());
+                out.normals
+                    .push((normal_matrix * *n).normalize_or(Vec3::Y).to_array());
+            }
+            out.primitives.push(Primitive {
+                material: out.materials.len(),
+                indices: indices[..usable].iter().map(|i| i + base).collect(),
+            });
+            out.materials.push(self.material(prim.get("material"))?);
+        }
+        Ok(out)
+    }
+
+    fn material(&self, index: Option<&Value>) -> Result<Material, ImportError> {
+        let Some(index) = index else {
+            return Ok(Material::of_kind(MaterialKind::Bark));
+        };
+        let m = self.item("materials", index)?;
+        let name = m["name"].as_str().unwrap_or("material").to_owned();
+        let kind = [MaterialKind::Leaf, MaterialKind::Flower, MaterialKind::Root]
+            .into_iter()
+            .find(|k| name.contains(k.name()))
+            .unwrap_or(MaterialKind::Bark);
+        let factor = &m["pbrMetallicRoughness"]["baseColorFactor"];
+        let channel = |i: usize| factor[i].as_f64().map_or(0.8, |v| v.clamp(0.0, 1.0) as f32);
+        Ok(Material {
+            name,
+            kind,
+            color: [channel(0), channel(1), channel(2)],
+            texture: None,
+        })
+    }
+
+    /// The bytes of an accessor's elements: (data from the first element, stride, count).
+    fn view(&self, accessor: &Value, element: usize) -> Result<(&[u8], usize, usize), ImportError> {
+        let count = accessor["count"]
+            .as_u64()
+            .ok_or_else(|| invalid("accessor without count"))? as usize;
+        let view = self.item("bufferViews", &accessor["bufferView"])?;
+        if view["buffer"].as_u64() != Some(0) {
+            return Err(invalid("only the GLB's own buffer 0 is read"));
+        }
+        let stride = view["byteStride"].as_u64().map_or(element, |s| s as usize);
+        let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let view_end = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + view["byteLength"].as_u64().unwrap_or(0) as usize;
+        let needed = if count == 0 {
+            0
+        } else {
+            stride
+                .checked_mul(count - 1)
+                .and_then(|n| n.checked_add(element))
+                .ok_or_else(|| ImportError::Truncated("accessor size overflows".into()))?
+        };
+        let end = start
+            .checked_add(needed)
+            .ok_or_else(|| ImportError::Truncated("accessor offset overflows".into()))?;
+        if stride < element || end > view_end || end > self.bin.len() {
+            return Err(ImportError::Truncated(format!(
+                "accessor of {count} elements runs past its buffer view"
+            )));
+        }
+        Ok((&self.bin[start..end], stride, count))
+    }
+
+    fn vec3s(&self, accessor: &Value) -> Result<Vec<Vec3>, ImportError> {
+        if accessor["componentType"].as_u64() != Some(5126) || accessor["type"] != "VEC3" {
+            return Err(invalid("positions and normals must be FLOAT VEC3"));
+        }
+        let (data, stride, count) = self.view(accessor, 12)?;
+        Ok((0..count)
+            .map(|i| {
+                let f = |k: usize| {
+                    let b = &data[i * stride + 4 * k..i * stride + 4 * k + 4];
+                    f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                };
+                Vec3::new(f(0), f(1), f(2))
+            })
+            .collect())
+    }
+
+    fn indices(&self, accessor: &Value) -> Result<Vec<u32>, ImportError> {
+        let size = match accessor["componentType"].as_u64() {
+            Some(5121) => 1,
+            Some(5123) => 2,
+            Some(5125) => 4,
+            _ => return Err(invalid("indices must be UNSIGNED_BYTE, SHORT or INT")),
+        };
+        let (data, stride, count) = self.view(accessor, size)?;
+        Ok((0..count)
+            .map(|i| {
+                let b = &data[i * stride..i * stride + size];
+                match size {
+                    1 => u32::from(b[0]),
+                    2 => u32::from(u16::from_le_bytes([b[0], b[1]])),
+                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                }
+            })
+            .collect())
+    }
+}
+
+fn local_transform(node: &Value) -> Result<Mat4, ImportError> {
+    let floats = |name: &str, n: usize| -> Result<Option<Vec<f32>>, ImportError> {
+        match node.get(name) {
+            None => Ok(None),
+            Some(v) => {
+                let list: Option<Vec<f32>> = v.as_array().filter(|a| a.len() == n).map(|a| {
+                    a.iter()
+                        .filter_map(|x| x.as_f64().map(|x| x as f32))
+                        .collect()
+                });
+                match list {
+                    Some(l) if l.len() == n && l.iter().all(|x| x.is_finite()) => Ok(Some(l)),
+                    _ => Err(invalid(format!("node {name} must be {n} finite numbers"))),
+                }
+            }
+        }
+    };
+    if let Some(m) = floats("matrix", 16)? {
+        return Ok(Mat4::from_cols_slice(&m));
+    }
+    let t = floats("translation", 3)?.map_or(Vec3::ZERO, |v| Vec3::new(v[0], v[1], v[2]));
+    let r = floats("rotation", 4)?.map_or(Quat::IDENTITY, |v| {
+        Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize()
+    });
+    let s = floats("scale", 3)?.map_or(Vec3::ONE, |v| Vec3::new(v[0], v[1], v[2]));
+    Ok(Mat4::from_scale_rotation_translation(s, r, t))
+}
+
+fn flat_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            normals[i as usize] += n;
+        }
+    }
+    normals
+        .into_iter()
+        .map(|n| n.normalize_or(Vec3::Y))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::to_glb;
+
+    fn triangle_mesh() -> Mesh {
+        Mesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            normals: vec![[0.0, 0.0, 1.0]; 3],
+            primitives: vec![Primitive {
+                material: 0,
+                indices: vec![0, 1, 2],
+            }],
+            materials: vec![Material::of_kind(MaterialKind::Leaf)],
+        }
+    }
+
+    #[test]
+    fn reads_back_what_it_writes_with_transforms_baked() {
+        let mesh = triangle_mesh();
+        let mut a = SceneNode::new("a", &mesh);
+        a.translation = Vec3::new(5.0, 0.0, 0.0);
+        let mut b = SceneNode::new("b", &mesh);
+        b.rotation = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+        let glb = to_glb(&Scene { nodes: vec![a, b] }).unwrap();
+        let back = read_glb(&glb).unwrap();
+        assert_eq!(back.meshes.len(), 2);
+        assert_eq!(back.meshes[0].1.positions[1], [6.0, 0.0, 0.0]);
+        let p = Vec3::from_array(back.meshes[1].1.positions[1]);
+        assert!((p - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        assert_eq!(back.meshes[0].1.materials[0].kind, MaterialKind::Leaf);
+        assert_eq!(back.meshes[0].1.triangle_count(), 1);
+    }
+
+    #[test]
+    fn truncated_and_garbage_files_are_errors() {
+        let mesh = triangle_mesh();
+        let glb = to_glb(&Scene::single(SceneNode::new("a", &mesh))).unwrap();
+        for cut in [0, 11, 12, 20, glb.len() / 2, glb.len() - 4] {
+            assert!(read_glb(&glb[..cut]).is_err(), "cut at {cut}");
+        }
+        assert!(read_glb(b"not a glb at all").is_err());
+        let mut flipped = glb.clone();
+        for (i, b) in flipped.iter_mut().enumerate().skip(20) {
+            if i % 7 == 0 {
+                *b ^= 0x5a;
+            }
+        }
+        let _ = read_glb(&flipped); // must not panic
+    }
+}
