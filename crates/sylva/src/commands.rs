@@ -7,15 +7,13 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use sylva_core::io::write_atomic;
-use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings};
+use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings, Strategy};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
-use sylva_models::Genome;
-use sylva_models::bintree::Bits;
 
 use crate::assets::{Grown, asset_format, check_png, load_genome};
 use crate::config::{EvolveConfig, ModelName, read_text};
 use crate::error::InputError;
-use crate::problem::{BinTreeProblem, BinTreeStrategy, strategy};
+use crate::problem::{BinTreeProblem, ModelProblem, strategy};
 use crate::report::{fitness_svg, stats_csv};
 
 /// Arguments of `sylva evolve`; `None` keeps the config's value.
@@ -39,9 +37,10 @@ pub struct EvolveArgs {
 
 /// The checkpoint file: the effective config and the engine's checkpoint.
 #[derive(Serialize, Deserialize)]
-struct SavedRun {
+#[serde(bound(serialize = "G: Serialize", deserialize = "G: Deserialize<'de>"))]
+struct SavedRun<G> {
     config: EvolveConfig,
-    checkpoint: Checkpoint<Bits>,
+    checkpoint: Checkpoint<G>,
 }
 
 const CHECKPOINT: &str = "checkpoint.json";
@@ -65,7 +64,11 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     match config.model {
-        ModelName::BinTree => evolve_bintree(&config, &out, args.resume),
+        ModelName::BinTree => {
+            let problem = BinTreeProblem::new(&config.bintree);
+            let strategy = strategy(&config.bintree);
+            evolve_problem(&config, &out, args.resume, problem, strategy)
+        }
     }
 }
 
@@ -79,14 +82,25 @@ fn resumable(config: &EvolveConfig) -> EvolveConfig {
     c
 }
 
-fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Result<()> {
-    let problem = BinTreeProblem::new(&config.bintree);
+/// Runs (or resumes) an evolution and writes every result file.
+fn evolve_problem<P, S>(
+    config: &EvolveConfig,
+    out: &Path,
+    resume: bool,
+    problem: P,
+    strategy: S,
+) -> anyhow::Result<()>
+where
+    P: ModelProblem + Clone,
+    P::Genome: Serialize + for<'de> Deserialize<'de>,
+    S: Strategy<P>,
+{
     let evaluator = Evaluator::with_threads(config.run.threads as usize)
         .context("starting the worker threads")?;
     let checkpoint_path = out.join(CHECKPOINT);
-    let mut run: Run<BinTreeProblem, BinTreeStrategy> = if resume {
+    let mut run: Run<P, S> = if resume {
         let text = read_text(&checkpoint_path)?;
-        let saved: SavedRun = serde_json::from_str(&text).map_err(|e| {
+        let saved: SavedRun<P::Genome> = serde_json::from_str(&text).map_err(|e| {
             InputError::at(&checkpoint_path, &text, e.line(), e.column(), e.to_string())
         })?;
         if resumable(&saved.config) != resumable(config) {
@@ -97,25 +111,15 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
             )
             .into());
         }
-        Run::resume(
-            problem.clone(),
-            strategy(&config.bintree),
-            evaluator,
-            saved.checkpoint,
-        )
-        .map_err(|e| InputError::new(checkpoint_path.display().to_string(), e.to_string()))?
+        Run::resume(problem.clone(), strategy, evaluator, saved.checkpoint)
+            .map_err(|e| InputError::new(checkpoint_path.display().to_string(), e.to_string()))?
     } else {
         let settings = RunSettings {
             seed: config.run.seed,
             population: config.run.population as usize,
             keep_history: 0,
         };
-        Run::new(
-            problem.clone(),
-            strategy(&config.bintree),
-            evaluator,
-            settings,
-        )?
+        Run::new(problem.clone(), strategy, evaluator, settings)?
     };
 
     let target = config.run.generations;
@@ -126,7 +130,7 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
         .expect("the template is valid"),
     );
     bar.set_position(u64::from(run.generation().min(target)));
-    let save = |run: &Run<BinTreeProblem, BinTreeStrategy>| -> anyhow::Result<()> {
+    let save = |run: &Run<P, S>| -> anyhow::Result<()> {
         let saved = SavedRun {
             config: config.clone(),
             checkpoint: run.checkpoint(),
@@ -158,10 +162,10 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
         "stats.csv",
         stats_csv(run.term_names(), run.stats()).as_bytes(),
     )?;
-    let title = format!("Binary trees, seed {}", config.run.seed);
+    let title = format!("{}, seed {}", problem.title(), config.run.seed);
     write("fitness.svg", fitness_svg(run.stats(), &title)?.as_bytes())?;
     let best = run.best();
-    let genome = Genome::BinTree(problem.decode(&best.genome));
+    let genome = problem.genome_file(&best.genome);
     write("best.json", genome.to_json().as_bytes())?;
     let grown = Grown::new(genome, 0)?;
     grown.export(&out.join("best.glb"))?;
@@ -187,8 +191,9 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
         total_evals as f64 / seconds.max(1e-9),
     );
     println!(
-        "best tree: {} cylinders, {} triangles; wrote {}/{{stats.csv, best.json, best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
+        "best plant: {} segments, {} organs, {} triangles; wrote {}/{{stats.csv, best.json, best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
         grown.plant.segments.len(),
+        grown.plant.organs.len(),
         grown.mesh.triangle_count(),
         out.display()
     );
@@ -196,9 +201,9 @@ fn evolve_bintree(config: &EvolveConfig, out: &Path, resume: bool) -> anyhow::Re
 }
 
 /// A contact sheet of the best `count` members of the current population.
-fn population_sheet(
-    run: &Run<BinTreeProblem, BinTreeStrategy>,
-    problem: &BinTreeProblem,
+fn population_sheet<P: ModelProblem, S: Strategy<P>>(
+    run: &Run<P, S>,
+    problem: &P,
     count: usize,
     path: &Path,
 ) -> anyhow::Result<()> {
@@ -208,7 +213,7 @@ fn population_sheet(
     order.truncate(count);
     let grown = order
         .iter()
-        .map(|&i| Grown::new(Genome::BinTree(problem.decode(&pop[i].genome)), 0))
+        .map(|&i| Grown::new(problem.genome_file(&pop[i].genome), 0))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let cells: Vec<SheetCell> = order
         .iter()

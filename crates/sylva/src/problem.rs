@@ -5,9 +5,29 @@ use rand::Rng;
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
+use sylva_models::Genome;
 use sylva_models::bintree::{BITS, BinTree, Bits};
 
 use crate::config::{BinTreeConfig, CrossoverKind};
+
+/// What `sylva evolve` needs from a problem besides the engine's [`Problem`]: how an evolved
+/// genome becomes a genome file (to grow, export and picture it) and what to call the run.
+pub trait ModelProblem: Problem {
+    /// The genome file an evolved genome stands for.
+    fn genome_file(&self, genome: &Self::Genome) -> Genome;
+    /// A short title for plots, e.g. "Binary trees".
+    fn title(&self) -> &'static str;
+}
+
+impl ModelProblem for BinTreeProblem {
+    fn genome_file(&self, bits: &Bits) -> Genome {
+        Genome::BinTree(self.decode(bits))
+    }
+
+    fn title(&self) -> &'static str {
+        "Binary trees"
+    }
+}
 
 /// Evolve binary trees towards Susinno's weighted fitness.
 #[derive(Clone, Debug, PartialEq)]
