@@ -18,6 +18,7 @@
 
 pub mod bintree;
 pub mod genome;
+pub mod lsystem;
 pub mod tag;
 
 pub use genome::{Genome, GenomeError};
