@@ -4,6 +4,8 @@
 //!   named terms; higher is better).
 //! - [`Mutate`] and [`Crossover`]: variation operators, one method each, randomness passed in.
 //! - [`Strategy`]: how one generation becomes the next; [`MeanReplacement`] is Susinno's.
+//! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,
+//!   elitism), as Poncin's GP runs used.
 //! - [`Evaluator`]: the one seam where work goes parallel (rayon), results kept in order.
 //! - [`Run`]: generations, batches, statistics, a [`Browser`] over the family, and
 //!   [`Checkpoint`]s that resume exactly.
@@ -48,6 +50,7 @@
 
 pub mod bits;
 pub mod fitness;
+pub mod generational;
 pub mod individual;
 pub mod problem;
 pub mod rng;
@@ -56,6 +59,7 @@ pub mod strategy;
 pub mod variation;
 
 pub use fitness::{Fitness, MAX_TERMS};
+pub use generational::{Generational, GenerationalError, GenerationalSettings};
 pub use individual::{Individual, IndividualId, Origin};
 pub use problem::{Evaluator, Problem};
 pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};

@@ -2,6 +2,8 @@
 //!
 //! - [`tree`]: Susinno's six tree measures ([`TreeMeasures`], with two of Sylva's) read
 //!   from any plant, and his weighted fitness ([`SusinnoWeights`]), reported term by term.
+//! - [`poncin`]: Poncin's terms for GP-grown trees (target surface, branch count, spread,
+//!   thickness, density grid) and their weighted total ([`PoncinFitness`]).
 //!
 //! ```
 //! use sylva_fitness::{SusinnoWeights, TreeMeasures};
@@ -15,6 +17,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod poncin;
 pub mod tree;
 
+pub use poncin::{PoncinFitness, PoncinScore, PoncinScratch, PoncinWeights};
 pub use tree::{SusinnoScore, SusinnoWeights, TreeMeasures};

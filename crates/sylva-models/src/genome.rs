@@ -7,13 +7,15 @@
 use serde::Deserialize;
 use sylva_core::Plant;
 
-use crate::{DevelopError, bintree};
+use crate::{DevelopError, automata, bintree};
 
 /// A genome of any model.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Genome {
     /// Susinno's recursive binary tree.
     BinTree(bintree::BinTree),
+    /// Poncin's GP-programmed turtle automata.
+    Automata(Box<automata::AutomataGenome>),
 }
 
 /// Why a genome file was refused; `line` and `column` are 1-based, 0 when unknown.
@@ -53,7 +55,7 @@ struct Header {
     format: u32,
 }
 
-const MODELS: [&str; 1] = [bintree::MODEL];
+const MODELS: [&str; 2] = [bintree::MODEL, automata::MODEL];
 
 fn model_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     let name = String::deserialize(d)?;
@@ -85,6 +87,7 @@ impl Genome {
         let _ = header.format;
         match header.model.as_str() {
             bintree::MODEL => Ok(Genome::BinTree(serde_json::from_str(text)?)),
+            automata::MODEL => Ok(Genome::Automata(Box::new(serde_json::from_str(text)?))),
             other => Err(GenomeError {
                 message: format!("unknown model `{other}`"),
                 line: 0,
@@ -97,6 +100,7 @@ impl Genome {
     pub fn to_json(&self) -> String {
         let mut s = match self {
             Genome::BinTree(g) => serde_json::to_string_pretty(g),
+            Genome::Automata(g) => serde_json::to_string_pretty(g),
         }
         .expect("genomes hold only finite numbers and strings");
         s.push('\n');
@@ -107,6 +111,7 @@ impl Genome {
     pub fn to_value(&self) -> serde_json::Value {
         match self {
             Genome::BinTree(g) => serde_json::to_value(g),
+            Genome::Automata(g) => serde_json::to_value(g),
         }
         .expect("genomes hold only finite numbers and strings")
     }
@@ -115,6 +120,7 @@ impl Genome {
     pub fn model(&self) -> &'static str {
         match self {
             Genome::BinTree(_) => bintree::MODEL,
+            Genome::Automata(_) => automata::MODEL,
         }
     }
 
@@ -122,6 +128,7 @@ impl Genome {
     pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
         match self {
             Genome::BinTree(g) => g.develop(seed),
+            Genome::Automata(g) => g.develop(seed),
         }
     }
 }

@@ -1,5 +1,7 @@
 //! Sylva's plant models: each turns a genome into a [`Plant`](sylva_core::Plant).
 //!
+//! - [`automata`]: Poncin's GP trees compiled by cellular encoding into turtle automata,
+//!   their simulator and GP operators.
 //! - [`bintree`]: Susinno's recursive binary tree, with its analytic tree measures and the
 //!   bit encoding of its genetic algorithm.
 //! - [`genome`]: genome files of any model ([`Genome`]), with errors that point at the line
@@ -16,6 +18,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod automata;
 pub mod bintree;
 pub mod genome;
 pub mod lsystem;

@@ -63,13 +63,29 @@ impl Grown {
 
     /// Renders and writes a picture.
     pub fn picture(&self, path: &Path, view: View, size: (u32, u32)) -> anyhow::Result<()> {
+        self.picture_with(path, view, size, None)
+    }
+
+    /// Renders and writes a picture, with guides (a target surface, grid cells) beside the
+    /// plant.
+    pub fn picture_with(
+        &self,
+        path: &Path,
+        view: View,
+        size: (u32, u32),
+        guides: Option<&Mesh>,
+    ) -> anyhow::Result<()> {
         let options = RenderOptions {
             width: size.0,
             height: size.1,
             view,
             ..RenderOptions::default()
         };
-        let image = render::render(&self.scene(), &options).context("rendering")?;
+        let mut scene = self.scene();
+        if let Some(mesh) = guides {
+            scene.nodes.push(SceneNode::new("guides", mesh));
+        }
+        let image = render::render(&scene, &options).context("rendering")?;
         render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
     }
 }

@@ -13,7 +13,7 @@ use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use crate::assets::{Grown, asset_format, check_png, load_genome};
 use crate::config::{EvolveConfig, ModelName, read_text};
 use crate::error::InputError;
-use crate::problem::{BinTreeProblem, ModelProblem, strategy};
+use crate::problem::{AutomataProblem, BinTreeProblem, ModelProblem, automata_strategy, strategy};
 use crate::report::{fitness_svg, stats_csv};
 
 /// Arguments of `sylva evolve`; `None` keeps the config's value.
@@ -57,16 +57,25 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
     run.seed = args.seed.unwrap_or(run.seed);
     run.threads = args.threads.unwrap_or(run.threads);
     let out = args.out.clone().unwrap_or_else(|| {
-        let model = match config.model {
-            ModelName::BinTree => "bintree",
-        };
-        PathBuf::from(format!("runs/{model}-seed{}", config.run.seed))
+        PathBuf::from(format!("runs/{}-seed{}", config.model.name(), config.run.seed))
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     match config.model {
         ModelName::BinTree => {
             let problem = BinTreeProblem::new(&config.bintree);
             let strategy = strategy(&config.bintree);
+            evolve_problem(&config, &out, args.resume, problem, strategy)
+        }
+        ModelName::Automata => {
+            let problem = AutomataProblem::new(&config.automata);
+            let strategy = automata_strategy(&problem, &config.automata).map_err(|e| {
+                InputError::new(
+                    args.config
+                        .as_ref()
+                        .map_or("config".into(), |p| p.display().to_string()),
+                    format!("[automata.breeding]: {e}"),
+                )
+            })?;
             evolve_problem(&config, &out, args.resume, problem, strategy)
         }
     }
@@ -170,7 +179,16 @@ where
     let grown = Grown::new(genome, 0)?;
     grown.export(&out.join("best.glb"))?;
     let size = config.output.image_size;
-    grown.picture(&out.join("best.png"), config.output.view, (size, size))?;
+    let guides = match problem.guides() {
+        Some(plant) => Some(guide_mesh(&plant)?),
+        None => None,
+    };
+    grown.picture_with(
+        &out.join("best.png"),
+        config.output.view,
+        (size, size),
+        guides.as_ref(),
+    )?;
     population_sheet(
         &run,
         &problem,
@@ -198,6 +216,16 @@ where
         out.display()
     );
     Ok(())
+}
+
+/// Meshes guide wires thinly.
+fn guide_mesh(plant: &sylva_core::Plant) -> anyhow::Result<sylva_mesh::Mesh> {
+    let options = sylva_mesh::mesher::MeshOptions {
+        radial_segments: 4,
+        cap_ends: false,
+        ..Default::default()
+    };
+    sylva_mesh::mesher::mesh_plant(plant, &options).context("meshing the guides")
 }
 
 /// A contact sheet of the best `count` members of the current population.

@@ -55,6 +55,9 @@ pub struct EvolveConfig {
     /// Settings of the binary-tree model and its genetic algorithm.
     #[serde(default)]
     pub bintree: BinTreeConfig,
+    /// Settings of the automata model, its GP and Poncin's fitness.
+    #[serde(default)]
+    pub automata: AutomataConfig,
     /// What the run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -66,6 +69,7 @@ impl Default for EvolveConfig {
             model: ModelName::BinTree,
             run: RunConfig::default(),
             bintree: BinTreeConfig::default(),
+            automata: AutomataConfig::default(),
             output: OutputConfig::default(),
         }
     }
@@ -78,6 +82,19 @@ pub enum ModelName {
     #[default]
     #[serde(rename = "bintree")]
     BinTree,
+    /// Poncin's GP-programmed turtle automata.
+    #[serde(rename = "automata")]
+    Automata,
+}
+
+impl ModelName {
+    /// The model's name in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelName::BinTree => "bintree",
+            ModelName::Automata => "automata",
+        }
+    }
 }
 
 /// Run size and seed.
@@ -168,6 +185,138 @@ impl Default for BinTreeConfig {
 sylva_core::ranged_number!(checkpoint_seconds, "checkpoint_seconds", 0.0, 3600.0, " s");
 sylva_core::ranged_number!(min_radius, "min_radius", 0.001, 1.0, " m");
 sylva_core::ranged_number!(mutation_rate, "mutation_rate", 0.0, 1.0, "");
+
+/// The automata model's GP run (Poncin): tree shape limits, breeding, growth and fitness.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AutomataConfig {
+    /// Automata per individual (children of `Top`), 1 to 8. Default 2.
+    #[serde(deserialize_with = "automata_count")]
+    pub automata: u32,
+    /// Smallest depth of initial bodies (ramped half-and-half), 1 to 16. Default 4.
+    #[serde(deserialize_with = "init_depth")]
+    pub init_min_depth: u32,
+    /// Largest depth of initial bodies, 1 to 16. Default 8.
+    #[serde(deserialize_with = "init_depth")]
+    pub init_max_depth: u32,
+    /// Deepest tree breeding may make, 2 to 64. Default 17.
+    #[serde(deserialize_with = "max_depth")]
+    pub max_depth: u32,
+    /// Most nodes of a tree, 20 to 5000. Default 500 (the paper's largest individuals).
+    #[serde(deserialize_with = "max_size")]
+    pub max_size: u32,
+    /// Tournament selection and the 88 / 10 / 2 operator rates.
+    pub breeding: sylva_evolve::GenerationalSettings,
+    /// How programs grow.
+    pub growth: GrowthConfig,
+    /// Poncin's fitness: target shape, counts, spread, thickness and density grid.
+    pub fitness: sylva_fitness::PoncinFitness,
+}
+
+impl Default for AutomataConfig {
+    fn default() -> Self {
+        AutomataConfig {
+            automata: 2,
+            init_min_depth: 4,
+            init_max_depth: 8,
+            max_depth: 17,
+            max_size: 500,
+            breeding: sylva_evolve::GenerationalSettings::default(),
+            growth: GrowthConfig::default(),
+            fitness: sylva_fitness::PoncinFitness::default(),
+        }
+    }
+}
+
+fn automata_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "automata", 1, 8)
+}
+fn init_depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "init depth", 1, 16)
+}
+fn max_depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "max_depth", 2, 64)
+}
+fn max_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "max_size", 20, 5000)
+}
+fn iterations<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "iterations", 1, 100_000)
+}
+sylva_core::ranged_number!(growth_unit, "unit", 1e-6, 1000.0, " m");
+sylva_core::ranged_number!(gravity, "gravity", 0.0, 90.0, " degrees per step");
+sylva_core::ranged_number!(degrees_per_unit, "degrees_per_unit", 0.0, 36.0, " degrees");
+sylva_core::ranged_number!(growth_radius, "radius", 0.0, 1000.0, " units");
+sylva_core::ranged_number!(leaf_length, "leaf_length", 0.0, 1000.0, " units");
+
+/// How evolved programs grow; the same settings go into `best.json`. See the automata
+/// model's genome fields for what each means.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GrowthConfig {
+    /// Iteration limit, 1 to 100,000. Default 100.
+    #[serde(deserialize_with = "iterations")]
+    pub iterations: u32,
+    /// Metres per paper unit. Default 0.1.
+    #[serde(deserialize_with = "growth_unit")]
+    pub unit: f64,
+    /// Gravity bending, degrees per step at a horizontal heading. Default 0.
+    #[serde(deserialize_with = "gravity")]
+    pub gravity: f64,
+    /// Degrees per unit of a rotation value. Default 10.
+    #[serde(deserialize_with = "degrees_per_unit")]
+    pub degrees_per_unit: f64,
+    /// Radius at thickness 1, paper units. Default 3.
+    #[serde(deserialize_with = "growth_radius")]
+    pub radius: f64,
+    /// Leaf length, paper units. Default 4.
+    #[serde(deserialize_with = "leaf_length")]
+    pub leaf_length: f64,
+    /// What an If's else branch does when it ends. Default rejoin.
+    pub else_end: sylva_models::automata::ElseEnd,
+    /// What an automaton does at its end. Default die.
+    pub at_end: sylva_models::automata::AtEnd,
+    /// Runaway bounds.
+    pub limits: sylva_models::automata::Limits,
+}
+
+impl Default for GrowthConfig {
+    fn default() -> Self {
+        let g = sylva_models::automata::AutomataGenome::new(
+            "(Top (Wait))"
+                .parse()
+                .expect("a one-automaton tree that only waits is valid"),
+        );
+        GrowthConfig {
+            iterations: g.iterations,
+            unit: g.unit,
+            gravity: g.gravity,
+            degrees_per_unit: g.degrees_per_unit,
+            radius: g.radius,
+            leaf_length: g.leaf_length,
+            else_end: g.else_end,
+            at_end: g.at_end,
+            limits: g.limits,
+        }
+    }
+}
+
+impl GrowthConfig {
+    /// The genome file of a program grown with these settings.
+    pub fn genome(&self, program: sylva_models::automata::GpTree) -> sylva_models::automata::AutomataGenome {
+        let mut g = sylva_models::automata::AutomataGenome::new(program);
+        g.iterations = self.iterations;
+        g.unit = self.unit;
+        g.gravity = self.gravity;
+        g.degrees_per_unit = self.degrees_per_unit;
+        g.radius = self.radius;
+        g.leaf_length = self.leaf_length;
+        g.else_end = self.else_end;
+        g.at_end = self.at_end;
+        g.limits = self.limits;
+        g
+    }
+}
 
 /// What a run writes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

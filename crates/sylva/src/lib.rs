@@ -6,10 +6,12 @@
 //! - [`assets`]: a genome grown, meshed, exported and pictured.
 //! - [`report`]: `stats.csv` and `fitness.svg`.
 //! - [`error`]: bad-input errors that point at file, line and column (exit code 2).
+//! - [`guides`]: target surfaces and grid cells drawn beside plants in pictures.
 
 pub mod assets;
 pub mod commands;
 pub mod config;
 pub mod error;
+pub mod guides;
 pub mod problem;
 pub mod report;

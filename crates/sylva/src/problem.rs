@@ -1,7 +1,21 @@
 //! The binary tree as an evolution problem: Susinno's GA on a bit string, scored by his six
 //! weighted tree measures computed analytically (no plant is built per evaluation).
 
+use std::cell::RefCell;
+
 use rand::Rng;
+use sylva_core::glam::Vec3;
+use sylva_core::{Material, MaterialKind, Plant};
+use sylva_evolve::Generational;
+use sylva_fitness::poncin::{PoncinContext, TERM_NAMES as PONCIN_TERMS, TargetShape};
+use sylva_fitness::{PoncinFitness, PoncinScore, PoncinScratch};
+use sylva_models::automata::{
+    Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator, SubtreeCrossover,
+    SubtreeMutation,
+};
+
+use crate::config::{AutomataConfig, GrowthConfig};
+use crate::guides::{box_wire, ellipsoid_wire, guide_plant};
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
@@ -17,6 +31,10 @@ pub trait ModelProblem: Problem {
     fn genome_file(&self, genome: &Self::Genome) -> Genome;
     /// A short title for plots, e.g. "Binary trees".
     fn title(&self) -> &'static str;
+    /// Guides drawn beside the plant in pictures (a target surface, forbidden cells).
+    fn guides(&self) -> Option<Plant> {
+        None
+    }
 }
 
 impl ModelProblem for BinTreeProblem {
@@ -95,4 +113,187 @@ pub fn strategy(config: &BinTreeConfig) -> BinTreeStrategy {
         },
         cull_clones: config.cull_clones,
     }
+}
+
+/// Evolve automata programs towards Poncin's fitness (a target shape, a number of branches,
+/// spread, thickness and a density grid).
+#[derive(Clone, Debug)]
+pub struct AutomataProblem {
+    /// Initialisation and breeding limits.
+    pub gp: GpConfig,
+    /// How programs grow (also written into `best.json`).
+    pub growth: GrowthConfig,
+    /// The fitness.
+    pub fitness: PoncinFitness,
+    semantics: Semantics,
+    grow: GrowOptions,
+}
+
+/// Per-thread buffers, so evaluating does not allocate once they have grown. They hold no
+/// state between evaluations: results never depend on which thread evaluated what.
+struct AutomataScratch {
+    simulator: Simulator,
+    program: Option<Program>,
+    plant: Plant,
+    poncin: PoncinScratch,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<AutomataScratch> = RefCell::new(AutomataScratch {
+        simulator: Simulator::new(),
+        program: None,
+        plant: Plant::default(),
+        poncin: PoncinScratch::new(),
+    });
+}
+
+impl AutomataProblem {
+    /// The problem a config describes.
+    pub fn new(config: &AutomataConfig) -> Self {
+        let gp = GpConfig {
+            automata: config.automata as u8,
+            min_init_depth: config.init_min_depth.min(config.init_max_depth),
+            max_init_depth: config.init_max_depth.max(config.init_min_depth),
+            max_depth: config.max_depth,
+            max_size: config.max_size,
+            ..GpConfig::default()
+        };
+        let template = config
+            .growth
+            .genome("(Top (Wait))".parse().expect("a tree that only waits is valid"));
+        AutomataProblem {
+            gp,
+            growth: config.growth.clone(),
+            fitness: config.fitness.clone(),
+            semantics: template.semantics(),
+            grow: template.grow_options(),
+        }
+    }
+
+    /// Grows a program the way evaluation does (chords only) and scores it.
+    pub fn score(&self, tree: &GpTree) -> PoncinScore {
+        SCRATCH.with(|cell| {
+            let mut guard = cell.borrow_mut();
+            let s = &mut *guard;
+            let program = match &mut s.program {
+                Some(p) => {
+                    p.recompile(tree, &self.semantics);
+                    p
+                }
+                None => s.program.insert(Program::compile(tree, &self.semantics)),
+            };
+            let report = s
+                .simulator
+                .run(program, &self.grow, Detail::Chords, &mut s.plant);
+            // Pairs are exact up to 64 endpoints; beyond, the fixed seed keeps evaluation a
+            // pure function of the genome.
+            let ctx = PoncinContext {
+                seed: 0,
+                negative_thickness: report.negative_thickness,
+            };
+            self.fitness.score(&s.plant, ctx, &mut s.poncin)
+        })
+    }
+
+    /// The target surface and the forbidden grid cells, as wire frames in metres.
+    pub fn guides(&self) -> Option<Plant> {
+        let unit = self.fitness.unit as f32;
+        let (mut plant, surface) = guide_plant([0.35, 0.42, 0.55]).ok()?;
+        let wire = 0.4 * unit;
+        match self.fitness.target {
+            TargetShape::Sphere { center, radius } => ellipsoid_wire(
+                &mut plant,
+                center.as_vec3() * unit,
+                Vec3::splat(radius as f32 * unit),
+                wire,
+                surface,
+            ),
+            TargetShape::Ellipsoid { center, radii } => ellipsoid_wire(
+                &mut plant,
+                center.as_vec3() * unit,
+                radii.as_vec3() * unit,
+                wire,
+                surface,
+            ),
+            TargetShape::Box { center, size } => box_wire(
+                &mut plant,
+                (center - size * 0.5).as_vec3() * unit,
+                (center + size * 0.5).as_vec3() * unit,
+                wire,
+                surface,
+            ),
+            _ => Ok(()),
+        }
+        .ok()?;
+        if let Some(grid) = &self.fitness.grid {
+            let forbidden = plant
+                .add_material(Material {
+                    name: "forbidden".into(),
+                    kind: MaterialKind::Bark,
+                    color: [0.8, 0.08, 0.05],
+                    texture: None,
+                })
+                .ok()?;
+            for i in 0..grid.len() {
+                if grid.weight(i) < 0.0 {
+                    let (lo, hi) = grid.cell_bounds(i);
+                    box_wire(
+                        &mut plant,
+                        lo.as_vec3() * unit,
+                        hi.as_vec3() * unit,
+                        wire,
+                        forbidden,
+                    )
+                    .ok()?;
+                }
+            }
+        }
+        Some(plant)
+    }
+}
+
+impl Problem for AutomataProblem {
+    type Genome = GpTree;
+
+    fn term_names(&self) -> Vec<String> {
+        PONCIN_TERMS.iter().map(|s| (*s).to_owned()).collect()
+    }
+
+    fn evaluate(&self, tree: &GpTree) -> Fitness {
+        let score = self.score(tree);
+        Fitness::new(score.adjusted(), &score.terms())
+    }
+
+    fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> GpTree {
+        self.gp.random_tree(rng)
+    }
+}
+
+impl ModelProblem for AutomataProblem {
+    fn genome_file(&self, tree: &GpTree) -> Genome {
+        Genome::Automata(Box::new(self.growth.genome(tree.clone())))
+    }
+
+    fn title(&self) -> &'static str {
+        "Automata trees (Poncin)"
+    }
+
+    fn guides(&self) -> Option<Plant> {
+        AutomataProblem::guides(self)
+    }
+}
+
+/// Poncin's GP breeding with the configured operators.
+pub type AutomataStrategy = Generational<SubtreeCrossover, SubtreeMutation>;
+
+/// The breeding a config describes.
+pub fn automata_strategy(
+    problem: &AutomataProblem,
+    config: &AutomataConfig,
+) -> Result<AutomataStrategy, sylva_evolve::GenerationalError> {
+    Generational::new(
+        SubtreeCrossover { config: problem.gp },
+        SubtreeMutation { config: problem.gp },
+        config.breeding.clone(),
+    )
 }

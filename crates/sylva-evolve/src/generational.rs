@@ -1,0 +1,370 @@
+//! lilgp-style generational breeding: tournaments, then crossover, reproduction or mutation.
+//!
+//! [`Generational`] replaces the whole population every generation, as lilgp (which Poncin's
+//! GP runs used) does:
+//!
+//! ```text
+//! keep the best `elitism` members unchanged                      (operator "elite")
+//! for every other slot:
+//!     draw an operator: crossover 88%, reproduction 10%, mutation 2%
+//!     crossover:    child of two tournament winners               ("crossover")
+//!     reproduction: a copy of one tournament winner               ("reproduction")
+//!     mutation:     a mutated copy of one tournament winner       ("mutation")
+//! ```
+//!
+//! A tournament draws [`GenerationalSettings::tournament`] members uniformly, with
+//! replacement, from the previous generation and returns the fittest (ties go to the lower
+//! slot). The default size, 7, is lilgp's and Koza's usual choice: strong enough pressure for
+//! a GP population of thousands without collapsing it in a few generations.
+//!
+//! Elitism (default 1) copies the best members first, so the best genome is never lost; 0 is
+//! lilgp's plain generational step.
+//!
+//! Slot `s` of generation `g` draws everything from `rng::stream(seed, g, s)` and is made and
+//! evaluated in one job of [`Evaluator::map`](crate::Evaluator::map), so a run is identical for any thread count and
+//! a resumed run continues exactly.
+//!
+//! **Re-evaluation.** Copies (elites and reproductions) keep their genome, so their fitness
+//! could be reused. Poncin found that caching a *sampled* fitness (random pairs of endpoints)
+//! lets individuals that were wrongly marked very good survive for ever, and advised
+//! re-evaluating every generation; [`GenerationalSettings::reevaluate`] (default `true`)
+//! does that. Turn it off to save evaluations when the fitness is exact. Note that
+//! [`Problem::evaluate`] is meant to be a pure function of the genome: a sampled term only
+//! changes on re-evaluation if the problem varies its sampling (for instance per
+//! generation) itself.
+
+use std::borrow::Cow;
+
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::fitness::Fitness;
+use crate::individual::{Individual, IndividualId, Origin};
+use crate::problem::Problem;
+use crate::rng;
+use crate::strategy::{Breeding, Strategy};
+use crate::variation::{Crossover, Mutate};
+
+/// How far the three rates may add up away from 1.
+const RATE_SUM_TOLERANCE: f64 = 1e-6;
+
+/// Why generational settings are refused.
+#[derive(Debug, Error, PartialEq)]
+pub enum GenerationalError {
+    /// A tournament of no one.
+    #[error("`tournament` must be at least 1, got 0")]
+    EmptyTournament,
+    /// A rate that is NaN, infinite or outside 0..=1.
+    #[error("`{name}` rate must be a number from 0 to 1, got {value}")]
+    BadRate {
+        /// Which rate.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// Rates that do not add up to 1.
+    #[error(
+        "crossover, reproduction and mutation rates must add up to 1, got {crossover} + \
+         {reproduction} + {mutation} = {sum}"
+    )]
+    RateSum {
+        /// Crossover rate.
+        crossover: f64,
+        /// Reproduction rate.
+        reproduction: f64,
+        /// Mutation rate.
+        mutation: f64,
+        /// Their sum.
+        sum: f64,
+    },
+}
+
+/// Settings of [`Generational`], as read from a config file; defaults are the paper's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GenerationalSettings {
+    /// Members drawn per tournament (with replacement). Default 7.
+    pub tournament: usize,
+    /// Share of offspring made by crossover. Default 0.88.
+    pub crossover: f64,
+    /// Share of offspring copied unchanged. Default 0.10.
+    pub reproduction: f64,
+    /// Share of offspring made by mutating a copy. Default 0.02.
+    pub mutation: f64,
+    /// Best members carried over unchanged (at most the population). Default 1.
+    pub elitism: usize,
+    /// Re-evaluate copies (elites, reproductions) rather than reuse their fitness.
+    /// Default `true` (see the module docs).
+    pub reevaluate: bool,
+}
+
+impl Default for GenerationalSettings {
+    fn default() -> Self {
+        GenerationalSettings {
+            tournament: 7,
+            crossover: 0.88,
+            reproduction: 0.10,
+            mutation: 0.02,
+            elitism: 1,
+            reevaluate: true,
+        }
+    }
+}
+
+impl GenerationalSettings {
+    /// Checks the tournament size and that the rates are in 0..=1 and add up to 1.
+    pub fn validate(&self) -> Result<(), GenerationalError> {
+        if self.tournament == 0 {
+            return Err(GenerationalError::EmptyTournament);
+        }
+        for (name, value) in [
+            ("crossover", self.crossover),
+            ("reproduction", self.reproduction),
+            ("mutation", self.mutation),
+        ] {
+            if !(0.0..=1.0).contains(&value) {
+                return Err(GenerationalError::BadRate { name, value });
+            }
+        }
+        let sum = self.crossover + self.reproduction + self.mutation;
+        if (sum - 1.0).abs() > RATE_SUM_TOLERANCE {
+            return Err(GenerationalError::RateSum {
+                crossover: self.crossover,
+                reproduction: self.reproduction,
+                mutation: self.mutation,
+                sum,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// lilgp's generational step (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Generational<X, M> {
+    /// Makes a child of two tournament winners.
+    pub crossover: X,
+    /// Changes a copy of one tournament winner.
+    pub mutation: M,
+    settings: GenerationalSettings,
+}
+
+impl<X, M> Generational<X, M> {
+    /// A strategy with validated settings.
+    pub fn new(
+        crossover: X,
+        mutation: M,
+        settings: GenerationalSettings,
+    ) -> Result<Self, GenerationalError> {
+        settings.validate()?;
+        Ok(Generational {
+            crossover,
+            mutation,
+            settings,
+        })
+    }
+
+    /// The settings in use.
+    pub fn settings(&self) -> &GenerationalSettings {
+        &self.settings
+    }
+}
+
+/// The operator a slot uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Operator {
+    Elite,
+    Crossover,
+    Reproduction,
+    Mutation,
+}
+
+impl Operator {
+    fn name(self) -> &'static str {
+        match self {
+            Operator::Elite => "elite",
+            Operator::Crossover => "crossover",
+            Operator::Reproduction => "reproduction",
+            Operator::Mutation => "mutation",
+        }
+    }
+}
+
+/// A slot's result: genome, fitness, operator, parents (slots of the old population), and
+/// whether an evaluation ran.
+struct Offspring<G> {
+    genome: G,
+    fitness: Option<Fitness>,
+    operator: Operator,
+    parents: [Option<usize>; 2],
+    evaluated: bool,
+}
+
+/// `a` is fitter than `b` (ties go to the lower slot).
+fn fitter<G>(population: &[Individual<G>], a: usize, b: usize) -> bool {
+    population[a]
+        .total()
+        .total_cmp(&population[b].total())
+        .then(b.cmp(&a))
+        .is_gt()
+}
+
+/// The winner of a tournament of `size` members drawn with replacement.
+fn tournament<G, R: rand::Rng + ?Sized>(
+    population: &[Individual<G>],
+    size: usize,
+    rng: &mut R,
+) -> usize {
+    let mut best = rng.random_range(0..population.len());
+    for _ in 1..size {
+        let other = rng.random_range(0..population.len());
+        if fitter(population, other, best) {
+            best = other;
+        }
+    }
+    best
+}
+
+/// Slots of the `k` fittest members, fittest first.
+fn elites<G>(population: &[Individual<G>], k: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..population.len()).collect();
+    order.sort_by(|&a, &b| {
+        population[b]
+            .total()
+            .total_cmp(&population[a].total())
+            .then(a.cmp(&b))
+    });
+    order.truncate(k);
+    order
+}
+
+impl<P, X, M> Strategy<P> for Generational<X, M>
+where
+    P: Problem,
+    X: Crossover<P::Genome> + Sync,
+    M: Mutate<P::Genome> + Sync,
+{
+    fn breed(
+        &self,
+        problem: &P,
+        population: &mut [Individual<P::Genome>],
+        ctx: &mut Breeding<'_>,
+    ) -> u64 {
+        if population.is_empty() {
+            return 0;
+        }
+        let s = &self.settings;
+        let elite = elites(population, s.elitism.min(population.len()));
+        let (seed, generation) = (ctx.seed, ctx.generation);
+        let old = &*population;
+        let copy = |parent: usize, operator: Operator| {
+            let genome = old[parent].genome.clone();
+            let (fitness, evaluated) = if s.reevaluate || old[parent].fitness.is_none() {
+                (Some(problem.evaluate(&genome)), true)
+            } else {
+                (old[parent].fitness, false)
+            };
+            Offspring {
+                genome,
+                fitness,
+                operator,
+                parents: [Some(parent), None],
+                evaluated,
+            }
+        };
+        let offspring = ctx.evaluator.map(old.len(), |slot| {
+            if let Some(&parent) = elite.get(slot) {
+                return copy(parent, Operator::Elite);
+            }
+            let mut rng = rng::stream(seed, generation, slot as u32);
+            let draw: f64 = rng.random();
+            if draw < s.crossover {
+                let a = tournament(old, s.tournament, &mut rng);
+                let b = tournament(old, s.tournament, &mut rng);
+                let genome = self
+                    .crossover
+                    .crossover(&old[a].genome, &old[b].genome, &mut rng);
+                Offspring {
+                    fitness: Some(problem.evaluate(&genome)),
+                    genome,
+                    operator: Operator::Crossover,
+                    parents: [Some(a), Some(b)],
+                    evaluated: true,
+                }
+            } else if draw < s.crossover + s.reproduction {
+                copy(
+                    tournament(old, s.tournament, &mut rng),
+                    Operator::Reproduction,
+                )
+            } else {
+                let parent = tournament(old, s.tournament, &mut rng);
+                let mut genome = old[parent].genome.clone();
+                self.mutation.mutate(&mut genome, &mut rng);
+                Offspring {
+                    fitness: Some(problem.evaluate(&genome)),
+                    genome,
+                    operator: Operator::Mutation,
+                    parents: [Some(parent), None],
+                    evaluated: true,
+                }
+            }
+        });
+        let parent_ids: Vec<IndividualId> = population.iter().map(|i| i.id).collect();
+        let mut evaluations = 0;
+        for (slot, child) in offspring.into_iter().enumerate() {
+            evaluations += u64::from(child.evaluated);
+            population[slot] = Individual {
+                id: ctx.next_id(),
+                genome: child.genome,
+                fitness: child.fitness,
+                origin: Origin {
+                    generation,
+                    operator: Cow::Borrowed(child.operator.name()),
+                    parents: child
+                        .parents
+                        .iter()
+                        .flatten()
+                        .map(|&p| parent_ids[p])
+                        .collect(),
+                },
+            };
+        }
+        evaluations
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_papers_and_valid() {
+        let s = GenerationalSettings::default();
+        assert_eq!(
+            (s.crossover, s.reproduction, s.mutation),
+            (0.88, 0.10, 0.02)
+        );
+        assert_eq!(s.validate(), Ok(()));
+    }
+
+    #[test]
+    fn tournament_prefers_the_fitter() {
+        let pop: Vec<Individual<u8>> = (0..10u8)
+            .map(|i| Individual {
+                id: IndividualId(u64::from(i)),
+                genome: i,
+                fitness: Some(Fitness::new(f64::from(i), &[])),
+                origin: Origin::new(0, "random"),
+            })
+            .collect();
+        let mut rng = rng::seeded(3);
+        let wins: usize = (0..1000)
+            .map(|_| tournament(&pop, 7, &mut rng))
+            .filter(|&w| w >= 7)
+            .count();
+        // P(winner in the top 3 of 10 with 7 draws) = 1 - 0.7^7 ≈ 0.92.
+        assert!(wins > 880, "{wins}");
+        assert_eq!(elites(&pop, 3), vec![9, 8, 7]);
+    }
+}

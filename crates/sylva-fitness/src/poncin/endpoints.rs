@@ -1,0 +1,89 @@
+//! The fitness cases: a plant's endpoints, read once per evaluation into reusable buffers.
+//!
+//! An endpoint is the end of a segment that no segment continues or branches from, exactly
+//! [`Plant::tips`]; its level is the segment's branch order (0 for the trunk). Each endpoint
+//! also carries the direction of the branch it ends, from the base of its axis (the start of
+//! the lateral segment that began the branch, or the plant's foot for the trunk) to the
+//! endpoint, which F_angle compares.
+
+use glam::DVec3;
+use sylva_core::Plant;
+
+/// One endpoint, as the terms read it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Endpoint {
+    /// Position in paper units (metres divided by the unit).
+    pub position: DVec3,
+    /// Unit direction from the base of its axis to it; zero for an axis without length.
+    pub direction: DVec3,
+    /// Branch level: the order of its segment (0 for the trunk).
+    pub level: u16,
+    /// Radius at the end of its segment, metres.
+    pub radius: f64,
+}
+
+/// Buffers one evaluation needs; keep one per thread and pass it to every
+/// [`PoncinFitness::score`](super::PoncinFitness::score) call, so that scoring does not
+/// allocate once the buffers have grown to the largest plant seen.
+#[derive(Clone, Debug, Default)]
+pub struct PoncinScratch {
+    /// Per segment: whether any segment grows from it.
+    has_child: Vec<bool>,
+    /// Per segment: the first segment of its axis.
+    axis: Vec<u32>,
+    pub(crate) endpoints: Vec<Endpoint>,
+    /// Endpoint positions as f32 columns (x, y, z), for the exact pair loop.
+    pub(crate) columns: [Vec<f32>; 3],
+    pub(crate) cells: Vec<u32>,
+}
+
+impl PoncinScratch {
+    /// Empty buffers.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Reads the plant's endpoints, positions divided by `unit` (metres per paper unit).
+    /// Segments whose parent is not an earlier segment are treated as roots.
+    pub fn read(&mut self, plant: &Plant, unit: f64) -> &[Endpoint] {
+        let segments = &plant.segments;
+        self.has_child.clear();
+        self.has_child.resize(segments.len(), false);
+        self.axis.clear();
+        for (i, s) in segments.iter().enumerate() {
+            let axis = match s.parent.map(|p| p.index()) {
+                Some(p) if p < i => {
+                    self.has_child[p] = true;
+                    if s.lateral { i as u32 } else { self.axis[p] }
+                }
+                _ => i as u32,
+            };
+            self.axis.push(axis);
+        }
+        self.endpoints.clear();
+        for column in &mut self.columns {
+            column.clear();
+        }
+        let inv_unit = 1.0 / unit;
+        let ends = segments.iter().zip(&self.has_child).zip(&self.axis);
+        for ((s, _), &axis) in ends.filter(|((_, has_child), _)| !**has_child) {
+            let position = s.end.as_dvec3() * inv_unit;
+            for (column, x) in self.columns.iter_mut().zip(position.to_array()) {
+                column.push(x as f32);
+            }
+            let base = segments[axis as usize].start;
+            self.endpoints.push(Endpoint {
+                position,
+                direction: (s.end - base).as_dvec3().normalize_or_zero(),
+                level: s.order,
+                radius: f64::from(s.end_radius),
+            });
+        }
+        &self.endpoints
+    }
+
+    /// The endpoints of the last plant read.
+    pub fn endpoints(&self) -> &[Endpoint] {
+        &self.endpoints
+    }
+}
