@@ -1,5 +1,6 @@
 //! Rendering throughput: the evolved default oak (36,840 triangles) and a 202k-triangle
-//! test tree at 800 x 800 with 2x supersampling, with and without ground and shadows.
+//! test tree at 800 x 800 with 2x supersampling, with and without ground and shadows, and
+//! with textured bark, leaves and flowers.
 //!
 //! Run with `cargo bench -p sylva-mesh --bench render`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -46,6 +47,17 @@ fn render(c: &mut Criterion) {
             b.iter(|| renderer.render(black_box(&scene), &options).unwrap())
         });
     }
+    // The same tree with bark, leaf and petal textures (made once, kept by the renderer).
+    let mut textured = plant;
+    for (m, id) in textured.materials.iter_mut().zip([0, 3, 6]) {
+        m.texture = Some(id);
+    }
+    let textured = mesh_plant(&textured, &MeshOptions::default()).unwrap();
+    let scene = Scene::single(SceneNode::new("tree", &textured));
+    let options = RenderOptions::default();
+    group.bench_function("textured", |b| {
+        b.iter(|| renderer.render(black_box(&scene), &options).unwrap())
+    });
     group.finish();
 }
 

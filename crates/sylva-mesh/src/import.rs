@@ -3,9 +3,12 @@
 //!
 //! What is read: the default scene's node tree (translation, rotation, scale or matrix,
 //! composed down the hierarchy), triangle primitives with `FLOAT` `VEC3` positions and
-//! optional normals (flat normals are computed when missing), `UNSIGNED_BYTE`, `SHORT` or `INT`
-//! indices (or none), and each material's base colour. Textures, skins, morph targets,
-//! sparse accessors and non-triangle modes are ignored. Every node's transform is baked into
+//! optional normals (flat normals are computed when missing), optional `TEXCOORD_0` (`FLOAT`,
+//! or normalised `UNSIGNED_BYTE` or `SHORT`; `(0, 0)` when missing), `UNSIGNED_BYTE`, `SHORT`
+//! or `INT` indices (or none), and each material's base colour. A base colour texture whose
+//! image is named `sylva-texture-<id>` (as Sylva's GLB writer names them) gives the
+//! material that texture id back; other textures, skins, morph targets, sparse accessors and
+//! non-triangle modes are ignored. Every node's transform is baked into
 //! a world-space copy of its mesh. Every offset and count is checked, so a truncated or
 //! hostile file is an error, never a panic.
 
@@ -208,6 +211,16 @@ impl Reader<'_> {
             if normals.len() != positions.len() {
                 return Err(invalid("NORMAL and POSITION counts differ"));
             }
+            match prim["attributes"].get("TEXCOORD_0") {
+                Some(t) => {
+                    let uvs = self.vec2s(self.item("accessors", t)?)?;
+                    if uvs.len() != positions.len() {
+                        return Err(invalid("TEXCOORD_0 and POSITION counts differ"));
+                    }
+                    out.uvs.extend(uvs);
+                }
+                None => out.uvs.resize(out.uvs.len() + positions.len(), [0.0; 2]),
+            }
             for (p, n) in positions.iter().zip(&normals) {
                 out.positions.push(world.transform_point3(*p).to_array());
                 out.normals
@@ -238,8 +251,23 @@ impl Reader<'_> {
             name,
             kind,
             color: [channel(0), channel(1), channel(2)],
-            texture: None,
+            texture: self.sylva_texture(&m["pbrMetallicRoughness"]["baseColorTexture"]),
         })
+    }
+
+    /// The Sylva texture id behind a texture reference, if its image is one of Sylva's.
+    fn sylva_texture(&self, info: &Value) -> Option<u16> {
+        let texture = self
+            .list("textures")
+            .get(info["index"].as_u64()? as usize)?;
+        let image = self
+            .list("images")
+            .get(texture["source"].as_u64()? as usize)?;
+        image["name"]
+            .as_str()?
+            .strip_prefix(crate::export::IMAGE_NAME_PREFIX)?
+            .parse()
+            .ok()
     }
 
     /// The bytes of an accessor's elements: (data from the first element, stride, count).
@@ -287,6 +315,37 @@ impl Reader<'_> {
                     f32::from_le_bytes([b[0], b[1], b[2], b[3]])
                 };
                 Vec3::new(f(0), f(1), f(2))
+            })
+            .collect())
+    }
+
+    fn vec2s(&self, accessor: &Value) -> Result<Vec<[f32; 2]>, ImportError> {
+        if accessor["type"] != "VEC2" {
+            return Err(invalid("TEXCOORD_0 must be VEC2"));
+        }
+        let normalized = accessor["normalized"].as_bool().unwrap_or(false);
+        let (size, scale) = match accessor["componentType"].as_u64() {
+            Some(5126) => (4, 1.0),
+            Some(5121) if normalized => (1, 1.0 / 255.0),
+            Some(5123) if normalized => (2, 1.0 / 65_535.0),
+            _ => {
+                return Err(invalid(
+                    "TEXCOORD_0 must be FLOAT, or normalised UNSIGNED_BYTE or SHORT",
+                ));
+            }
+        };
+        let (data, stride, count) = self.view(accessor, 2 * size)?;
+        Ok((0..count)
+            .map(|i| {
+                let c = |k: usize| {
+                    let b = &data[i * stride + size * k..i * stride + size * (k + 1)];
+                    match size {
+                        1 => f32::from(b[0]) * scale,
+                        2 => f32::from(u16::from_le_bytes([b[0], b[1]])) * scale,
+                        _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                    }
+                };
+                [c(0), c(1)]
             })
             .collect())
     }
@@ -364,6 +423,7 @@ mod tests {
         Mesh {
             positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
             normals: vec![[0.0, 0.0, 1.0]; 3],
+            uvs: vec![[0.0, 0.0], [1.0, 0.25], [0.5, 3.5]],
             primitives: vec![Primitive {
                 material: 0,
                 indices: vec![0, 1, 2],
@@ -387,6 +447,40 @@ mod tests {
         assert!((p - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
         assert_eq!(back.meshes[0].1.materials[0].kind, MaterialKind::Leaf);
         assert_eq!(back.meshes[0].1.triangle_count(), 1);
+        // Untextured materials need no texture coordinates, so none are written.
+        assert_eq!(back.meshes[0].1.uvs, [[0.0; 2]; 3]);
+        assert_eq!(back.meshes[0].1.materials[0].texture, None);
+    }
+
+    #[test]
+    fn uvs_and_texture_ids_round_trip() {
+        let mut mesh = crate::export::tests::small_mesh();
+        mesh.materials[0].texture = Some(2);
+        mesh.materials[2].texture = Some(14);
+        let glb = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let back = read_glb(&glb).unwrap();
+        let m = &back.meshes[0].1;
+        // Primitives come back one vertex block each, in order: vertices of a primitive are
+        // copied, so compare through the indices. Only textured ones carry coordinates.
+        for (p, q) in mesh.primitives.iter().zip(&m.primitives) {
+            let textured = mesh.materials[p.material].texture.is_some();
+            for (&i, &j) in p.indices.iter().zip(&q.indices) {
+                let expected = if textured {
+                    mesh.uvs[i as usize]
+                } else {
+                    [0.0; 2]
+                };
+                assert_eq!(m.uvs[j as usize], expected);
+            }
+        }
+        // A textured mesh without texture coordinates reads back as zeros.
+        let textures: Vec<Option<u16>> = m.materials.iter().map(|m| m.texture).collect();
+        assert_eq!(textures, [Some(2), None, Some(14)]);
+        let mut bare = triangle_mesh();
+        bare.uvs.clear();
+        bare.materials[0].texture = Some(4);
+        let glb = to_glb(&Scene::single(SceneNode::new("b", &bare))).unwrap();
+        assert_eq!(read_glb(&glb).unwrap().meshes[0].1.uvs, [[0.0; 2]; 3]);
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! The triangle mesh every exporter and the renderer read.
 //!
-//! One vertex buffer (positions and unit normals) shared by several [`Primitive`]s, one per
-//! material, each a list of counter-clockwise triangles (front faces wind counter-clockwise
-//! seen from outside). Leaves are double-sided by geometry: each blade is emitted twice with
+//! One vertex buffer (positions, unit normals and texture coordinates) shared by several
+//! [`Primitive`]s, one per material, each a list of counter-clockwise triangles (front faces
+//! wind counter-clockwise seen from outside). A material whose `texture` is set shows that
+//! [`texture`](crate::texture) through the coordinates, multiplied by its colour. Leaves are double-sided by geometry: each blade is emitted twice with
 //! opposite windings and normals, so every exporter and viewer shows both faces correctly.
 
 use sylva_core::{Aabb, Material, glam::Vec3};
@@ -23,6 +24,10 @@ pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     /// Unit vertex normals, one per position.
     pub normals: Vec<[f32; 3]>,
+    /// Texture coordinates `[u, v]`, one per position (`v` runs down the texture picture, as
+    /// in glTF). May be empty for a mesh built by hand without them: exporters then write
+    /// `(0, 0)` and the renderer samples there. The mesher always fills them.
+    pub uvs: Vec<[f32; 2]>,
     /// Triangle lists, one per material that has triangles.
     pub primitives: Vec<Primitive>,
     /// The materials primitives refer to.
@@ -53,6 +58,7 @@ impl Mesh {
     pub fn clear(&mut self) {
         self.positions.clear();
         self.normals.clear();
+        self.uvs.clear();
         for p in &mut self.primitives {
             p.indices.clear();
         }

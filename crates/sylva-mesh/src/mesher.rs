@@ -13,8 +13,10 @@
 //! plant.add_segment(Vec3::Y, Vec3::new(0.2, 2.0, 0.0), (0.08, 0.05), Some(a), false, Plant::BARK)?;
 //! let mut mesher = Mesher::new(MeshOptions::default())?;
 //! let mesh = mesher.mesh(&plant)?;
-//! // Two segments of one axis share the ring at their joint: 3 rings of 12, plus 2 caps.
-//! assert_eq!(mesh.vertex_count(), 3 * 12 + 2 * 13);
+//! // Two segments of one axis share the ring at their joint: 3 rings of 12 + 1 (the last
+//! // vertex repeats the first for the texture seam), plus 2 caps of 1 + 12.
+//! assert_eq!(mesh.vertex_count(), 3 * 13 + 2 * 13);
+//! assert_eq!(mesh.uvs.len(), mesh.vertex_count());
 //! assert_eq!(mesh.triangle_count(), 2 * 2 * 12 + 2 * 12);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -25,8 +27,9 @@
 //!   non-lateral segment that is not its parent's *first* non-lateral child (several
 //!   non-lateral children: the first continues the axis, the others are meshed as laterals).
 //!   Each axis becomes one tube.
-//! - **Rings.** A tube of `k` segments has `k + 1` rings of `radial_segments` vertices; two
-//!   consecutive segments share the ring at their joint, so there are no cracks. A ring's
+//! - **Rings.** A tube of `k` segments has `k + 1` rings of `radial_segments + 1` vertices
+//!   (the last repeats the first at the texture seam, with the same position and normal);
+//!   two consecutive segments share the ring at their joint, so there are no cracks. A ring's
 //!   radius is the start radius of the axis's first segment for the first ring and the *end*
 //!   radius of the incoming segment for every later ring (a child's start radius is ignored
 //!   at a shared joint).
@@ -56,6 +59,15 @@
 //!   flower's diameter and `size.y` a petal's greatest width.
 //! - **Root tips** are small smooth-shaded octahedra from the base up local +Y: `size.x`
 //!   long, `size.y` wide.
+//! - **Texture coordinates** (see [`crate::texture`] for the textures). Tubes: `u = k / R`
+//!   around ring vertex `k` (0 to 1 at the seam, which the rotation-minimising frames keep
+//!   in a straight line along the axis), and `v` the arc length along the axis divided by
+//!   the circumference there (each span's by its mean radius), so texels stay square as a
+//!   tube tapers and `v` runs on, unbounded, for bark textures to repeat. Caps: a planar
+//!   disc, centre `(½, ½)`, rim on the circle of radius ½. Leaves: `u` across the blade (0
+//!   and 1 at the margins where it is widest, ½ on the midrib), `v` from 0 at the base to 1
+//!   at the tip; both sides alike. Petals: the same per petal (base `(½, 0)`, sides `(0, ½)`
+//!   and `(1, ½)`, tip `(½, 1)`). Root tips: their local XY plane, `v` base to tip.
 //! - **Output.** One [`Primitive`] per material that has triangles, in material order;
 //!   `mesh.materials` is a copy of `plant.materials`. Vertices come axis by axis in segment
 //!   order, then organs in order, so the same plant always gives the same mesh.
@@ -198,6 +210,9 @@ const MAX_COORD: f32 = 1e12;
 const MAX_SLOPE: f32 = 8.0;
 /// Petals rise this far (radians) from the flower's plane towards its axis.
 const PETAL_TILT: f32 = 20.0 * PI / 180.0;
+/// Tube spans thinner than this (metres) advance texture `v` as if they were this thick, so
+/// collapsed tubes keep finite coordinates.
+const MIN_UV_RADIUS: f32 = 1e-4;
 /// No continuation / no slot.
 const NONE: u32 = u32::MAX;
 
@@ -216,10 +231,15 @@ struct Petal {
 #[derive(Clone, Debug)]
 pub struct Mesher {
     options: MeshOptions,
-    /// `(cos, sin)` of each ring vertex's angle.
+    /// `(cos, sin)` of each ring vertex's angle; `R + 1` entries, the last (the seam) a copy
+    /// of the first, so both have bit-identical positions and normals.
     circle: Vec<(f32, f32)>,
     /// Indices of one tube segment's quads, relative to the first vertex of its lower ring.
     quad_pattern: Vec<u32>,
+    /// Texture `u` of each ring vertex: `k / R`, the seam vertex `R` at 1.
+    ring_u: Vec<f32>,
+    /// Texture coordinates of a cap's centre and ring vertices (a planar disc).
+    cap_uv: Vec<[f32; 2]>,
     /// Fan indices of a start cap (facing back) relative to its centre vertex.
     start_cap_pattern: Vec<u32>,
     /// Fan indices of a tip cap (facing forward) relative to its centre vertex.
@@ -228,6 +248,8 @@ pub struct Mesher {
     leaf_profile: Vec<(f32, f32)>,
     /// Both sides of a blade, relative to its first vertex.
     leaf_pattern: Vec<u32>,
+    /// Texture coordinates of one side of a blade, in vertex order.
+    leaf_uv: Vec<[f32; 2]>,
     /// Petal directions of the flower template.
     petals: Vec<Petal>,
     /// Per segment: its continuation child, or `NONE`.
@@ -245,6 +267,17 @@ const ROOT_TIP_INDICES: [u32; 24] = [
     1, 3, 2, 1, 4, 3, 1, 5, 4, 1, 2, 5, // upper faces, counter-clockwise from outside
     0, 2, 3, 0, 3, 4, 0, 4, 5, 0, 5, 2, // lower faces
 ];
+/// The octahedron's texture coordinates: its local XY plane projected, v from base to tip.
+const ROOT_TIP_UVS: [[f32; 2]; 6] = [
+    [0.5, 0.0],
+    [0.5, 1.0],
+    [1.0, 0.5],
+    [0.5, 0.5],
+    [0.0, 0.5],
+    [0.5, 0.5],
+];
+/// A petal's corners (base, right, tip, left): u across, v from base (0) to tip (1).
+const PETAL_UVS: [[f32; 2]; 4] = [[0.5, 0.0], [1.0, 0.5], [0.5, 1.0], [0.0, 0.5]];
 const ROOT_TIP_VERTICES: u64 = 6;
 const ROOT_TIP_TRIANGLES: u64 = 8;
 
@@ -256,22 +289,33 @@ impl Mesher {
         check_range("flower_petals", options.flower_petals, 3, 32, "3..=32")?;
         let r = options.radial_segments;
 
-        let circle = (0..r)
+        let mut circle: Vec<(f32, f32)> = (0..r)
             .map(|k| {
                 let (s, c) = (TAU * k as f32 / r as f32).sin_cos();
                 (c, s)
             })
             .collect();
-        // Quad k joins vertices k, k+1 of the lower ring to the same ones of the upper ring;
-        // with (u, v, tangent) right-handed, (a, b, d) and (a, d, c) wind counter-clockwise
-        // seen from outside.
+        circle.push(circle[0]);
+        let ring_u = (0..=r).map(|k| k as f32 / r as f32).collect();
+        let cap_uv = std::iter::once([0.5, 0.5])
+            .chain(
+                circle[..r as usize]
+                    .iter()
+                    .map(|&(c, s)| [0.5 + 0.5 * c, 0.5 + 0.5 * s]),
+            )
+            .collect();
+        // Quad k joins vertices k, k+1 of the lower ring to the same ones of the upper ring
+        // (rings have r + 1 vertices); with (u, v, tangent) right-handed, (a, b, d) and
+        // (a, d, c) wind counter-clockwise seen from outside. Caps have no seam: their ring
+        // is r vertices after the centre.
         let mut quad_pattern = Vec::with_capacity(6 * r as usize);
         let mut start_cap_pattern = Vec::with_capacity(3 * r as usize);
         let mut tip_cap_pattern = Vec::with_capacity(3 * r as usize);
         for k in 0..r {
-            let (a, b) = (k, (k + 1) % r);
-            let (c, d) = (a + r, b + r);
+            let (a, b) = (k, k + 1);
+            let (c, d) = (a + r + 1, b + r + 1);
             quad_pattern.extend_from_slice(&[a, b, d, a, d, c]);
+            let b = (k + 1) % r;
             start_cap_pattern.extend_from_slice(&[0, 1 + b, 1 + a]);
             tip_cap_pattern.extend_from_slice(&[0, 1 + a, 1 + b]);
         }
@@ -279,12 +323,19 @@ impl Mesher {
         // Lanceolate half-width sqrt(s)·(1 - s), normalised to 1/2 at its widest (s = 1/3).
         let n = options.leaf_stations;
         let widest = (1.0f32 / 3.0).sqrt() * (2.0 / 3.0);
-        let leaf_profile = (1..=n)
+        let leaf_profile: Vec<(f32, f32)> = (1..=n)
             .map(|i| {
                 let s = i as f32 / (n + 1) as f32;
                 (0.5 * s.sqrt() * (1.0 - s) / widest, s)
             })
             .collect();
+        // u across the blade (0 left margin at its widest .. 1 right), v from base to tip.
+        let mut leaf_uv = Vec::with_capacity(2 * n as usize + 2);
+        leaf_uv.push([0.5, 0.0]);
+        for &(h, s) in &leaf_profile {
+            leaf_uv.extend_from_slice(&[[0.5 - h, s], [0.5 + h, s]]);
+        }
+        leaf_uv.push([0.5, 1.0]);
         // One side: base 0, left i = 2i - 1, right i = 2i (i = 1..=n), tip 2n + 1.
         let mut front = Vec::with_capacity(6 * n as usize);
         front.extend_from_slice(&[0, 2, 1]);
@@ -318,11 +369,14 @@ impl Mesher {
         Ok(Mesher {
             options,
             circle,
+            ring_u,
+            cap_uv,
             quad_pattern,
             start_cap_pattern,
             tip_cap_pattern,
             leaf_profile,
             leaf_pattern,
+            leaf_uv,
             petals,
             next: Vec::new(),
             material_triangles: Vec::new(),
@@ -344,8 +398,10 @@ impl Mesher {
 
         out.positions.clear();
         out.normals.clear();
+        out.uvs.clear();
         out.positions.reserve(vertices);
         out.normals.reserve(vertices);
+        out.uvs.reserve(vertices);
         out.materials.clone_from(&plant.materials);
         // Reversed, so popping hands each material back the buffer it had last time.
         for p in out.primitives.drain(..).rev() {
@@ -462,9 +518,9 @@ impl Mesher {
         let (mut vertices, mut triangles) = (0u64, 0u64);
         for (i, s) in plant.segments.iter().enumerate() {
             let mut tris = 2 * r;
-            vertices += r;
+            vertices += r + 1;
             if self.starts_axis(plant, i) {
-                vertices += r;
+                vertices += r + 1;
                 if caps && s.start_radius > 0.0 {
                     vertices += r + 1;
                     tris += r;
@@ -535,7 +591,9 @@ impl Mesher {
             self.cap(&ring, -n_prev, first.material.index(), true, out);
         }
         let mut base = out.positions.len() as u32;
-        self.ring(&ring, out);
+        // Texture v: metres along the axis over the circumference there (see the docs).
+        let (mut tex_v, mut r_prev) = (0.0f32, first.start_radius);
+        self.ring(&ring, tex_v, out);
 
         let mut cur = start;
         loop {
@@ -570,12 +628,15 @@ impl Mesher {
             }
             let u = transport(x_prev, n_prev, u_prev, x, n);
             ring = Ring::new(x, n, u, radius, slope, stretch);
-            self.ring(&ring, out);
+            let circumference = TAU * (0.5 * (r_prev + radius)).max(MIN_UV_RADIUS);
+            tex_v += (x - x_prev).length() / circumference;
+            self.ring(&ring, tex_v, out);
             let slot = self.slots[seg.material.index()] as usize;
             out.primitives[slot]
                 .indices
                 .extend(self.quad_pattern.iter().map(|&i| i + base));
-            base += r;
+            base += r + 1;
+            r_prev = radius;
 
             if next == NONE {
                 if self.options.cap_ends && radius > 0.0 {
@@ -607,9 +668,9 @@ impl Mesher {
             .unwrap_or(Vec3::Y)
     }
 
-    /// Appends a ring's vertices.
+    /// Appends a ring's vertices, at texture `v`.
     #[inline]
-    fn ring(&self, ring: &Ring, out: &mut Mesh) {
+    fn ring(&self, ring: &Ring, v: f32, out: &mut Mesh) {
         let Ring {
             center,
             pu,
@@ -628,6 +689,7 @@ impl Mesher {
                 .iter()
                 .map(|&(c, s)| (nu * c + nv * s + nt).to_array()),
         );
+        out.uvs.extend(self.ring_u.iter().map(|&u| [u, v]));
     }
 
     /// Appends a flat cap over `ring`: a centre vertex, the ring again with `normal`, and a
@@ -635,15 +697,17 @@ impl Mesher {
     fn cap(&self, ring: &Ring, normal: Vec3, material: usize, start: bool, out: &mut Mesh) {
         let center_index = out.positions.len() as u32;
         let Ring { center, pu, pv, .. } = *ring;
+        let ring_circle = &self.circle[..self.circle.len() - 1];
         out.positions.push(center.to_array());
         out.positions.extend(
-            self.circle
+            ring_circle
                 .iter()
                 .map(|&(c, s)| (center + pu * c + pv * s).to_array()),
         );
         let n = normal.to_array();
         out.normals
-            .extend(std::iter::repeat_n(n, self.circle.len() + 1));
+            .extend(std::iter::repeat_n(n, ring_circle.len() + 1));
+        out.uvs.extend_from_slice(&self.cap_uv);
         let pattern = if start {
             &self.start_cap_pattern
         } else {
@@ -680,6 +744,9 @@ impl Mesher {
                         let side = 2 * self.leaf_profile.len() + 2;
                         out.normals
                             .extend(std::iter::repeat_n(normal.to_array(), side));
+                        // Both sides share the mapping: the back shows the front's mirror,
+                        // as a real blade seen from behind does.
+                        out.uvs.extend_from_slice(&self.leaf_uv);
                     }
                     out.primitives[slot]
                         .indices
@@ -696,6 +763,7 @@ impl Mesher {
                         for normal in [front, -front] {
                             out.positions.extend(corners.map(|c| c.to_array()));
                             out.normals.extend([normal.to_array(); 4]);
+                            out.uvs.extend_from_slice(&PETAL_UVS);
                         }
                         // Front (base, right, tip), (base, tip, left); back reversed.
                         let b = base + 8 * p as u32;
@@ -730,6 +798,7 @@ impl Mesher {
                         out.positions.push(p.to_array());
                         out.normals.push(n.normalize_or(Vec3::Y).to_array());
                     }
+                    out.uvs.extend_from_slice(&ROOT_TIP_UVS);
                     out.primitives[slot]
                         .indices
                         .extend(ROOT_TIP_INDICES.iter().map(|&i| i + base));
@@ -946,10 +1015,17 @@ mod tests {
     use sylva_core::{Organ, PlantMeta, SegmentId};
 
     const R: usize = 12;
+    /// Vertices of a tube ring: the seam vertex repeats the first.
+    const RV: usize = R + 1;
 
     /// Checks what every mesh must satisfy; returns nothing, panics with a reason.
     fn check_invariants(mesh: &Mesh) {
         assert_eq!(mesh.positions.len(), mesh.normals.len());
+        assert_eq!(mesh.positions.len(), mesh.uvs.len());
+        for uv in &mesh.uvs {
+            assert!(uv.iter().all(|c| c.is_finite()), "uv {uv:?}");
+            assert!((0.0..=1.0).contains(&uv[0]) && uv[1] >= 0.0, "uv {uv:?}");
+        }
         for p in &mesh.positions {
             assert!(p.iter().all(|c| c.is_finite()), "position {p:?}");
         }
@@ -1093,7 +1169,7 @@ mod tests {
             let points: Vec<Vec3> = (0..=n).map(|i| Vec3::Y * i as f32).collect();
             let p = chain(&points, 0.1);
             let m = mesh_of(&p);
-            assert_eq!(m.vertex_count(), (n + 1) * R + 2 * (R + 1));
+            assert_eq!(m.vertex_count(), (n + 1) * RV + 2 * (R + 1));
             assert_eq!(m.triangle_count(), 2 * R * n + 2 * R);
             let options = MeshOptions {
                 cap_ends: false,
@@ -1101,7 +1177,7 @@ mod tests {
                 ..Default::default()
             };
             let m = mesh_plant(&p, &options).unwrap();
-            assert_eq!(m.vertex_count(), (n + 1) * 7);
+            assert_eq!(m.vertex_count(), (n + 1) * 8);
             assert_eq!(m.triangle_count(), 2 * 7 * n);
             assert_eq!(winding_agreement(&m), 1.0);
         }
@@ -1145,7 +1221,7 @@ mod tests {
         let r = 0.2;
         let p = chain(&[Vec3::ZERO, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)], r);
         let m = mesh_of(&p);
-        let joint = &m.positions[(R + 1) + R..(R + 1) + 2 * R];
+        let joint = &m.positions[(R + 1) + RV..(R + 1) + 2 * RV];
         for q in joint {
             let q = Vec3::from_array(*q);
             // Distance to the incoming axis (the Y axis) and to the outgoing one (y = 1).
@@ -1167,7 +1243,7 @@ mod tests {
         );
         let p = chain(&[Vec3::ZERO, Vec3::Y, turn], 0.1);
         let m = mesh_of(&p);
-        let joint = &m.positions[(R + 1) + R..(R + 1) + 2 * R];
+        let joint = &m.positions[(R + 1) + RV..(R + 1) + 2 * RV];
         let far = joint
             .iter()
             .map(|q| (Vec3::from_array(*q) - Vec3::Y).length())
@@ -1179,7 +1255,7 @@ mod tests {
     /// vertex 0's normal is the frame's `u` for untapered tubes.
     fn ring_us(m: &Mesh, first_ring: usize, rings: usize) -> Vec<Vec3> {
         (0..rings)
-            .map(|i| Vec3::from_array(m.normals[first_ring + i * R]))
+            .map(|i| Vec3::from_array(m.normals[first_ring + i * RV]))
             .collect()
     }
 
@@ -1244,7 +1320,7 @@ mod tests {
         .unwrap();
         let m = mesh_of(&p);
         let radius = |ring: usize| {
-            let q = Vec3::from_array(m.positions[R + 1 + ring * R]);
+            let q = Vec3::from_array(m.positions[R + 1 + ring * RV]);
             Vec2::new(q.x, q.z).length()
         };
         assert!((radius(0) - 0.3).abs() < 1e-6);
@@ -1292,7 +1368,7 @@ mod tests {
         .unwrap();
         let m = mesh_of(&p);
         // Axis 0: cap, 2 rings, cap. Axis 1 starts with its cap's centre vertex.
-        let axis = 2 * (R + 1) + 2 * R;
+        let axis = 2 * (R + 1) + 2 * RV;
         let start = Vec3::from_array(m.positions[axis]);
         // The trunk's radius halfway up is 0.15; the whole ring of radius 0.05 stays inside it.
         let pull = (0.15 - 0.05) / std::f32::consts::FRAC_1_SQRT_2;
@@ -1323,7 +1399,7 @@ mod tests {
         )
         .unwrap();
         let m = mesh_of(&p);
-        let axis = 2 * (R + 1) + 2 * R;
+        let axis = 2 * (R + 1) + 2 * RV;
         assert_eq!(m.positions[axis], [0.0, 1.0, 0.0]);
     }
 
@@ -1353,7 +1429,7 @@ mod tests {
         .unwrap();
         let m = mesh_of(&p);
         // Two axes: one of two segments (3 rings), one of one (2 rings), each with two caps.
-        assert_eq!(m.vertex_count(), 5 * R + 4 * (R + 1));
+        assert_eq!(m.vertex_count(), 5 * RV + 4 * (R + 1));
     }
 
     #[test]
@@ -1372,7 +1448,7 @@ mod tests {
                 let m = mesh_of(&chain(&points, radius));
                 let segments = points.len() - 1;
                 let caps = if radius > 0.0 { 2 * (R + 1) } else { 0 };
-                assert_eq!(m.vertex_count(), (segments + 1) * R + caps, "{points:?}");
+                assert_eq!(m.vertex_count(), (segments + 1) * RV + caps, "{points:?}");
             }
         }
     }
@@ -1513,6 +1589,104 @@ mod tests {
     }
 
     #[test]
+    fn leaf_sides_share_uvs_spanning_the_blade() {
+        let mut p = plant();
+        let q = Quat::from_rotation_z(0.3) * Quat::from_rotation_y(1.0);
+        p.add_organ(organ(OrganKind::Leaf, q, Vec2::new(0.4, 0.1), Plant::LEAF))
+            .unwrap();
+        let m = mesh_of(&p);
+        let side = m.vertex_count() / 2;
+        assert_eq!(m.uvs[..side], m.uvs[side..], "both sides map alike");
+        assert_eq!(m.uvs[0], [0.5, 0.0], "base");
+        assert_eq!(m.uvs[side - 1], [0.5, 1.0], "tip");
+        let u = m.uvs.iter().map(|uv| uv[0]);
+        let (lo, hi) = u.fold((1.0f32, 0.0f32), |(lo, hi), u| (lo.min(u), hi.max(u)));
+        assert!(lo < 0.02 && hi > 0.98, "{lo}..{hi}");
+        // u − ½ is the offset across over the width, v the height over the length.
+        let o = p.organs[0];
+        for (pos, uv) in m.positions.iter().zip(&m.uvs) {
+            let local = q.inverse() * (Vec3::from_array(*pos) - o.position);
+            assert!(
+                (local.x / 0.1 - (uv[0] - 0.5)).abs() < 1e-5,
+                "{local} {uv:?}"
+            );
+            assert!((local.y / 0.4 - uv[1]).abs() < 1e-5, "{local} {uv:?}");
+        }
+    }
+
+    #[test]
+    fn tube_uvs_wrap_at_a_seam_and_run_along_the_axis() {
+        // A straight tube of radius 0.1 up Y in two segments of 1 m.
+        let m = mesh_of(&chain(&[Vec3::ZERO, Vec3::Y, Vec3::Y * 2.0], 0.1));
+        for ring in 0..3 {
+            let first = R + 1 + ring * RV;
+            let uvs = &m.uvs[first..first + RV];
+            for (k, uv) in uvs.iter().enumerate() {
+                assert_eq!(uv[0], k as f32 / R as f32);
+            }
+            // The seam vertex sits on the first, with the same normal.
+            assert_eq!(m.positions[first], m.positions[first + R]);
+            assert_eq!(m.normals[first], m.normals[first + R]);
+            let expected = ring as f32 / (TAU * 0.1);
+            assert!(uvs.iter().all(|uv| (uv[1] - expected).abs() < 1e-5));
+        }
+        // Caps are planar discs around (½, ½).
+        assert_eq!(m.uvs[0], [0.5, 0.5]);
+        for uv in &m.uvs[1..=R] {
+            let r = Vec2::new(uv[0] - 0.5, uv[1] - 0.5).length();
+            assert!((r - 0.5).abs() < 1e-5, "{uv:?}");
+        }
+    }
+
+    #[test]
+    fn tapering_tubes_keep_texels_square() {
+        let mut p = plant();
+        let a = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.2, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        p.add_segment(
+            Vec3::Y,
+            Vec3::Y * 2.0,
+            (0.1, 0.05),
+            Some(a),
+            false,
+            Plant::BARK,
+        )
+        .unwrap();
+        let m = mesh_of(&p);
+        let v = |ring: usize| m.uvs[R + 1 + ring * RV][1];
+        // Each span advances v by its length over its mean circumference.
+        assert!((v(1) - 1.0 / (TAU * 0.15)).abs() < 1e-5);
+        assert!((v(2) - v(1) - 1.0 / (TAU * 0.075)).abs() < 1e-4);
+    }
+
+    #[test]
+    fn petal_and_root_tip_uvs() {
+        let mut p = plant();
+        p.add_organ(organ(
+            OrganKind::Flower,
+            Quat::IDENTITY,
+            Vec2::new(0.2, 0.05),
+            Plant::FLOWER,
+        ))
+        .unwrap();
+        p.add_organ(organ(
+            OrganKind::RootTip,
+            Quat::IDENTITY,
+            Vec2::new(0.05, 0.01),
+            Plant::FLOWER,
+        ))
+        .unwrap();
+        let m = mesh_of(&p);
+        let petals = &m.uvs[..8 * 5];
+        for corners in petals.chunks_exact(4) {
+            assert_eq!(corners, [[0.5, 0.0], [1.0, 0.5], [0.5, 1.0], [0.0, 0.5]]);
+        }
+        assert_eq!(m.uvs[8 * 5], [0.5, 0.0], "root tip base");
+        assert_eq!(m.uvs[8 * 5 + 1], [0.5, 1.0], "root tip point");
+    }
+
+    #[test]
     fn flowers_are_double_sided_stars_facing_up_their_axis() {
         let mut p = plant();
         let q = Quat::from_rotation_z(0.4);
@@ -1640,6 +1814,7 @@ mod tests {
             let mut b: Vec<*const u32> = m.primitives.iter().map(|p| p.indices.as_ptr()).collect();
             b.push(m.positions.as_ptr().cast());
             b.push(m.normals.as_ptr().cast());
+            b.push(m.uvs.as_ptr().cast());
             b
         };
         let before = buffers(&out);

@@ -139,7 +139,30 @@ fn written_glbs_pass_the_khronos_validator() {
     );
     write("no-nodes.glb", &Scene::default());
 
-    // Past 65 535 vertices: 32-bit indices.
+    // Textured materials: bark and root each with their own texture, leaf and flower sharing
+    // one, and a second plant with an untextured bark, a petal texture and an id past the
+    // designs; the two plants share the leaf texture.
+    let mut textured = tree_with_organs();
+    let textures = [Some(0), Some(3), Some(3), Some(1)];
+    for (m, t) in textured.materials.iter_mut().zip(textures) {
+        m.texture = t;
+    }
+    let textured = mesh(&textured);
+    let mut other = common::binary_tree(2, 3);
+    other.materials[1].texture = Some(3);
+    other.materials[2].texture = Some(16);
+    let other = mesh(&other);
+    assert!(other.materials[0].texture.is_none());
+    let mut second = SceneNode::new("other", &other);
+    second.translation = Vec3::new(2.0, 0.0, 0.0);
+    write(
+        "textured.glb",
+        &Scene {
+            nodes: vec![SceneNode::new("textured", &textured), second],
+        },
+    );
+
+    // Past 65 535 vertices: 32-bit indices.    // Past 65 535 vertices: 32-bit indices.
     let big = mesh(&common::binary_tree(8, 12));
     assert!(big.vertex_count() > 65_535, "{}", big.vertex_count());
     write("big.glb", &Scene::single(SceneNode::new("big", &big)));

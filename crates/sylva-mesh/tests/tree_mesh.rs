@@ -18,6 +18,12 @@ fn bench_tree_is_big_valid_and_deterministic() {
         mesh.triangle_count()
     );
     assert!(mesh.positions.iter().flatten().all(|c| c.is_finite()));
+    assert_eq!(mesh.uvs.len(), mesh.vertex_count());
+    assert!(
+        mesh.uvs
+            .iter()
+            .all(|uv| (0.0..=1.0).contains(&uv[0]) && uv[1].is_finite() && uv[1] >= 0.0)
+    );
     for n in &mesh.normals {
         let len = Vec3::from_array(*n).length();
         assert!((len - 1.0).abs() < 1e-4, "normal of length {len}");

@@ -3,11 +3,21 @@
 //! Layout: one glTF node per scene node, all at the root of one scene; one glTF mesh per
 //! distinct [`Mesh`] (nodes that borrow the same mesh, compared by address, share it); one
 //! primitive per [`Primitive`](crate::Primitive), all sharing the mesh's POSITION and NORMAL
-//! accessors. Indices are `u16` when the mesh has at most 65 535 vertices (65 535 itself is
+//! accessors. Primitives whose material has a texture also share a TEXCOORD_0 accessor
+//! (`(0, 0)` throughout for a mesh without `uvs`); the others have none, since the validator
+//! reports texture coordinates no material reads as unused, and a mesh without textured
+//! materials gets no TEXCOORD_0 at all. Indices are `u16` when the mesh has at most 65 535 vertices (65 535 itself is
 //! the primitive-restart value glTF forbids), `u32` otherwise. Materials are metallic-roughness
 //! with the plant colour as base colour, not metallic and rough (0.9); identical materials
 //! are written once. They are not `doubleSided`: leaves and petals already carry a back face,
 //! and a double-sided material would draw both coincident faces from either side.
+//!
+//! A material with a texture id also gets `baseColorTexture`: each distinct id used is one
+//! PNG ([`crate::texture`]) embedded in its own buffer view (no `target`), an `image` named
+//! `sylva-texture-<id>` (which [`crate::import`] reads back as the id), and a `texture`
+//! with a sampler that repeats in u, and in v for bark or clamps to the edge for leaves and
+//! petals, with trilinear filtering. The colour stays in `baseColorFactor`, which glTF
+//! multiplies with the texture.
 //!
 //! Each buffer view holds one tightly packed accessor (no `byteStride`), starts on a 4-byte
 //! boundary and has its `target` set. The JSON chunk is padded with spaces and the BIN chunk
@@ -32,6 +42,12 @@ const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
+const LINEAR: u32 = 9729;
+const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+const REPEAT: u32 = 10497;
+const CLAMP_TO_EDGE: u32 = 33071;
+/// The prefix of the glTF image names that carry a Sylva texture id.
+pub(crate) const IMAGE_NAME_PREFIX: &str = "sylva-texture-";
 /// Most vertices that `u16` indices can address (65 535 is reserved for primitive restart).
 const U16_VERTICES: usize = 65_535;
 /// Roughness of every material: plants are matte.
@@ -50,7 +66,7 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         let mesh = match mesh_of.get(&key) {
             Some(&m) => m,
             None => {
-                let m = w.mesh(node.mesh, &node.name);
+                let m = w.mesh(node.mesh, &node.name)?;
                 mesh_of.insert(key, m);
                 m
             }
@@ -97,6 +113,9 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         ("nodes", nodes),
         ("meshes", w.meshes),
         ("materials", w.materials),
+        ("textures", w.textures),
+        ("images", w.images),
+        ("samplers", w.samplers),
         ("accessors", w.accessors),
         ("bufferViews", w.views),
         (
@@ -147,21 +166,28 @@ struct Writer {
     accessors: Vec<Value>,
     meshes: Vec<Value>,
     materials: Vec<Value>,
-    /// (name, colour bits) to material index, to write identical materials once.
-    material_of: HashMap<(String, [u32; 3]), usize>,
+    textures: Vec<Value>,
+    images: Vec<Value>,
+    samplers: Vec<Value>,
+    /// (name, colour bits, texture) to material index, to write identical materials once.
+    material_of: HashMap<(String, [u32; 3], Option<u16>), usize>,
+    /// Texture id to glTF texture index, to embed each picture once.
+    texture_of: HashMap<u16, usize>,
+    /// The sampler for textures that repeat along v ([0]) and that clamp ([1]), once written.
+    sampler_of: [Option<usize>; 2],
 }
 
 impl Writer {
     /// Writes a mesh's data and returns its glTF mesh index; `None` when it has no triangles.
-    fn mesh(&mut self, mesh: &Mesh, name: &str) -> Option<usize> {
+    fn mesh(&mut self, mesh: &Mesh, name: &str) -> Result<Option<usize>, ExportError> {
         if mesh.primitives.iter().all(|p| p.indices.is_empty()) {
-            return None;
+            return Ok(None);
         }
         let count = mesh.positions.len();
         let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         let start = self.bin.len();
         let index_count: usize = mesh.primitives.iter().map(|p| p.indices.len() + 2).sum();
-        self.bin.reserve(24 * count + 4 * index_count);
+        self.bin.reserve(32 * count + 4 * index_count);
         for p in &mesh.positions {
             let p = Vec3::from_array(*p);
             (min, max) = (min.min(p), max.max(p));
@@ -182,6 +208,28 @@ impl Writer {
         let normal = self.accessor(json!({
             "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
         }));
+        let textured = |p: &crate::Primitive| {
+            !p.indices.is_empty() && mesh.materials[p.material].texture.is_some()
+        };
+        let texcoord = if mesh.primitives.iter().any(textured) {
+            let start = self.bin.len();
+            if mesh.uvs.len() == count {
+                for uv in &mesh.uvs {
+                    for c in uv {
+                        self.bin.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
+            } else {
+                // check_scene allows only one per position or none.
+                self.bin.resize(start + 8 * count, 0);
+            }
+            let view = self.view(start, ARRAY_BUFFER);
+            Some(self.accessor(json!({
+                "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC2",
+            })))
+        } else {
+            None
+        };
 
         let wide = count > U16_VERTICES;
         let mut primitives = Vec::new();
@@ -205,26 +253,79 @@ impl Writer {
                 "count": p.indices.len(),
                 "type": "SCALAR",
             }));
-            let material = self.material(&mesh.materials[p.material]);
+            let material = self.material(&mesh.materials[p.material])?;
+            let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
+            if let (Some(t), true) = (texcoord, textured(p)) {
+                attributes["TEXCOORD_0"] = json!(t);
+            }
             primitives.push(json!({
-                "attributes": { "POSITION": position, "NORMAL": normal },
+                "attributes": attributes,
                 "indices": indices,
                 "material": material,
             }));
         }
         self.meshes
             .push(json!({ "name": name, "primitives": primitives }));
-        Some(self.meshes.len() - 1)
+        Ok(Some(self.meshes.len() - 1))
     }
 
     /// A buffer view over `bin[start..]`, which starts on a 4-byte boundary.
     fn view(&mut self, start: usize, target: u32) -> usize {
+        let view = self.untargeted_view(start);
+        self.views[view]["target"] = json!(target);
+        view
+    }
+
+    /// A buffer view without a target (for image data), over `bin[start..]`.
+    fn untargeted_view(&mut self, start: usize) -> usize {
         debug_assert_eq!(start % 4, 0);
         let length = self.bin.len() - start;
         self.views.push(json!({
-            "buffer": 0, "byteOffset": start, "byteLength": length, "target": target,
+            "buffer": 0, "byteOffset": start, "byteLength": length,
         }));
         self.views.len() - 1
+    }
+
+    /// The glTF texture showing Sylva texture `id`, embedding its PNG the first time.
+    fn texture(&mut self, id: u16) -> Result<usize, ExportError> {
+        if let Some(&t) = self.texture_of.get(&id) {
+            return Ok(t);
+        }
+        let texture = crate::texture::texture(id);
+        let png = texture
+            .png()
+            .map_err(|source| ExportError::Png { id, source })?;
+        let start = self.bin.len();
+        self.bin.extend_from_slice(&png);
+        let view = self.untargeted_view(start);
+        pad4(&mut self.bin, 0);
+        self.images.push(json!({
+            "bufferView": view,
+            "mimeType": "image/png",
+            "name": format!("{IMAGE_NAME_PREFIX}{id}"),
+        }));
+        let repeats = texture.info().family.repeats_v();
+        let slot = usize::from(!repeats);
+        let sampler = match self.sampler_of[slot] {
+            Some(s) => s,
+            None => {
+                self.samplers.push(json!({
+                    "magFilter": LINEAR,
+                    "minFilter": LINEAR_MIPMAP_LINEAR,
+                    "wrapS": REPEAT,
+                    "wrapT": if repeats { REPEAT } else { CLAMP_TO_EDGE },
+                }));
+                self.sampler_of[slot] = Some(self.samplers.len() - 1);
+                self.samplers.len() - 1
+            }
+        };
+        self.textures.push(json!({
+            "name": texture.info().name,
+            "sampler": sampler,
+            "source": self.images.len() - 1,
+        }));
+        self.texture_of.insert(id, self.textures.len() - 1);
+        Ok(self.textures.len() - 1)
     }
 
     fn accessor(&mut self, accessor: Value) -> usize {
@@ -232,22 +333,26 @@ impl Writer {
         self.accessors.len() - 1
     }
 
-    fn material(&mut self, m: &sylva_core::Material) -> usize {
-        let key = (m.name.clone(), m.color.map(f32::to_bits));
+    fn material(&mut self, m: &sylva_core::Material) -> Result<usize, ExportError> {
+        let key = (m.name.clone(), m.color.map(f32::to_bits), m.texture);
         if let Some(&i) = self.material_of.get(&key) {
-            return i;
+            return Ok(i);
         }
         let [r, g, b] = m.color.map(|c| short(c.clamp(0.0, 1.0)));
+        let mut pbr = json!({
+            "baseColorFactor": [r, g, b, 1.0],
+            "metallicFactor": 0.0,
+            "roughnessFactor": ROUGHNESS,
+        });
+        if let Some(id) = m.texture {
+            pbr["baseColorTexture"] = json!({ "index": self.texture(id)? });
+        }
         self.materials.push(json!({
             "name": m.name,
-            "pbrMetallicRoughness": {
-                "baseColorFactor": [r, g, b, 1.0],
-                "metallicFactor": 0.0,
-                "roughnessFactor": ROUGHNESS,
-            },
+            "pbrMetallicRoughness": pbr,
         }));
         self.material_of.insert(key, self.materials.len() - 1);
-        self.materials.len() - 1
+        Ok(self.materials.len() - 1)
     }
 }
 
@@ -330,6 +435,11 @@ mod tests {
             mesh.primitives.len()
         );
         assert_eq!(json["accessors"][2]["componentType"], UNSIGNED_SHORT);
+        // Untextured: no texture coordinates, images or samplers.
+        for p in json["meshes"][0]["primitives"].as_array().unwrap() {
+            assert!(p["attributes"].get("TEXCOORD_0").is_none());
+        }
+        assert!(json.get("images").is_none() && json.get("samplers").is_none());
         let pos = &json["accessors"][0];
         let b = mesh.bounds();
         assert_eq!(pos["min"], json!(b.min.to_array()));
@@ -406,6 +516,76 @@ mod tests {
         });
         let (json, _) = chunks(&to_glb(&Scene::single(SceneNode::new("w", &mesh))).unwrap());
         assert_eq!(json["accessors"][2]["componentType"], UNSIGNED_INT);
+    }
+
+    #[test]
+    fn textures_are_embedded_once_per_id() {
+        let mut mesh = small_mesh();
+        // bark: texture 0; leaf: 3; flower: 3 too (shared); plus an untextured material.
+        mesh.materials[0].texture = Some(0);
+        mesh.materials[1].texture = Some(3);
+        mesh.materials[2].texture = Some(3);
+        let glb = to_glb(&Scene::single(SceneNode::new("t", &mesh))).unwrap();
+        let (json, bin) = chunks(&glb);
+        let bin = bin.unwrap();
+        // Every primitive is textured: all read the one TEXCOORD_0 accessor.
+        assert_eq!(json["accessors"][2]["type"], "VEC2");
+        for p in json["meshes"][0]["primitives"].as_array().unwrap() {
+            assert_eq!(p["attributes"]["TEXCOORD_0"], 2);
+        }
+        let images = json["images"].as_array().unwrap();
+        assert_eq!(images.len(), 2);
+        assert_eq!(images[0]["name"], "sylva-texture-0");
+        assert_eq!(images[1]["name"], "sylva-texture-3");
+        for image in images {
+            assert_eq!(image["mimeType"], "image/png");
+            let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
+            assert!(view.get("target").is_none(), "image views have no target");
+            let start = view["byteOffset"].as_u64().unwrap() as usize;
+            let len = view["byteLength"].as_u64().unwrap() as usize;
+            assert_eq!(start % 4, 0);
+            let png = &bin[start..start + len];
+            assert!(png.starts_with(b"\x89PNG"));
+            let id: u16 = image["name"].as_str().unwrap()[IMAGE_NAME_PREFIX.len()..]
+                .parse()
+                .unwrap();
+            assert_eq!(png, crate::texture::texture(id).png().unwrap());
+        }
+        // Bark repeats both ways; the leaf texture is clamped along v.
+        let samplers = json["samplers"].as_array().unwrap();
+        assert_eq!(samplers.len(), 2);
+        assert_eq!(samplers[0]["wrapT"], REPEAT);
+        assert_eq!(samplers[1]["wrapT"], CLAMP_TO_EDGE);
+        let textures = json["textures"].as_array().unwrap();
+        assert_eq!(textures.len(), 2);
+        assert_eq!(textures[1]["sampler"], 1);
+        let materials = json["materials"].as_array().unwrap();
+        let texture_of =
+            |m: &Value| m["pbrMetallicRoughness"]["baseColorTexture"]["index"].as_u64();
+        assert_eq!(texture_of(&materials[0]), Some(0));
+        assert_eq!(texture_of(&materials[1]), Some(1));
+        assert_eq!(texture_of(&materials[2]), Some(1));
+        // The colour is still the factor.
+        let c = mesh.materials[1].color;
+        assert_eq!(
+            materials[1]["pbrMetallicRoughness"]["baseColorFactor"][1],
+            json!(short(c[1]))
+        );
+
+        // Same material name and colour but no texture: a separate, untextured material.
+        let mut plain = mesh.clone();
+        plain.materials[1].texture = None;
+        let scene = Scene {
+            nodes: vec![SceneNode::new("t", &mesh), SceneNode::new("p", &plain)],
+        };
+        let (json, _) = chunks(&to_glb(&scene).unwrap());
+        let materials = json["materials"].as_array().unwrap();
+        assert_eq!(materials.len(), 4);
+        assert!(texture_of(&materials[3]).is_none());
+        let leaf = &json["meshes"][1]["primitives"][1];
+        assert!(leaf["attributes"].get("TEXCOORD_0").is_none());
+        assert!(json["meshes"][1]["primitives"][0]["attributes"]["TEXCOORD_0"].is_u64());
+        assert_eq!(json["images"].as_array().unwrap().len(), 2);
     }
 
     #[test]

@@ -4,9 +4,15 @@
 //!   [`Mesh`] (nodes borrowing the same mesh share it), the node's extras kept as glTF
 //!   `extras`. Checked by the Khronos validator in the tests.
 //! - [`to_obj`]: world-space vertices, one object per node, one `usemtl` per primitive.
-//! - [`to_vrml`]: one `Transform` per node, one `Shape` per primitive.
+//! - [`to_vrml`] / [`to_vrml_with_textures`]: one `Transform` per node, one `Shape` per
+//!   primitive.
 //! - [`write_scene`]: picks the format from the file extension ([`Format::from_path`]) and
 //!   writes atomically, so a reader never sees half a file.
+//!
+//! Textures ([`crate::texture`]): a GLB embeds the PNG of each texture id its materials use.
+//! OBJ and VRML97 refer to PNG files next to the model, named `<stem>_tex<id>.png` after the
+//! model's file stem (made a single word, see [`texture_files`]); [`write_scene`] writes them
+//! before the files that name them.
 //!
 //! Every exporter is deterministic: the same scene gives the same bytes.
 //!
@@ -32,9 +38,10 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+pub(crate) use glb::IMAGE_NAME_PREFIX;
 pub use glb::to_glb;
 pub use obj::to_obj;
-pub use vrml::to_vrml;
+pub use vrml::{DEFAULT_TEXTURE_STEM, to_vrml, to_vrml_with_textures};
 
 use crate::mesh::Mesh;
 use crate::scene::Scene;
@@ -86,6 +93,25 @@ pub enum ExportError {
         positions: usize,
         /// Normals in its mesh.
         normals: usize,
+    },
+    /// A mesh has texture coordinates, but not one per position.
+    #[error("node {node}: {positions} positions but {uvs} texture coordinates")]
+    UvCount {
+        /// The scene node.
+        node: usize,
+        /// Positions in its mesh.
+        positions: usize,
+        /// Texture coordinates in its mesh.
+        uvs: usize,
+    },
+    /// A texture could not be encoded as PNG.
+    #[error("cannot encode texture {id} as PNG: {source}")]
+    Png {
+        /// The texture id.
+        id: u16,
+        /// What went wrong.
+        #[source]
+        source: image::ImageError,
     },
     /// A primitive's index count is not a multiple of three.
     #[error("node {node}, primitive {primitive}: {len} indices is not whole triangles")]
@@ -173,9 +199,11 @@ impl Format {
 }
 
 /// Writes `scene` to `path` in the format its extension names, atomically. An OBJ also gets
-/// its MTL file next to it, with the same stem (written first, so the OBJ never refers to a
-/// missing MTL). The scene is checked first ([`check_scene`]), so no malformed file is
-/// written.
+/// its MTL file next to it, named after the OBJ's stem made a single word (spaces become
+/// `_`, as in the OBJ's `mtllib` line); OBJ and VRML97 files also get the PNGs of the
+/// textures their materials use ([`texture_files`]). These are written first, so the model
+/// never refers to a missing file. The scene is checked first ([`check_scene`]), so no
+/// malformed file is written.
 pub fn write_scene(path: &Path, scene: &Scene) -> Result<(), ExportError> {
     let format = Format::from_path(path)?;
     check_scene(scene)?;
@@ -185,24 +213,68 @@ pub fn write_scene(path: &Path, scene: &Scene) -> Result<(), ExportError> {
             source,
         })
     };
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned());
+    let sibling = |name: &str| path.with_file_name(name);
+    let write_textures = || -> Result<(), ExportError> {
+        for (name, png) in texture_files(scene, &stem)? {
+            write(&sibling(&name), &png)?;
+        }
+        Ok(())
+    };
     match format {
         Format::Glb => write(path, &to_glb(scene)?),
-        Format::Vrml => write(path, to_vrml(scene).as_bytes()),
+        Format::Vrml => {
+            write_textures()?;
+            write(path, to_vrml_with_textures(scene, &stem).as_bytes())
+        }
         Format::Obj => {
-            let mtl_path = path.with_extension("mtl");
-            let mtl_name = mtl_path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "scene.mtl".to_owned());
+            let mtl_name = format!("{}.mtl", stem.replace(char::is_whitespace, "_"));
             let (obj, mtl) = to_obj(scene, &mtl_name);
-            write(&mtl_path, mtl.as_bytes())?;
+            write_textures()?;
+            write(&sibling(&mtl_name), mtl.as_bytes())?;
             write(path, obj.as_bytes())
         }
     }
 }
 
-/// Checks that every node can be exported faithfully: finite transforms, positions, normals
-/// and colours; as many normals as positions; whole triangles; indices and materials in range.
+/// The PNG files OBJ and VRML97 exports of `scene` refer to: one `(file name, PNG bytes)`
+/// per texture id that a material of a primitive with triangles uses, in id order. Files
+/// are named `<stem>_tex<id>.png` with `stem` made a single word as OBJ and VRML names are
+/// (letters, digits, `_` and `-` kept, anything else `_`), which is how [`to_obj`] (from its
+/// MTL file's stem) and [`to_vrml_with_textures`] name them.
+pub fn texture_files(scene: &Scene, stem: &str) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
+    let stem = token(stem);
+    used_textures(scene)
+        .into_iter()
+        .map(|id| {
+            let png = crate::texture::texture(id)
+                .png()
+                .map_err(|source| ExportError::Png { id, source })?;
+            Ok((crate::texture::texture_file_name(&stem, id), png))
+        })
+        .collect()
+}
+
+/// Texture ids used by materials of primitives that have triangles, ascending.
+fn used_textures(scene: &Scene) -> std::collections::BTreeSet<u16> {
+    scene
+        .nodes
+        .iter()
+        .flat_map(|n| {
+            n.mesh
+                .primitives
+                .iter()
+                .filter(|p| !p.indices.is_empty())
+                .filter_map(|p| n.mesh.materials.get(p.material)?.texture)
+        })
+        .collect()
+}
+
+/// Checks that every node can be exported faithfully: finite transforms, positions, normals,
+/// texture coordinates and colours; as many normals as positions, and as many texture
+/// coordinates or none; whole triangles; indices and materials in range.
 /// [`to_glb`] and [`write_scene`] call it; [`to_obj`] and [`to_vrml`] instead skip or replace
 /// what is broken, so they never fail.
 pub fn check_scene(scene: &Scene) -> Result<(), ExportError> {
@@ -246,6 +318,19 @@ fn check_mesh(node: usize, mesh: &Mesh) -> Result<(), ExportError> {
         return Err(ExportError::NotFinite {
             node,
             what: "a vertex normal",
+        });
+    }
+    if !mesh.uvs.is_empty() && mesh.uvs.len() != mesh.positions.len() {
+        return Err(ExportError::UvCount {
+            node,
+            positions: mesh.positions.len(),
+            uvs: mesh.uvs.len(),
+        });
+    }
+    if !mesh.uvs.iter().flatten().all(|c| c.is_finite()) {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "a texture coordinate",
         });
     }
     if mesh
@@ -427,6 +512,75 @@ pub(crate) mod tests {
             std::fs::read(dir.path().join("p.glb")).unwrap(),
             to_glb(&scene).unwrap()
         );
+    }
+
+    #[test]
+    fn write_scene_writes_the_textures_obj_and_vrml_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut mesh = small_mesh();
+        mesh.materials[0].texture = Some(2);
+        mesh.materials[1].texture = Some(5);
+        mesh.materials[2].texture = Some(5);
+        let scene = Scene::single(SceneNode::new("plant", &mesh));
+        for name in ["my tree.obj", "p.wrl", "p.glb"] {
+            write_scene(&dir.path().join(name), &scene).unwrap();
+        }
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "my tree.obj",
+                "my_tree.mtl",
+                "my_tree_tex2.png",
+                "my_tree_tex5.png",
+                "p.glb",
+                "p.wrl",
+                "p_tex2.png",
+                "p_tex5.png",
+            ],
+            "one PNG per texture id, named as the files refer to them; no temporary files"
+        );
+        let png = std::fs::read(dir.path().join("p_tex5.png")).unwrap();
+        assert_eq!(png, crate::texture::texture(5).png().unwrap());
+        let obj = std::fs::read_to_string(dir.path().join("my tree.obj")).unwrap();
+        assert!(obj.contains("mtllib my_tree.mtl\n"));
+        let mtl = std::fs::read_to_string(dir.path().join("my_tree.mtl")).unwrap();
+        assert!(mtl.contains("map_Kd my_tree_tex2.png\n"));
+        assert!(mtl.contains("map_Kd -clamp on my_tree_tex5.png\n"));
+        let wrl = std::fs::read_to_string(dir.path().join("p.wrl")).unwrap();
+        assert!(wrl.contains("url \"p_tex2.png\""));
+        assert!(wrl.contains("url \"p_tex5.png\""));
+
+        let files = texture_files(&scene, "a b").unwrap();
+        let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["a_b_tex2.png", "a_b_tex5.png"]);
+        // Untextured scenes need no files.
+        let plain = small_mesh();
+        assert!(
+            texture_files(&Scene::single(SceneNode::new("p", &plain)), "p")
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn texture_coordinates_are_checked() {
+        let mut mesh = small_mesh();
+        mesh.uvs.pop();
+        let e = check_scene(&Scene::single(SceneNode::new("x", &mesh))).unwrap_err();
+        assert!(matches!(e, ExportError::UvCount { .. }), "{e}");
+        let mut mesh = small_mesh();
+        mesh.uvs[2][1] = f32::INFINITY;
+        let e = check_scene(&Scene::single(SceneNode::new("x", &mesh))).unwrap_err();
+        assert!(matches!(e, ExportError::NotFinite { .. }), "{e}");
+        // None at all is fine: exporters write (0, 0).
+        let mut mesh = small_mesh();
+        mesh.uvs.clear();
+        check_scene(&Scene::single(SceneNode::new("x", &mesh))).unwrap();
     }
 
     #[test]

@@ -2,20 +2,27 @@
 //!
 //! OBJ has no instancing and no transforms, so every node's vertices are written already in
 //! world space, under an `o` and a `g` named after the node; indices are 1-based and offset
-//! by the vertices of the nodes before. Normals come in the same order as vertices, so faces
-//! are `f a//a b//b c//c`. Each primitive starts with `usemtl`.
+//! by the vertices of the nodes before. Texture coordinates (`vt`) and normals (`vn`) come in
+//! the same order as vertices, so faces are `f a/a/a b/b/b c/c/c`. OBJ's `v` points up the
+//! picture where the mesh's (glTF's) points down, so `vt` holds `u` and `1 - v`. Each
+//! primitive starts with `usemtl`.
 //!
-//! Materials are written once per distinct (name, colour). When two nodes use one name with
-//! different colours, the later one is renamed `n<node>_<name>` (with a number appended if
-//! that is taken too). Names are made single words (spaces become `_`).
+//! Materials are written once per distinct (name, colour, texture). When two nodes use one
+//! name with different colours or textures, the later one is renamed `n<node>_<name>` (with
+//! a number appended if that is taken too). Names are made single words (spaces become `_`).
+//! A textured material gets `map_Kd <stem>_tex<id>.png`, `stem` being the MTL file's (see
+//! [`super::texture_files`]); MTL multiplies the map by `Kd`, like glTF. Leaf and petal
+//! textures, which do not repeat along `v`, are clamped (`-clamp on`).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
+use std::path::Path;
 
 use sylva_core::glam::Vec3;
 
-use super::{push_vec3, token, valid_triangles};
+use super::{push_float, push_vec3, token, valid_triangles};
 use crate::scene::Scene;
+use crate::texture::{texture_file_name, texture_info};
 
 /// Encodes `scene` as OBJ text and the text of its MTL file, which the OBJ names as
 /// `mtl_file_name` in its `mtllib` line. Never fails: indices out of range are dropped and
@@ -33,9 +40,14 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
         mtl_file_name.replace(char::is_whitespace, "_")
     );
 
-    // Material name -> its colour bits, and (name, colour bits) -> name written.
-    let mut colour_of: HashMap<String, [u32; 3]> = HashMap::new();
-    let mut written: HashMap<(String, [u32; 3]), String> = HashMap::new();
+    let texture_stem = token(
+        &Path::new(mtl_file_name)
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy()),
+    );
+    // Names written, and (name, colour bits, texture) -> name written.
+    let mut taken: HashSet<String> = HashSet::new();
+    let mut written: HashMap<(String, [u32; 3], Option<u16>), String> = HashMap::new();
     let mut offset = 1usize;
     for (index, node) in scene.nodes.iter().enumerate() {
         let mesh = node.mesh;
@@ -45,6 +57,14 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
             obj.push_str("v ");
             let world = node.transform_point(Vec3::from_array(*p));
             push_vec3(&mut obj, world.to_array());
+            obj.push('\n');
+        }
+        for i in 0..mesh.positions.len() {
+            let [u, v] = mesh.uvs.get(i).copied().unwrap_or([0.0, 0.0]);
+            obj.push_str("vt ");
+            push_float(&mut obj, u);
+            obj.push(' ');
+            push_float(&mut obj, 1.0 - v);
             obj.push('\n');
         }
         let rotation = node.rotation.normalize();
@@ -60,14 +80,14 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
                 continue;
             };
             let bits = material.color.map(f32::to_bits);
-            let key = (material.name.clone(), bits);
+            let key = (material.name.clone(), bits, material.texture);
             let mtl_name = match written.get(&key) {
                 Some(n) => n.clone(),
                 None => {
                     let base = token(&material.name);
                     let mut n = base.clone();
                     let mut k = 1;
-                    while colour_of.contains_key(&n) {
+                    while taken.contains(&n) {
                         n = if k == 1 {
                             format!("n{index}_{base}")
                         } else {
@@ -75,16 +95,25 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
                         };
                         k += 1;
                     }
-                    colour_of.insert(n.clone(), bits);
+                    taken.insert(n.clone());
                     written.insert(key, n.clone());
                     write_material(&mut mtl, &n, material.color);
+                    if let Some(id) = material.texture {
+                        let clamp = if texture_info(id).family.repeats_v() {
+                            ""
+                        } else {
+                            "-clamp on "
+                        };
+                        let file = texture_file_name(&texture_stem, id);
+                        let _ = writeln!(mtl, "map_Kd {clamp}{file}");
+                    }
                     n
                 }
             };
             let _ = writeln!(obj, "usemtl {mtl_name}");
             for t in valid_triangles(&p.indices, mesh.positions.len()) {
                 let [a, b, c] = t.map(|i| i as usize + offset);
-                let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
+                let _ = writeln!(obj, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
             }
         }
         offset += mesh.positions.len();
@@ -133,6 +162,7 @@ mod tests {
         let v = mesh.vertex_count();
         assert_eq!(lines(&obj, "v ").len(), 2 * v);
         assert_eq!(lines(&obj, "vn ").len(), 2 * v);
+        assert_eq!(lines(&obj, "vt ").len(), 2 * v);
         assert_eq!(lines(&obj, "f ").len(), 2 * mesh.triangle_count());
         assert_eq!(lines(&obj, "mtllib "), ["mtllib garden.mtl"]);
         assert_eq!(lines(&obj, "o "), ["o first", "o second_plant"]);
@@ -148,16 +178,17 @@ mod tests {
         // Every face index is within the vertices written.
         for f in lines(&obj, "f ") {
             for corner in f[2..].split(' ') {
-                let (a, b) = corner.split_once("//").unwrap();
-                assert_eq!(a, b);
-                let i: usize = a.parse().unwrap();
+                let parts: Vec<&str> = corner.split('/').collect();
+                assert_eq!(parts.len(), 3);
+                assert!(parts[0] == parts[1] && parts[1] == parts[2], "{corner}");
+                let i: usize = parts[0].parse().unwrap();
                 assert!((1..=2 * v).contains(&i));
             }
         }
         // The second node's faces start after the first node's vertices.
         let second = obj.split("o second_plant").nth(1).unwrap();
         let first_face = lines(second, "f ")[0];
-        let i: usize = first_face[2..].split("//").next().unwrap().parse().unwrap();
+        let i: usize = first_face[2..].split('/').next().unwrap().parse().unwrap();
         assert!(i > v);
     }
 
@@ -173,6 +204,39 @@ mod tests {
         assert!(mtl.contains("newmtl bark\n") && mtl.contains("newmtl n1_bark\n"));
         assert!(obj.contains("usemtl n1_bark"));
         assert_eq!(lines(&mtl, "newmtl ").len(), 4);
+    }
+
+    #[test]
+    fn textures_become_map_kd_and_uvs_flip_v() {
+        let mut mesh = small_mesh();
+        mesh.materials[0].texture = Some(1);
+        mesh.materials[2].texture = Some(7);
+        let (obj, mtl) = to_obj(&Scene::single(SceneNode::new("p", &mesh)), "my_tree.mtl");
+        assert_eq!(
+            lines(&mtl, "map_Kd "),
+            [
+                "map_Kd my_tree_tex1.png",
+                "map_Kd -clamp on my_tree_tex7.png"
+            ]
+        );
+        // The map follows its material.
+        let bark = mtl
+            .split("newmtl ")
+            .find(|m| m.starts_with("bark"))
+            .unwrap();
+        assert!(bark.contains("map_Kd my_tree_tex1.png"));
+        let leaf = mtl
+            .split("newmtl ")
+            .find(|m| m.starts_with("leaf"))
+            .unwrap();
+        assert!(!leaf.contains("map_Kd"));
+        let vts = lines(&obj, "vt ");
+        assert_eq!(vts.len(), mesh.vertex_count());
+        for (line, uv) in vts.iter().zip(&mesh.uvs) {
+            let xy: Vec<f32> = line[3..].split(' ').map(|x| x.parse().unwrap()).collect();
+            assert_eq!(xy[0], uv[0]);
+            assert!((xy[1] - (1.0 - uv[1])).abs() < 1e-6);
+        }
     }
 
     #[test]

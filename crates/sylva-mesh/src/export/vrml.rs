@@ -2,11 +2,18 @@
 //!
 //! One `Transform` per node (translation, and rotation as axis and angle), named with `DEF`
 //! after the node; inside it one `Shape` per primitive: an `Appearance` whose `Material` has
-//! the plant colour as `diffuseColor`, and an `IndexedFaceSet` with per-vertex normals,
-//! `solid FALSE` and `ccw TRUE`. A mesh's `Coordinate` and `Normal` nodes are written once,
-//! with `DEF`, the first time it appears, and re-used with `USE` by its other primitives and
-//! by every other node that borrows the same mesh. Numbers are written in the shortest form
-//! that reads back as the same `f32`.
+//! the plant colour as `diffuseColor`, and an `IndexedFaceSet` with per-vertex normals and
+//! texture coordinates, `solid FALSE` and `ccw TRUE`. A mesh's `Coordinate`, `Normal` and
+//! `TextureCoordinate` nodes are written once, with `DEF`, the first time it appears, and
+//! re-used with `USE` by its other primitives and by every other node that borrows the same
+//! mesh. Texture coordinates hold `u` and `1 - v` (VRML's `t` points up the picture); faces
+//! index them like their vertices (no `texCoordIndex`). Numbers are written in the shortest
+//! form that reads back as the same `f32`.
+//!
+//! A textured material's `Appearance` also has `texture ImageTexture { url
+//! "<stem>_tex<id>.png" }` ([`super::texture_files`] gives the files), with `repeatT FALSE`
+//! for leaf and petal textures. The textures are grey, one component, which VRML97
+//! multiplies with `diffuseColor` (an RGB texture would replace it).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -16,10 +23,23 @@ use sylva_core::glam::Vec3;
 use super::{push_float, push_vec3, token, valid_triangles};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::texture::{texture_file_name, texture_info};
 
-/// Encodes `scene` as a VRML97 (`.wrl`) file. Never fails: indices out of range are dropped
-/// and non-finite numbers written as 0 (use [`super::check_scene`] to refuse such scenes).
+/// The stem [`to_vrml`] names texture files after: `scene_tex<id>.png`.
+pub const DEFAULT_TEXTURE_STEM: &str = "scene";
+
+/// Encodes `scene` as a VRML97 (`.wrl`) file whose textures are `scene_tex<id>.png`
+/// ([`DEFAULT_TEXTURE_STEM`]); see [`to_vrml_with_textures`].
 pub fn to_vrml(scene: &Scene) -> String {
+    to_vrml_with_textures(scene, DEFAULT_TEXTURE_STEM)
+}
+
+/// Encodes `scene` as a VRML97 (`.wrl`) file whose materials' textures are the files
+/// `<stem>_tex<id>.png` next to it, as [`super::texture_files`]`(scene, stem)` names them.
+/// Never fails: indices out of range are dropped and non-finite numbers written as 0 (use
+/// [`super::check_scene`] to refuse such scenes).
+pub fn to_vrml_with_textures(scene: &Scene, stem: &str) -> String {
+    let stem = token(stem);
     let vertices: usize = scene.nodes.iter().map(|n| n.mesh.positions.len()).sum();
     let mut out = String::with_capacity(64 * vertices + 256);
     let _ = writeln!(
@@ -48,7 +68,7 @@ pub fn to_vrml(scene: &Scene) -> String {
         out.push(' ');
         push_float(&mut out, angle);
         out.push_str("\n  children [\n");
-        shapes(&mut out, node.mesh, id, fresh);
+        shapes(&mut out, node.mesh, id, fresh, &stem);
         out.push_str("  ]\n}\n");
     }
     out
@@ -56,23 +76,35 @@ pub fn to_vrml(scene: &Scene) -> String {
 
 /// Writes one `Shape` per primitive of `mesh`; the first defines the mesh's coordinates and
 /// normals when `fresh`, every other one uses them.
-fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool) {
+fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool, stem: &str) {
     let count = mesh.positions.len();
     for p in &mesh.primitives {
         let mut triangles = valid_triangles(&p.indices, count).peekable();
         if triangles.peek().is_none() {
             continue;
         }
-        let color = mesh
-            .materials
-            .get(p.material)
+        let material = mesh.materials.get(p.material);
+        let color = material
             .map_or([0.8; 3], |m| m.color)
             .map(|c| c.clamp(0.0, 1.0));
         out.push_str(
             "    Shape {\n      appearance Appearance {\n        material Material { diffuseColor ",
         );
         push_vec3(out, color);
-        out.push_str(" }\n      }\n      geometry IndexedFaceSet {\n");
+        out.push_str(" }\n");
+        if let Some(t) = material.and_then(|m| m.texture) {
+            let repeat = if texture_info(t).family.repeats_v() {
+                ""
+            } else {
+                " repeatT FALSE"
+            };
+            let _ = writeln!(
+                out,
+                "        texture ImageTexture {{ url \"{}\"{repeat} }}",
+                texture_file_name(stem, t)
+            );
+        }
+        out.push_str("      }\n      geometry IndexedFaceSet {\n");
         if fresh {
             let _ = writeln!(out, "        coord DEF M{id}_P Coordinate {{ point [");
             for v in &mesh.positions {
@@ -91,9 +123,25 @@ fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool) {
                 out.push_str(",\n");
             }
             out.push_str("        ] }\n");
+            let _ = writeln!(
+                out,
+                "        texCoord DEF M{id}_T TextureCoordinate {{ point ["
+            );
+            for i in 0..count {
+                let [u, v] = mesh.uvs.get(i).copied().unwrap_or([0.0, 0.0]);
+                out.push_str("          ");
+                push_float(out, u);
+                out.push(' ');
+                push_float(out, 1.0 - v);
+                out.push_str(",\n");
+            }
+            out.push_str("        ] }\n");
             fresh = false;
         } else {
-            let _ = writeln!(out, "        coord USE M{id}_P\n        normal USE M{id}_N");
+            let _ = writeln!(
+                out,
+                "        coord USE M{id}_P\n        normal USE M{id}_N\n        texCoord USE M{id}_T"
+            );
         }
         out.push_str("        coordIndex [\n");
         for [a, b, c] in triangles {
@@ -155,7 +203,16 @@ mod tests {
         assert_eq!(text.matches("Transform {").count(), 3);
         assert_eq!(text.matches("Shape {").count(), 3 * mesh.primitives.len());
         // Two distinct meshes: two DEFs each of coordinates and normals, USEd elsewhere.
-        assert_eq!(text.matches("Coordinate {").count(), 2);
+        assert_eq!(text.matches(" Coordinate {").count(), 2);
+        assert_eq!(text.matches("TextureCoordinate {").count(), 2);
+        assert_eq!(
+            text.matches("texCoord USE M0_T").count(),
+            2 * mesh.primitives.len() - 1
+        );
+        assert!(
+            !text.contains("ImageTexture"),
+            "no textures, no ImageTexture"
+        );
         assert_eq!(
             text.matches("coord USE M0_P").count(),
             2 * mesh.primitives.len() - 1
@@ -168,6 +225,26 @@ mod tests {
             text.matches("solid FALSE").count(),
             3 * mesh.primitives.len()
         );
+    }
+
+    #[test]
+    fn textured_materials_get_an_image_texture() {
+        let mut mesh = small_mesh();
+        mesh.materials[0].texture = Some(2);
+        mesh.materials[1].texture = Some(4);
+        let text = to_vrml_with_textures(&Scene::single(SceneNode::new("p", &mesh)), "oak 1");
+        assert!(balanced(&text));
+        assert!(text.contains("texture ImageTexture { url \"oak_1_tex2.png\" }\n"));
+        assert!(text.contains("texture ImageTexture { url \"oak_1_tex4.png\" repeatT FALSE }"));
+        assert_eq!(text.matches("ImageTexture").count(), 2);
+        // Texture coordinates flip v.
+        let uv = mesh.uvs[1];
+        let first = text.split("TextureCoordinate { point [\n").nth(1).unwrap();
+        let second_line = first.lines().nth(1).unwrap().trim().trim_end_matches(',');
+        let xy: Vec<f32> = second_line.split(' ').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(xy[0], uv[0]);
+        assert!((xy[1] - (1.0 - uv[1])).abs() < 1e-6);
+        assert!(to_vrml(&Scene::single(SceneNode::new("p", &mesh))).contains("scene_tex2.png"));
     }
 
     #[test]

@@ -11,7 +11,10 @@
 //! is drawn from the key light for shadows. A ground disc at y = 0 is drawn first, then
 //! every front-facing triangle, with fixed-point edge functions, a depth buffer and
 //! per-sample Lambert shading from perspective-correct interpolated vertex normals (hemisphere
-//! ambient, shadowed key light from the upper front-left, cool fill). The picture is drawn
+//! ambient, shadowed key light from the upper front-left, cool fill). A material with a
+//! texture id multiplies its colour by that [`texture`](crate::texture), sampled at the
+//! perspective-correct texture coordinates with trilinear filtering; the renderer makes each
+//! texture once and keeps it. The picture is drawn
 //! at `supersample` times the size and box-filtered down in linear light. Invalid input never
 //! panics: vertices that are not finite (or beyond ±1e15 m) drop their triangles, zero-area
 //! and back-facing triangles are skipped, an empty scene gives the ground alone.
@@ -25,8 +28,10 @@
 //! let mesh = Mesh {
 //!     positions: vec![[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, -1.0]],
 //!     normals: vec![[0.0, 1.0, 0.0]; 3],
+//!     uvs: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
 //!     primitives: vec![Primitive { material: 0, indices: vec![0, 1, 2] }],
-//!     materials: vec![Material::of_kind(MaterialKind::Leaf)],
+//!     // Texture 3 is a veined leaf (see sylva_mesh::texture).
+//!     materials: vec![Material { texture: Some(3), ..Material::of_kind(MaterialKind::Leaf) }],
 //! };
 //! let scene = Scene::single(SceneNode::new("leaf", &mesh));
 //! let options = RenderOptions { width: 64, height: 48, view: View::Iso, ..Default::default() };
@@ -41,6 +46,7 @@ mod camera;
 mod raster;
 mod shade;
 mod sheet;
+mod texel;
 mod text;
 
 #[cfg(test)]
@@ -54,12 +60,16 @@ use std::str::FromStr;
 
 use image::RgbImage;
 use serde::{Deserialize, Serialize};
-use sylva_core::{Aabb, glam::Vec3};
+use sylva_core::{
+    Aabb,
+    glam::{Vec2, Vec3},
+};
 
 use crate::scene::{Scene, SceneNode};
 use camera::{Camera, Fit};
 use raster::{Cull, ScreenVert, Tri};
 use shade::{GROUND_SEGMENTS, Ground, Lights, ShadowMap};
+use texel::TextureCache;
 
 pub use sheet::{CAPTION_HEIGHT, SheetCell, SheetOptions, contact_sheet};
 
@@ -288,6 +298,8 @@ struct Vtx {
     p: Vec3,
     /// World unit normal, zero when the mesh has none usable.
     n: Vec3,
+    /// Texture coordinates, zero when the mesh has none.
+    uv: Vec2,
     /// Position in the sample grid.
     s: ScreenVert,
     /// 1 / depth from the eye (the depth buffer holds this: larger is nearer).
@@ -296,7 +308,8 @@ struct Vtx {
     ok: bool,
 }
 
-/// A renderer that keeps its sample, depth and shadow buffers between pictures.
+/// A renderer that keeps its sample, depth and shadow buffers, and the textures it has made,
+/// between pictures.
 #[derive(Default)]
 pub struct Renderer {
     /// Packed sRGB per sample.
@@ -306,6 +319,8 @@ pub struct Renderer {
     shadow: ShadowMap,
     /// One node's vertices.
     verts: Vec<Vtx>,
+    /// Textures made so far, by id.
+    textures: TextureCache,
 }
 
 impl fmt::Debug for Renderer {
@@ -454,6 +469,7 @@ impl Renderer {
             Some(Vtx {
                 p,
                 n: Vec3::Y,
+                uv: Vec2::ZERO,
                 s: ScreenVert::from_samples(x, y)?,
                 iz,
                 ok: true,
@@ -503,6 +519,7 @@ impl Renderer {
             depth,
             shadow,
             verts,
+            textures,
         } = self;
         let mesh = node.mesh;
         verts.clear();
@@ -523,16 +540,19 @@ impl Renderer {
             Vtx {
                 p: world,
                 n,
+                uv: mesh
+                    .uvs
+                    .get(k)
+                    .map_or(Vec2::ZERO, |&uv| Vec2::from_array(uv)),
                 s,
                 iz,
                 ok: true,
             }
         }));
         for prim in &mesh.primitives {
-            let albedo = mesh
-                .materials
-                .get(prim.material)
-                .map_or(Vec3::splat(0.5), |m| shade::albedo(m.color));
+            let material = mesh.materials.get(prim.material);
+            let albedo = material.map_or(Vec3::splat(0.5), |m| shade::albedo(m.color));
+            let texture = material.and_then(|m| m.texture).map(|id| textures.get(id));
             for t in prim.indices.chunks_exact(3) {
                 let Some([a, b, c]) = triangle(verts, t) else {
                     continue;
@@ -557,6 +577,13 @@ impl Renderer {
                 } else {
                     (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO)
                 };
+                // Texture coordinates over depth, and the level of detail from the
+                // triangle's texture area per screen sample.
+                let sampler = texture.map(|tex| {
+                    let uv_area = 0.5 * (b.uv - a.uv).perp_dot(c.uv - a.uv).abs();
+                    let lod = tex.lod(uv_area / tri.sample_area());
+                    (tex, lod, a.uv * a.iz, b.uv * b.iz, c.uv * c.iz)
+                });
                 tri.for_each(|i, l1, l2| {
                     let l0 = 1.0 - l1 - l2;
                     let iz = l0 * a.iz + l1 * b.iz + l2 * c.iz;
@@ -569,6 +596,14 @@ impl Renderer {
                         shadow.lit((la * l0 + lb * l1 + lc * l2) / iz, n)
                     } else {
                         1.0
+                    };
+                    let albedo = match sampler {
+                        // Untextured pictures are exactly what they were before textures.
+                        None => albedo,
+                        Some((tex, lod, ua, ub, uc)) => {
+                            let uv = (ua * l0 + ub * l1 + uc * l2) / iz;
+                            albedo * tex.sample(lod, uv.x, uv.y)
+                        }
                     };
                     color[i] = shade::pack(srgb, albedo * lights.shade(n, lit));
                 });

@@ -154,6 +154,13 @@ impl Tri {
         })
     }
 
+    /// The triangle's area in samples².
+    #[inline]
+    pub(crate) fn sample_area(&self) -> f32 {
+        // inv_area is 1 / (twice the area in sub-sample units²).
+        0.5 / (self.inv_area * SUB * SUB)
+    }
+
     /// Calls `f(index, l1, l2)` for every covered sample, row by row, where `index` is
     /// `y * width + x` and `l1`, `l2` are the weights of (possibly swapped, see
     /// [`Tri::flipped`]) vertices 1 and 2.

@@ -195,7 +195,7 @@ impl Ground {
 /// `x.floor()` as an integer, saturating (and 0 for NaN), without a call into libm: the
 /// baseline x86-64 target has no floor instruction.
 #[inline]
-fn floor_i64(x: f32) -> i64 {
+pub(crate) fn floor_i64(x: f32) -> i64 {
     let t = x as i64;
     if (t as f32) > x {
         t.saturating_sub(1)

@@ -605,3 +605,88 @@ fn tree_pictures() {
     let sheet = contact_sheet(&cells, &opts).unwrap();
     write_png(&dir.join("render-sheet.png"), &sheet).unwrap();
 }
+
+/// Two upright quads side by side facing the camera, both of one colour: the left one
+/// untextured, the right one showing texture `id` once across.
+fn textured_pair(id: u16) -> Mesh {
+    let mut mesh = Mesh {
+        materials: vec![
+            material(MaterialKind::Bark, [0.6, 0.6, 0.6]),
+            sylva_core::Material {
+                texture: Some(id),
+                ..material(MaterialKind::Bark, [0.6, 0.6, 0.6])
+            },
+        ],
+        ..Mesh::default()
+    };
+    add_quad(&mut mesh, 0, Vec3::new(-1.1, 0.0, 0.0), Vec3::X, Vec3::Y);
+    add_quad(&mut mesh, 1, Vec3::new(1.1, 0.0, 0.0), Vec3::X, Vec3::Y);
+    // add_quad's corners run (-u-v, +u-v, +u+v, -u+v); v points down the picture.
+    let corners = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+    mesh.uvs = corners.iter().chain(&corners).copied().collect();
+    mesh
+}
+
+/// Distinct grey levels (red channel) and their spread over the pixels of columns `xs`,
+/// rows `ys`.
+fn variety(img: &RgbImage, xs: std::ops::Range<u32>, ys: std::ops::Range<u32>) -> (usize, u8) {
+    let mut seen = std::collections::BTreeSet::new();
+    for y in ys {
+        for x in xs.clone() {
+            seen.insert(img.get_pixel(x, y)[0]);
+        }
+    }
+    let spread = seen.last().copied().unwrap_or(0) - seen.first().copied().unwrap_or(0);
+    (seen.len(), spread)
+}
+
+#[test]
+fn textures_show_on_textured_materials_only() {
+    let opts = RenderOptions {
+        width: 200,
+        height: 100,
+        ..plain(View::Front)
+    };
+    for id in [0, 3, 8] {
+        let mesh = textured_pair(id);
+        let img = render(&scene(&mesh), &opts).unwrap();
+        // Inside each quad, away from its edges.
+        let (flat, _) = variety(&img, 30..80, 35..65);
+        let (textured, spread) = variety(&img, 120..170, 35..65);
+        assert_eq!(flat, 1, "an untextured flat quad is one colour");
+        assert!(
+            textured > 20 && spread > 40,
+            "texture {id}: {textured} levels, spread {spread}"
+        );
+    }
+}
+
+#[test]
+fn untextured_pictures_ignore_texture_coordinates() {
+    // Texture coordinates alone change nothing: only a material's texture id does.
+    let mut with_uvs = textured_pair(0);
+    with_uvs.materials[1].texture = None;
+    let mut without = with_uvs.clone();
+    without.uvs.clear();
+    let opts = RenderOptions::default();
+    assert_eq!(
+        render(&scene(&with_uvs), &opts).unwrap(),
+        render(&scene(&without), &opts).unwrap()
+    );
+}
+
+#[test]
+fn textures_are_made_once_per_renderer() {
+    let mesh = textured_pair(5);
+    let mut r = Renderer::new();
+    let opts = plain(View::Front);
+    let first = r.render(&scene(&mesh), &opts).unwrap();
+    assert_eq!(r.textures.len(), 1);
+    assert_eq!(r.render(&scene(&mesh), &opts).unwrap(), first);
+    assert_eq!(r.textures.len(), 1);
+    assert_eq!(
+        render(&scene(&mesh), &opts).unwrap(),
+        first,
+        "a fresh renderer agrees"
+    );
+}
