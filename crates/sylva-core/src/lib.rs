@@ -28,6 +28,7 @@
 //! # Ok::<(), sylva_core::PlantError>(())
 //! ```
 
+pub mod environment;
 pub mod hash;
 pub mod io;
 pub mod measures;

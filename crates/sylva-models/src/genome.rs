@@ -7,7 +7,7 @@
 use serde::Deserialize;
 use sylva_core::Plant;
 
-use crate::{DevelopError, automata, bintree};
+use crate::{DevelopError, automata, bintree, lsystem, plantmaker};
 
 /// A genome of any model.
 #[derive(Clone, Debug, PartialEq)]
@@ -16,6 +16,10 @@ pub enum Genome {
     BinTree(bintree::BinTree),
     /// Poncin's GP-programmed turtle automata.
     Automata(Box<automata::AutomataGenome>),
+    /// PlantMaker's branch, fan and inflorescence genome (Gal, Mahal and Sipper).
+    PlantMaker(Box<plantmaker::PlantMaker>),
+    /// Bornhofen and Lattaud's L-system plants grown by their physiology.
+    LSystem(Box<lsystem::LSystemGenome>),
 }
 
 /// Why a genome file was refused; `line` and `column` are 1-based, 0 when unknown.
@@ -55,7 +59,12 @@ struct Header {
     format: u32,
 }
 
-const MODELS: [&str; 2] = [bintree::MODEL, automata::MODEL];
+const MODELS: [&str; 4] = [
+    bintree::MODEL,
+    automata::MODEL,
+    plantmaker::MODEL,
+    lsystem::genome::MODEL,
+];
 
 fn model_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     let name = String::deserialize(d)?;
@@ -88,6 +97,12 @@ impl Genome {
         match header.model.as_str() {
             bintree::MODEL => Ok(Genome::BinTree(serde_json::from_str(text)?)),
             automata::MODEL => Ok(Genome::Automata(Box::new(serde_json::from_str(text)?))),
+            plantmaker::MODEL => Ok(Genome::PlantMaker(Box::new(
+                plantmaker::PlantMaker::from_json(text)?,
+            ))),
+            lsystem::genome::MODEL => Ok(Genome::LSystem(Box::new(
+                lsystem::LSystemGenome::from_json(text)?,
+            ))),
             other => Err(GenomeError {
                 message: format!("unknown model `{other}`"),
                 line: 0,
@@ -101,6 +116,8 @@ impl Genome {
         let mut s = match self {
             Genome::BinTree(g) => serde_json::to_string_pretty(g),
             Genome::Automata(g) => serde_json::to_string_pretty(g),
+            Genome::PlantMaker(g) => return g.to_json(),
+            Genome::LSystem(g) => return g.to_json(),
         }
         .expect("genomes hold only finite numbers and strings");
         s.push('\n');
@@ -112,6 +129,8 @@ impl Genome {
         match self {
             Genome::BinTree(g) => serde_json::to_value(g),
             Genome::Automata(g) => serde_json::to_value(g),
+            Genome::PlantMaker(g) => serde_json::to_value(g),
+            Genome::LSystem(g) => serde_json::to_value(g),
         }
         .expect("genomes hold only finite numbers and strings")
     }
@@ -121,6 +140,8 @@ impl Genome {
         match self {
             Genome::BinTree(_) => bintree::MODEL,
             Genome::Automata(_) => automata::MODEL,
+            Genome::PlantMaker(_) => plantmaker::MODEL,
+            Genome::LSystem(_) => lsystem::genome::MODEL,
         }
     }
 
@@ -129,6 +150,17 @@ impl Genome {
         match self {
             Genome::BinTree(g) => g.develop(seed),
             Genome::Automata(g) => g.develop(seed),
+            Genome::PlantMaker(g) => g.develop(seed),
+            Genome::LSystem(g) => g.develop(seed),
+        }
+    }
+
+    /// The seed a genome grows with when none is given: its own seed for PlantMaker
+    /// genomes (which carry one), 0 for the deterministic models.
+    pub fn default_seed(&self) -> u64 {
+        match self {
+            Genome::PlantMaker(g) => g.seed,
+            _ => 0,
         }
     }
 }

@@ -1,7 +1,5 @@
 //! Sylva's plant models: each turns a genome into a [`Plant`](sylva_core::Plant).
 //!
-//! - [`automata`]: Poncin's GP trees compiled by cellular encoding into turtle automata,
-//!   their simulator and GP operators.
 //! - [`bintree`]: Susinno's recursive binary tree, with its analytic tree measures and the
 //!   bit encoding of its genetic algorithm.
 //! - [`genome`]: genome files of any model ([`Genome`]), with errors that point at the line
@@ -22,6 +20,7 @@ pub mod automata;
 pub mod bintree;
 pub mod genome;
 pub mod lsystem;
+pub mod plantmaker;
 pub mod tag;
 
 pub use genome::{Genome, GenomeError};
@@ -35,4 +34,13 @@ pub enum DevelopError {
     /// The genome could not be serialised for its fingerprint.
     #[error("genome could not be serialised: {0}")]
     Serialize(#[from] serde_json::Error),
+    /// The genome asks for a larger plant than the model allows.
+    #[error("the plant would have more than {limit} parts (segments and organs)")]
+    TooLarge {
+        /// The limit, in segments plus organs.
+        limit: usize,
+    },
+    /// An L-system plant could not grow in its world (bad world or physiology settings).
+    #[error("{0}")]
+    LSystem(#[from] lsystem::garden::GardenError),
 }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use sylva_core::io::write_atomic;
 use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings, Strategy};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
+use sylva_models::Genome;
 
 use crate::assets::{Grown, asset_format, check_png, load_genome};
 use crate::config::{EvolveConfig, ModelName, read_text};
@@ -57,7 +58,11 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
     run.seed = args.seed.unwrap_or(run.seed);
     run.threads = args.threads.unwrap_or(run.threads);
     let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(format!("runs/{}-seed{}", config.model.name(), config.run.seed))
+        PathBuf::from(format!(
+            "runs/{}-seed{}",
+            config.model.name(),
+            config.run.seed
+        ))
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     match config.model {
@@ -273,8 +278,8 @@ pub struct GrowArgs {
     pub output: PathBuf,
     /// Optional picture.
     pub png: Option<PathBuf>,
-    /// Seed of the model's random choices.
-    pub seed: u64,
+    /// Seed of the model's random choices; `None` is the genome's default.
+    pub seed: Option<u64>,
 }
 
 /// `sylva grow`.
@@ -284,7 +289,8 @@ pub fn grow(args: &GrowArgs) -> anyhow::Result<()> {
         check_png(png)?;
     }
     let genome = load_genome(&args.genome)?;
-    let grown = Grown::new(genome, args.seed)?;
+    let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+    let grown = Grown::new(genome, seed)?;
     grown.export(&args.output)?;
     if let Some(png) = &args.png {
         grown.picture(png, View::Iso, (800, 800))?;
@@ -311,8 +317,8 @@ pub struct RenderArgs {
     pub view: View,
     /// Width and height.
     pub size: (u32, u32),
-    /// Seed for genomes.
-    pub seed: u64,
+    /// Seed for genomes; `None` is the genome's default.
+    pub seed: Option<u64>,
 }
 
 /// `sylva render`: a genome is grown and pictured; a GLB is read and pictured as it is.
@@ -339,11 +345,213 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", args.output.display()))?;
     } else {
         let genome = load_genome(&args.file)?;
-        let grown = Grown::new(genome, args.seed)?;
+        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let grown = Grown::new(genome, seed)?;
         grown.picture(&args.output, args.view, args.size)?;
     }
     println!("wrote {}", args.output.display());
     Ok(())
+}
+
+/// Arguments of `sylva garden`.
+#[derive(Clone, Debug)]
+pub struct GardenArgs {
+    /// Genome files, or one garden file.
+    pub inputs: Vec<PathBuf>,
+    /// Plants per genome.
+    pub count: u32,
+    /// Plot width and depth, metres.
+    pub area: (f64, f64),
+    /// Seed of seeds, positions and turns.
+    pub seed: u64,
+    /// Scene to write.
+    pub output: PathBuf,
+    /// Optional picture.
+    pub png: Option<PathBuf>,
+}
+
+/// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
+/// scene (one node per plant, each carrying its genome and seed) and the garden file.
+pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
+    use sylva_models::plantmaker::Garden;
+    asset_format(&args.output)?;
+    if let Some(png) = &args.png {
+        check_png(png)?;
+    }
+    let shown = |p: &Path| p.display().to_string();
+    let first = &args.inputs[0];
+    let text = read_text(first)?;
+    #[derive(Deserialize)]
+    struct Header {
+        model: String,
+    }
+    let is_garden =
+        serde_json::from_str::<Header>(&text).is_ok_and(|h| h.model == "plantmaker-garden");
+    let garden = if is_garden {
+        if args.inputs.len() > 1 {
+            return Err(InputError::new(
+                shown(first),
+                "a garden file is grown on its own; give either one garden file or genome files",
+            )
+            .into());
+        }
+        Garden::from_json(&text)
+            .map_err(|e| InputError::at(first, &text, e.line, e.column, e.message))?
+    } else {
+        let mut garden: Option<Garden> = None;
+        for path in &args.inputs {
+            let genome = match load_genome(path)? {
+                Genome::PlantMaker(g) => *g,
+                other => {
+                    return Err(InputError::new(
+                        shown(path),
+                        format!(
+                            "gardens grow PlantMaker genomes; this is a `{}` genome",
+                            other.model()
+                        ),
+                    )
+                    .into());
+                }
+            };
+            match &mut garden {
+                Some(g) => g.add(genome, args.count as usize),
+                None => {
+                    garden = Some(Garden::new(
+                        genome,
+                        args.count as usize,
+                        [args.area.0, args.area.1],
+                        args.seed,
+                    ))
+                }
+            }
+        }
+        garden.expect("clap requires at least one input")
+    };
+    let grown = garden
+        .grow()
+        .map_err(|e| InputError::new(shown(first), e.to_string()))?;
+    let meshes = grown
+        .plants
+        .iter()
+        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sylva_mesh::mesher::MeshOptions::default()))
+        .collect::<Result<Vec<_>, _>>()
+        .context("meshing the garden")?;
+    let mut scene = sylva_mesh::Scene::default();
+    for ((placement, mesh), i) in grown.placements.iter().zip(&meshes).zip(0..) {
+        let genome = &garden.plants[placement.group].genome;
+        let mut node = sylva_mesh::SceneNode::new(format!("plant-{i}"), mesh);
+        node.translation = placement.translation;
+        node.rotation = placement.rotation();
+        node.extras = Some(serde_json::json!({
+            "genome": serde_json::to_value(genome)?,
+            "seed": placement.seed,
+            "sylva_version": env!("CARGO_PKG_VERSION"),
+        }));
+        scene.nodes.push(node);
+    }
+    sylva_mesh::export::write_scene(&args.output, &scene)
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    if !is_garden {
+        let garden_path = args.output.with_extension("garden.json");
+        write_atomic(&garden_path, garden.to_json().as_bytes())
+            .with_context(|| format!("writing {}", garden_path.display()))?;
+        println!("wrote {}", garden_path.display());
+    }
+    if let Some(png) = &args.png {
+        let options = render::RenderOptions {
+            width: 1200,
+            height: 800,
+            ..render::RenderOptions::default()
+        };
+        let image = render::render(&scene, &options).context("rendering")?;
+        render::write_png(png, &image).with_context(|| format!("writing {}", png.display()))?;
+    }
+    println!(
+        "wrote {}: {} plants, {} triangles",
+        args.output.display(),
+        scene.nodes.len(),
+        scene.triangle_count()
+    );
+    Ok(())
+}
+
+/// `sylva simulate`: runs an L-system experiment and writes its report, per-step records,
+/// the grown garden as a GLB and a picture.
+pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
+    use sylva_models::lsystem::experiments::Simulation;
+    let text = read_text(config)?;
+    let simulation: Simulation = toml::from_str(&text).map_err(|e| match e.span() {
+        Some(span) => InputError::spanned(config, &text, span, e.message().to_owned()),
+        None => InputError::new(config.display().to_string(), e.message().to_owned()),
+    })?;
+    let out = out.map(Path::to_path_buf).unwrap_or_else(|| {
+        let stem = config
+            .file_stem()
+            .map_or("simulation".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("runs").join(stem)
+    });
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let base = config.parent().unwrap_or(Path::new("."));
+    let outcome = simulation
+        .run(base)
+        .map_err(|e| InputError::new(config.display().to_string(), e.to_string()))?;
+    let report = outcome.report();
+    let write = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
+        let path = out.join(name);
+        write_atomic(&path, bytes).with_context(|| format!("writing {}", path.display()))
+    };
+    write("report.txt", report.as_bytes())?;
+    write("records.csv", outcome.csv().as_bytes())?;
+    let meshes = outcome
+        .plants()
+        .iter()
+        .map(|p| {
+            sylva_mesh::mesher::mesh_plant(&p.plant, &sylva_mesh::mesher::MeshOptions::default())
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .context("meshing the plants")?;
+    let mut scene = sylva_mesh::Scene::default();
+    for (placed, mesh) in outcome.plants().iter().zip(&meshes) {
+        let mut node = sylva_mesh::SceneNode::new(placed.label.clone(), mesh);
+        node.translation = placed.position;
+        node.extras = Some(serde_json::json!({
+            "biomass_g": placed.biomass,
+            "sylva_version": env!("CARGO_PKG_VERSION"),
+        }));
+        scene.nodes.push(node);
+    }
+    sylva_mesh::export::write_scene(&out.join("scene.glb"), &scene).context("writing scene.glb")?;
+    let options = render::RenderOptions {
+        width: 1200,
+        height: 800,
+        ..render::RenderOptions::default()
+    };
+    let image = render::render(&scene, &options).context("rendering")?;
+    render::write_png(&out.join("scene.png"), &image).context("writing scene.png")?;
+    print!("{report}");
+    println!(
+        "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",
+        out.display()
+    );
+    Ok(())
+}
+
+/// Parses `WIDTHxDEPTH` in metres, each from 0.1 to 100,000.
+pub fn parse_area(text: &str) -> Result<(f64, f64), String> {
+    let bad = || {
+        format!("expected WIDTHxDEPTH in metres, each from 0.1 to 100000, like 30x20; got {text:?}")
+    };
+    let (w, d) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: f64 = w.trim().parse().map_err(|_| bad())?;
+    let d: f64 = d.trim().parse().map_err(|_| bad())?;
+    if [w, d]
+        .iter()
+        .all(|v| v.is_finite() && (0.1..=100_000.0).contains(v))
+    {
+        Ok((w, d))
+    } else {
+        Err(bad())
+    }
 }
 
 /// Parses `WIDTHxHEIGHT`, each 16 to 8192 pixels.

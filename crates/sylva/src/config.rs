@@ -303,7 +303,10 @@ impl Default for GrowthConfig {
 
 impl GrowthConfig {
     /// The genome file of a program grown with these settings.
-    pub fn genome(&self, program: sylva_models::automata::GpTree) -> sylva_models::automata::AutomataGenome {
+    pub fn genome(
+        &self,
+        program: sylva_models::automata::GpTree,
+    ) -> sylva_models::automata::AutomataGenome {
         let mut g = sylva_models::automata::AutomataGenome::new(program);
         g.iterations = self.iterations;
         g.unit = self.unit;

@@ -31,14 +31,8 @@ fn polyline(
 ) -> Result<(), PlantError> {
     let mut parent = None;
     for pair in points.windows(2) {
-        parent = Some(plant.add_segment(
-            pair[0],
-            pair[1],
-            (radius, radius),
-            parent,
-            false,
-            material,
-        )?);
+        parent =
+            Some(plant.add_segment(pair[0], pair[1], (radius, radius), parent, false, material)?);
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use sylva::commands::{self, EvolveArgs, GrowArgs, RenderArgs};
+use sylva::commands::{self, EvolveArgs, GardenArgs, GrowArgs, RenderArgs};
 use sylva::error::InputError;
 use sylva_mesh::render::View;
 
@@ -59,9 +59,42 @@ enum Command {
         /// Also render a picture.
         #[arg(long)]
         png: Option<PathBuf>,
-        /// Seed for the model's random choices.
-        #[arg(long, default_value_t = 0)]
+        /// Seed for the model's random choices [default: the genome's own seed for
+        /// PlantMaker genomes, 0 otherwise].
+        #[arg(long)]
+        seed: Option<u64>,
+    },
+    /// Plant a garden: many plants of one or more genomes (each with its own seed) placed on
+    /// the ground without overlapping, in one GLB scene. Also writes the garden file
+    /// (`OUT.garden.json`: the genomes and seeds, nothing else), which grows the same scene.
+    Garden {
+        /// PlantMaker genome files, or one garden file (`*.garden.json`).
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Plants per genome.
+        #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        count: u32,
+        /// Plot size in metres, WIDTHxDEPTH, centred on the origin.
+        #[arg(long, default_value = "20x20", value_parser = commands::parse_area)]
+        area: (f64, f64),
+        /// Seed of the plants' seeds, positions and turns.
+        #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Output scene (.glb, .obj or .wrl).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also render a picture.
+        #[arg(long)]
+        png: Option<PathBuf>,
+    },
+    /// Run one of Bornhofen and Lattaud's experiments (an L-system garden in a voxel world
+    /// of light and minerals); writes report.txt, records.csv, scene.glb and scene.png.
+    Simulate {
+        /// Experiment config (`[herbs-under-tree]`, `[lateral-light]` or `[empty-rules]`).
+        config: PathBuf,
+        /// Output directory [default: runs/<config name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Render a genome (.json) or a GLB (.glb) to a PNG picture.
     Render {
@@ -76,9 +109,10 @@ enum Command {
         /// Picture size, WIDTHxHEIGHT.
         #[arg(long, default_value = "800x800", value_parser = commands::parse_size)]
         size: (u32, u32),
-        /// Seed for the model's random choices (genomes only).
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
+        /// Seed for the model's random choices (genomes only) [default: the genome's own
+        /// seed for PlantMaker genomes, 0 otherwise].
+        #[arg(long)]
+        seed: Option<u64>,
     },
 }
 
@@ -117,6 +151,22 @@ fn main() -> ExitCode {
             png,
             seed,
         }),
+        Command::Garden {
+            inputs,
+            count,
+            area,
+            seed,
+            output,
+            png,
+        } => commands::garden(&GardenArgs {
+            inputs,
+            count,
+            area,
+            seed,
+            output,
+            png,
+        }),
+        Command::Simulate { config, out } => commands::simulate(&config, out.as_deref()),
         Command::Render {
             file,
             output,

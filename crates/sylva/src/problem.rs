@@ -158,9 +158,11 @@ impl AutomataProblem {
             max_size: config.max_size,
             ..GpConfig::default()
         };
-        let template = config
-            .growth
-            .genome("(Top (Wait))".parse().expect("a tree that only waits is valid"));
+        let template = config.growth.genome(
+            "(Top (Wait))"
+                .parse()
+                .expect("a tree that only waits is valid"),
+        );
         AutomataProblem {
             gp,
             growth: config.growth.clone(),

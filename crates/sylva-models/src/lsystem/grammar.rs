@@ -215,7 +215,8 @@ impl fmt::Display for Word<'_> {
     }
 }
 
-fn parse_rule(index: usize, line: &str, compartment: Compartment) -> Result<Rule, RuleError> {
+/// Parses rule `index` (0 rewrites `A`) of a compartment, written `A -> successor`.
+pub fn parse_rule(index: usize, line: &str, compartment: Compartment) -> Result<Rule, RuleError> {
     let err = |column: usize, message: String| RuleError {
         rule: index,
         column,
