@@ -461,3 +461,136 @@ fn bad_configs_and_flags_are_refused() {
     assert!(String::from_utf8_lossy(&wrong_ext.stderr).contains("fbx"));
     fs::remove_dir_all(&dir).unwrap();
 }
+
+fn example(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(path)
+}
+
+#[test]
+fn every_example_genome_grows_into_a_valid_glb() {
+    let dir = temp_dir("examples");
+    let mut glbs = Vec::new();
+    for name in [
+        "bintree/oak.json",
+        "automata/helix.json",
+        "plantmaker/fern.json",
+        "plantmaker/palm.json",
+        "plantmaker/flowering-bush.json",
+        "plantmaker/tulip.json",
+        "plantmaker/conifer.json",
+        "lsystem/bush.json",
+        "lsystem/herb.json",
+    ] {
+        let glb = dir.join(name.replace('/', "-").replace(".json", ".glb"));
+        let out = sylva(&["grow", s(&example(name)), "-o", s(&glb)]);
+        ok(&out);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(!stdout.contains(" 0 triangles"), "{name}: {stdout}");
+        glbs.push(glb);
+    }
+    validate(&glbs);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_garden_file_regrows_the_same_scene() {
+    let dir = temp_dir("garden");
+    let forest = dir.join("forest.glb");
+    ok(&sylva(&[
+        "garden",
+        s(&example("plantmaker/conifer.json")),
+        s(&example("plantmaker/fern.json")),
+        "--count",
+        "4",
+        "--area",
+        "20x20",
+        "--seed",
+        "3",
+        "-o",
+        s(&forest),
+    ]));
+    let garden = dir.join("forest.garden.json");
+    let again = dir.join("again.glb");
+    ok(&sylva(&["garden", s(&garden), "-o", s(&again)]));
+    assert_eq!(fs::read(&forest).unwrap(), fs::read(&again).unwrap());
+    validate(&[forest]);
+    // Too many plants for the plot is bad input, not a crash.
+    let crowded = sylva(&[
+        "garden",
+        s(&example("plantmaker/conifer.json")),
+        "--count",
+        "500",
+        "--area",
+        "3x3",
+        "-o",
+        s(&dir.join("crowded.glb")),
+    ]);
+    assert_eq!(crowded.status.code(), Some(2));
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_herbs_under_a_tree_grow_less() {
+    let dir = temp_dir("simulate");
+    let out = sylva(&[
+        "simulate",
+        s(&example("lsystem/herbs-under-tree.toml")),
+        "--out",
+        s(&dir),
+    ]);
+    ok(&out);
+    let report = fs::read_to_string(dir.join("report.txt")).unwrap();
+    let ratio: f64 = report
+        .lines()
+        .find_map(|l| l.strip_prefix("biomass ratio shaded/open: "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(ratio < 0.6, "{report}");
+    assert!(
+        fs::read_to_string(dir.join("records.csv"))
+            .unwrap()
+            .lines()
+            .count()
+            > 10
+    );
+    validate(&[dir.join("scene.glb")]);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn automata_runs_write_their_table_2_columns() {
+    let dir = temp_dir("automata");
+    let config = dir.join("a.toml");
+    let text = fs::read_to_string(example("automata/box-above.toml"))
+        .unwrap()
+        .replace("generations = 100", "generations = 3")
+        .replace("population = 1000", "population = 40")
+        .replace("sheet_size = 24", "sheet_size = 2\nimage_size = 64");
+    fs::write(&config, text).unwrap();
+    let out = dir.join("run");
+    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    let stats = fs::read_to_string(out.join("stats.csv")).unwrap();
+    assert!(
+        stats.starts_with(
+            "generation,best,mean,branches,leaves,forbidden_leaves,f_pos,f_num,f_dist,f_angle,\
+             f_thick,f_grid,f_total,evals_per_s"
+        ),
+        "{stats}"
+    );
+    assert_eq!(stats.lines().count(), 5);
+    validate(&[out.join("best.glb")]);
+    ok(&sylva(&[
+        "grow",
+        s(&out.join("best.json")),
+        "-o",
+        s(&dir.join("regrown.glb")),
+    ]));
+    assert_eq!(
+        fs::read(out.join("best.glb")).unwrap(),
+        fs::read(dir.join("regrown.glb")).unwrap()
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}
