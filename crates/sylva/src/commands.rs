@@ -14,7 +14,10 @@ use sylva_models::Genome;
 use crate::assets::{Grown, asset_format, check_png, load_genome};
 use crate::config::{EvolveConfig, ModelName, read_text};
 use crate::error::InputError;
-use crate::problem::{AutomataProblem, BinTreeProblem, ModelProblem, automata_strategy, strategy};
+use crate::problem::{
+    AutomataProblem, BinTreeProblem, ModelProblem, PlantMakerProblem, automata_strategy,
+    plantmaker_strategy, strategy,
+};
 use crate::report::{fitness_svg, stats_csv};
 
 /// Arguments of `sylva evolve`; `None` keeps the config's value.
@@ -69,7 +72,25 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
         ModelName::BinTree => {
             let problem = BinTreeProblem::new(&config.bintree);
             let strategy = strategy(&config.bintree);
-            evolve_problem(&config, &out, args.resume, problem, strategy)
+            evolve_problem(&config, &out, args.resume, problem, strategy, Vec::new())
+        }
+        ModelName::PlantMaker => {
+            let problem = PlantMakerProblem::new(&config.plantmaker);
+            let strategy = plantmaker_strategy(&config.plantmaker).map_err(|e| {
+                InputError::new(
+                    args.config
+                        .as_ref()
+                        .map_or("config".into(), |p| p.display().to_string()),
+                    format!("[plantmaker.breeding]: {e}"),
+                )
+            })?;
+            let base = args
+                .config
+                .as_ref()
+                .and_then(|p| p.parent())
+                .unwrap_or(Path::new("."));
+            let start = plantmaker_start(&config, base)?;
+            evolve_problem(&config, &out, args.resume, problem, strategy, start)
         }
         ModelName::Automata => {
             let problem = AutomataProblem::new(&config.automata);
@@ -81,9 +102,50 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
                     format!("[automata.breeding]: {e}"),
                 )
             })?;
-            evolve_problem(&config, &out, args.resume, problem, strategy)
+            evolve_problem(&config, &out, args.resume, problem, strategy, Vec::new())
         }
     }
+}
+
+/// The first generation of a PlantMaker run: each start genome, then mutants of them in turn.
+fn plantmaker_start(
+    config: &EvolveConfig,
+    base: &Path,
+) -> anyhow::Result<Vec<sylva_models::plantmaker::PlantMaker>> {
+    use sylva_evolve::Mutate;
+    let pm = &config.plantmaker;
+    let mut chosen = Vec::new();
+    for file in &pm.start {
+        let path = base.join(file);
+        match load_genome(&path)? {
+            Genome::PlantMaker(g) => chosen.push(*g),
+            other => {
+                return Err(InputError::new(
+                    path.display().to_string(),
+                    format!(
+                        "`start` genomes must be PlantMaker genomes, not `{}`",
+                        other.model()
+                    ),
+                )
+                .into());
+            }
+        }
+    }
+    if chosen.is_empty() {
+        return Ok(chosen);
+    }
+    let mutation = sylva_models::plantmaker::Mutation {
+        rate: pm.mutation_rate,
+        spread: pm.mutation_spread,
+    };
+    let mut rng = sylva_evolve::rng::stream(config.run.seed, 0, u32::MAX);
+    let mut start = chosen.clone();
+    while start.len() < config.run.population as usize {
+        let mut g = chosen[start.len() % chosen.len()].clone();
+        mutation.mutate(&mut g, &mut rng);
+        start.push(g);
+    }
+    Ok(start)
 }
 
 /// The parts of a config that must match for a run to resume (everything but the length of
@@ -103,6 +165,7 @@ fn evolve_problem<P, S>(
     resume: bool,
     problem: P,
     strategy: S,
+    start: Vec<P::Genome>,
 ) -> anyhow::Result<()>
 where
     P: ModelProblem + Clone,
@@ -133,7 +196,7 @@ where
             population: config.run.population as usize,
             keep_history: 0,
         };
-        Run::new(problem.clone(), strategy, evaluator, settings)?
+        Run::with_genomes(problem.clone(), strategy, evaluator, settings, start)?
     };
 
     let target = config.run.generations;
@@ -181,7 +244,8 @@ where
     let best = run.best();
     let genome = problem.genome_file(&best.genome);
     write("best.json", genome.to_json().as_bytes())?;
-    let grown = Grown::new(genome, 0)?;
+    let seed = genome.default_seed();
+    let grown = Grown::new(genome, seed)?;
     grown.export(&out.join("best.glb"))?;
     let size = config.output.image_size;
     let guides = match problem.guides() {
@@ -246,7 +310,11 @@ fn population_sheet<P: ModelProblem, S: Strategy<P>>(
     order.truncate(count);
     let grown = order
         .iter()
-        .map(|&i| Grown::new(problem.genome_file(&pop[i].genome), 0))
+        .map(|&i| {
+            let genome = problem.genome_file(&pop[i].genome);
+            let seed = genome.default_seed();
+            Grown::new(genome, seed)
+        })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let cells: Vec<SheetCell> = order
         .iter()

@@ -58,6 +58,9 @@ pub struct EvolveConfig {
     /// Settings of the automata model, its GP and Poncin's fitness.
     #[serde(default)]
     pub automata: AutomataConfig,
+    /// Settings of PlantMaker evolution without a person.
+    #[serde(default)]
+    pub plantmaker: PlantMakerConfig,
     /// What the run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -70,6 +73,7 @@ impl Default for EvolveConfig {
             run: RunConfig::default(),
             bintree: BinTreeConfig::default(),
             automata: AutomataConfig::default(),
+            plantmaker: PlantMakerConfig::default(),
             output: OutputConfig::default(),
         }
     }
@@ -85,6 +89,9 @@ pub enum ModelName {
     /// Poncin's GP-programmed turtle automata.
     #[serde(rename = "automata")]
     Automata,
+    /// PlantMaker genomes (Gal, Mahal and Sipper).
+    #[serde(rename = "plantmaker")]
+    PlantMaker,
 }
 
 impl ModelName {
@@ -93,6 +100,7 @@ impl ModelName {
         match self {
             ModelName::BinTree => "bintree",
             ModelName::Automata => "automata",
+            ModelName::PlantMaker => "plantmaker",
         }
     }
 }
@@ -318,6 +326,68 @@ impl GrowthConfig {
         g.at_end = self.at_end;
         g.limits = self.limits;
         g
+    }
+}
+
+/// PlantMaker evolution without a person: genome sizes, breeding and a fitness from the
+/// shared terms (by default: endpoints on a 1 m sphere centred 1.2 m up, about 30 branch
+/// endpoints, spread; lengths in metres, so `fitness.unit` is 1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlantMakerConfig {
+    /// Branch prototypes per genome, 1 to 32. Default 5.
+    #[serde(deserialize_with = "segment_count")]
+    pub branches: u32,
+    /// Fans per genome, 1 to 32. Default 5.
+    #[serde(deserialize_with = "segment_count")]
+    pub fans: u32,
+    /// Inflorescences per genome, 1 to 32. Default 5.
+    #[serde(deserialize_with = "segment_count")]
+    pub inflorescences: u32,
+    /// Crossover level: low, medium or high. Default medium.
+    pub crossover: sylva_models::plantmaker::Level,
+    /// Probability that a variable changes in a mutation, 0 to 1. Default 0.1.
+    #[serde(deserialize_with = "mutation_rate")]
+    pub mutation_rate: f64,
+    /// Mutation noise as a fraction of a variable's range, 0 to 1. Default 0.15.
+    #[serde(deserialize_with = "mutation_spread")]
+    pub mutation_spread: f64,
+    /// Genome files the first generation starts from, relative to the config file (the
+    /// paper's users start from plants they chose); the rest of it is their mutants. Empty
+    /// (the default): a random first generation.
+    pub start: Vec<std::path::PathBuf>,
+    /// Tournament selection and operator rates.
+    pub breeding: sylva_evolve::GenerationalSettings,
+    /// The fitness (Poncin's terms over the grown plant).
+    pub fitness: sylva_fitness::PoncinFitness,
+}
+
+fn segment_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "segment count", 1, 32)
+}
+sylva_core::ranged_number!(mutation_spread, "mutation_spread", 0.0, 1.0, "");
+
+impl Default for PlantMakerConfig {
+    fn default() -> Self {
+        let mut fitness = sylva_fitness::PoncinFitness {
+            unit: 1.0,
+            ..Default::default()
+        };
+        fitness.target = sylva_fitness::poncin::TargetShape::Sphere {
+            center: sylva_core::glam::DVec3::new(0.0, 1.2, 0.0),
+            radius: 1.0,
+        };
+        PlantMakerConfig {
+            branches: 5,
+            fans: 5,
+            inflorescences: 5,
+            crossover: sylva_models::plantmaker::Level::Medium,
+            mutation_rate: 0.1,
+            mutation_spread: 0.15,
+            start: Vec::new(),
+            breeding: sylva_evolve::GenerationalSettings::default(),
+            fitness,
+        }
     }
 }
 

@@ -14,13 +14,14 @@ use sylva_models::automata::{
     SubtreeMutation,
 };
 
-use crate::config::{AutomataConfig, GrowthConfig};
+use crate::config::{AutomataConfig, GrowthConfig, PlantMakerConfig};
 use crate::guides::{box_wire, ellipsoid_wire, guide_plant};
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
 use sylva_models::Genome;
 use sylva_models::bintree::{BITS, BinTree, Bits};
+use sylva_models::plantmaker::{Mutation as PlantMakerMutation, PlantMaker, PlantMakerCrossover};
 
 use crate::config::{BinTreeConfig, CrossoverKind};
 
@@ -296,6 +297,88 @@ pub fn automata_strategy(
     Generational::new(
         SubtreeCrossover { config: problem.gp },
         SubtreeMutation { config: problem.gp },
+        config.breeding.clone(),
+    )
+}
+
+/// Evolve PlantMaker genomes without a person, towards Poncin's shared terms over the grown
+/// plant (a target shape, a number of endpoints, spread, and a density grid of leaves).
+#[derive(Clone, Debug)]
+pub struct PlantMakerProblem {
+    /// Genome sizes and operators.
+    pub config: PlantMakerConfig,
+}
+
+impl PlantMakerProblem {
+    /// The problem a config describes.
+    pub fn new(config: &PlantMakerConfig) -> Self {
+        PlantMakerProblem {
+            config: config.clone(),
+        }
+    }
+}
+
+impl Problem for PlantMakerProblem {
+    type Genome = PlantMaker;
+
+    fn term_names(&self) -> Vec<String> {
+        PONCIN_TERMS.iter().map(|s| (*s).to_owned()).collect()
+    }
+
+    /// Grows the genome with its own seed; a genome that fails to grow (too large) scores
+    /// the worst fitness.
+    fn evaluate(&self, genome: &PlantMaker) -> Fitness {
+        let Ok(plant) = genome.develop(genome.seed) else {
+            return Fitness::new(0.0, &[]);
+        };
+        SCRATCH.with(|cell| {
+            let ctx = PoncinContext {
+                seed: 0,
+                negative_thickness: 0,
+            };
+            let score = self
+                .config
+                .fitness
+                .score(&plant, ctx, &mut cell.borrow_mut().poncin);
+            Fitness::new(score.adjusted(), &score.terms())
+        })
+    }
+
+    fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> PlantMaker {
+        PlantMaker::random(
+            self.config.branches as usize,
+            self.config.fans as usize,
+            self.config.inflorescences as usize,
+            rng,
+        )
+    }
+}
+
+impl ModelProblem for PlantMakerProblem {
+    fn genome_file(&self, genome: &PlantMaker) -> Genome {
+        Genome::PlantMaker(Box::new(genome.clone()))
+    }
+
+    fn title(&self) -> &'static str {
+        "PlantMaker"
+    }
+}
+
+/// PlantMaker breeding with the configured crossover level and mutation.
+pub type PlantMakerStrategy = Generational<PlantMakerCrossover, PlantMakerMutation>;
+
+/// The breeding a config describes.
+pub fn plantmaker_strategy(
+    config: &PlantMakerConfig,
+) -> Result<PlantMakerStrategy, sylva_evolve::GenerationalError> {
+    Generational::new(
+        PlantMakerCrossover {
+            level: config.crossover,
+        },
+        PlantMakerMutation {
+            rate: config.mutation_rate,
+            spread: config.mutation_spread,
+        },
         config.breeding.clone(),
     )
 }

@@ -594,3 +594,58 @@ fn automata_runs_write_their_table_2_columns() {
     );
     fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn plantmaker_evolves_without_a_person() {
+    let dir = temp_dir("plantmaker-evolve");
+    let config = dir.join("p.toml");
+    let text = fs::read_to_string(example("plantmaker/evolve.toml"))
+        .unwrap()
+        .replace("generations = 30", "generations = 3")
+        .replace("population = 120", "population = 16")
+        .replace(
+            "start = [\"flowering-bush.json\"]",
+            &format!(
+                "start = [{:?}]",
+                example("plantmaker/tulip.json").display().to_string()
+            ),
+        )
+        .replace("sheet_size = 16", "sheet_size = 2\nimage_size = 64");
+    fs::write(&config, text).unwrap();
+    let out = dir.join("run");
+    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    let stats = fs::read_to_string(out.join("stats.csv")).unwrap();
+    assert_eq!(stats.lines().count(), 5);
+    let best: f64 = stats
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let first: f64 = stats
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(best >= first, "elitism keeps the best: {first} then {best}");
+    validate(&[out.join("best.glb")]);
+    // The best genome grows again into the same asset with its own seed.
+    ok(&sylva(&[
+        "grow",
+        s(&out.join("best.json")),
+        "-o",
+        s(&dir.join("again.glb")),
+    ]));
+    assert_eq!(
+        fs::read(out.join("best.glb")).unwrap(),
+        fs::read(dir.join("again.glb")).unwrap()
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}
