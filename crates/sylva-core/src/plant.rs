@@ -345,6 +345,46 @@ impl Plant {
         Ok(())
     }
 
+    /// A copy without the segments and organs whose material is of `kind` (for instance
+    /// roots, to show a plant above ground only). Segments whose parent goes are kept as
+    /// roots of the skeleton; ids are renumbered, parents first as before.
+    pub fn without(&self, kind: MaterialKind) -> Plant {
+        let hidden = |m: MaterialId| {
+            self.materials
+                .get(m.index())
+                .is_some_and(|x| x.kind == kind)
+        };
+        let mut new_id: Vec<Option<SegmentId>> = Vec::with_capacity(self.segments.len());
+        let mut plant = Plant {
+            segments: Vec::new(),
+            organs: Vec::new(),
+            materials: self.materials.clone(),
+            meta: self.meta.clone(),
+        };
+        for s in &self.segments {
+            if hidden(s.material) {
+                new_id.push(None);
+                continue;
+            }
+            let parent = s.parent.and_then(|p| new_id[p.index()]);
+            let mut kept = *s;
+            kept.parent = parent;
+            kept.lateral = s.lateral && parent.is_some();
+            new_id.push(Some(SegmentId(plant.segments.len() as u32)));
+            plant.segments.push(kept);
+        }
+        plant.organs = self
+            .organs
+            .iter()
+            .filter(|o| !hidden(o.material))
+            .map(|o| Organ {
+                parent: o.parent.and_then(|p| new_id[p.index()]),
+                ..*o
+            })
+            .collect();
+        plant
+    }
+
     /// A segment by id.
     #[inline]
     pub fn segment(&self, id: SegmentId) -> &Segment {
@@ -393,6 +433,35 @@ mod tests {
         assert_eq!(p.segment(b).order, 0);
         assert_eq!(p.segment(c).order, 1);
         assert_eq!(p.child_counts(), vec![2, 0, 0]);
+    }
+
+    #[test]
+    fn without_removes_a_kind_and_renumbers() {
+        let mut p = Plant::new(PlantMeta::default());
+        let root = p
+            .add_material(Material::of_kind(MaterialKind::Root))
+            .unwrap();
+        let a = p
+            .add_segment(Vec3::ZERO, -Vec3::Y, (0.1, 0.1), None, false, root)
+            .unwrap();
+        p.add_segment(-Vec3::Y, -Vec3::Y * 2.0, (0.1, 0.1), Some(a), false, root)
+            .unwrap();
+        let b = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        p.add_segment(
+            Vec3::Y,
+            Vec3::Y * 2.0,
+            (0.1, 0.1),
+            Some(b),
+            true,
+            Plant::BARK,
+        )
+        .unwrap();
+        let shoot = p.without(MaterialKind::Root);
+        assert_eq!(shoot.segments.len(), 2);
+        assert_eq!(shoot.segments[1].parent, Some(SegmentId(0)));
+        assert_eq!(p.without(MaterialKind::Leaf), p);
     }
 
     #[test]

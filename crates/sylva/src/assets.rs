@@ -27,9 +27,18 @@ pub struct Grown {
 impl Grown {
     /// Grows and meshes a genome.
     pub fn new(genome: Genome, seed: u64) -> anyhow::Result<Grown> {
-        let plant = genome
+        Self::with_roots(genome, seed, true)
+    }
+
+    /// Grows and meshes a genome, leaving out the roots when `roots` is false (they stay
+    /// out of the exported asset and the pictures).
+    pub fn with_roots(genome: Genome, seed: u64, roots: bool) -> anyhow::Result<Grown> {
+        let mut plant = genome
             .develop(seed)
             .with_context(|| format!("growing the {} genome", genome.model()))?;
+        if !roots {
+            plant = plant.without(sylva_core::MaterialKind::Root);
+        }
         let mesh = mesh_plant(&plant, &MeshOptions::default()).context("meshing the plant")?;
         Ok(Grown {
             genome,

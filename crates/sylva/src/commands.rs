@@ -16,7 +16,7 @@ use crate::config::{EvolveConfig, ModelName, read_text};
 use crate::error::InputError;
 use crate::problem::{
     AutomataProblem, BinTreeProblem, ModelProblem, PlantMakerProblem, automata_strategy,
-    plantmaker_strategy, strategy,
+    lsystem_run, plantmaker_strategy, strategy,
 };
 use crate::report::{fitness_svg, stats_csv};
 
@@ -91,6 +91,38 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
                 .unwrap_or(Path::new("."));
             let start = plantmaker_start(&config, base)?;
             evolve_problem(&config, &out, args.resume, problem, strategy, start)
+        }
+        ModelName::LSystem => {
+            let base = args
+                .config
+                .as_ref()
+                .and_then(|p| p.parent())
+                .unwrap_or(Path::new("."));
+            let start = match &config.lsystem.start {
+                Some(file) => match load_genome(&base.join(file))? {
+                    Genome::LSystem(g) => *g,
+                    other => {
+                        return Err(InputError::new(
+                            base.join(file).display().to_string(),
+                            format!(
+                                "`start` must be an L-system genome, not `{}`",
+                                other.model()
+                            ),
+                        )
+                        .into());
+                    }
+                },
+                None => sylva_models::lsystem::LSystemGenome::empty(),
+            };
+            let (problem, strategy) = lsystem_run(&config.lsystem, start).map_err(|e| {
+                InputError::new(
+                    args.config
+                        .as_ref()
+                        .map_or("config".into(), |p| p.display().to_string()),
+                    format!("[lsystem.breeding]: {e}"),
+                )
+            })?;
+            evolve_problem(&config, &out, args.resume, problem, strategy, Vec::new())
         }
         ModelName::Automata => {
             let problem = AutomataProblem::new(&config.automata);
@@ -348,6 +380,8 @@ pub struct GrowArgs {
     pub png: Option<PathBuf>,
     /// Seed of the model's random choices; `None` is the genome's default.
     pub seed: Option<u64>,
+    /// Leave the roots out.
+    pub hide_roots: bool,
 }
 
 /// `sylva grow`.
@@ -358,7 +392,7 @@ pub fn grow(args: &GrowArgs) -> anyhow::Result<()> {
     }
     let genome = load_genome(&args.genome)?;
     let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-    let grown = Grown::new(genome, seed)?;
+    let grown = Grown::with_roots(genome, seed, !args.hide_roots)?;
     grown.export(&args.output)?;
     if let Some(png) = &args.png {
         grown.picture(png, View::Iso, (800, 800))?;
@@ -387,6 +421,8 @@ pub struct RenderArgs {
     pub size: (u32, u32),
     /// Seed for genomes; `None` is the genome's default.
     pub seed: Option<u64>,
+    /// Leave the roots out (genomes only).
+    pub hide_roots: bool,
 }
 
 /// `sylva render`: a genome is grown and pictured; a GLB is read and pictured as it is.
@@ -414,7 +450,7 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     } else {
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-        let grown = Grown::new(genome, seed)?;
+        let grown = Grown::with_roots(genome, seed, !args.hide_roots)?;
         grown.picture(&args.output, args.view, args.size)?;
     }
     println!("wrote {}", args.output.display());
@@ -599,6 +635,117 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
     print!("{report}");
     println!(
         "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",
+        out.display()
+    );
+    Ok(())
+}
+
+/// `sylva breed`: one round of the paper's design loop.
+pub fn breed(
+    mother: &Path,
+    out: &Path,
+    children: usize,
+    seed: u64,
+    hide_roots: bool,
+) -> anyhow::Result<()> {
+    use sylva_models::lsystem::breed::{BreedSettings, breed_garden};
+    let genome = match load_genome(mother)? {
+        Genome::LSystem(g) => *g,
+        other => {
+            return Err(InputError::new(
+                mother.display().to_string(),
+                format!(
+                    "breeding grows L-system genomes; this is a `{}` genome",
+                    other.model()
+                ),
+            )
+            .into());
+        }
+    };
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let settings = BreedSettings {
+        children,
+        ..BreedSettings::default()
+    };
+    let mut rng = sylva_evolve::rng::seeded(seed);
+    let garden = breed_garden(&genome, &settings, &mut rng)
+        .map_err(|e| InputError::new(mother.display().to_string(), e.to_string()))?;
+    let shown = |p: &sylva_core::Plant| {
+        if hide_roots {
+            p.without(sylva_core::MaterialKind::Root)
+        } else {
+            p.clone()
+        }
+    };
+    let plants: Vec<sylva_core::Plant> = garden.specimens.iter().map(|s| shown(&s.plant)).collect();
+    let meshes = plants
+        .iter()
+        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sylva_mesh::mesher::MeshOptions::default()))
+        .collect::<Result<Vec<_>, _>>()
+        .context("meshing the specimens")?;
+    let mut scene = sylva_mesh::Scene::default();
+    let mut cells = Vec::new();
+    let mut table =
+        String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");
+    for (i, (specimen, mesh)) in garden.specimens.iter().zip(&meshes).enumerate() {
+        let name = if specimen.is_mother {
+            "mother".to_owned()
+        } else {
+            format!("child-{i}")
+        };
+        let file = format!("{name}.json");
+        write_atomic(&out.join(&file), specimen.genome.to_json().as_bytes())
+            .with_context(|| format!("writing {file}"))?;
+        let mut node = sylva_mesh::SceneNode::new(name.clone(), mesh);
+        node.translation =
+            sylva_core::glam::Vec3::new(specimen.position.x, 0.0, specimen.position.y);
+        node.extras = Some(serde_json::json!({
+            "genome": serde_json::to_value(&specimen.genome)?,
+            "seed": seed,
+            "sylva_version": env!("CARGO_PKG_VERSION"),
+        }));
+        scene.nodes.push(node);
+        cells.push(SheetCell {
+            scene: sylva_mesh::Scene::single(sylva_mesh::SceneNode::new(name.clone(), mesh)),
+            caption: format!("{name} {:.2} g", specimen.stats.biomass),
+        });
+        let _ = std::fmt::Write::write_fmt(
+            &mut table,
+            format_args!(
+                "{name},{},{},{},{},{},{},{file}\n",
+                specimen.stats.biomass,
+                specimen.stats.light,
+                specimen.stats.uptake,
+                specimen.stats.modules[0],
+                specimen.stats.modules[2],
+                specimen.stats.germinated()
+            ),
+        );
+    }
+    write_atomic(&out.join("specimens.csv"), table.as_bytes()).context("writing specimens.csv")?;
+    sylva_mesh::export::write_scene(&out.join("garden.glb"), &scene)
+        .context("writing garden.glb")?;
+    let options = render::RenderOptions {
+        width: 1200,
+        height: 800,
+        ..render::RenderOptions::default()
+    };
+    let image = render::render(&scene, &options).context("rendering")?;
+    render::write_png(&out.join("garden.png"), &image).context("writing garden.png")?;
+    let sheet = render::contact_sheet(
+        &cells,
+        &SheetOptions {
+            title: Some(format!("Mother and {} children", cells.len() - 1)),
+            ..SheetOptions::default()
+        },
+    )
+    .context("drawing the specimens")?;
+    render::write_png(&out.join("specimens.png"), &sheet).context("writing specimens.png")?;
+    print!("{table}");
+    println!(
+        "wrote {}/{{garden.glb, garden.png, specimens.png, specimens.csv, mother.json, child-*.json}}; \
+         pick one and breed it: sylva breed {}/child-N.json --out NEXT",
+        out.display(),
         out.display()
     );
     Ok(())

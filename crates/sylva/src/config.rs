@@ -61,6 +61,9 @@ pub struct EvolveConfig {
     /// Settings of PlantMaker evolution without a person.
     #[serde(default)]
     pub plantmaker: PlantMakerConfig,
+    /// Settings of L-system evolution without a person.
+    #[serde(default)]
+    pub lsystem: LSystemConfig,
     /// What the run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -74,6 +77,7 @@ impl Default for EvolveConfig {
             bintree: BinTreeConfig::default(),
             automata: AutomataConfig::default(),
             plantmaker: PlantMakerConfig::default(),
+            lsystem: LSystemConfig::default(),
             output: OutputConfig::default(),
         }
     }
@@ -92,6 +96,9 @@ pub enum ModelName {
     /// PlantMaker genomes (Gal, Mahal and Sipper).
     #[serde(rename = "plantmaker")]
     PlantMaker,
+    /// L-system plants grown by their physiology (Bornhofen and Lattaud).
+    #[serde(rename = "lsystem")]
+    LSystem,
 }
 
 impl ModelName {
@@ -101,6 +108,7 @@ impl ModelName {
             ModelName::BinTree => "bintree",
             ModelName::Automata => "automata",
             ModelName::PlantMaker => "plantmaker",
+            ModelName::LSystem => "lsystem",
         }
     }
 }
@@ -387,6 +395,52 @@ impl Default for PlantMakerConfig {
             start: Vec::new(),
             breeding: sylva_evolve::GenerationalSettings::default(),
             fitness,
+        }
+    }
+}
+
+/// L-system evolution without a person: every genome grows alone in the voxel world and is
+/// scored by its biomass or the light it captured. The paper breeds by mutation alone, so
+/// the default breeding has no crossover.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LSystemConfig {
+    /// Genome the first generation grows out of, relative to the config file. Default:
+    /// empty rules (the paper's start, which does not germinate).
+    pub start: Option<std::path::PathBuf>,
+    /// What to select for: `"biomass"` or `"light"`. Default biomass.
+    pub score: sylva_models::lsystem::breed::Score,
+    /// Rounds of mutation that make a first-generation genome from the start, 0 to 1000.
+    /// Default 10.
+    #[serde(deserialize_with = "random_rounds")]
+    pub random_rounds: u32,
+    /// Mutation probabilities (section 3.3).
+    pub rates: sylva_models::lsystem::mutate::MutationRates,
+    /// World and time each genome grows in.
+    pub grow: sylva_models::lsystem::garden::GrowSettings,
+    /// Tournament selection and operator rates. Default: no crossover, 20% reproduction,
+    /// 80% mutation, elitism 1.
+    pub breeding: sylva_evolve::GenerationalSettings,
+}
+
+fn random_rounds<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    sylva_core::ranged::integer(d, "random_rounds", 0, 1000)
+}
+
+impl Default for LSystemConfig {
+    fn default() -> Self {
+        LSystemConfig {
+            start: None,
+            score: sylva_models::lsystem::breed::Score::Biomass,
+            random_rounds: 10,
+            rates: sylva_models::lsystem::mutate::MutationRates::default(),
+            grow: sylva_models::lsystem::garden::GrowSettings::default(),
+            breeding: sylva_evolve::GenerationalSettings {
+                crossover: 0.0,
+                reproduction: 0.2,
+                mutation: 0.8,
+                ..Default::default()
+            },
         }
     }
 }

@@ -63,6 +63,9 @@ enum Command {
         /// PlantMaker genomes, 0 otherwise].
         #[arg(long)]
         seed: Option<u64>,
+        /// Leave the roots out.
+        #[arg(long)]
+        hide_roots: bool,
     },
     /// Plant a garden: many plants of one or more genomes (each with its own seed) placed on
     /// the ground without overlapping, in one GLB scene. Also writes the garden file
@@ -96,6 +99,25 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Breed L-system plants like Dawkins' biomorphs: grow the mother (in one corner) and her
+    /// mutated children together in one voxel world; writes a picture of the garden and each
+    /// specimen's genome, so you can pick the next mother and breed again.
+    Breed {
+        /// The mother's genome (an L-system genome file).
+        mother: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Children sown with the mother (at most 8: nine specimens in all).
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=8))]
+        children: u32,
+        /// Seed of the mutations.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Leave the roots out of the picture and the GLB.
+        #[arg(long)]
+        hide_roots: bool,
+    },
     /// Render a genome (.json) or a GLB (.glb) to a PNG picture.
     Render {
         /// Genome JSON or GLB.
@@ -113,6 +135,9 @@ enum Command {
         /// seed for PlantMaker genomes, 0 otherwise].
         #[arg(long)]
         seed: Option<u64>,
+        /// Leave the roots out (genomes only).
+        #[arg(long)]
+        hide_roots: bool,
     },
 }
 
@@ -145,11 +170,13 @@ fn main() -> ExitCode {
             output,
             png,
             seed,
+            hide_roots,
         } => commands::grow(&GrowArgs {
             genome,
             output,
             png,
             seed,
+            hide_roots,
         }),
         Command::Garden {
             inputs,
@@ -167,18 +194,27 @@ fn main() -> ExitCode {
             png,
         }),
         Command::Simulate { config, out } => commands::simulate(&config, out.as_deref()),
+        Command::Breed {
+            mother,
+            out,
+            children,
+            seed,
+            hide_roots,
+        } => commands::breed(&mother, &out, children as usize, seed, hide_roots),
         Command::Render {
             file,
             output,
             view,
             size,
             seed,
+            hide_roots,
         } => commands::render(&RenderArgs {
             file,
             output,
             view,
             size,
             seed,
+            hide_roots,
         }),
     };
     match result {

@@ -14,13 +14,15 @@ use sylva_models::automata::{
     SubtreeMutation,
 };
 
-use crate::config::{AutomataConfig, GrowthConfig, PlantMakerConfig};
+use crate::config::{AutomataConfig, GrowthConfig, LSystemConfig, PlantMakerConfig};
 use crate::guides::{box_wire, ellipsoid_wire, guide_plant};
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
 use sylva_models::Genome;
 use sylva_models::bintree::{BITS, BinTree, Bits};
+use sylva_models::lsystem::breed::LSystemProblem;
+use sylva_models::lsystem::{CompartmentCrossover, LSystemGenome, LSystemMutation};
 use sylva_models::plantmaker::{Mutation as PlantMakerMutation, PlantMaker, PlantMakerCrossover};
 
 use crate::config::{BinTreeConfig, CrossoverKind};
@@ -381,4 +383,58 @@ pub fn plantmaker_strategy(
         },
         config.breeding.clone(),
     )
+}
+
+/// Evolve L-system plants without a person ([`LSystemProblem`] grows each alone and scores it).
+#[derive(Clone, Debug)]
+pub struct LSystemRun(pub LSystemProblem);
+
+impl Problem for LSystemRun {
+    type Genome = LSystemGenome;
+
+    fn term_names(&self) -> Vec<String> {
+        self.0.term_names()
+    }
+
+    fn evaluate(&self, genome: &LSystemGenome) -> Fitness {
+        self.0.evaluate(genome)
+    }
+
+    fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> LSystemGenome {
+        self.0.random_genome(rng)
+    }
+}
+
+impl ModelProblem for LSystemRun {
+    fn genome_file(&self, genome: &LSystemGenome) -> Genome {
+        Genome::LSystem(Box::new(genome.clone()))
+    }
+
+    fn title(&self) -> &'static str {
+        "L-system plants (Bornhofen and Lattaud)"
+    }
+}
+
+/// L-system breeding: mutation (and, if asked, compartment crossover).
+pub type LSystemStrategy = Generational<CompartmentCrossover, LSystemMutation>;
+
+/// The problem and breeding an `[lsystem]` config describes; `start` is the first
+/// generation's origin.
+pub fn lsystem_run(
+    config: &LSystemConfig,
+    start: LSystemGenome,
+) -> Result<(LSystemRun, LSystemStrategy), sylva_evolve::GenerationalError> {
+    let mutation = LSystemMutation {
+        rates: config.rates,
+        parameter_scale: 0.0,
+    };
+    let problem = LSystemProblem {
+        grow: config.grow,
+        score: config.score,
+        start,
+        random_rounds: config.random_rounds,
+        mutation,
+    };
+    let strategy = Generational::new(CompartmentCrossover, mutation, config.breeding.clone())?;
+    Ok((LSystemRun(problem), strategy))
 }

@@ -649,3 +649,66 @@ fn plantmaker_evolves_without_a_person() {
     );
     fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn lsystem_plants_breed_and_evolve() {
+    let dir = temp_dir("lsystem");
+    // One round of the design loop: nine specimens, each with its genome file.
+    let round = dir.join("round1");
+    ok(&sylva(&[
+        "breed",
+        s(&example("lsystem/herb.json")),
+        "--out",
+        s(&round),
+        "--hide-roots",
+    ]));
+    let table = fs::read_to_string(round.join("specimens.csv")).unwrap();
+    assert_eq!(table.lines().count(), 10, "{table}");
+    validate(&[round.join("garden.glb")]);
+    // The next round breeds a chosen child.
+    ok(&sylva(&[
+        "breed",
+        s(&round.join("child-3.json")),
+        "--out",
+        s(&dir.join("round2")),
+        "--children",
+        "2",
+    ]));
+    // Hiding roots removes segments.
+    let count = |args: &[&str]| -> usize {
+        let out = sylva(args);
+        ok(&out);
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        text.split(": ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let herb = example("lsystem/herb.json");
+    let glb = dir.join("h.glb");
+    let all = count(&["grow", s(&herb), "-o", s(&glb)]);
+    let shoot = count(&["grow", s(&herb), "-o", s(&glb), "--hide-roots"]);
+    assert!(shoot < all, "{shoot} < {all}");
+    // Evolution without a person, from empty rules, selecting biomass.
+    let config = dir.join("e.toml");
+    let text = fs::read_to_string(example("lsystem/evolve.toml"))
+        .unwrap()
+        .replace("generations = 15", "generations = 2")
+        .replace("population = 24", "population = 6")
+        .replace("sheet_size = 12", "sheet_size = 2")
+        .replace("image_size = 600", "image_size = 64");
+    fs::write(&config, text).unwrap();
+    let out = dir.join("run");
+    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    let stats = fs::read_to_string(out.join("stats.csv")).unwrap();
+    assert!(
+        stats.starts_with("generation,best,mean,biomass,light,uptake"),
+        "{stats}"
+    );
+    validate(&[out.join("best.glb")]);
+    fs::remove_dir_all(&dir).unwrap();
+}

@@ -495,3 +495,34 @@ mod tests {
         assert_eq!(LSystemGenome::from_json(&text).unwrap(), g);
     }
 }
+
+/// Crossover of two L-system plants (Sylva's addition; the paper breeds by mutation alone):
+/// the child takes each compartment's L-system, the angles and the module shapes, each from
+/// either parent with equal odds, and the first parent's physiology. Whole L-systems travel
+/// together, so rules keep the letters they refer to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CompartmentCrossover;
+
+impl sylva_evolve::Crossover<LSystemGenome> for CompartmentCrossover {
+    fn crossover<R: Rng + ?Sized>(
+        &self,
+        a: &LSystemGenome,
+        b: &LSystemGenome,
+        rng: &mut R,
+    ) -> LSystemGenome {
+        let mut child = a.clone();
+        if rng.random_bool(0.5) {
+            child.shoot = b.shoot.clone();
+        }
+        if rng.random_bool(0.5) {
+            child.root = b.root.clone();
+        }
+        if rng.random_bool(0.5) {
+            child.angles = b.angles;
+        }
+        if rng.random_bool(0.5) {
+            child.modules = b.modules;
+        }
+        child
+    }
+}

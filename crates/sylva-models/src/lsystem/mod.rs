@@ -37,4 +37,4 @@ pub mod interpret;
 pub mod mutate;
 pub mod physiology;
 
-pub use genome::{LSystemGenome, LSystemMutation};
+pub use genome::{CompartmentCrossover, LSystemGenome, LSystemMutation};
