@@ -699,6 +699,13 @@ fn lsystem_plants_breed_and_evolve() {
         .unwrap()
         .replace("generations = 15", "generations = 2")
         .replace("population = 24", "population = 6")
+        .replace(
+            "start = \"herb.json\"",
+            &format!(
+                "start = {:?}",
+                example("lsystem/herb.json").display().to_string()
+            ),
+        )
         .replace("sheet_size = 12", "sheet_size = 2")
         .replace("image_size = 600", "image_size = 64");
     fs::write(&config, text).unwrap();
