@@ -95,6 +95,10 @@ pub struct MeshOptions {
     pub radial_segments: u32,
     /// Close each axis's start and tip with a flat cap. Default `true`.
     pub cap_ends: bool,
+    /// Round the caps: the cap's centre is raised by the ring's radius and shaded smoothly,
+    /// so tubes end in domes, as sphylls (cylinders with spherical ends) do. Same vertex and
+    /// triangle counts as flat caps. Default `false`.
+    pub round_caps: bool,
     /// Refuse plants that would need more triangles than this, rather than running out of
     /// memory. Default 50 000 000.
     pub max_triangles: usize,
@@ -111,6 +115,7 @@ impl Default for MeshOptions {
         MeshOptions {
             radial_segments: 12,
             cap_ends: true,
+            round_caps: false,
             max_triangles: 50_000_000,
             leaf_stations: 4,
             flower_petals: 5,
@@ -698,15 +703,28 @@ impl Mesher {
         let center_index = out.positions.len() as u32;
         let Ring { center, pu, pv, .. } = *ring;
         let ring_circle = &self.circle[..self.circle.len() - 1];
-        out.positions.push(center.to_array());
-        out.positions.extend(
-            ring_circle
-                .iter()
-                .map(|&(c, s)| (center + pu * c + pv * s).to_array()),
-        );
         let n = normal.to_array();
-        out.normals
-            .extend(std::iter::repeat_n(n, ring_circle.len() + 1));
+        if self.options.round_caps {
+            // A dome: the centre rises by the radius, and the rim keeps the tube's radial
+            // normals, so shading runs smoothly from the tube over the end.
+            let radius = 0.5 * (pu.length() + pv.length());
+            out.positions.push((center + normal * radius).to_array());
+            out.normals.push(n);
+            for &(c, s) in ring_circle {
+                let radial = pu * c + pv * s;
+                out.positions.push((center + radial).to_array());
+                out.normals.push(radial.normalize_or(normal).to_array());
+            }
+        } else {
+            out.positions.push(center.to_array());
+            out.positions.extend(
+                ring_circle
+                    .iter()
+                    .map(|&(c, s)| (center + pu * c + pv * s).to_array()),
+            );
+            out.normals
+                .extend(std::iter::repeat_n(n, ring_circle.len() + 1));
+        }
         out.uvs.extend_from_slice(&self.cap_uv);
         let pattern = if start {
             &self.start_cap_pattern
@@ -1112,6 +1130,34 @@ mod tests {
             material,
             parent: None,
         }
+    }
+
+    #[test]
+    fn round_caps_are_domes() {
+        let p = chain(&[Vec3::ZERO, Vec3::Y * 2.0], 0.25);
+        let flat = mesh_of(&p);
+        let options = MeshOptions {
+            round_caps: true,
+            ..MeshOptions::default()
+        };
+        let round = Mesher::new(options).unwrap().mesh(&p).unwrap();
+        assert_eq!(round.vertex_count(), flat.vertex_count());
+        assert_eq!(round.triangle_count(), flat.triangle_count());
+        let top = round
+            .positions
+            .iter()
+            .map(|p| p[1])
+            .fold(f32::MIN, f32::max);
+        let bottom = round
+            .positions
+            .iter()
+            .map(|p| p[1])
+            .fold(f32::MAX, f32::min);
+        assert!(
+            (top - 2.25).abs() < 1e-5 && (bottom + 0.25).abs() < 1e-5,
+            "{top} {bottom}"
+        );
+        check_invariants(&round);
     }
 
     #[test]

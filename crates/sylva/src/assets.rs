@@ -39,7 +39,12 @@ impl Grown {
         if !roots {
             plant = plant.without(sylva_core::MaterialKind::Root);
         }
-        let mesh = mesh_plant(&plant, &MeshOptions::default()).context("meshing the plant")?;
+        // L-system modules are sphylls: cylinders with spherical ends.
+        let options = MeshOptions {
+            round_caps: genome.model() == sylva_models::lsystem::genome::MODEL,
+            ..MeshOptions::default()
+        };
+        let mesh = mesh_plant(&plant, &options).context("meshing the plant")?;
         Ok(Grown {
             genome,
             seed,

@@ -606,12 +606,15 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
     };
     write("report.txt", report.as_bytes())?;
     write("records.csv", outcome.csv().as_bytes())?;
+    // L-system modules are sphylls: cylinders with spherical ends.
+    let sphylls = sylva_mesh::mesher::MeshOptions {
+        round_caps: true,
+        ..Default::default()
+    };
     let meshes = outcome
         .plants()
         .iter()
-        .map(|p| {
-            sylva_mesh::mesher::mesh_plant(&p.plant, &sylva_mesh::mesher::MeshOptions::default())
-        })
+        .map(|p| sylva_mesh::mesher::mesh_plant(&p.plant, &sphylls))
         .collect::<Result<Vec<_>, _>>()
         .context("meshing the plants")?;
     let mut scene = sylva_mesh::Scene::default();
@@ -678,9 +681,13 @@ pub fn breed(
         }
     };
     let plants: Vec<sylva_core::Plant> = garden.specimens.iter().map(|s| shown(&s.plant)).collect();
+    let sphylls = sylva_mesh::mesher::MeshOptions {
+        round_caps: true,
+        ..Default::default()
+    };
     let meshes = plants
         .iter()
-        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sylva_mesh::mesher::MeshOptions::default()))
+        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sphylls))
         .collect::<Result<Vec<_>, _>>()
         .context("meshing the specimens")?;
     let mut scene = sylva_mesh::Scene::default();
