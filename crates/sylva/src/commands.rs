@@ -719,17 +719,30 @@ pub fn breed(
         let _ = std::fmt::Write::write_fmt(
             &mut table,
             format_args!(
-                "{name},{},{},{},{},{},{},{file}\n",
+                "{name},{},{},{},{},{},{},{},{file}\n",
                 specimen.stats.biomass,
                 specimen.stats.light,
                 specimen.stats.uptake,
                 specimen.stats.modules[0],
                 specimen.stats.modules[2],
-                specimen.stats.germinated()
+                specimen.stats.germinated(),
+                specimen.stats.bounds.symbols + specimen.stats.bounds.modules
             ),
         );
     }
     write_atomic(&out.join("specimens.csv"), table.as_bytes()).context("writing specimens.csv")?;
+    for (i, specimen) in garden.specimens.iter().enumerate() {
+        let b = specimen.stats.bounds;
+        if b.any() {
+            eprintln!(
+                "note: specimen {i} hit a growth bound from step {}: {} rewrites refused by the \
+                 symbol limit, {} by the module limit",
+                b.first_step.unwrap_or(0),
+                b.symbols,
+                b.modules
+            );
+        }
+    }
     sylva_mesh::export::write_scene(&out.join("garden.glb"), &scene)
         .context("writing garden.glb")?;
     let options = render::RenderOptions {
