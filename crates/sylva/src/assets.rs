@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Context;
 use sylva_core::Plant;
 use sylva_mesh::export::{self, Format};
-use sylva_mesh::mesher::{MeshOptions, mesh_plant};
+use sylva_mesh::mesher::{MeshOptions, Mesher, mesh_plant};
 use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_models::Genome;
@@ -39,12 +39,8 @@ impl Grown {
         if !roots {
             plant = plant.without(sylva_core::MaterialKind::Root);
         }
-        // L-system modules are sphylls: cylinders with spherical ends.
-        let options = MeshOptions {
-            round_caps: genome.model() == sylva_models::lsystem::genome::MODEL,
-            ..MeshOptions::default()
-        };
-        let mesh = mesh_plant(&plant, &options).context("meshing the plant")?;
+        let mesh =
+            mesh_plant(&plant, &mesh_options(genome.model())).context("meshing the plant")?;
         Ok(Grown {
             genome,
             seed,
@@ -55,11 +51,7 @@ impl Grown {
 
     /// What the asset carries to be grown again: genome, seed and Sylva version.
     pub fn extras(&self) -> serde_json::Value {
-        serde_json::json!({
-            "genome": self.genome.to_value(),
-            "seed": self.seed,
-            "sylva_version": env!("CARGO_PKG_VERSION"),
-        })
+        origin_extras(self.genome.to_value(), self.seed)
     }
 
     /// A scene holding this plant at the origin.
@@ -89,29 +81,74 @@ impl Grown {
         size: (u32, u32),
         guides: Option<&Mesh>,
     ) -> anyhow::Result<()> {
-        let options = RenderOptions {
-            width: size.0,
-            height: size.1,
-            view,
-            ..RenderOptions::default()
-        };
         let mut scene = self.scene();
         if let Some(mesh) = guides {
             scene.nodes.push(SceneNode::new("guides", mesh));
         }
-        let image = render::render(&scene, &options).context("rendering")?;
-        render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
+        write_picture(&scene, path, view, size)
     }
+}
+
+/// What every exported plant carries to be grown again: its genome, seed and Sylva version.
+pub fn origin_extras(genome: serde_json::Value, seed: u64) -> serde_json::Value {
+    serde_json::json!({
+        "genome": genome,
+        "seed": seed,
+        "sylva_version": env!("CARGO_PKG_VERSION"),
+    })
+}
+
+/// How plants of a model are meshed: L-system modules are sphylls (cylinders with spherical
+/// ends), so their tubes end in domes; every other model uses the defaults.
+pub fn mesh_options(model: &str) -> MeshOptions {
+    MeshOptions {
+        round_caps: model == sylva_models::lsystem::genome::MODEL,
+        ..MeshOptions::default()
+    }
+}
+
+/// Meshes several plants with one mesher (its buffers are reused).
+pub fn mesh_all<'a>(
+    plants: impl IntoIterator<Item = &'a Plant>,
+    options: &MeshOptions,
+) -> anyhow::Result<Vec<Mesh>> {
+    let mut mesher = Mesher::new(options.clone()).context("mesh options")?;
+    plants
+        .into_iter()
+        .map(|p| mesher.mesh(p).context("meshing a plant"))
+        .collect()
+}
+
+/// Renders a scene and writes it as PNG.
+pub fn write_picture(
+    scene: &Scene,
+    path: &Path,
+    view: View,
+    size: (u32, u32),
+) -> anyhow::Result<()> {
+    let options = RenderOptions {
+        width: size.0,
+        height: size.1,
+        view,
+        ..RenderOptions::default()
+    };
+    let image = render::render(scene, &options).context("rendering")?;
+    render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
 }
 
 /// Reads a genome file; errors point at the line and column.
 pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
     let text = crate::config::read_text(path)?;
-    Genome::from_json(&text).map_err(|e| {
+    genome_from_text(path, &text)
+}
+
+/// Parses a genome file already read from `path`.
+pub fn genome_from_text(path: &Path, text: &str) -> Result<Genome, InputError> {
+    Genome::from_json(text).map_err(|e| {
         if e.line == 0 {
             InputError::new(path.display().to_string(), e.message)
         } else {
-            InputError::at(path, &text, e.line, e.column, e.message)
+            InputError::at(path, text, e.line, e.column, e.message)
         }
     })
 }

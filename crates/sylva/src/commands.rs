@@ -11,7 +11,13 @@ use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings, Strategy};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva_models::Genome;
 
-use crate::assets::{Grown, asset_format, check_png, load_genome};
+use crate::assets::{
+    Grown, asset_format, check_png, genome_from_text, load_genome, mesh_all, mesh_options,
+    origin_extras, write_picture,
+};
+
+/// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
+const SCENE_PICTURE: (u32, u32) = (1200, 800);
 use crate::config::{EvolveConfig, ModelName, read_text};
 use crate::error::InputError;
 use crate::problem::{
@@ -77,12 +83,7 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
         ModelName::PlantMaker => {
             let problem = PlantMakerProblem::new(&config.plantmaker);
             let strategy = plantmaker_strategy(&config.plantmaker).map_err(|e| {
-                InputError::new(
-                    args.config
-                        .as_ref()
-                        .map_or("config".into(), |p| p.display().to_string()),
-                    format!("[plantmaker.breeding]: {e}"),
-                )
+                InputError::new(config_name(args), format!("[plantmaker.breeding]: {e}"))
             })?;
             let base = args
                 .config
@@ -115,24 +116,14 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
                 None => sylva_models::lsystem::LSystemGenome::empty(),
             };
             let (problem, strategy) = lsystem_run(&config.lsystem, start).map_err(|e| {
-                InputError::new(
-                    args.config
-                        .as_ref()
-                        .map_or("config".into(), |p| p.display().to_string()),
-                    format!("[lsystem.breeding]: {e}"),
-                )
+                InputError::new(config_name(args), format!("[lsystem.breeding]: {e}"))
             })?;
             evolve_problem(&config, &out, args.resume, problem, strategy, Vec::new())
         }
         ModelName::Automata => {
             let problem = AutomataProblem::new(&config.automata);
             let strategy = automata_strategy(&problem, &config.automata).map_err(|e| {
-                InputError::new(
-                    args.config
-                        .as_ref()
-                        .map_or("config".into(), |p| p.display().to_string()),
-                    format!("[automata.breeding]: {e}"),
-                )
+                InputError::new(config_name(args), format!("[automata.breeding]: {e}"))
             })?;
             evolve_problem(&config, &out, args.resume, problem, strategy, Vec::new())
         }
@@ -178,6 +169,13 @@ fn plantmaker_start(
         start.push(g);
     }
     Ok(start)
+}
+
+/// How to name the config in an error: its path, or "config" for the built-in one.
+fn config_name(args: &EvolveArgs) -> String {
+    args.config
+        .as_ref()
+        .map_or("config".into(), |p| p.display().to_string())
 }
 
 /// The parts of a config that must match for a run to resume (everything but the length of
@@ -438,15 +436,7 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
             .map_err(|e| InputError::new(&shown, format!("cannot read: {e}")))?;
         let imported = sylva_mesh::import::read_glb(&bytes)
             .map_err(|e| InputError::new(&shown, e.to_string()))?;
-        let options = render::RenderOptions {
-            width: args.size.0,
-            height: args.size.1,
-            view: args.view,
-            ..render::RenderOptions::default()
-        };
-        let image = render::render(&imported.scene(), &options).context("rendering")?;
-        render::write_png(&args.output, &image)
-            .with_context(|| format!("writing {}", args.output.display()))?;
+        write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
@@ -503,8 +493,14 @@ pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
             .map_err(|e| InputError::at(first, &text, e.line, e.column, e.message))?
     } else {
         let mut garden: Option<Garden> = None;
-        for path in &args.inputs {
-            let genome = match load_genome(path)? {
+        for (i, path) in args.inputs.iter().enumerate() {
+            // The first file is already read.
+            let genome = if i == 0 {
+                genome_from_text(path, &text)?
+            } else {
+                load_genome(path)?
+            };
+            let genome = match genome {
                 Genome::PlantMaker(g) => *g,
                 other => {
                     return Err(InputError::new(
@@ -534,23 +530,17 @@ pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
     let grown = garden
         .grow()
         .map_err(|e| InputError::new(shown(first), e.to_string()))?;
-    let meshes = grown
-        .plants
-        .iter()
-        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sylva_mesh::mesher::MeshOptions::default()))
-        .collect::<Result<Vec<_>, _>>()
-        .context("meshing the garden")?;
+    let meshes = mesh_all(
+        &grown.plants,
+        &mesh_options(sylva_models::plantmaker::MODEL),
+    )?;
     let mut scene = sylva_mesh::Scene::default();
     for ((placement, mesh), i) in grown.placements.iter().zip(&meshes).zip(0..) {
         let genome = &garden.plants[placement.group].genome;
         let mut node = sylva_mesh::SceneNode::new(format!("plant-{i}"), mesh);
         node.translation = placement.translation;
         node.rotation = placement.rotation();
-        node.extras = Some(serde_json::json!({
-            "genome": serde_json::to_value(genome)?,
-            "seed": placement.seed,
-            "sylva_version": env!("CARGO_PKG_VERSION"),
-        }));
+        node.extras = Some(origin_extras(serde_json::to_value(genome)?, placement.seed));
         scene.nodes.push(node);
     }
     sylva_mesh::export::write_scene(&args.output, &scene)
@@ -562,13 +552,7 @@ pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
         println!("wrote {}", garden_path.display());
     }
     if let Some(png) = &args.png {
-        let options = render::RenderOptions {
-            width: 1200,
-            height: 800,
-            ..render::RenderOptions::default()
-        };
-        let image = render::render(&scene, &options).context("rendering")?;
-        render::write_png(png, &image).with_context(|| format!("writing {}", png.display()))?;
+        write_picture(&scene, png, View::Iso, SCENE_PICTURE)?;
     }
     println!(
         "wrote {}: {} plants, {} triangles",
@@ -606,17 +590,10 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
     };
     write("report.txt", report.as_bytes())?;
     write("records.csv", outcome.csv().as_bytes())?;
-    // L-system modules are sphylls: cylinders with spherical ends.
-    let sphylls = sylva_mesh::mesher::MeshOptions {
-        round_caps: true,
-        ..Default::default()
-    };
-    let meshes = outcome
-        .plants()
-        .iter()
-        .map(|p| sylva_mesh::mesher::mesh_plant(&p.plant, &sphylls))
-        .collect::<Result<Vec<_>, _>>()
-        .context("meshing the plants")?;
+    let meshes = mesh_all(
+        outcome.plants().iter().map(|p| &p.plant),
+        &mesh_options(sylva_models::lsystem::genome::MODEL),
+    )?;
     let mut scene = sylva_mesh::Scene::default();
     for (placed, mesh) in outcome.plants().iter().zip(&meshes) {
         let mut node = sylva_mesh::SceneNode::new(placed.label.clone(), mesh);
@@ -628,13 +605,7 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
         scene.nodes.push(node);
     }
     sylva_mesh::export::write_scene(&out.join("scene.glb"), &scene).context("writing scene.glb")?;
-    let options = render::RenderOptions {
-        width: 1200,
-        height: 800,
-        ..render::RenderOptions::default()
-    };
-    let image = render::render(&scene, &options).context("rendering")?;
-    render::write_png(&out.join("scene.png"), &image).context("writing scene.png")?;
+    write_picture(&scene, &out.join("scene.png"), View::Iso, SCENE_PICTURE)?;
     print!("{report}");
     println!(
         "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",
@@ -681,15 +652,7 @@ pub fn breed(
         }
     };
     let plants: Vec<sylva_core::Plant> = garden.specimens.iter().map(|s| shown(&s.plant)).collect();
-    let sphylls = sylva_mesh::mesher::MeshOptions {
-        round_caps: true,
-        ..Default::default()
-    };
-    let meshes = plants
-        .iter()
-        .map(|p| sylva_mesh::mesher::mesh_plant(p, &sphylls))
-        .collect::<Result<Vec<_>, _>>()
-        .context("meshing the specimens")?;
+    let meshes = mesh_all(&plants, &mesh_options(sylva_models::lsystem::genome::MODEL))?;
     let mut scene = sylva_mesh::Scene::default();
     let mut cells = Vec::new();
     let mut table =
@@ -706,11 +669,7 @@ pub fn breed(
         let mut node = sylva_mesh::SceneNode::new(name.clone(), mesh);
         node.translation =
             sylva_core::glam::Vec3::new(specimen.position.x, 0.0, specimen.position.y);
-        node.extras = Some(serde_json::json!({
-            "genome": serde_json::to_value(&specimen.genome)?,
-            "seed": seed,
-            "sylva_version": env!("CARGO_PKG_VERSION"),
-        }));
+        node.extras = Some(origin_extras(serde_json::to_value(&specimen.genome)?, seed));
         scene.nodes.push(node);
         cells.push(SheetCell {
             scene: sylva_mesh::Scene::single(sylva_mesh::SceneNode::new(name.clone(), mesh)),
@@ -745,13 +704,7 @@ pub fn breed(
     }
     sylva_mesh::export::write_scene(&out.join("garden.glb"), &scene)
         .context("writing garden.glb")?;
-    let options = render::RenderOptions {
-        width: 1200,
-        height: 800,
-        ..render::RenderOptions::default()
-    };
-    let image = render::render(&scene, &options).context("rendering")?;
-    render::write_png(&out.join("garden.png"), &image).context("writing garden.png")?;
+    write_picture(&scene, &out.join("garden.png"), View::Iso, SCENE_PICTURE)?;
     let sheet = render::contact_sheet(
         &cells,
         &SheetOptions {
