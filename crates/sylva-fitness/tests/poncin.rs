@@ -6,9 +6,10 @@ use proptest::prelude::*;
 use sylva_core::glam::{DVec3, Quat, Vec2, Vec3};
 use sylva_core::{Organ, OrganKind, Plant, PlantMeta, SegmentId};
 use sylva_fitness::poncin::{
-    DensityGrid, GRID_MAX, GridBox, GridCell, GridConfig, NumTarget, PairMode, PairOptions,
-    PoncinContext, PoncinFitness, PoncinScore, PoncinScratch, PoncinWeights, TERM_NAMES,
-    TargetShape, ThickOptions, WORST_PAIR, f_angle, f_dist, f_grid, f_num, f_pos, f_thick,
+    DensityGrid, EndpointRule, GRID_MAX, GridBox, GridCell, GridConfig, NumTarget, PairMode,
+    PairOptions, PoncinContext, PoncinFitness, PoncinScore, PoncinScratch, PoncinWeights,
+    TERM_NAMES, TargetShape, ThickOptions, WORST_PAIR, f_angle, f_dist, f_grid, f_num, f_pos,
+    f_thick,
 };
 
 const UNIT: f64 = 0.1;
@@ -85,7 +86,7 @@ fn f_num_counts_endpoints_in_total_and_per_level() {
 fn endpoints_are_the_plants_tips() {
     let p = two_branches();
     let mut scratch = PoncinScratch::new();
-    let ends = scratch.read(&p, UNIT);
+    let ends = scratch.read(&p, UNIT, EndpointRule::Tips);
     let tips: Vec<Vec3> = p.tips().collect();
     assert_eq!(ends.len(), tips.len());
     for (e, t) in ends.iter().zip(&tips) {
@@ -94,6 +95,57 @@ fn endpoints_are_the_plants_tips() {
     }
     assert!((ends[0].direction - DVec3::X).length() < 1e-9);
     assert!((ends[1].direction + DVec3::Z).length() < 1e-9);
+}
+
+#[test]
+fn axis_endpoints_are_where_each_axis_was_last_drawn() {
+    // A trunk that forks without a lateral (a Push/Pop path, then the trunk goes on), and
+    // one lateral branch from the trunk's top.
+    let mut p = Plant::new(PlantMeta::default());
+    let v = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+    let r = (0.1, 0.1);
+    let s0 = p
+        .add_segment(v(0.0, 0.0), v(0.0, 1.0), r, None, false, Plant::BARK)
+        .unwrap();
+    p.add_segment(v(0.0, 1.0), v(0.5, 1.5), r, Some(s0), false, Plant::BARK)
+        .unwrap();
+    let s2 = p
+        .add_segment(v(0.0, 1.0), v(0.0, 2.0), r, Some(s0), false, Plant::BARK)
+        .unwrap();
+    p.add_segment(v(0.0, 2.0), v(1.0, 2.0), r, Some(s2), true, Plant::BARK)
+        .unwrap();
+    let mut scratch = PoncinScratch::new();
+    let at = |ends: &[sylva_fitness::poncin::Endpoint]| -> Vec<(i64, i64, u16)> {
+        ends.iter()
+            .map(|e| {
+                (
+                    e.position.x.round() as i64,
+                    e.position.y.round() as i64,
+                    e.level,
+                )
+            })
+            .collect()
+    };
+    // Tips: the end of the fork path and of the branch.
+    assert_eq!(
+        at(scratch.read(&p, UNIT, EndpointRule::Tips)),
+        [(5, 15, 0), (10, 20, 1)]
+    );
+    // Axes: where the trunk ended (though a branch grows there) and the branch; the fork
+    // path adds none.
+    assert_eq!(
+        at(scratch.read(&p, UNIT, EndpointRule::Axes)),
+        [(0, 20, 0), (10, 20, 1)]
+    );
+    let config = |endpoints| PoncinFitness {
+        endpoints,
+        num_target: NumTarget::Total(0),
+        ..PoncinFitness::default()
+    };
+    let mut score = |rule| config(rule).score(&p, PoncinContext::default(), &mut scratch);
+    assert_eq!(score(EndpointRule::Tips).branches, 2);
+    assert_eq!(score(EndpointRule::Axes).branches, 2);
+    assert_ne!(score(EndpointRule::Tips).pos, score(EndpointRule::Axes).pos);
 }
 
 #[test]

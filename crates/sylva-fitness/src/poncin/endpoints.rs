@@ -1,13 +1,32 @@
 //! The fitness cases: a plant's endpoints, read once per evaluation into reusable buffers.
 //!
-//! An endpoint is the end of a segment that no segment continues or branches from, exactly
-//! [`Plant::tips`]; its level is the segment's branch order (0 for the trunk). Each endpoint
+//! Which points are endpoints is an [`EndpointRule`]: every tip of the plant
+//! ([`Plant::tips`]), or one per axis, where the axis was last drawn (for the automata: where
+//! each automaton instance ended). An endpoint's level is its segment's branch order (0 for
+//! the trunk). Each endpoint
 //! also carries the direction of the branch it ends, from the base of its axis (the start of
 //! the lateral segment that began the branch, or the plant's foot for the trunk) to the
 //! endpoint, which F_angle compares.
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use sylva_core::Plant;
+
+/// What counts as an endpoint (a fitness case) of a plant.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EndpointRule {
+    /// Every tip: the end of each segment that no segment continues or branches from.
+    #[default]
+    Tips,
+    /// One per axis (a run of non-lateral segments from a lateral one or a root): the end of
+    /// its last-drawn segment. For the automata, an axis is an automaton instance and this
+    /// is where it ended, the paper's "endpoints of all the automata instantiated", so a
+    /// Push/Pop fork inside one automaton adds no endpoint: only creating automata does,
+    /// which is what F_num is for ("encourages the creation of branches, i.e. the use of
+    /// Automata 2 by Automata 1").
+    Axes,
+}
 
 /// One endpoint, as the terms read it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +50,8 @@ pub struct PoncinScratch {
     has_child: Vec<bool>,
     /// Per segment: the first segment of its axis.
     axis: Vec<u32>,
+    /// Per axis (indexed by its first segment): its last segment.
+    last: Vec<u32>,
     pub(crate) endpoints: Vec<Endpoint>,
     /// Endpoint positions as f32 columns (x, y, z), for the exact pair loop.
     pub(crate) columns: [Vec<f32>; 3],
@@ -43,9 +64,9 @@ impl PoncinScratch {
         Self::default()
     }
 
-    /// Reads the plant's endpoints, positions divided by `unit` (metres per paper unit).
-    /// Segments whose parent is not an earlier segment are treated as roots.
-    pub fn read(&mut self, plant: &Plant, unit: f64) -> &[Endpoint] {
+    /// Reads the plant's endpoints by `rule`, positions divided by `unit` (metres per paper
+    /// unit). Segments whose parent is not an earlier segment are treated as roots.
+    pub fn read(&mut self, plant: &Plant, unit: f64, rule: EndpointRule) -> &[Endpoint] {
         let segments = &plant.segments;
         self.has_child.clear();
         self.has_child.resize(segments.len(), false);
@@ -59,6 +80,17 @@ impl PoncinScratch {
                 _ => i as u32,
             };
             self.axis.push(axis);
+        }
+        if rule == EndpointRule::Axes {
+            // An axis's end is its last segment: mark every other segment as continued.
+            self.last.clear();
+            self.last.resize(segments.len(), u32::MAX);
+            for (i, &axis) in self.axis.iter().enumerate() {
+                self.last[axis as usize] = i as u32;
+            }
+            for (i, &axis) in self.axis.iter().enumerate() {
+                self.has_child[i] = self.last[axis as usize] != i as u32;
+            }
         }
         self.endpoints.clear();
         for column in &mut self.columns {

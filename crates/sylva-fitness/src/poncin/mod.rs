@@ -77,7 +77,7 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 use sylva_core::{OrganKind, Plant, ranged_number};
 
-pub use endpoints::{Endpoint, PoncinScratch};
+pub use endpoints::{Endpoint, EndpointRule, PoncinScratch};
 pub use grid::{
     DensityGrid, GRID_MAX, GridBox, GridCell, GridConfig, GridError, PAPER_TARGET, cell_error,
     f_cell,
@@ -450,6 +450,8 @@ pub struct PoncinFitness {
     pub target: TargetShape,
     /// F_num's target. Default 30 endpoints.
     pub num_target: NumTarget,
+    /// What an endpoint is. Default [`EndpointRule::Tips`].
+    pub endpoints: EndpointRule,
     /// Pairs for F_dist and F_angle. Default exact up to 64 endpoints.
     pub pairs: PairOptions,
     /// F_thick's references and radius scale.
@@ -471,6 +473,7 @@ impl Default for PoncinFitness {
             weights: PoncinWeights::TEXT,
             target: TargetShape::default(),
             num_target: NumTarget::default(),
+            endpoints: EndpointRule::Tips,
             pairs: PairOptions::default(),
             thick: ThickOptions::default(),
             grid: None,
@@ -492,7 +495,7 @@ impl PoncinFitness {
         ctx: PoncinContext,
         scratch: &mut PoncinScratch,
     ) -> PoncinScore {
-        scratch.read(plant, self.unit);
+        scratch.read(plant, self.unit, self.endpoints);
         let ends = &scratch.endpoints;
         let spread = self
             .pairs
@@ -538,7 +541,7 @@ fn endpoints_of(plant: &Plant, unit: f64) -> Vec<Endpoint> {
 
 fn read(plant: &Plant, unit: f64) -> PoncinScratch {
     let mut scratch = PoncinScratch::new();
-    scratch.read(plant, unit);
+    scratch.read(plant, unit, EndpointRule::Tips);
     scratch
 }
 
