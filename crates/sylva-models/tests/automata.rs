@@ -325,6 +325,27 @@ fn points_states_organs_and_values_are_bounded() {
 }
 
 #[test]
+fn the_root_starts_with_its_configured_length() {
+    let o = GrowOptions {
+        root_length: 2.5,
+        ..GrowOptions::default()
+    };
+    let text = "(Top (Seq (Repeat 10 (Wait)) (CreateAutomaton A2)) (Repeat 4 (Wait)))";
+    let (plant, _) = grow(text, &o, &Semantics::default());
+    let top = |lateral: bool| {
+        plant
+            .segments
+            .iter()
+            .filter(|s| s.order == u16::from(lateral))
+            .map(|s| s.end.y)
+            .fold(0.0, f32::max)
+    };
+    // 10 steps of 2.5 units of 0.1 m; the child inherits the Length: 4 more steps.
+    assert!((top(false) - 2.5).abs() < 1e-5, "{}", top(false));
+    assert!((top(true) - 3.5).abs() < 1e-5, "{}", top(true));
+}
+
+#[test]
 fn push_pop_with_moves_draws_a_fork() {
     // Two steps up, then a side path of three steps inside a Push/Pop, then two more up.
     let text = "(Top (Seq (Repeat 2 (Wait)) (Seq (PushPop (Seq (RotateL 9) (Repeat 3 (Wait)))) \

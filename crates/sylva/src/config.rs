@@ -259,6 +259,7 @@ fn max_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
 fn iterations<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     sylva_core::ranged::integer(d, "iterations", 1, 100_000)
 }
+sylva_core::ranged_number!(root_length, "root_length", 0.0, 1000.0, " units");
 sylva_core::ranged_number!(growth_unit, "unit", 1e-6, 1000.0, " m");
 sylva_core::ranged_number!(gravity, "gravity", 0.0, 90.0, " degrees per step");
 sylva_core::ranged_number!(degrees_per_unit, "degrees_per_unit", 0.0, 36.0, " degrees");
@@ -273,6 +274,9 @@ pub struct GrowthConfig {
     /// Iteration limit, 1 to 100,000. Default 100.
     #[serde(deserialize_with = "iterations")]
     pub iterations: u32,
+    /// The root automaton's starting Length, paper units per step. Default 1.
+    #[serde(deserialize_with = "root_length")]
+    pub root_length: f64,
     /// Metres per paper unit. Default 0.1.
     #[serde(deserialize_with = "growth_unit")]
     pub unit: f64,
@@ -305,6 +309,7 @@ impl Default for GrowthConfig {
         );
         GrowthConfig {
             iterations: g.iterations,
+            root_length: g.root_length,
             unit: g.unit,
             gravity: g.gravity,
             degrees_per_unit: g.degrees_per_unit,
@@ -325,6 +330,7 @@ impl GrowthConfig {
     ) -> sylva_models::automata::AutomataGenome {
         let mut g = sylva_models::automata::AutomataGenome::new(program);
         g.iterations = self.iterations;
+        g.root_length = self.root_length;
         g.unit = self.unit;
         g.gravity = self.gravity;
         g.degrees_per_unit = self.degrees_per_unit;

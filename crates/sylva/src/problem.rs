@@ -2,6 +2,8 @@
 //! weighted tree measures computed analytically (no plant is built per evaluation).
 
 use std::cell::RefCell;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rand::Rng;
 use sylva_core::glam::Vec3;
@@ -130,6 +132,8 @@ pub struct AutomataProblem {
     pub fitness: PoncinFitness,
     semantics: Semantics,
     grow: GrowOptions,
+    /// Automaton-steps simulated by this problem and its clones, for speed reports.
+    steps: Arc<AtomicU64>,
 }
 
 /// Per-thread buffers, so evaluating does not allocate once they have grown. They hold no
@@ -172,7 +176,14 @@ impl AutomataProblem {
             fitness: config.fitness.clone(),
             semantics: template.semantics(),
             grow: template.grow_options(),
+            steps: Arc::default(),
         }
+    }
+
+    /// Automaton-steps simulated so far by all evaluations (one automaton running one
+    /// iteration is one step), across threads.
+    pub fn automaton_steps(&self) -> u64 {
+        self.steps.load(Ordering::Relaxed)
     }
 
     /// Grows a program the way evaluation does (chords only) and scores it.
@@ -190,6 +201,8 @@ impl AutomataProblem {
             let report = s
                 .simulator
                 .run(program, &self.grow, Detail::Chords, &mut s.plant);
+            self.steps
+                .fetch_add(report.automaton_steps, Ordering::Relaxed);
             // Pairs are exact up to 64 endpoints; beyond, the fixed seed keeps evaluation a
             // pure function of the genome.
             let ctx = PoncinContext {

@@ -15,7 +15,14 @@
 //! | `(Seq a b)` | none of its own: `a`'s exit is linked to `b`'s entry |
 //! | `(If… var value then else)` | one test state; `next` → `then`, `alt` → `else`; both branches continue after the `If` ([`ElseEnd::Rejoin`]) or the `else` branch ends the automaton ([`ElseEnd::End`]) |
 //! | `(PushPop body)` | `Push` → body → `Pop` → continuation |
-//! | `(Repeat n body)` | `RepeatInit` (counter := n) → `RepeatTest`: counter > 0 ? (counter -= 1, body → test) : continuation |
+//! | `(Repeat n body)` | `RepeatInit`: counter := n, then the first test → body or continuation; `RepeatTest`: counter > 0 ? (counter -= 1, body → test) : continuation |
+//! | `(Repeat n (Wait))` | the same, with the test marked `RepeatWait`: test and `Wait` in one dispatch |
+//!
+//! A loop's entry does its first test itself, and a test whose body is a lone `Wait` waits
+//! itself: evolved trees are mostly nested `Repeat`s (how an automaton lives n steps; a
+//! `RepeatIndex` in a late-born branch often counts 0), and these two fusions cut a quarter
+//! of the dispatches. Each fused state still counts as the two states it stands for, so
+//! reports and [`Limits::states_per_step`](super::Limits) read as for the plain automaton.
 //! | `(Wait)`, `(Killme)`, rotations, `CreateAutomaton`, `Assign`, `Add`, `Multiply` | one state each |
 //!
 //! By construction every state is reachable from its automaton's entry (a `Killme` keeps its
@@ -65,12 +72,17 @@ pub enum Op {
     Push,
     /// Restores them.
     Pop,
-    /// `counter[slot] = x` (a whole number 0..=10).
+    /// `counter[slot] = x` (a whole number 0..=10), then the test of [`Op::RepeatTest`].
     RepeatInit,
-    /// `counter[slot] = max(0, x - index)`, index = the automaton's birth rank.
+    /// `counter[slot] = max(0, x - index)`, index = the automaton's birth rank, then the
+    /// test of [`Op::RepeatTest`].
     RepeatIndexInit,
     /// `counter[slot] > 0` ? (decrement, `next`: the body) : `alt`: after the loop.
     RepeatTest,
+    /// A `RepeatTest` whose body is a lone `Wait` (`next`, which links back here): when the
+    /// counter is positive, decrement it and end the iteration's steps here, as test and
+    /// `Wait` would (and counted as those two states); otherwise `alt`.
+    RepeatWait,
 }
 
 /// One state of a compiled automaton.
@@ -325,20 +337,25 @@ impl Program {
                     alt: cont,
                 });
                 let body = self.op(nodes, i + 2, test, cx);
-                self.states[test as usize].next = body;
+                let t = &mut self.states[test as usize];
+                t.next = body;
+                if nodes[i + 2] == Node::Wait {
+                    t.op = Op::RepeatWait;
+                }
                 let op = if node == Node::Repeat {
                     Op::RepeatInit
                 } else {
                     Op::RepeatIndexInit
                 };
+                // The entry tests too: its ways out are the test's.
                 self.push(State {
                     op,
                     arg: 0,
                     slot,
                     x: value(nodes[i + 1]).round().abs(),
                     y: 0.0,
-                    next: test,
-                    alt: 0,
+                    next: body,
+                    alt: cont,
                 })
             }
             node @ (Node::RotateH | Node::RotateL | Node::RotateU) => {
@@ -441,8 +458,10 @@ impl Program {
                 }
                 depth[s] = d;
                 let st = self.states[s];
-                if matches!(st.op, Op::RepeatInit | Op::RepeatIndexInit | Op::RepeatTest)
-                    && st.slot >= code.counters
+                if matches!(
+                    st.op,
+                    Op::RepeatInit | Op::RepeatIndexInit | Op::RepeatTest | Op::RepeatWait
+                ) && st.slot >= code.counters
                 {
                     return Err(format!(
                         "state {s} uses counter {} of {}",
@@ -461,7 +480,13 @@ impl Program {
                 work.push((st.next, after));
                 if matches!(
                     st.op,
-                    Op::IfLess | Op::IfGreater | Op::IfEqual | Op::RepeatTest
+                    Op::IfLess
+                        | Op::IfGreater
+                        | Op::IfEqual
+                        | Op::RepeatInit
+                        | Op::RepeatIndexInit
+                        | Op::RepeatTest
+                        | Op::RepeatWait
                 ) {
                     work.push((st.alt, d));
                 }
@@ -513,18 +538,20 @@ mod tests {
         assert_eq!(s[i.next as usize].op, Op::Push);
         let init = &s[i.alt as usize];
         assert_eq!((init.op, init.x), (Op::RepeatInit, 3.0));
-        let test = &s[init.next as usize];
-        assert_eq!(test.op, Op::RepeatTest);
         assert_eq!(
-            s[test.alt as usize].op,
+            s[init.alt as usize].op,
             Op::Kill,
-            "the loop exits to what follows"
+            "an empty loop is skipped"
         );
-        assert_eq!(s[test.next as usize].op, Op::Wait);
+        let wait = &s[init.next as usize];
+        assert_eq!(wait.op, Op::Wait, "the entry tests and goes to the body");
+        let test = &s[wait.next as usize];
         assert_eq!(
-            s[test.next as usize].next, init.next,
-            "the body loops to the test"
+            test.op,
+            Op::RepeatWait,
+            "a lone Wait body is fused into its test"
         );
+        assert_eq!((test.next, test.alt), (init.next, init.alt));
     }
 
     #[test]

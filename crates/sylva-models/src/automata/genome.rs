@@ -47,6 +47,9 @@ pub struct AutomataGenome {
     /// Iteration limit, 1 to 100 000. Default 100.
     #[serde(default = "d_iterations", deserialize_with = "iterations")]
     pub iterations: u32,
+    /// The root automaton's starting Length, paper units per step, 0 to 1000. Default 1.
+    #[serde(default = "d_root_length", deserialize_with = "root_length")]
+    pub root_length: f64,
     /// Metres per paper unit, 0.000001 to 1000. Default 0.1.
     #[serde(default = "d_unit", deserialize_with = "unit")]
     pub unit: f64,
@@ -88,6 +91,9 @@ pub struct AutomataGenome {
 fn d_iterations() -> u32 {
     100
 }
+fn d_root_length() -> f64 {
+    1.0
+}
 fn d_unit() -> f64 {
     0.1
 }
@@ -110,6 +116,7 @@ fn d_tolerance() -> f64 {
 fn iterations<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     sylva_core::ranged::integer(d, "iterations", 1, 100_000)
 }
+ranged_number!(root_length, "root_length", 0.0, 1000.0, " units");
 ranged_number!(unit, "unit", 1e-6, 1000.0, " m");
 ranged_number!(gravity, "gravity", 0.0, 90.0, " degrees per step");
 ranged_number!(degrees_per_unit, "degrees_per_unit", 0.0, 36.0, " degrees");
@@ -142,6 +149,7 @@ impl AutomataGenome {
             format: FormatV1,
             program,
             iterations: d_iterations(),
+            root_length: d_root_length(),
             unit: d_unit(),
             gravity: 0.0,
             degrees_per_unit: d_degrees(),
@@ -184,6 +192,7 @@ impl AutomataGenome {
     pub fn grow_options(&self) -> GrowOptions {
         GrowOptions {
             iterations: self.iterations,
+            root_length: self.root_length as f32,
             unit: self.unit as f32,
             gravity: self.gravity as f32,
             radius: self.radius as f32,

@@ -67,6 +67,8 @@ const THICKNESS: usize = 1;
 /// unit length by about one ulp, so 16 turns stay within 1e-6 and each move costs a few
 /// multiplications instead of a renormalisation.
 const RENORMALISE: u8 = 16;
+/// The golden angle, radians: successive leaves turn by it about the vertical.
+const GOLDEN_ANGLE: f32 = 2.399_963_2;
 /// Leaves droop this far below horizontal, radians (10°).
 const LEAF_DROOP: f32 = 0.174_532_93;
 
@@ -78,7 +80,9 @@ pub enum Detail {
     Full,
     /// One segment per run between branch points (creations, Push/Pop forks) and to each
     /// tip: the same tips, leaves, levels and end thicknesses as [`Detail::Full`], far fewer
-    /// segments. For fitness evaluation.
+    /// segments. Leaves and flowers keep their position and size but not their orientation
+    /// (left at identity: no fitness term reads it, and it costs more than the rest of an
+    /// organ). For fitness evaluation.
     Chords,
 }
 
@@ -159,6 +163,11 @@ impl Default for Limits {
 pub struct GrowOptions {
     /// Iteration limit. Default 100 (section 5.1).
     pub iterations: u32,
+    /// The root automaton's Length when it starts, paper units per step. Default 1; range
+    /// 0..=1e3. The paper does not give it; with 100 iterations, a Length of 2 to 3 lets
+    /// a tree reach across its 300-unit sphere, which evolution finds far more often than
+    /// learning to raise Length (see `examples/automata/sphere.toml`).
+    pub root_length: f32,
     /// Metres per paper unit. Default 0.1, so the paper's sphere of radius 150 centred 200
     /// up is 15 m wide and a 100-step trunk of Length 1 is 10 m tall. Range 1e-6..=1e3.
     pub unit: f32,
@@ -186,6 +195,7 @@ impl Default for GrowOptions {
     fn default() -> Self {
         GrowOptions {
             iterations: 100,
+            root_length: 1.0,
             unit: 0.1,
             gravity: 0.0,
             radius: 3.0,
@@ -211,6 +221,7 @@ impl GrowOptions {
     pub fn sanitized(&self) -> GrowOptions {
         let d = GrowOptions::default();
         GrowOptions {
+            root_length: legal(self.root_length, 0.0, 1e3, d.root_length),
             unit: legal(self.unit, 1e-6, 1e3, d.unit),
             gravity: legal(self.gravity, 0.0, 90.0, d.gravity),
             radius: legal(self.radius, 0.0, 1e3, d.radius),
@@ -428,7 +439,11 @@ fn orthonormalise(f: &mut Frame) {
     f.up = f.heading.cross(f.left);
 }
 
-fn leaf_rotation(frame: &Frame, horizontal: bool) -> Quat {
+/// A leaf's orientation. Horizontal leaves are also turned about the vertical by the golden
+/// angle times the leaf's index: leaves an automaton adds at one spot (`(Repeat 5
+/// (CreateAutomaton Leaf))` is common in evolved trees) fan out instead of lying on top of
+/// each other, and the "randomly generated" leaves of section 4.5 stay deterministic.
+fn leaf_rotation(frame: &Frame, horizontal: bool, index: u32) -> Quat {
     let m = if horizontal {
         let flat = [frame.up, frame.left, frame.heading]
             .into_iter()
@@ -438,7 +453,8 @@ fn leaf_rotation(frame: &Frame, horizontal: bool) -> Quat {
         let (s, c) = LEAF_DROOP.sin_cos();
         let along = (flat * c - Vec3::Y * s).normalize();
         let face = (Vec3::Y - along * along.y).normalize();
-        Mat3::from_cols(along.cross(face), along, face)
+        let fan = Mat3::from_rotation_y(GOLDEN_ANGLE * (index % 1024) as f32);
+        fan * Mat3::from_cols(along.cross(face), along, face)
     } else {
         Mat3::from_cols(-frame.left, frame.up, -frame.heading)
     };
@@ -494,7 +510,7 @@ impl Simulator {
             return rep;
         }
         let mut vars = [0.0; VARIABLES];
-        vars[LENGTH] = 1.0;
+        vars[LENGTH] = options.root_length;
         vars[THICKNESS] = 1.0;
         mem.spawn(&cx, 0, Vec3::ZERO, Frame::UPRIGHT, vars, NONE, 0);
         adopt(insts, live, &mut mem.newborn);
@@ -615,7 +631,8 @@ impl Memory {
                 break false;
             }
             budget -= 1;
-            let s = &states[pc];
+            let here = pc;
+            let s = &states[here];
             pc = s.next as usize;
             match s.op {
                 Op::Wait => break true,
@@ -667,12 +684,23 @@ impl Memory {
                 }
                 Op::Push => self.push(me, cx),
                 Op::Pop => self.pop(me, cx, plant),
-                Op::RepeatInit => {
-                    self.counters[(me.counter_base + u32::from(s.slot)) as usize] = s.x as u8;
-                }
-                Op::RepeatIndexInit => {
-                    let count = (s.x - me.index.min(255) as f32).max(0.0);
-                    self.counters[(me.counter_base + u32::from(s.slot)) as usize] = count as u8;
+                Op::RepeatInit | Op::RepeatIndexInit => {
+                    // The entry and the first test: two states.
+                    if budget == 0 {
+                        rep.bounds.state_limit_kills += 1;
+                        break false;
+                    }
+                    budget -= 1;
+                    let count = if s.op == Op::RepeatInit {
+                        s.x as u8
+                    } else {
+                        (s.x - me.index.min(255) as f32).max(0.0) as u8
+                    };
+                    if count > 0 {
+                        self.counters[(me.counter_base + u32::from(s.slot)) as usize] = count - 1;
+                    } else {
+                        pc = s.alt as usize;
+                    }
                 }
                 Op::RepeatTest => {
                     let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
@@ -681,6 +709,21 @@ impl Memory {
                     } else {
                         pc = s.alt as usize;
                     }
+                }
+                Op::RepeatWait => {
+                    let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
+                    if *c > 0 {
+                        // The test and its body's Wait: two states, the Wait resuming here.
+                        if budget == 0 {
+                            rep.bounds.state_limit_kills += 1;
+                            break false;
+                        }
+                        budget -= 1;
+                        *c -= 1;
+                        pc = here;
+                        break true;
+                    }
+                    pc = s.alt as usize;
                 }
                 Op::Create => self.create(me, usize::from(s.arg), cx, plant, rep),
                 Op::Leaf => self.organ(me, OrganKind::Leaf, cx, plant, rep),
@@ -876,21 +919,26 @@ impl Memory {
         }
         let unit = cx.options.unit;
         let mut frame = me.frame;
-        if me.turns > 0 {
+        if cx.full && me.turns > 0 {
             orthonormalise(&mut frame);
         }
         let (orientation, size, material) = if kind == OrganKind::Leaf {
             rep.leaves += 1;
             let len = cx.options.leaf_length * unit;
-            (
-                leaf_rotation(&frame, cx.options.horizontal_leaves),
-                Vec2::new(len, 0.4 * len),
-                Plant::LEAF,
-            )
+            let q = if cx.full {
+                leaf_rotation(&frame, cx.options.horizontal_leaves, rep.leaves)
+            } else {
+                Quat::IDENTITY
+            };
+            (q, Vec2::new(len, 0.4 * len), Plant::LEAF)
         } else {
             rep.flowers += 1;
             let size = cx.options.flower_size * unit;
-            let q = frame.rotation();
+            let q = if cx.full {
+                frame.rotation()
+            } else {
+                Quat::IDENTITY
+            };
             (
                 if q.is_finite() { q } else { Quat::IDENTITY },
                 Vec2::new(size, 0.35 * size),
