@@ -187,6 +187,33 @@ proptest! {
         let program = Program::compile(&m, &Semantics::default());
         prop_assert_eq!(program.verify(), Ok(()));
     }
+
+    #[test]
+    fn node_info_agrees_with_a_walk_from_the_root(seed in any::<u64>()) {
+        let tree = random_tree(seed);
+        let info = tree.node_info();
+        // Depth and automaton by walking down from the root with explicit ranges.
+        let mut expected = vec![(0usize, 0u8); tree.len()];
+        let mut work = vec![(0usize, 0usize, 0u8)];
+        while let Some((i, depth, automaton)) = work.pop() {
+            expected[i] = (depth, automaton);
+            let mut child = i + 1;
+            for k in 0..tree.nodes()[i].arity() {
+                let a = if i == 0 { k as u8 } else { automaton };
+                work.push((child, depth + 1, a));
+                child = tree.subtree_end(child);
+            }
+        }
+        for (i, facts) in info.iter().enumerate() {
+            prop_assert_eq!(facts.end as usize, tree.subtree_end(i));
+            prop_assert_eq!((usize::from(facts.depth), facts.automaton), expected[i]);
+            let height = (i + 1..tree.subtree_end(i))
+                .map(|j| usize::from(info[j].depth) - usize::from(facts.depth))
+                .max()
+                .unwrap_or(0);
+            prop_assert_eq!(usize::from(facts.height), height);
+        }
+    }
 }
 
 /// No Top below the root, creations only forward, organs only from the last automaton.

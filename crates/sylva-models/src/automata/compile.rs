@@ -17,11 +17,13 @@
 //! | `(PushPop body)` | `Push` → body → `Pop` → continuation |
 //! | `(Repeat n body)` | `RepeatInit`: counter := n, then the first test → body or continuation; `RepeatTest`: counter > 0 ? (counter -= 1, body → test) : continuation |
 //! | `(Repeat n (Wait))` | the same, with the test marked `RepeatWait`: test and `Wait` in one dispatch |
+//! | `(Repeat n (Repeat m body))` | the outer test marked `RepeatNest`: it enters the inner loop in the same dispatch |
 //!
-//! A loop's entry does its first test itself, and a test whose body is a lone `Wait` waits
-//! itself: evolved trees are mostly nested `Repeat`s (how an automaton lives n steps; a
-//! `RepeatIndex` in a late-born branch often counts 0), and these two fusions cut a quarter
-//! of the dispatches. Each fused state still counts as the two states it stands for, so
+//! A loop's entry does its first test itself, a test whose body is a lone `Wait` waits
+//! itself, and a test whose body begins with a loop enters it: evolved trees are mostly
+//! nested `Repeat`s (how an automaton lives n steps; a `RepeatIndex` in a late-born branch
+//! often counts 0, so its outer loop spins through it), and these fusions cut a third of the
+//! dispatches. Each fused state still counts as the two states it stands for, so
 //! reports and [`Limits::states_per_step`](super::Limits) read as for the plain automaton.
 //! | `(Wait)`, `(Killme)`, rotations, `CreateAutomaton`, `Assign`, `Add`, `Multiply` | one state each |
 //!
@@ -32,7 +34,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::tree::{GpTree, Node, Target};
+use super::tree::{GpTree, Node, NodeInfo, Target};
 
 /// What a state does. Field use is listed with each op.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -79,6 +81,10 @@ pub enum Op {
     RepeatIndexInit,
     /// `counter[slot] > 0` ? (decrement, `next`: the body) : `alt`: after the loop.
     RepeatTest,
+    /// A `RepeatTest` whose body begins with a loop: when the counter is positive, decrement
+    /// it and enter that loop (its `RepeatInit` or `RepeatIndexInit` at `next`) in the same
+    /// dispatch, counted as the test and the entry's two states; otherwise `alt`.
+    RepeatNest,
     /// A `RepeatTest` whose body is a lone `Wait` (`next`, which links back here): when the
     /// counter is positive, decrement it and end the iteration's steps here, as test and
     /// `Wait` would (and counted as those two states); otherwise `alt`.
@@ -187,8 +193,6 @@ pub struct Program {
     states: Vec<State>,
     automata: Vec<AutomatonCode>,
     restart: bool,
-    ends: Vec<u32>,
-    scratch: Vec<u32>,
 }
 
 /// Compile-time context for one automaton.
@@ -230,18 +234,7 @@ impl Program {
         self.automata.clear();
         self.restart = semantics.at_end == AtEnd::Restart;
         self.states.push(State::END);
-        // Subtree ends, by one backward pass.
-        self.ends.clear();
-        self.ends.resize(nodes.len(), 0);
-        self.scratch.clear();
-        for i in (0..nodes.len()).rev() {
-            let mut end = i as u32 + 1;
-            for _ in 0..nodes[i].arity() {
-                end = self.scratch.pop().unwrap_or(end).max(end);
-            }
-            self.ends[i] = end;
-            self.scratch.push(end);
-        }
+        let info = tree.node_info();
         let degrees = if semantics.degrees_per_unit.is_finite() {
             semantics.degrees_per_unit
         } else {
@@ -257,13 +250,13 @@ impl Program {
                 depth: 0,
                 push_depth: 0,
             };
-            let entry = self.op(nodes, at, 0, &mut cx);
+            let entry = self.op(nodes, info, at, 0, &mut cx);
             self.automata.push(AutomatonCode {
                 entry,
                 counters: cx.counters,
                 push_depth: cx.push_depth,
             });
-            at = self.ends[at] as usize;
+            at = info[at].end as usize;
         }
     }
 
@@ -285,22 +278,22 @@ impl Program {
     }
 
     /// Compiles the operator at `i`, followed by `cont`; returns its entry state.
-    fn op(&mut self, nodes: &[Node], i: usize, cont: u32, cx: &mut Cx) -> u32 {
+    fn op(&mut self, nodes: &[Node], info: &[NodeInfo], i: usize, cont: u32, cx: &mut Cx) -> u32 {
         match nodes[i] {
             Node::Seq => {
-                let b = self.ends[i + 1] as usize;
-                let second = self.op(nodes, b, cont, cx);
-                self.op(nodes, i + 1, second, cx)
+                let b = info[i + 1].end as usize;
+                let second = self.op(nodes, info, b, cont, cx);
+                self.op(nodes, info, i + 1, second, cx)
             }
             node @ (Node::IfLess | Node::IfGreater | Node::IfEqual) => {
                 let then = i + 3;
-                let otherwise = self.ends[then] as usize;
-                let then_entry = self.op(nodes, then, cont, cx);
+                let otherwise = info[then].end as usize;
+                let then_entry = self.op(nodes, info, then, cont, cx);
                 let else_cont = match cx.else_end {
                     ElseEnd::Rejoin => cont,
                     ElseEnd::End => 0,
                 };
-                let else_entry = self.op(nodes, otherwise, else_cont, cx);
+                let else_entry = self.op(nodes, info, otherwise, else_cont, cx);
                 let op = match node {
                     Node::IfLess => Op::IfLess,
                     Node::IfGreater => Op::IfGreater,
@@ -320,7 +313,7 @@ impl Program {
                 cx.depth += 1;
                 cx.push_depth = cx.push_depth.max(cx.depth);
                 let pop = self.simple(Op::Pop, 0, 0.0, 0.0, cont);
-                let body = self.op(nodes, i + 1, pop, cx);
+                let body = self.op(nodes, info, i + 1, pop, cx);
                 cx.depth -= 1;
                 self.simple(Op::Push, 0, 0.0, 0.0, body)
             }
@@ -336,11 +329,15 @@ impl Program {
                     next: 0,
                     alt: cont,
                 });
-                let body = self.op(nodes, i + 2, test, cx);
+                let body = self.op(nodes, info, i + 2, test, cx);
                 let t = &mut self.states[test as usize];
                 t.next = body;
                 if nodes[i + 2] == Node::Wait {
                     t.op = Op::RepeatWait;
+                }
+                let body_op = self.states[body as usize].op;
+                if matches!(body_op, Op::RepeatInit | Op::RepeatIndexInit) {
+                    self.states[test as usize].op = Op::RepeatNest;
                 }
                 let op = if node == Node::Repeat {
                     Op::RepeatInit
@@ -460,7 +457,11 @@ impl Program {
                 let st = self.states[s];
                 if matches!(
                     st.op,
-                    Op::RepeatInit | Op::RepeatIndexInit | Op::RepeatTest | Op::RepeatWait
+                    Op::RepeatInit
+                        | Op::RepeatIndexInit
+                        | Op::RepeatTest
+                        | Op::RepeatNest
+                        | Op::RepeatWait
                 ) && st.slot >= code.counters
                 {
                     return Err(format!(
@@ -486,6 +487,7 @@ impl Program {
                         | Op::RepeatInit
                         | Op::RepeatIndexInit
                         | Op::RepeatTest
+                        | Op::RepeatNest
                         | Op::RepeatWait
                 ) {
                     work.push((st.alt, d));

@@ -24,11 +24,13 @@
 //! Random values are multiples of [`GpConfig::value_step`] (0.1: the paper's "fixed point
 //! values"), which also keeps printed trees short.
 
+use std::cell::RefCell;
+
 use rand::{Rng, RngExt};
 use sylva_evolve::{Crossover, Mutate};
 
 use super::tree::{
-    GpTree, MAX_AUTOMATA, MAX_NODES, Node, NodeInfo, Target, Type, VALUE_LIMIT, VARIABLES, Var,
+    GpTree, MAX_AUTOMATA, MAX_NODES, Node, Target, Type, VALUE_LIMIT, VARIABLES, Var,
 };
 
 /// Operators with operator children, by family: the ones "full" uses to reach its depth.
@@ -317,41 +319,52 @@ impl GpConfig {
     }
 
     /// A random point of `tree` passing `keep`: a function point with probability
-    /// `function_point_rate` when both kinds pass.
+    /// `function_point_rate` when both kinds pass. One pass, gathering the candidates into
+    /// `found`'s buffers.
     fn point<R: Rng + ?Sized>(
         &self,
         tree: &GpTree,
         keep: impl Fn(usize) -> bool,
         rng: &mut R,
+        found: &mut Points,
     ) -> Option<usize> {
-        let nodes = tree.nodes();
-        let (mut functions, mut terminals) = (0usize, 0usize);
-        for (i, n) in nodes.iter().enumerate() {
+        found.functions.clear();
+        found.terminals.clear();
+        for (i, n) in tree.nodes().iter().enumerate() {
             if keep(i) {
                 if n.arity() > 0 {
-                    functions += 1;
+                    found.functions.push(i as u32);
                 } else {
-                    terminals += 1;
+                    found.terminals.push(i as u32);
                 }
             }
         }
-        let want_function = match (functions, terminals) {
+        let want_function = match (found.functions.len(), found.terminals.len()) {
             (0, 0) => return None,
             (0, _) => false,
             (_, 0) => true,
             _ => rng.random_bool(self.function_point_rate.clamp(0.0, 1.0)),
         };
-        let mut k = rng.random_range(0..if want_function { functions } else { terminals });
-        for (i, n) in nodes.iter().enumerate() {
-            if keep(i) && (n.arity() > 0) == want_function {
-                if k == 0 {
-                    return Some(i);
-                }
-                k -= 1;
-            }
-        }
-        None
+        let pool = if want_function {
+            &found.functions
+        } else {
+            &found.terminals
+        };
+        Some(pool[rng.random_range(0..pool.len())] as usize)
     }
+}
+
+/// Candidate points, by kind; reused between calls.
+#[derive(Default)]
+struct Points {
+    functions: Vec<u32>,
+    terminals: Vec<u32>,
+}
+
+thread_local! {
+    /// One thread's candidate points, so choosing points does not allocate once they have
+    /// grown.
+    static SCRATCH: RefCell<Points> = RefCell::default();
 }
 
 /// A tree of `count` automata that all just wait (never needed; a guard).
@@ -402,13 +415,23 @@ pub fn repair_target(
 
 impl Crossover<GpTree> for SubtreeCrossover {
     fn crossover<R: Rng + ?Sized>(&self, a: &GpTree, b: &GpTree, rng: &mut R) -> GpTree {
+        SCRATCH.with(|cell| self.cross(a, b, rng, &mut cell.borrow_mut()))
+    }
+}
+
+impl SubtreeCrossover {
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        a: &GpTree,
+        b: &GpTree,
+        rng: &mut R,
+        points: &mut Points,
+    ) -> GpTree {
         let c = &self.config;
-        let (mut ia, mut ib): (Vec<NodeInfo>, Vec<NodeInfo>) = (Vec::new(), Vec::new());
-        a.node_info(&mut ia);
-        b.node_info(&mut ib);
+        let (ia, ib) = (a.node_info(), b.node_info());
         let (limit, depth_limit) = (c.size_limit(), c.depth_limit());
         for _ in 0..ATTEMPTS {
-            let Some(pa) = c.point(a, |i| i > 0, rng) else {
+            let Some(pa) = c.point(a, |i| i > 0, rng, points) else {
                 break;
             };
             let ty = a.nodes()[pa].ty();
@@ -423,8 +446,8 @@ impl Crossover<GpTree> for SubtreeCrossover {
             };
             let ka = ia[pa].automaton;
             let pb = c
-                .point(b, |j| fits(j) && ib[j].automaton == ka, rng)
-                .or_else(|| c.point(b, fits, rng));
+                .point(b, |j| fits(j) && ib[j].automaton == ka, rng, points)
+                .or_else(|| c.point(b, fits, rng, points));
             let Some(pb) = pb else {
                 continue;
             };
@@ -449,10 +472,15 @@ impl Crossover<GpTree> for SubtreeCrossover {
 
 impl Mutate<GpTree> for SubtreeMutation {
     fn mutate<R: Rng + ?Sized>(&self, tree: &mut GpTree, rng: &mut R) {
+        SCRATCH.with(|cell| self.mutate_with(tree, rng, &mut cell.borrow_mut()));
+    }
+}
+
+impl SubtreeMutation {
+    fn mutate_with<R: Rng + ?Sized>(&self, tree: &mut GpTree, rng: &mut R, points: &mut Points) {
         let c = &self.config;
-        let mut info = Vec::new();
-        tree.node_info(&mut info);
-        let Some(p) = c.point(tree, |i| i > 0, rng) else {
+        let info = tree.node_info();
+        let Some(p) = c.point(tree, |i| i > 0, rng, points) else {
             return;
         };
         let node = tree.nodes()[p];

@@ -53,7 +53,7 @@ use glam::{Mat3, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::{Frame, MaterialKind, Organ, OrganKind, Plant, PlantMeta, Segment, SegmentId};
 
-use super::compile::{Op, Program};
+use super::compile::{Op, Program, State};
 use super::tree::{VARIABLES, Var};
 
 /// Variables are clamped to `±VARIABLE_LIMIT` after each `Add` or `Multiply`.
@@ -691,21 +691,27 @@ impl Memory {
                         break false;
                     }
                     budget -= 1;
-                    let count = if s.op == Op::RepeatInit {
-                        s.x as u8
-                    } else {
-                        (s.x - me.index.min(255) as f32).max(0.0) as u8
-                    };
-                    if count > 0 {
-                        self.counters[(me.counter_base + u32::from(s.slot)) as usize] = count - 1;
-                    } else {
-                        pc = s.alt as usize;
-                    }
+                    pc = self.enter_loop(me, s);
                 }
                 Op::RepeatTest => {
                     let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
                     if *c > 0 {
                         *c -= 1;
+                    } else {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::RepeatNest => {
+                    let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
+                    if *c > 0 {
+                        *c -= 1;
+                        // The body is a loop entry (two states): run it here.
+                        if budget < 2 {
+                            rep.bounds.state_limit_kills += 1;
+                            break false;
+                        }
+                        budget -= 2;
+                        pc = self.enter_loop(me, &states[pc]);
                     } else {
                         pc = s.alt as usize;
                     }
@@ -741,6 +747,23 @@ impl Memory {
             self.finish(me, cx, plant);
         }
         alive
+    }
+
+    /// Enters the loop whose entry is `entry` (a `RepeatInit` or `RepeatIndexInit`): sets its
+    /// counter and runs its first test; returns the next state.
+    #[inline(always)]
+    fn enter_loop(&mut self, me: &Inst, entry: &State) -> usize {
+        let count = if entry.op == Op::RepeatInit {
+            entry.x as u8
+        } else {
+            (entry.x - me.index.min(255) as f32).max(0.0) as u8
+        };
+        if count > 0 {
+            self.counters[(me.counter_base + u32::from(entry.slot)) as usize] = count - 1;
+            entry.next as usize
+        } else {
+            entry.alt as usize
+        }
     }
 
     /// Moves one step along H and records the position.

@@ -225,9 +225,22 @@ impl Node {
     /// Number of children.
     #[inline]
     pub fn arity(self) -> usize {
+        // `child_types().len()`, spelled out: breeding calls this for every node.
         match self {
             Node::Top(n) => usize::from(n),
-            other => other.child_types().len(),
+            Node::IfLess | Node::IfGreater | Node::IfEqual => 4,
+            Node::Seq
+            | Node::Repeat
+            | Node::RepeatIndex
+            | Node::Assign
+            | Node::Add
+            | Node::Multiply => 2,
+            Node::PushPop
+            | Node::RotateH
+            | Node::RotateL
+            | Node::RotateU
+            | Node::CreateAutomaton => 1,
+            Node::Wait | Node::Killme | Node::Value(_) | Node::Var(_) | Node::Target(_) => 0,
         }
     }
 
@@ -387,10 +400,13 @@ pub fn legal_targets(automaton: usize, count: usize) -> String {
     }
 }
 
-/// A valid GP tree: well typed, following the rules of construction.
+/// A valid GP tree: well typed, following the rules of construction. It keeps the
+/// [`NodeInfo`] of its nodes, found while checking them, for breeding (each tree is a parent
+/// about twice a generation, and crossover needs the facts of every node of both parents).
 #[derive(Clone, Debug)]
 pub struct GpTree {
     nodes: Vec<Node>,
+    info: Vec<NodeInfo>,
 }
 
 impl PartialEq for GpTree {
@@ -417,8 +433,10 @@ pub struct NodeInfo {
 impl GpTree {
     /// Checks `nodes` and wraps them.
     pub fn new(nodes: Vec<Node>) -> Result<GpTree, TreeError> {
-        validate(&nodes)?;
-        Ok(GpTree { nodes })
+        let mut info = Vec::new();
+        validate(&nodes, &mut info)?;
+        ends_and_heights(&nodes, &mut info);
+        Ok(GpTree { nodes, info })
     }
 
     /// The nodes, in prefix order.
@@ -469,14 +487,13 @@ impl GpTree {
     /// Depth of the tree: edges on the longest path from the root (a `Top` with terminal
     /// bodies has depth 1).
     pub fn depth(&self) -> usize {
-        let mut info = Vec::new();
-        self.node_info(&mut info);
-        usize::from(info[0].height)
+        usize::from(self.info[0].height)
     }
 
-    /// Fills `out` (cleared first) with one [`NodeInfo`] per node.
-    pub fn node_info(&self, out: &mut Vec<NodeInfo>) {
-        node_info(&self.nodes, out);
+    /// One [`NodeInfo`] per node.
+    #[inline]
+    pub fn node_info(&self) -> &[NodeInfo] {
+        &self.info
     }
 }
 
@@ -491,56 +508,32 @@ pub(crate) fn subtree_end(nodes: &[Node], index: usize) -> usize {
     i
 }
 
-/// Per-node end, depth, height and automaton of a well-formed prefix list.
-pub(crate) fn node_info(nodes: &[Node], out: &mut Vec<NodeInfo>) {
-    out.clear();
-    out.resize(nodes.len(), NodeInfo::default());
-    // Forward: depth and automaton, with a stack of (children left, depth, automaton).
-    let mut stack: Vec<(usize, u16, u8)> = Vec::with_capacity(32);
-    for (i, node) in nodes.iter().enumerate() {
-        let (depth, automaton) = match stack.last_mut() {
-            None => (0, 0),
-            Some(top) => {
-                let d = top.1 + 1;
-                // A Top's children: the automaton number is counted by children already seen.
-                let a = if top.1 == 0 && matches!(nodes[0], Node::Top(_)) {
-                    (nodes[0].arity() - top.0) as u8
-                } else {
-                    top.2
-                };
-                top.0 -= 1;
-                (d, a)
-            }
-        };
-        out[i].depth = depth;
-        out[i].automaton = automaton;
-        while stack.last().is_some_and(|t| t.0 == 0) {
-            stack.pop();
-        }
-        if node.arity() > 0 {
-            stack.push((node.arity(), depth, automaton));
-        }
-    }
-    // Backward: end and height, with a stack of (end, height) of finished subtrees.
-    let mut done: Vec<(u32, u16)> = Vec::with_capacity(32);
-    for i in (0..nodes.len()).rev() {
-        let k = nodes[i].arity();
+/// Fills in the ends and heights of `info` (depths and automata already set) for a
+/// well-formed prefix list: backwards, since children come after their parent, their ends
+/// are known, and a subtree ends where its last child's does.
+fn ends_and_heights(nodes: &[Node], info: &mut [NodeInfo]) {
+    let n = nodes.len();
+    for i in (0..n).rev() {
         let mut end = i as u32 + 1;
         let mut height = 0u16;
-        for _ in 0..k {
-            if let Some((e, h)) = done.pop() {
-                end = end.max(e);
-                height = height.max(h + 1);
+        let mut child = i + 1;
+        for _ in 0..nodes[i].arity() {
+            if child >= n {
+                break;
             }
+            let c = info[child];
+            end = c.end;
+            height = height.max(c.height + 1);
+            child = c.end as usize;
         }
-        out[i].end = end;
-        out[i].height = height;
-        done.push((end, height));
+        info[i].end = end;
+        info[i].height = height;
     }
 }
 
-/// Checks types, rules of construction and limits.
-fn validate(nodes: &[Node]) -> Result<(), TreeError> {
+/// Checks types, rules of construction and limits; fills `info` with each node's depth and
+/// automaton on the way.
+fn validate(nodes: &[Node], info: &mut Vec<NodeInfo>) -> Result<(), TreeError> {
     if nodes.is_empty() {
         return Err(TreeError::Empty);
     }
@@ -560,6 +553,9 @@ fn validate(nodes: &[Node]) -> Result<(), TreeError> {
     if !(1..=MAX_AUTOMATA).contains(&count) {
         return Err(TreeError::AutomataCount(count));
     }
+    info.clear();
+    info.reserve(nodes.len());
+    info.push(NodeInfo::default());
     // Slots still to fill: (type, automaton 1-based, depth), last to be filled first.
     let mut slots: Vec<(Type, usize, usize)> = Vec::with_capacity(64);
     for a in (1..=count).rev() {
@@ -599,8 +595,14 @@ fn validate(nodes: &[Node]) -> Result<(), TreeError> {
             }
             _ => {}
         }
-        for k in (0..node.arity()).rev() {
-            slots.push((node.child_type(k), automaton, depth + 1));
+        info.push(NodeInfo {
+            end: 0,
+            depth: depth as u16,
+            height: 0,
+            automaton: (automaton - 1) as u8,
+        });
+        for &ty in node.child_types().iter().rev() {
+            slots.push((ty, automaton, depth + 1));
         }
     }
     if slots.is_empty() {
@@ -643,6 +645,36 @@ mod tests {
     }
 
     #[test]
+    fn arity_counts_the_child_types() {
+        let value = Node::Value(1.0);
+        let all = [
+            Node::Seq,
+            Node::IfLess,
+            Node::IfGreater,
+            Node::IfEqual,
+            Node::PushPop,
+            Node::Repeat,
+            Node::RepeatIndex,
+            Node::RotateH,
+            Node::RotateL,
+            Node::RotateU,
+            Node::CreateAutomaton,
+            Node::Assign,
+            Node::Add,
+            Node::Multiply,
+            Node::Wait,
+            Node::Killme,
+            value,
+            Node::Var(Var::LENGTH),
+            Node::Target(Target::Leaf),
+        ];
+        for node in all {
+            assert_eq!(node.arity(), node.child_types().len(), "{node:?}");
+        }
+        assert_eq!(Node::Top(3).arity(), 3);
+    }
+
+    #[test]
     fn node_is_small() {
         assert_eq!(std::mem::size_of::<Node>(), 8);
     }
@@ -653,8 +685,7 @@ mod tests {
         assert_eq!(t.automata(), 2);
         assert_eq!(t.bodies(), vec![1..6, 6..10]);
         assert_eq!(t.depth(), 3);
-        let mut info = Vec::new();
-        t.node_info(&mut info);
+        let info = t.node_info();
         assert_eq!(info[0].end, 10);
         assert_eq!(info[1].end, 6);
         assert_eq!(info[1].automaton, 0);
