@@ -595,6 +595,47 @@ fn automata_runs_write_their_table_2_columns() {
     fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Runs an automata example as shipped (small pictures only); returns its stats rows.
+fn automata_example_stats(name: &str, dir: &Path) -> Vec<Vec<f64>> {
+    let config = dir.join(name);
+    let text = fs::read_to_string(example(&format!("automata/{name}")))
+        .unwrap()
+        .replace("sheet_size = 24", "sheet_size = 2\nimage_size = 64");
+    fs::write(&config, text).unwrap();
+    let out = dir.join(name.replace(".toml", ""));
+    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    fs::read_to_string(out.join("stats.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+/// The bar for Poncin's runs, met by the examples as shipped (docs/automata.md):
+/// the sphere run gets past the two-endpoint trap, and the box-above run keeps its leaves out
+/// of the forbidden cells.
+#[test]
+fn the_automata_examples_beat_the_trap_and_avoid_the_box() {
+    let dir = temp_dir("automata-examples");
+    // Columns: generation, best, mean, branches, leaves, forbidden_leaves, f_pos, f_num, …
+    let (branches, leaves, forbidden, f_pos, f_num) = (3, 4, 5, 6, 7);
+    let sphere = automata_example_stats("sphere.toml", &dir);
+    assert_eq!(sphere.len(), 51, "1000 individuals for 50 generations");
+    assert!(
+        sphere[10][branches] >= 10.0,
+        "generation 10: {:?}",
+        sphere[10]
+    );
+    assert!(sphere[50][f_num] <= 2.0, "generation 50: {:?}", sphere[50]);
+    assert!(sphere[50][f_pos] <= 20.0, "generation 50: {:?}", sphere[50]);
+    let box_above = automata_example_stats("box-above.toml", &dir);
+    let last = &box_above[box_above.len() - 1];
+    assert_eq!(box_above.len(), 101);
+    assert!(last[leaves] > 0.0 && last[forbidden] == 0.0, "{last:?}");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn plantmaker_evolves_without_a_person() {
     let dir = temp_dir("plantmaker-evolve");
