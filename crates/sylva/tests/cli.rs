@@ -428,6 +428,16 @@ fn bad_configs_and_flags_are_refused() {
         ),
         ("[output]\nview = \"back\"\n", "2:8", "iso"),
         ("[run\n", "1:", ""),
+        (
+            "model = \"automata\"\n[automata.growth]\nroot_length = -1\n",
+            "3:15",
+            "root_length",
+        ),
+        (
+            "model = \"automata\"\n[automata.fitness]\nendpoints = \"leaves\"\n",
+            "3:13",
+            "axes",
+        ),
     ] {
         fs::write(&config, text).unwrap();
         let o = sylva(&["evolve", s(&config), "--out", s(&out)]);
@@ -567,7 +577,7 @@ fn automata_runs_write_their_table_2_columns() {
     let text = fs::read_to_string(example("automata/box-above.toml"))
         .unwrap()
         .replace("generations = 100", "generations = 3")
-        .replace("population = 1000", "population = 40")
+        .replace("population = 1000", "population = 200")
         .replace("sheet_size = 24", "sheet_size = 2\nimage_size = 64");
     fs::write(&config, text).unwrap();
     let out = dir.join("run");
@@ -582,6 +592,22 @@ fn automata_runs_write_their_table_2_columns() {
     );
     assert_eq!(stats.lines().count(), 5);
     validate(&[out.join("best.glb")]);
+    // The same run on one thread: same stats and bytes (the per-thread buffers of the
+    // simulator, fitness and breeding carry nothing between individuals).
+    let serial = dir.join("serial");
+    ok(&sylva(&[
+        "evolve",
+        s(&config),
+        "--out",
+        s(&serial),
+        "--threads",
+        "1",
+    ]));
+    assert_eq!(stats_without_timing(&out), stats_without_timing(&serial));
+    assert_eq!(
+        fs::read(out.join("best.glb")).unwrap(),
+        fs::read(serial.join("best.glb")).unwrap()
+    );
     ok(&sylva(&[
         "grow",
         s(&out.join("best.json")),

@@ -41,8 +41,9 @@
 //!   `value × degrees_per_unit` degrees ([`Semantics::degrees_per_unit`], default 10): ±100°,
 //!   so the helix's 70° branches are `(RotateL 7)` and small bends stay reachable.
 //! - **Variables.** Length, Thickness and four general variables `Var1`..`Var4` (fixed: an
-//!   inline array). The root starts with Length 1, Thickness 1 (section 4.4.2), the rest 0,
-//!   heading up (+Y). Variables are clamped to ±10⁶ (counted), so nothing becomes infinite.
+//!   inline array). The root starts with Thickness 1 (section 4.4.2), Length
+//!   [`GrowOptions::root_length`] (default 1; the evolution examples use 2.5, so 100
+//!   iterations reach across the paper's sphere), the rest 0, heading up (+Y). Variables are clamped to ±10⁶ (counted), so nothing becomes infinite.
 //! - **If** compares a variable with a value: `IfLess` (<), `IfGreater` (>) and `IfEqual`
 //!   (within [`Semantics::equal_tolerance`], default 0.5). Both branches continue after the
 //!   `If` by default ([`ElseEnd::Rejoin`]); the literal reading, where only *then* is the
@@ -70,13 +71,16 @@
 //!   `radius × mapped thickness × unit` ([`GrowOptions::radius`], default 3 units).
 //! - **Units.** Paper units × [`GrowOptions::unit`] metres (default 0.1): the paper's target
 //!   sphere of radius 150 centred 200 up is 15 m across, 5 m above the ground.
-//! - **Endpoints** are the tips of the plant ([`sylva_core::Plant::tips`]): where an
-//!   instance's path ends (death or the iteration limit) and where a path drawn inside a
-//!   Push/Pop ends. An instance that never moves draws nothing and has no endpoint.
+//! - **Endpoints** (the fitness cases) are chosen by the fitness
+//!   (`sylva_fitness::poncin::EndpointRule`): every tip of the plant, where an instance's
+//!   path ends and where a path drawn inside a Push/Pop ends; or one per instance, where it
+//!   ended (Table 1's "endpoints of all the automata instantiated"), which the evolution
+//!   examples use. An instance that never moves draws nothing and has no endpoint.
 //! - **Gravity** ([`GrowOptions::gravity`], default off) bends every heading towards the
 //!   ground each step, more the more horizontal it is (Figure 17's pine).
-//! - **Leaves** are turned near horizontal by default (section 4.5). The model is
-//!   deterministic; the seed is only recorded.
+//! - **Leaves** are turned near horizontal by default (section 4.5), each turned about the
+//!   vertical by the golden angle times its index, so leaves added at one spot fan out. The
+//!   model is deterministic; the seed is only recorded.
 //!
 //! # The helix (Figures 1 and 2)
 //!
