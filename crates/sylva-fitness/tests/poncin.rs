@@ -8,8 +8,8 @@ use sylva_core::{Organ, OrganKind, Plant, PlantMeta, SegmentId};
 use sylva_fitness::poncin::{
     DensityGrid, EndpointRule, GRID_MAX, GridBox, GridCell, GridConfig, NumTarget, PairMode,
     PairOptions, PoncinContext, PoncinFitness, PoncinScore, PoncinScratch, PoncinWeights,
-    TERM_NAMES, TargetShape, ThickOptions, WORST_PAIR, f_angle, f_dist, f_grid, f_num, f_pos,
-    f_thick,
+    TERM_NAMES, TargetShape, ThickMeasure, ThickOptions, WORST_PAIR, f_angle, f_dist, f_grid,
+    f_num, f_pos, f_thick,
 };
 
 const UNIT: f64 = 0.1;
@@ -146,6 +146,44 @@ fn axis_endpoints_are_where_each_axis_was_last_drawn() {
     assert_eq!(score(EndpointRule::Tips).branches, 2);
     assert_eq!(score(EndpointRule::Axes).branches, 2);
     assert_ne!(score(EndpointRule::Tips).pos, score(EndpointRule::Axes).pos);
+}
+
+#[test]
+fn the_taper_measure_rewards_thinning_gradually() {
+    // A trunk of four 1 m segments, radius per thickness 0.3 m, ending at thickness 1/6:
+    // thinning evenly, or dropping to 1/6 in its first metre (the same endpoint).
+    let trunk = |thickness: [f32; 5]| {
+        let mut p = Plant::new(PlantMeta::default());
+        let mut parent = None;
+        for k in 0..4 {
+            let (a, b) = (Vec3::Y * k as f32, Vec3::Y * (k + 1) as f32);
+            let r = (0.3 * thickness[k], 0.3 * thickness[k + 1]);
+            parent = Some(p.add_segment(a, b, r, parent, false, Plant::BARK).unwrap());
+        }
+        p
+    };
+    let step = (1.0 - 1.0 / 6.0) / 4.0;
+    let even = trunk([
+        1.0,
+        1.0 - step,
+        1.0 - 2.0 * step,
+        1.0 - 3.0 * step,
+        1.0 / 6.0,
+    ]);
+    let sudden = trunk([1.0, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0]);
+    let endpoints = ThickOptions::default();
+    let taper = ThickOptions {
+        measure: ThickMeasure::Taper,
+        ..ThickOptions::default()
+    };
+    // The paper's measure cannot tell them apart; the taper measure can.
+    close(f_thick(&even, &endpoints, 0), 0.0);
+    close(f_thick(&sudden, &endpoints, 0), 0.0);
+    assert!(f_thick(&even, &taper, 0) < 1e-6);
+    // Ends at 1, 2, 3 m of 4 fall short of the line by 3/4, 2/4, 1/4 of 5/6: mean 5/16.
+    close(f_thick(&sudden, &taper, 0), 5.0 / 16.0);
+    // A negative thickness is still penalised.
+    close(f_thick(&even, &taper, 2) - f_thick(&even, &taper, 0), 2.0);
 }
 
 #[test]

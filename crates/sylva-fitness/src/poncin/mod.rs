@@ -7,7 +7,7 @@
 //! | [`f_num`] | number of branches | `abs(30 − N)`, or per branch level ([`NumTarget`]) |
 //! | [`f_dist`] | endpoints far apart | mean of `200 / (‖A − B‖ + 5)` over pairs ([`pairs`]) |
 //! | [`f_angle`] | branches pointing apart | mean of `200 / (θ° + 5)` over pairs ([`pairs`]) |
-//! | [`f_thick`] | thinning branches | mean `abs(thickness − reference(level))`, plus a penalty per negative thickness ([`ThickOptions`]) |
+//! | [`f_thick`] | thinning branches | mean `abs(thickness − reference(level))` over the endpoints, or along a taper ([`ThickMeasure`]), plus a penalty per negative thickness ([`ThickOptions`]) |
 //! | [`f_grid`] | leaves in favoured cells, none in forbidden ones | a cost in 0..=100 from the paper's `F_cell` ([`grid`]) |
 //!
 //! All terms are costs (0 is perfect). [`PoncinFitness::score`] computes them together,
@@ -311,6 +311,24 @@ pub struct ThickOptions {
     /// one endpoint can have in 0..1).
     #[serde(deserialize_with = "penalty")]
     pub negative_penalty: f64,
+    /// What is compared with the references. Default [`ThickMeasure::Endpoints`] (the
+    /// paper's).
+    pub measure: ThickMeasure,
+}
+
+/// What F_thick compares with its references.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ThickMeasure {
+    /// Each endpoint's thickness against its level's reference (section 4.4.2). A tree that
+    /// thins every branch to the minimum just above its foot meets it: only the ends count.
+    #[default]
+    Endpoints,
+    /// Every segment's end against a straight taper along its axis, from the thickness where
+    /// the axis starts (1 for the trunk; the junction's for a branch) to its level's
+    /// reference at the axis's end; the mean deviation weighted by segment length. Rewards
+    /// thinning gradually, as trunks and branches do. Sylva's, not the paper's.
+    Taper,
 }
 
 impl Default for ThickOptions {
@@ -319,6 +337,7 @@ impl Default for ThickOptions {
             references: vec![1.0 / 6.0, 1.0 / 9.0, 1.0 / 12.0],
             radius_per_thickness: 0.3,
             negative_penalty: 1.0,
+            measure: ThickMeasure::Endpoints,
         }
     }
 }
@@ -511,9 +530,15 @@ impl PoncinFitness {
             num: self.num_target.deviation(ends),
             dist: sane(spread.dist),
             angle: sane(spread.angle),
-            thick: sane(self.thick.deviation(ends, ctx.negative_thickness)),
             ..PoncinScore::default()
         };
+        s.thick = sane(match self.thick.measure {
+            ThickMeasure::Endpoints => self.thick.deviation(ends, ctx.negative_thickness),
+            ThickMeasure::Taper => {
+                scratch.taper_deviation(plant, &self.thick)
+                    + self.thick.negative_penalty * f64::from(ctx.negative_thickness)
+            }
+        });
         let rest = self.weights.rest(&s);
         if let Some(grid) = &self.grid {
             grid.count_leaves(plant, self.unit, &mut scratch.cells);
@@ -566,9 +591,13 @@ pub fn f_angle(plant: &Plant, pairs: &PairOptions, seed: u64) -> f64 {
     pairs.spread(&read(plant, 1.0), seed, true).angle
 }
 
-/// F_thick of a plant (see [`ThickOptions`]).
+/// F_thick of a plant (see [`ThickOptions`] and [`ThickMeasure`]).
 pub fn f_thick(plant: &Plant, thick: &ThickOptions, negative_thickness: u32) -> f64 {
-    thick.deviation(&endpoints_of(plant, 1.0), negative_thickness)
+    let penalty = thick.negative_penalty * f64::from(negative_thickness);
+    match thick.measure {
+        ThickMeasure::Endpoints => thick.deviation(&endpoints_of(plant, 1.0), negative_thickness),
+        ThickMeasure::Taper => read(plant, 1.0).taper_deviation(plant, thick) + penalty,
+    }
 }
 
 /// F_grid of a plant, ungated: the grid's cost in 0..=100 (see [`grid`]).
