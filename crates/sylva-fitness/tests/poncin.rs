@@ -149,9 +149,9 @@ fn axis_endpoints_are_where_each_axis_was_last_drawn() {
 }
 
 #[test]
-fn the_taper_measure_rewards_thinning_gradually() {
-    // A trunk of four 1 m segments, radius per thickness 0.3 m, ending at thickness 1/6:
-    // thinning evenly, or dropping to 1/6 in its first metre (the same endpoint).
+fn the_taper_measure_rewards_thinning_gradually_from_the_foot() {
+    // A trunk of four 1 m segments (radius per thickness 0.3 m) ending at thickness 1/6:
+    // thinning geometrically, or dropping to 1/6 in its first metre (the same endpoint).
     let trunk = |thickness: [f32; 5]| {
         let mut p = Plant::new(PlantMeta::default());
         let mut parent = None;
@@ -162,13 +162,13 @@ fn the_taper_measure_rewards_thinning_gradually() {
         }
         p
     };
-    let step = (1.0 - 1.0 / 6.0) / 4.0;
+    let at = |d: f64| (1.0f64 / 6.0).powf(d / 4.0);
     let even = trunk([
         1.0,
-        1.0 - step,
-        1.0 - 2.0 * step,
-        1.0 - 3.0 * step,
-        1.0 / 6.0,
+        at(1.0) as f32,
+        at(2.0) as f32,
+        at(3.0) as f32,
+        at(4.0) as f32,
     ]);
     let sudden = trunk([1.0, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0]);
     let endpoints = ThickOptions::default();
@@ -177,13 +177,25 @@ fn the_taper_measure_rewards_thinning_gradually() {
         ..ThickOptions::default()
     };
     // The paper's measure cannot tell them apart; the taper measure can.
-    close(f_thick(&even, &endpoints, 0), 0.0);
-    close(f_thick(&sudden, &endpoints, 0), 0.0);
+    assert!(f_thick(&even, &endpoints, 0) < 1e-6);
+    assert!(f_thick(&sudden, &endpoints, 0) < 1e-6);
     assert!(f_thick(&even, &taper, 0) < 1e-6);
-    // Ends at 1, 2, 3 m of 4 fall short of the line by 3/4, 2/4, 1/4 of 5/6: mean 5/16.
-    close(f_thick(&sudden, &taper, 0), 5.0 / 16.0);
+    let expected = (1..=4).map(|d| at(f64::from(d)) - 1.0 / 6.0).sum::<f64>() / 4.0;
+    assert!((f_thick(&sudden, &taper, 0) - expected).abs() < 1e-6);
+    // A branch from the foot counts its path from the foot too: a level-1 tip farthest out
+    // sets the reference to 1/9 there.
+    let mut forked = even.clone();
+    let top = forked.segments[3].end;
+    let tip = top + Vec3::X * 4.0;
+    let r = (0.3 * at(4.0) as f32, 0.3 / 9.0);
+    let last = Some(SegmentId(3));
+    forked
+        .add_segment(top, tip, r, last, true, Plant::BARK)
+        .unwrap();
+    assert!(f_thick(&forked, &taper, 0) > 0.0);
     // A negative thickness is still penalised.
-    close(f_thick(&even, &taper, 2) - f_thick(&even, &taper, 0), 2.0);
+    let penalty = f_thick(&even, &taper, 2) - f_thick(&even, &taper, 0);
+    assert!((penalty - 2.0).abs() < 1e-9);
 }
 
 #[test]

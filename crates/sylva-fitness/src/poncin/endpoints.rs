@@ -52,10 +52,8 @@ pub struct PoncinScratch {
     axis: Vec<u32>,
     /// Per axis (indexed by its first segment): its last segment.
     last: Vec<u32>,
-    /// Per segment: path length from its axis's base to its end (the taper measure).
+    /// Per segment: path length from the foot to its end (the taper measure).
     along: Vec<f64>,
-    /// Per axis (indexed by its first segment): its length (the taper measure).
-    axis_length: Vec<f64>,
     pub(crate) endpoints: Vec<Endpoint>,
     /// Endpoint positions as f32 columns (x, y, z), for the exact pair loop.
     pub(crate) columns: [Vec<f32>; 3],
@@ -120,44 +118,40 @@ impl PoncinScratch {
 
     /// F_thick's taper measure ([`super::ThickMeasure::Taper`]) of `plant`, which must be
     /// the plant last [`read`](Self::read): the length-weighted mean of
-    /// `|thickness − reference|` over segment ends, the reference running straight along each
-    /// axis from the thickness at its base to its level's reference at its end. 0 for a
-    /// plant without length.
+    /// `|thickness − reference|` over segment ends, where the reference falls geometrically
+    /// with path length from the foot, from 1 there to the farthest tip's level reference.
+    /// 0 for a plant without length.
     pub fn taper_deviation(&mut self, plant: &Plant, thick: &super::ThickOptions) -> f64 {
         let segments = &plant.segments;
-        let n = segments.len().min(self.axis.len());
         self.along.clear();
-        self.axis_length.clear();
-        self.axis_length.resize(n, 0.0);
-        for (i, s) in segments[..n].iter().enumerate() {
+        let (mut farthest, mut far_level) = (0.0, 0u16);
+        for (i, s) in segments.iter().enumerate() {
             let before = match s.parent.map(|p| p.index()) {
-                Some(p) if p < i && !s.lateral => self.along[p],
+                Some(p) if p < i => self.along[p],
                 _ => 0.0,
             };
             let along = before + f64::from(s.length());
             self.along.push(along);
-            let axis = self.axis[i] as usize;
-            self.axis_length[axis] = self.axis_length[axis].max(along);
+            if along > farthest {
+                (farthest, far_level) = (along, s.order);
+            }
         }
+        if farthest <= 0.0 {
+            return 0.0;
+        }
+        // ln of the farthest tip's reference (kept off 0, whose logarithm is -inf).
+        let ln_tip = thick.reference(far_level).max(1e-6).ln();
         let scale = 1.0 / thick.radius_per_thickness;
         let (mut deviation, mut length) = (0.0, 0.0);
-        for (i, s) in segments[..n].iter().enumerate() {
+        for (s, &along) in segments.iter().zip(&self.along) {
             let l = f64::from(s.length());
-            let axis = self.axis[i] as usize;
-            if l <= 0.0 || self.axis_length[axis] <= 0.0 {
-                continue;
+            if l > 0.0 {
+                let reference = (ln_tip * along / farthest).exp();
+                deviation += l * (f64::from(s.end_radius) * scale - reference).abs();
+                length += l;
             }
-            let base = f64::from(segments[axis].start_radius) * scale;
-            let t = self.along[i] / self.axis_length[axis];
-            let reference = base + (thick.reference(s.order) - base) * t;
-            deviation += l * (f64::from(s.end_radius) * scale - reference).abs();
-            length += l;
         }
-        if length > 0.0 {
-            deviation / length
-        } else {
-            0.0
-        }
+        deviation / length
     }
 
     /// The endpoints of the last plant read.

@@ -324,10 +324,12 @@ pub enum ThickMeasure {
     /// thins every branch to the minimum just above its foot meets it: only the ends count.
     #[default]
     Endpoints,
-    /// Every segment's end against a straight taper along its axis, from the thickness where
-    /// the axis starts (1 for the trunk; the junction's for a branch) to its level's
-    /// reference at the axis's end; the mean deviation weighted by segment length. Rewards
-    /// thinning gradually, as trunks and branches do. Sylva's, not the paper's.
+    /// Every segment's end against a taper from the foot: the reference falls geometrically
+    /// with path length from the foot, from 1 there to the farthest tip's level reference
+    /// (`thickness = tip^(d / D)`, as a per-step `Multiply Thickness` gives); the mean
+    /// deviation weighted by segment length. Rewards thinning gradually from trunk to twigs.
+    /// Sylva's, not the paper's. (A taper along each axis from where it starts was tried
+    /// first: evolution met it with a short tapering trunk that all branches hang from.)
     Taper,
 }
 
