@@ -10,7 +10,7 @@ use sylva_core::glam::{DVec3, Quat, Vec3};
 use sylva_core::{Organ, OrganKind, Plant, PlantMeta};
 use sylva_fitness::poncin::{
     DensityGrid, GridConfig, NumTarget, PairMode, PairOptions, PoncinContext, PoncinFitness,
-    PoncinScratch, PoncinWeights, TargetShape,
+    PoncinScratch, PoncinWeights, TargetShape, ThickMeasure, ThickOptions,
 };
 
 #[global_allocator]
@@ -54,9 +54,12 @@ fn scoring_does_not_allocate_once_warm() {
         cells: vec![],
     })
     .unwrap();
+    // Both pair modes, each with one of the thickness measures.
+    let measures = [ThickMeasure::Endpoints, ThickMeasure::Taper];
     let configs: Vec<PoncinFitness> = [PairMode::Exact, PairMode::Sampled]
         .into_iter()
-        .map(|mode| PoncinFitness {
+        .zip(measures)
+        .map(|(mode, measure)| PoncinFitness {
             weights: PoncinWeights {
                 angle: 1.0,
                 grid: 10.0,
@@ -73,6 +76,10 @@ fn scoring_does_not_allocate_once_warm() {
             },
             grid: Some(grid.clone()),
             grid_gate: 1e12,
+            thick: ThickOptions {
+                measure,
+                ..ThickOptions::default()
+            },
             ..PoncinFitness::default()
         })
         .collect();
