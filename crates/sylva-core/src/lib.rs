@@ -8,7 +8,9 @@
 //!   [`TreeMeasures`].
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
+//! - [`par`]: the one seam where work goes parallel ([`par::Pool`]).
 //! - [`ranged`]: range-checked fields for genome and config files.
+//! - [`rng`]: ChaCha8 streams from a seed, the only source of randomness.
 //!
 //! Conventions: Y is up, right-handed, metres; angles are radians in code.
 //!
@@ -32,8 +34,10 @@ pub mod environment;
 pub mod hash;
 pub mod io;
 pub mod measures;
+pub mod par;
 pub mod plant;
 pub mod ranged;
+pub mod rng;
 pub mod turtle;
 
 pub use glam;

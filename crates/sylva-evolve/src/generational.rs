@@ -21,7 +21,7 @@
 //! lilgp's plain generational step.
 //!
 //! Slot `s` of generation `g` draws everything from `rng::stream(seed, g, s)` and is made and
-//! evaluated in one job of [`Evaluator::map`](crate::Evaluator::map), so a run is identical for any thread count and
+//! evaluated in one job of [`Pool::map`](crate::Pool::map), so a run is identical for any thread count and
 //! a resumed run continues exactly.
 //!
 //! **Re-evaluation.** Copies (elites and reproductions) keep their genome, so their fitness

@@ -6,18 +6,19 @@
 //! - [`Strategy`]: how one generation becomes the next; [`MeanReplacement`] is Susinno's.
 //! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,
 //!   elitism), as Poncin's GP runs used.
-//! - [`Evaluator`]: the one seam where work goes parallel (rayon), results kept in order.
+//! - [`Pool`]: the one seam where work goes parallel (serial or rayon), results kept in
+//!   order (from `sylva_core::par`).
 //! - [`Run`]: generations, batches, statistics, a [`Browser`] over the family, and
 //!   [`Checkpoint`]s that resume exactly.
 //! - [`bits`]: fixed-length bit strings with bit-flip mutation and crossovers.
-//! - [`rng`]: ChaCha8 streams keyed by `(seed, generation, slot)`.
+//! - [`rng`]: ChaCha8 streams keyed by `(seed, generation, slot)` (from `sylva_core::rng`).
 //!
 //! Determinism: the same problem, settings and seed give the same populations and
 //! statistics (less wall time) for any number of threads.
 //!
 //! ```
 //! use sylva_evolve::{
-//!     Evaluator, Fitness, MeanReplacement, Problem, Run, RunSettings,
+//!     Pool, Fitness, MeanReplacement, Problem, Run, RunSettings,
 //!     bits::{BitFlip, BitString, OnePoint},
 //! };
 //!
@@ -41,7 +42,7 @@
 //!     cull_clones: true,
 //! };
 //! let settings = RunSettings { seed: 1, population: 60, keep_history: 0 };
-//! let mut run = Run::new(OneMax, strategy, Evaluator::Serial, settings)?;
+//! let mut run = Run::new(OneMax, strategy, Pool::Serial, settings)?;
 //! let first = run.stats()[0].best;
 //! run.run_batch(40, |_| {});
 //! assert!(run.best().total() > first);
@@ -53,7 +54,6 @@ pub mod fitness;
 pub mod generational;
 pub mod individual;
 pub mod problem;
-pub mod rng;
 pub mod run;
 pub mod strategy;
 pub mod variation;
@@ -61,7 +61,9 @@ pub mod variation;
 pub use fitness::{Fitness, MAX_TERMS};
 pub use generational::{Generational, GenerationalError, GenerationalSettings};
 pub use individual::{Individual, IndividualId, Origin};
-pub use problem::{Evaluator, Problem};
+pub use problem::Problem;
 pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};
 pub use strategy::{Breeding, MeanReplacement, Strategy};
+pub use sylva_core::par::Pool;
+pub use sylva_core::rng;
 pub use variation::{Crossover, Mutate};

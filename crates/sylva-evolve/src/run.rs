@@ -15,9 +15,10 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::Pool;
 use crate::fitness::MAX_TERMS;
 use crate::individual::{Individual, IndividualId, Origin};
-use crate::problem::{Evaluator, Problem};
+use crate::problem::Problem;
 use crate::rng;
 use crate::strategy::{Breeding, Strategy, evaluate_missing, mean_total, two_best};
 
@@ -100,7 +101,7 @@ pub const CHECKPOINT_FORMAT: u32 = 1;
 pub struct Run<P: Problem, S> {
     problem: P,
     strategy: S,
-    evaluator: Evaluator,
+    evaluator: Pool,
     settings: RunSettings,
     term_names: Vec<String>,
     generation: u32,
@@ -115,7 +116,7 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
     pub fn new(
         problem: P,
         strategy: S,
-        evaluator: Evaluator,
+        evaluator: Pool,
         settings: RunSettings,
     ) -> Result<Self, EvolveError> {
         Self::with_genomes(problem, strategy, evaluator, settings, Vec::new())
@@ -126,7 +127,7 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
     pub fn with_genomes(
         problem: P,
         strategy: S,
-        evaluator: Evaluator,
+        evaluator: Pool,
         settings: RunSettings,
         genomes: Vec<P::Genome>,
     ) -> Result<Self, EvolveError> {
@@ -176,7 +177,7 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
     pub fn resume(
         problem: P,
         strategy: S,
-        evaluator: Evaluator,
+        evaluator: Pool,
         checkpoint: Checkpoint<P::Genome>,
     ) -> Result<Self, EvolveError> {
         let bad = |why: String| Err(EvolveError::BadCheckpoint(why));

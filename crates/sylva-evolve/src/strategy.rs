@@ -1,7 +1,7 @@
 //! How one generation becomes the next.
 //!
 //! A [`Strategy`] breeds in place: it reads the evaluated population, makes offspring with
-//! variation operators, evaluates them through the [`Evaluator`] and writes them back.
+//! variation operators, evaluates them through the [`Pool`] and writes them back.
 //! Every offspring slot draws from its own random stream (see [`crate::rng`]).
 //!
 //! [`MeanReplacement`] is the generation step of Susinno's *Deciduous Evolution*:
@@ -26,9 +26,10 @@
 
 use std::borrow::Cow;
 
+use crate::Pool;
 use crate::fitness::Fitness;
 use crate::individual::{Individual, IndividualId, Origin};
-use crate::problem::{Evaluator, Problem};
+use crate::problem::Problem;
 use crate::rng;
 use crate::variation::{Crossover, Mutate};
 
@@ -39,13 +40,13 @@ pub struct Breeding<'a> {
     /// The generation being made (1 for the first bred generation).
     pub generation: u32,
     /// Where evaluation runs.
-    pub evaluator: &'a Evaluator,
+    pub evaluator: &'a Pool,
     next_id: &'a mut u64,
 }
 
 impl<'a> Breeding<'a> {
     /// A breeding context; ids are taken from `next_id` upwards.
-    pub fn new(seed: u64, generation: u32, evaluator: &'a Evaluator, next_id: &'a mut u64) -> Self {
+    pub fn new(seed: u64, generation: u32, evaluator: &'a Pool, next_id: &'a mut u64) -> Self {
         Breeding {
             seed,
             generation,
@@ -194,7 +195,7 @@ where
 pub fn evaluate_missing<P: Problem>(
     problem: &P,
     population: &mut [Individual<P::Genome>],
-    evaluator: &Evaluator,
+    evaluator: &Pool,
 ) -> u64 {
     let todo: Vec<usize> = (0..population.len())
         .filter(|&i| population[i].fitness.is_none())

@@ -4,8 +4,7 @@
 use rand::Rng;
 use sylva_evolve::bits::{BitFlip, BitString, OnePoint};
 use sylva_evolve::{
-    Browser, Checkpoint, Evaluator, Fitness, IndividualId, MeanReplacement, Problem, Run,
-    RunSettings,
+    Browser, Checkpoint, Fitness, IndividualId, MeanReplacement, Pool, Problem, Run, RunSettings,
 };
 
 type Bits = BitString<2>;
@@ -58,7 +57,7 @@ fn same_result_for_any_thread_count() {
     let prints: Vec<String> = [1, 2, 3]
         .into_iter()
         .map(|threads| {
-            let ev = Evaluator::with_threads(threads).unwrap();
+            let ev = Pool::with_threads(threads).unwrap();
             let mut run = Run::new(Rugged, strategy(), ev, settings(64)).unwrap();
             run.run_batch(30, |_| {});
             fingerprint(&run)
@@ -70,22 +69,22 @@ fn same_result_for_any_thread_count() {
 
 #[test]
 fn resume_continues_exactly() {
-    let mut straight = Run::new(Rugged, strategy(), Evaluator::Serial, settings(40)).unwrap();
+    let mut straight = Run::new(Rugged, strategy(), Pool::Serial, settings(40)).unwrap();
     straight.run_batch(20, |_| {});
 
-    let mut first = Run::new(Rugged, strategy(), Evaluator::Serial, settings(40)).unwrap();
+    let mut first = Run::new(Rugged, strategy(), Pool::Serial, settings(40)).unwrap();
     first.run_batch(8, |_| {});
     let json = serde_json::to_string(&first.checkpoint()).unwrap();
     drop(first);
     let checkpoint: Checkpoint<Bits> = serde_json::from_str(&json).unwrap();
-    let mut resumed = Run::resume(Rugged, strategy(), Evaluator::Serial, checkpoint).unwrap();
+    let mut resumed = Run::resume(Rugged, strategy(), Pool::Serial, checkpoint).unwrap();
     resumed.run_batch(12, |_| {});
     assert_eq!(fingerprint(&resumed), fingerprint(&straight));
 }
 
 #[test]
 fn best_never_decreases_and_is_never_replaced() {
-    let mut run = Run::new(Rugged, strategy(), Evaluator::Serial, settings(30)).unwrap();
+    let mut run = Run::new(Rugged, strategy(), Pool::Serial, settings(30)).unwrap();
     for _ in 0..60 {
         let before = run.best().clone();
         run.step();
@@ -135,7 +134,7 @@ fn the_papers_anomaly_cannot_discard_the_best() {
         cull_clones: false,
     };
     let mut run =
-        Run::with_genomes(Plateau, strategy, Evaluator::Serial, settings(10), genomes).unwrap();
+        Run::with_genomes(Plateau, strategy, Pool::Serial, settings(10), genomes).unwrap();
     for _ in 0..20 {
         run.step();
         assert_eq!(run.best().total(), 0.7);
@@ -145,7 +144,7 @@ fn the_papers_anomaly_cannot_discard_the_best() {
 
 #[test]
 fn browser_walks_slots_and_generations() {
-    let mut run = Run::new(Rugged, strategy(), Evaluator::Serial, settings(8)).unwrap();
+    let mut run = Run::new(Rugged, strategy(), Pool::Serial, settings(8)).unwrap();
     run.run_batch(10, |_| {});
     let mut b = Browser::at_best(&run);
     assert_eq!(b.current(&run).unwrap().id, run.best().id);
@@ -170,14 +169,14 @@ fn browser_walks_slots_and_generations() {
 
 #[test]
 fn refuses_empty_population_and_bad_checkpoints() {
-    assert!(Run::new(Rugged, strategy(), Evaluator::Serial, settings(0)).is_err());
-    let run = Run::new(Rugged, strategy(), Evaluator::Serial, settings(4)).unwrap();
+    assert!(Run::new(Rugged, strategy(), Pool::Serial, settings(0)).is_err());
+    let run = Run::new(Rugged, strategy(), Pool::Serial, settings(4)).unwrap();
     let mut cp = run.checkpoint();
     cp.population.pop();
-    assert!(Run::resume(Rugged, strategy(), Evaluator::Serial, cp).is_err());
+    assert!(Run::resume(Rugged, strategy(), Pool::Serial, cp).is_err());
     let mut cp = run.checkpoint();
     cp.format = 99;
-    assert!(Run::resume(Rugged, strategy(), Evaluator::Serial, cp).is_err());
+    assert!(Run::resume(Rugged, strategy(), Pool::Serial, cp).is_err());
 }
 
 #[test]
@@ -191,7 +190,7 @@ fn clones_stall_the_papers_step_unless_culled() {
         };
         let genomes = vec![Bits::zeros(100).unwrap(); 12];
         let mut run =
-            Run::with_genomes(Rugged, strategy, Evaluator::Serial, settings(12), genomes).unwrap();
+            Run::with_genomes(Rugged, strategy, Pool::Serial, settings(12), genomes).unwrap();
         let before = run.best().total();
         run.run_batch(10, |_| {});
         let evaluations: u64 = run.stats()[1..].iter().map(|s| s.evaluations).sum();

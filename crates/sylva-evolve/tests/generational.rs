@@ -8,8 +8,8 @@ use std::collections::HashMap;
 use rand::Rng;
 use sylva_evolve::bits::{BitFlip, BitString, OnePoint};
 use sylva_evolve::{
-    Checkpoint, Evaluator, Fitness, Generational, GenerationalError, GenerationalSettings, Problem,
-    Run, RunSettings,
+    Checkpoint, Fitness, Generational, GenerationalError, GenerationalSettings, Pool, Problem, Run,
+    RunSettings,
 };
 
 type Bits = BitString<2>;
@@ -60,7 +60,7 @@ fn improves() {
     let mut run = Run::new(
         Rugged,
         strategy(GenerationalSettings::default()),
-        Evaluator::Serial,
+        Pool::Serial,
         settings(80),
     )
     .unwrap();
@@ -82,7 +82,7 @@ fn same_result_for_one_and_two_threads() {
     let prints: Vec<String> = [1, 2]
         .into_iter()
         .map(|threads| {
-            let ev = Evaluator::with_threads(threads).unwrap();
+            let ev = Pool::with_threads(threads).unwrap();
             let mut run = Run::new(
                 Rugged,
                 strategy(GenerationalSettings::default()),
@@ -100,15 +100,15 @@ fn same_result_for_one_and_two_threads() {
 #[test]
 fn resume_from_checkpoint_equals_uninterrupted() {
     let make = || strategy(GenerationalSettings::default());
-    let mut straight = Run::new(Rugged, make(), Evaluator::Serial, settings(40)).unwrap();
+    let mut straight = Run::new(Rugged, make(), Pool::Serial, settings(40)).unwrap();
     straight.run_batch(15, |_| {});
 
-    let mut first = Run::new(Rugged, make(), Evaluator::Serial, settings(40)).unwrap();
+    let mut first = Run::new(Rugged, make(), Pool::Serial, settings(40)).unwrap();
     first.run_batch(6, |_| {});
     let json = serde_json::to_string(&first.checkpoint()).unwrap();
     drop(first);
     let checkpoint: Checkpoint<Bits> = serde_json::from_str(&json).unwrap();
-    let mut resumed = Run::resume(Rugged, make(), Evaluator::Serial, checkpoint).unwrap();
+    let mut resumed = Run::resume(Rugged, make(), Pool::Serial, checkpoint).unwrap();
     resumed.run_batch(9, |_| {});
     assert_eq!(fingerprint(&resumed), fingerprint(&straight));
 }
@@ -187,7 +187,7 @@ fn elitism_keeps_the_best() {
         )
         .unwrap()
     };
-    let mut run = Run::new(Rugged, make(2), Evaluator::Serial, settings(20)).unwrap();
+    let mut run = Run::new(Rugged, make(2), Pool::Serial, settings(20)).unwrap();
     for _ in 0..30 {
         let before = run.best().clone();
         run.step();
@@ -197,7 +197,7 @@ fn elitism_keeps_the_best() {
         assert_eq!(elite.origin.operator, "elite");
         assert_eq!(elite.origin.parents, vec![before.id]);
     }
-    let mut lossy = Run::new(Rugged, make(0), Evaluator::Serial, settings(20)).unwrap();
+    let mut lossy = Run::new(Rugged, make(0), Pool::Serial, settings(20)).unwrap();
     let mut lost = false;
     for _ in 0..30 {
         let before = lossy.best().total();
@@ -215,7 +215,7 @@ fn operators_follow_the_rates_and_record_parents() {
     let mut run = Run::new(
         Rugged,
         strategy(GenerationalSettings::default()),
-        Evaluator::Serial,
+        Pool::Serial,
         settings(2000),
     )
     .unwrap();
@@ -248,7 +248,7 @@ fn copies_reuse_fitness_only_when_asked() {
             reevaluate,
             ..GenerationalSettings::default()
         };
-        let mut run = Run::new(Rugged, strategy(s), Evaluator::Serial, settings(500)).unwrap();
+        let mut run = Run::new(Rugged, strategy(s), Pool::Serial, settings(500)).unwrap();
         run.step();
         let copies = run
             .population()

@@ -67,7 +67,11 @@ fn sheet(cells: &[SheetCell], view: View, title: &str, name: &str) {
         view,
         title: Some(title.to_owned()),
     };
-    write_png(&out(name), &contact_sheet(cells, &options).unwrap()).unwrap();
+    write_png(
+        &out(name),
+        &contact_sheet(cells, &options, &sylva_core::par::Pool::Serial).unwrap(),
+    )
+    .unwrap();
 }
 
 #[test]

@@ -13,8 +13,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sylva_core::rng;
 use sylva_core::{Plant, PlantMeta};
-use sylva_evolve::rng;
 use sylva_models::automata::{
     AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
 };

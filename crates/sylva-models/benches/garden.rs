@@ -8,6 +8,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sylva_core::environment::EnvironmentSettings;
+use sylva_core::par::Pool;
 use sylva_models::lsystem::LSystemGenome;
 use sylva_models::lsystem::breed::grid_position;
 use sylva_models::lsystem::garden::{Garden, Sowing};
@@ -23,9 +24,9 @@ fn sowings(genomes: &[LSystemGenome]) -> Vec<Sowing> {
         .collect()
 }
 
-fn grow(sowings: &[Sowing]) -> Garden {
+fn grow(sowings: &[Sowing], pool: &Pool) -> Garden {
     let mut garden = Garden::new(EnvironmentSettings::default(), sowings.to_vec()).unwrap();
-    garden.run(100).unwrap();
+    garden.run(100, pool).unwrap();
     garden
 }
 
@@ -39,11 +40,12 @@ fn garden(c: &mut Criterion) {
     ];
     let mut group = c.benchmark_group("lsystem garden, 100 steps, 64^3 voxels");
     group.sample_size(10);
+    let pool = Pool::with_threads(0).unwrap();
     for (name, sowings) in &cases {
-        let g = grow(sowings);
+        let g = grow(sowings, &pool);
         let modules: u32 = g.plants().iter().map(|p| p.modules()).sum();
         eprintln!("{name}: {modules} modules after 100 steps");
-        group.bench_function(*name, |b| b.iter(|| black_box(grow(sowings))));
+        group.bench_function(*name, |b| b.iter(|| black_box(grow(sowings, &pool))));
     }
     group.finish();
 }

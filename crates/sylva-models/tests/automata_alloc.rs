@@ -6,8 +6,8 @@
 use std::alloc::System;
 
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
+use sylva_core::rng;
 use sylva_core::{Plant, PlantMeta};
-use sylva_evolve::rng;
 use sylva_models::automata::{
     AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
 };

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use proptest::prelude::*;
-use sylva_evolve::rng;
+use sylva_core::rng;
 use sylva_models::Genome;
 use sylva_models::bintree::{BITS, BinTree, Bits};
 

@@ -6,11 +6,12 @@ use std::path::PathBuf;
 use proptest::prelude::*;
 use sylva_core::environment::EnvironmentSettings;
 use sylva_core::glam::Vec2;
+use sylva_core::par::Pool;
 use sylva_evolve::{Mutate, Problem};
 use sylva_models::lsystem::breed::{
     BreedSettings, LSystemProblem, breed_garden, grid_position, largest_biomass,
 };
-use sylva_models::lsystem::experiments::{Simulation, load_genome};
+use sylva_models::lsystem::experiments::Simulation;
 use sylva_models::lsystem::garden::{Garden, GrowSettings, Sowing};
 use sylva_models::lsystem::genome::{LSystem, LSystemGenome, LSystemMutation, mutate_parameter};
 use sylva_models::lsystem::grammar::Compartment;
@@ -22,7 +23,8 @@ fn examples() -> PathBuf {
 }
 
 fn example(name: &str) -> LSystemGenome {
-    load_genome(&examples().join(name)).unwrap()
+    let text = std::fs::read_to_string(examples().join(name)).unwrap();
+    LSystemGenome::from_json(&text).unwrap()
 }
 
 /// A 2 m garden: quick to grow.
@@ -121,7 +123,7 @@ fn carbon_and_minerals_are_conserved() {
     let start = garden.balance();
     assert!(start.error() < 1e-12);
     for step in 0..70 {
-        garden.step().unwrap();
+        garden.step(&Pool::Serial).unwrap();
         let b = garden.balance();
         assert!(b.error() < 1e-9, "step {step}: {b:?}");
     }
@@ -148,7 +150,7 @@ fn runaway_growth_is_bounded_and_reported() {
     g.physiology.max_symbols = 20;
     g.physiology.max_modules = 10;
     let mut garden = Garden::new(small_world(), vec![Sowing::new(g, Vec2::ZERO)]).unwrap();
-    garden.run(60).unwrap();
+    garden.run(60, &Pool::Serial).unwrap();
     let p = &garden.plants()[0];
     assert!(p.words()[0].len() <= 20);
     assert!(p.modules() <= 10);
@@ -158,7 +160,7 @@ fn runaway_growth_is_bounded_and_reported() {
     assert!(hit.symbols > 0 && hit.modules > 0, "{hit:?}");
     assert!(hit.first_step.is_some());
     // Steps are bounded too.
-    assert!(garden.run(200_000).is_err());
+    assert!(garden.run(200_000, &Pool::Serial).is_err());
 }
 
 fn garden_bytes(threads: usize, order: &[usize]) -> (String, Vec<f64>) {
@@ -172,16 +174,11 @@ fn garden_bytes(threads: usize, order: &[usize]) -> (String, Vec<f64>) {
         .iter()
         .map(|&i| Sowing::new(genomes[i].clone(), spots[i]))
         .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
-        let mut garden = Garden::new(small_world(), sowings).unwrap();
-        garden.run(40).unwrap();
-        let biomass = garden.plants().iter().map(|p| p.biomass()).collect();
-        (garden.csv(), biomass)
-    })
+    let pool = Pool::with_threads(threads).unwrap();
+    let mut garden = Garden::new(small_world(), sowings).unwrap();
+    garden.run(40, &pool).unwrap();
+    let biomass = garden.plants().iter().map(|p| p.biomass()).collect();
+    (garden.csv(), biomass)
 }
 
 #[test]
@@ -212,7 +209,7 @@ fn neighbours_compete_for_light_and_minerals() {
     let alone = {
         let mut g =
             Garden::new(small_world(), vec![Sowing::new(herb.clone(), Vec2::ZERO)]).unwrap();
-        g.run(40).unwrap();
+        g.run(40, &Pool::Serial).unwrap();
         g.plants()[0].biomass()
     };
     let crowded = {
@@ -220,7 +217,7 @@ fn neighbours_compete_for_light_and_minerals() {
             .map(|i| Sowing::new(herb.clone(), Vec2::new(0.06 * i as f32, 0.05)))
             .collect();
         let mut g = Garden::new(small_world(), sowings).unwrap();
-        g.run(40).unwrap();
+        g.run(40, &Pool::Serial).unwrap();
         g.plants().iter().map(|p| p.biomass()).sum::<f64>() / 4.0
     };
     assert!(
@@ -236,8 +233,8 @@ fn the_breeding_garden_follows_the_paper() {
         spacing: 0.6,
         ..BreedSettings::default()
     };
-    let mut rng = sylva_evolve::rng::seeded(4);
-    let garden = breed_garden(&LSystemGenome::empty(), &settings, &mut rng).unwrap();
+    let mut rng = sylva_core::rng::seeded(4);
+    let garden = breed_garden(&LSystemGenome::empty(), &settings, &mut rng, &Pool::Serial).unwrap();
     assert_eq!(garden.specimens.len(), 9);
     assert!(garden.specimens[0].is_mother);
     assert!(
@@ -268,7 +265,7 @@ fn the_problem_scores_biomass() {
     let empty = problem.evaluate(&LSystemGenome::empty());
     assert!(bush.total() > empty.total(), "{bush:?} {empty:?}");
     assert_eq!(bush.terms()[0], bush.total());
-    let mut rng = sylva_evolve::rng::seeded(1);
+    let mut rng = sylva_core::rng::seeded(1);
     let g = problem.random_genome(&mut rng);
     assert_eq!(LSystemGenome::from_json(&g.to_json()).unwrap(), g);
 }
@@ -302,7 +299,7 @@ proptest! {
             _ => example("herb.json"),
         };
         let mutation = LSystemMutation { rates: rates_high(), parameter_scale: 0.3 };
-        let mut rng = sylva_evolve::rng::seeded(seed);
+        let mut rng = sylva_core::rng::seeded(seed);
         for _ in 0..rounds {
             mutation.mutate(&mut g, &mut rng);
             let text = g.to_json();
@@ -319,7 +316,7 @@ proptest! {
     fn mutants_grow_within_bounds(seed in any::<u64>()) {
         let mut g = LSystemGenome::bush();
         let mutation = LSystemMutation { rates: rates_high(), parameter_scale: 0.3 };
-        let mut rng = sylva_evolve::rng::seeded(seed);
+        let mut rng = sylva_core::rng::seeded(seed);
         for _ in 0..8 {
             mutation.mutate(&mut g, &mut rng);
         }

@@ -7,10 +7,12 @@ use std::path::{Path, PathBuf};
 
 use sylva_core::Plant;
 use sylva_core::glam::Vec3;
+use sylva_core::par::Pool;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::render::{RenderOptions, View, render, write_png};
 use sylva_mesh::{Scene, SceneNode};
-use sylva_models::lsystem::experiments::{Simulation, SimulationOutcome, load_genome};
+use sylva_models::lsystem::LSystemGenome;
+use sylva_models::lsystem::experiments::{Simulation, SimulationOutcome};
 use sylva_models::lsystem::garden::GrowSettings;
 
 fn examples() -> PathBuf {
@@ -53,7 +55,7 @@ fn assert_plant_shaped(plant: &Plant, name: &str) {
 }
 
 fn grow_alone(file: &str, steps: u32) -> Plant {
-    let genome = load_genome(&examples().join(file)).unwrap();
+    let genome = load(&examples().join(file));
     let settings = GrowSettings {
         steps,
         ..GrowSettings::default()
@@ -83,7 +85,16 @@ fn pictures_of_single_plants() {
 fn run(config: &str) -> SimulationOutcome {
     let text = std::fs::read_to_string(examples().join(config)).unwrap();
     let sim: Simulation = toml::from_str(&text).unwrap();
-    sim.run(Path::new(&examples())).unwrap()
+    let genomes: Vec<_> = sim
+        .genome_files()
+        .iter()
+        .map(|f| load(&examples().join(f)))
+        .collect();
+    sim.run(&genomes, &Pool::with_threads(0).unwrap()).unwrap()
+}
+
+fn load(path: &Path) -> LSystemGenome {
+    LSystemGenome::from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]

@@ -106,13 +106,13 @@ fn seeds_and_offspring_sheets() {
     };
     write_png(
         Path::new("/tmp/plantmaker-seeds.png"),
-        &contact_sheet(&cells, &options).unwrap(),
+        &contact_sheet(&cells, &options, &sylva_core::par::Pool::Serial).unwrap(),
     )
     .unwrap();
 
     // Parents and offspring: a row per operator.
     let (a, b) = (get("palm"), get("tulip"));
-    let mut rng = sylva_evolve::rng::seeded(11);
+    let mut rng = sylva_core::rng::seeded(11);
     let parents = [
         Parent {
             genome: &a,
@@ -164,7 +164,7 @@ fn seeds_and_offspring_sheets() {
     };
     write_png(
         Path::new("/tmp/plantmaker-offspring.png"),
-        &contact_sheet(&cells, &options).unwrap(),
+        &contact_sheet(&cells, &options, &sylva_core::par::Pool::Serial).unwrap(),
     )
     .unwrap();
 }

@@ -13,13 +13,13 @@ use std::time::Instant;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sylva::config::EvolveConfig;
 use sylva::problem::{AutomataProblem, automata_strategy};
-use sylva_evolve::{Evaluator, Run, RunSettings};
+use sylva_evolve::{Pool, Run, RunSettings};
 
 const POPULATION: usize = 5000;
 const GENERATIONS: u32 = 100;
 
 /// Runs the typical run; returns its evaluations and automaton-steps.
-fn run(config: &EvolveConfig, evaluator: &Evaluator) -> (u64, u64) {
+fn run(config: &EvolveConfig, evaluator: &Pool) -> (u64, u64) {
     let problem = AutomataProblem::new(&config.automata);
     let strategy = automata_strategy(&problem, &config.automata).unwrap();
     let settings = RunSettings {
@@ -36,7 +36,7 @@ fn run(config: &EvolveConfig, evaluator: &Evaluator) -> (u64, u64) {
 fn typical_run(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/automata/sphere.toml");
     let config = EvolveConfig::load(&path).unwrap();
-    let evaluator = Evaluator::with_threads(0).unwrap();
+    let evaluator = Pool::with_threads(0).unwrap();
     let start = Instant::now();
     let (evaluations, steps) = run(&config, &evaluator);
     let seconds = start.elapsed().as_secs_f64();

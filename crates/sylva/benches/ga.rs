@@ -7,13 +7,13 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sylva::config::EvolveConfig;
 use sylva::problem::{BinTreeProblem, strategy};
-use sylva_evolve::{Evaluator, Run, RunSettings};
+use sylva_evolve::{Pool, Run, RunSettings};
 
 const POPULATION: usize = 1000;
 const GENERATIONS: u32 = 100;
 
 /// Runs the GA and returns how many evaluations it made.
-fn run(evaluator: &Evaluator) -> u64 {
+fn run(evaluator: &Pool) -> u64 {
     let config = EvolveConfig::default();
     let settings = RunSettings {
         seed: 1,
@@ -35,7 +35,7 @@ fn ga(c: &mut Criterion) {
     let mut group = c.benchmark_group("bintree_ga_1000x100");
     group.sample_size(10);
     for (name, threads) in [("1_thread", 1), ("all_cores", 0)] {
-        let evaluator = Evaluator::with_threads(threads).unwrap();
+        let evaluator = Pool::with_threads(threads).unwrap();
         let evaluations = run(&evaluator);
         eprintln!("{name}: {evaluations} evaluations per run");
         group.throughput(Throughput::Elements(evaluations));

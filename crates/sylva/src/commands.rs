@@ -7,7 +7,7 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use sylva_core::io::write_atomic;
-use sylva_evolve::{Checkpoint, Evaluator, Run, RunSettings, Strategy};
+use sylva_evolve::{Checkpoint, Pool, Run, RunSettings, Strategy};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva_models::Genome;
 
@@ -161,7 +161,7 @@ fn plantmaker_start(
         rate: pm.mutation_rate,
         spread: pm.mutation_spread,
     };
-    let mut rng = sylva_evolve::rng::stream(config.run.seed, 0, u32::MAX);
+    let mut rng = sylva_core::rng::stream(config.run.seed, 0, u32::MAX);
     let mut start = chosen.clone();
     while start.len() < config.run.population as usize {
         let mut g = chosen[start.len() % chosen.len()].clone();
@@ -202,8 +202,8 @@ where
     P::Genome: Serialize + for<'de> Deserialize<'de>,
     S: Strategy<P>,
 {
-    let evaluator = Evaluator::with_threads(config.run.threads as usize)
-        .context("starting the worker threads")?;
+    let pool =
+        Pool::with_threads(config.run.threads as usize).context("starting the worker threads")?;
     let checkpoint_path = out.join(CHECKPOINT);
     let mut run: Run<P, S> = if resume {
         let text = read_text(&checkpoint_path)?;
@@ -218,7 +218,7 @@ where
             )
             .into());
         }
-        Run::resume(problem.clone(), strategy, evaluator, saved.checkpoint)
+        Run::resume(problem.clone(), strategy, pool.clone(), saved.checkpoint)
             .map_err(|e| InputError::new(checkpoint_path.display().to_string(), e.to_string()))?
     } else {
         let settings = RunSettings {
@@ -226,7 +226,7 @@ where
             population: config.run.population as usize,
             keep_history: 0,
         };
-        Run::with_genomes(problem.clone(), strategy, evaluator, settings, start)?
+        Run::with_genomes(problem.clone(), strategy, pool.clone(), settings, start)?
     };
 
     let target = config.run.generations;
@@ -290,6 +290,7 @@ where
     )?;
     population_sheet(
         &run,
+        &pool,
         &problem,
         config.output.sheet_size as usize,
         &out.join("population.png"),
@@ -330,6 +331,7 @@ fn guide_mesh(plant: &sylva_core::Plant) -> anyhow::Result<sylva_mesh::Mesh> {
 /// A contact sheet of the best `count` members of the current population.
 fn population_sheet<P: ModelProblem, S: Strategy<P>>(
     run: &Run<P, S>,
+    pool: &Pool,
     problem: &P,
     count: usize,
     path: &Path,
@@ -363,7 +365,8 @@ fn population_sheet<P: ModelProblem, S: Strategy<P>>(
         )),
         ..SheetOptions::default()
     };
-    let image = render::contact_sheet(&cells, &options).context("drawing the contact sheet")?;
+    let image =
+        render::contact_sheet(&cells, &options, pool).context("drawing the contact sheet")?;
     render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
 }
 
@@ -580,16 +583,35 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let base = config.parent().unwrap_or(Path::new("."));
+    let genomes = simulation
+        .genome_files()
+        .iter()
+        .map(|file| match load_genome(&base.join(file))? {
+            Genome::LSystem(g) => Ok(*g),
+            other => Err(InputError::new(
+                base.join(file).display().to_string(),
+                format!(
+                    "experiments grow L-system genomes; this is a `{}` genome",
+                    other.model()
+                ),
+            )
+            .into()),
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let pool = Pool::with_threads(0).context("starting the worker threads")?;
     let outcome = simulation
-        .run(base)
+        .run(&genomes, &pool)
         .map_err(|e| InputError::new(config.display().to_string(), e.to_string()))?;
-    let report = outcome.report();
+    let report = crate::report::simulation_report(&outcome);
     let write = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
         let path = out.join(name);
         write_atomic(&path, bytes).with_context(|| format!("writing {}", path.display()))
     };
     write("report.txt", report.as_bytes())?;
-    write("records.csv", outcome.csv().as_bytes())?;
+    write(
+        "records.csv",
+        sylva_models::lsystem::garden::records_csv(outcome.records()).as_bytes(),
+    )?;
     let meshes = mesh_all(
         outcome.plants().iter().map(|p| &p.plant),
         &mesh_options(sylva_models::lsystem::genome::MODEL),
@@ -641,8 +663,9 @@ pub fn breed(
         children,
         ..BreedSettings::default()
     };
-    let mut rng = sylva_evolve::rng::seeded(seed);
-    let garden = breed_garden(&genome, &settings, &mut rng)
+    let mut rng = sylva_core::rng::seeded(seed);
+    let pool = Pool::with_threads(0).context("starting the worker threads")?;
+    let garden = breed_garden(&genome, &settings, &mut rng, &pool)
         .map_err(|e| InputError::new(mother.display().to_string(), e.to_string()))?;
     let shown = |p: &sylva_core::Plant| {
         if hide_roots {
@@ -682,8 +705,8 @@ pub fn breed(
                 specimen.stats.biomass,
                 specimen.stats.light,
                 specimen.stats.uptake,
-                specimen.stats.modules[0],
-                specimen.stats.modules[2],
+                specimen.stats.leaves(),
+                specimen.stats.fine_roots(),
                 specimen.stats.germinated(),
                 specimen.stats.bounds.symbols + specimen.stats.bounds.modules
             ),
@@ -711,6 +734,7 @@ pub fn breed(
             title: Some(format!("Mother and {} children", cells.len() - 1)),
             ..SheetOptions::default()
         },
+        &pool,
     )
     .context("drawing the specimens")?;
     render::write_png(&out.join("specimens.png"), &sheet).context("writing specimens.png")?;

@@ -1,23 +1,24 @@
 //! Contact sheets: many small captioned renders in a grid, for comparing a population.
 //!
-//! Cells are rendered in parallel (each worker keeps one [`Renderer`]) and pasted in order,
-//! so the sheet is byte-identical to rendering the cells one by one.
+//! Cells are rendered on a [`Pool`] (each worker keeps one [`Renderer`]) and pasted in
+//! order, so the sheet is byte-identical to rendering the cells one by one.
 //!
 //! ```
 //! use sylva_mesh::render::{SheetCell, SheetOptions, contact_sheet};
 //! use sylva_mesh::Scene;
+//! use sylva_core::par::Pool;
 //!
 //! let cells: Vec<SheetCell> = (0..5)
 //!     .map(|i| SheetCell { scene: Scene::default(), caption: format!("#{i}  fit 0.00") })
 //!     .collect();
 //! let options = SheetOptions { cell_width: 64, cell_height: 80, ..Default::default() };
-//! let sheet = contact_sheet(&cells, &options)?;
+//! let sheet = contact_sheet(&cells, &options, &Pool::Serial)?;
 //! assert_eq!(sheet.dimensions(), (3 * 64, 2 * 80)); // 5 cells: 3 columns, 2 rows
 //! # Ok::<(), sylva_mesh::render::RenderError>(())
 //! ```
 
 use image::{Rgb, RgbImage};
-use rayon::prelude::*;
+use sylva_core::par::Pool;
 
 use super::text::{GLYPH, draw_text, fit_text, text_width};
 use super::{MAX_SIZE, MIN_SIZE, RenderError, RenderOptions, Renderer, View};
@@ -77,7 +78,11 @@ impl Default for SheetOptions {
 
 /// Renders every cell with the default [`RenderOptions`] (ground, shadows, 2x supersampling)
 /// and lays them out row by row, each with its caption underneath.
-pub fn contact_sheet(cells: &[SheetCell], options: &SheetOptions) -> Result<RgbImage, RenderError> {
+pub fn contact_sheet(
+    cells: &[SheetCell],
+    options: &SheetOptions,
+    pool: &Pool,
+) -> Result<RgbImage, RenderError> {
     if cells.is_empty() {
         return Err(RenderError::EmptySheet);
     }
@@ -122,10 +127,10 @@ pub fn contact_sheet(cells: &[SheetCell], options: &SheetOptions) -> Result<RgbI
         view: options.view,
         ..RenderOptions::default()
     };
-    let pictures: Vec<Result<RgbImage, RenderError>> = cells
-        .par_iter()
-        .map_init(Renderer::new, |r, cell| r.render(&cell.scene, &picture))
-        .collect();
+    let pictures: Vec<Result<RgbImage, RenderError>> =
+        pool.map_init(cells.len(), Renderer::new, |r, i| {
+            r.render(&cells[i].scene, &picture)
+        });
 
     let mut sheet = RgbImage::from_pixel(width, height, Rgb(PAPER));
     if let Some(title) = &options.title {

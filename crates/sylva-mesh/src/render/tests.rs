@@ -480,7 +480,7 @@ fn contact_sheet_layout_and_captions() {
         title: Some("generation 7".into()),
         ..SheetOptions::default()
     };
-    let sheet = contact_sheet(&cells, &opts).unwrap();
+    let sheet = contact_sheet(&cells, &opts, &sylva_core::par::Pool::Serial).unwrap();
     let title = 28;
     assert_eq!(sheet.dimensions(), (3 * 80, title + 2 * 100));
     let dark = |x0: u32, y0: u32, w: u32, h: u32| {
@@ -520,7 +520,9 @@ fn contact_sheet_layout_and_captions() {
         ..opts.clone()
     };
     assert_eq!(
-        contact_sheet(&cells, &explicit).unwrap().dimensions(),
+        contact_sheet(&cells, &explicit, &sylva_core::par::Pool::Serial)
+            .unwrap()
+            .dimensions(),
         (400, 100)
     );
     let too_many_columns = SheetOptions {
@@ -528,7 +530,7 @@ fn contact_sheet_layout_and_captions() {
         ..explicit.clone()
     };
     assert_eq!(
-        contact_sheet(&cells, &too_many_columns)
+        contact_sheet(&cells, &too_many_columns, &sylva_core::par::Pool::Serial)
             .unwrap()
             .dimensions(),
         (400, 100)
@@ -542,7 +544,11 @@ fn contact_sheet_errors() {
         caption: String::new(),
     }];
     assert!(matches!(
-        contact_sheet(&[], &SheetOptions::default()),
+        contact_sheet(
+            &[],
+            &SheetOptions::default(),
+            &sylva_core::par::Pool::Serial
+        ),
         Err(RenderError::EmptySheet)
     ));
     for (w, h) in [(8, 100), (100, 20), (9000, 100), (100, 9000)] {
@@ -552,7 +558,7 @@ fn contact_sheet_errors() {
             ..SheetOptions::default()
         };
         assert!(matches!(
-            contact_sheet(&cells, &opts),
+            contact_sheet(&cells, &opts, &sylva_core::par::Pool::Serial),
             Err(RenderError::InvalidCell { .. })
         ));
     }
@@ -568,7 +574,7 @@ fn contact_sheet_errors() {
         ..SheetOptions::default()
     };
     assert!(matches!(
-        contact_sheet(&many, &big),
+        contact_sheet(&many, &big, &sylva_core::par::Pool::Serial),
         Err(RenderError::SheetTooLarge { .. })
     ));
 }
@@ -602,7 +608,7 @@ fn tree_pictures() {
         title: Some("Sylva contact sheet".into()),
         ..SheetOptions::default()
     };
-    let sheet = contact_sheet(&cells, &opts).unwrap();
+    let sheet = contact_sheet(&cells, &opts, &sylva_core::par::Pool::Serial).unwrap();
     write_png(&dir.join("render-sheet.png"), &sheet).unwrap();
 }
 

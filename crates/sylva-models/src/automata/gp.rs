@@ -520,7 +520,7 @@ impl SubtreeMutation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sylva_evolve::rng;
+    use sylva_core::rng;
 
     #[test]
     fn repair_keeps_relative_levels() {

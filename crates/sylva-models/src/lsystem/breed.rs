@@ -15,6 +15,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use sylva_core::Plant;
 use sylva_core::glam::Vec2;
+use sylva_core::par::Pool;
 use sylva_evolve::{Fitness, Mutate, Problem};
 
 use super::garden::{Garden, GardenError, GrowSettings, Sowing, StepRecord};
@@ -94,6 +95,16 @@ impl SpecimenStats {
         }
     }
 
+    /// Leaves it has.
+    pub fn leaves(&self) -> u32 {
+        self.modules[Module::Leaf.index()]
+    }
+
+    /// Fine roots it has.
+    pub fn fine_roots(&self) -> u32 {
+        self.modules[Module::FineRoot.index()]
+    }
+
     /// True when it grew at least one module.
     pub fn germinated(&self) -> bool {
         self.modules.iter().any(|&m| m > 0)
@@ -101,7 +112,7 @@ impl SpecimenStats {
 
     /// True when it has both leaves and fine roots: it can feed itself.
     pub fn has_leaves_and_roots(&self) -> bool {
-        self.modules[Module::Leaf.index()] > 0 && self.modules[Module::FineRoot.index()] > 0
+        self.leaves() > 0 && self.fine_roots() > 0
     }
 }
 
@@ -121,10 +132,12 @@ pub fn grid_position(i: usize, spacing: f32) -> Vec2 {
     Vec2::new((col - 1.0) * spacing, (row - 1.0) * spacing)
 }
 
-/// Grows the given genomes together on the breeding grid (the first in the corner).
+/// Grows the given genomes together on the breeding grid (the first in the corner); each
+/// plant's share of a step runs on `pool`.
 pub fn grow_together(
     genomes: Vec<LSystemGenome>,
     settings: &BreedSettings,
+    pool: &Pool,
 ) -> Result<BredGarden, GardenError> {
     if genomes.len() > MAX_SPECIMENS {
         return Err(GardenError::TooManyPlants(genomes.len()));
@@ -135,7 +148,7 @@ pub fn grow_together(
         .map(|(i, g)| Sowing::new(g, grid_position(i, settings.spacing)))
         .collect();
     let mut garden = Garden::new(settings.grow.world, sowings)?;
-    garden.run(settings.grow.steps)?;
+    garden.run(settings.grow.steps, pool)?;
     let records = garden.records().to_vec();
     let specimens = garden
         .plants()
@@ -158,6 +171,7 @@ pub fn breed_garden<R: Rng + ?Sized>(
     mother: &LSystemGenome,
     settings: &BreedSettings,
     rng: &mut R,
+    pool: &Pool,
 ) -> Result<BredGarden, GardenError> {
     let mutation = LSystemMutation {
         rates: settings.rates,
@@ -171,7 +185,7 @@ pub fn breed_garden<R: Rng + ?Sized>(
         mutation.mutate(&mut child, rng);
         genomes.push(child);
     }
-    grow_together(genomes, settings)
+    grow_together(genomes, settings, pool)
 }
 
 /// The chooser of runs without a person: the specimen with the largest biomass. On a tie
@@ -230,13 +244,14 @@ pub fn evolve_biomorphs(
     generations: u32,
     seed: u64,
     mut choose: impl FnMut(&BredGarden) -> usize,
+    pool: &Pool,
 ) -> Result<BiomorphRun, GardenError> {
     let mut mother = start.clone();
     let mut record = Vec::new();
     let mut last = None;
     for generation in 1..=generations {
-        let mut rng = sylva_evolve::rng::stream(seed, generation, 0);
-        let garden = breed_garden(&mother, settings, &mut rng)?;
+        let mut rng = sylva_core::rng::stream(seed, generation, 0);
+        let garden = breed_garden(&mother, settings, &mut rng, pool)?;
         let chosen = choose(&garden).min(garden.specimens.len().saturating_sub(1));
         let specimen = &garden.specimens[chosen];
         record.push(BiomorphGeneration {
@@ -254,7 +269,7 @@ pub fn evolve_biomorphs(
     }
     let last = match last {
         Some(g) => g,
-        None => grow_together(vec![mother.clone()], settings)?,
+        None => grow_together(vec![mother.clone()], settings, pool)?,
     };
     Ok(BiomorphRun {
         generations: record,
@@ -309,7 +324,7 @@ impl LSystemProblem {
             vec![Sowing::new(genome.clone(), Vec2::ZERO)],
         )
         .ok()?;
-        garden.run(self.grow.steps).ok()?;
+        garden.run(self.grow.steps, &Pool::Serial).ok()?;
         Some(SpecimenStats::of(&garden.plants()[0]))
     }
 }

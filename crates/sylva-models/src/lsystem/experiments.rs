@@ -10,45 +10,34 @@
 //!   biomass each generation, until plants have leaves and fine roots.
 //!
 //! A config file holds one of them as its only table, `[herbs-under-tree]`,
-//! `[lateral-light]` or `[empty-rules]` ([`Simulation`]); genome paths are relative to the
-//! config file. [`Simulation::run`] loads the genomes and runs; each outcome gives a
-//! one-line-per-figure [`report`](SimulationOutcome::report), the grown plants placed in
-//! the world ([`SimulationOutcome::plants`]) and the per-step CSV.
+//! `[lateral-light]` or `[empty-rules]` ([`Simulation`]); it names genome files relative to
+//! itself ([`Simulation::genome_files`]). The model reads no files: the caller loads those
+//! genomes and passes them to [`Simulation::run`]. Each outcome holds its measured figures,
+//! the grown plants placed in the world with their genomes ([`SimulationOutcome::plants`])
+//! and the per-step records ([`SimulationOutcome::records`]).
 
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 use sylva_core::environment::{EnvironmentSettings, LightSettings};
 use sylva_core::glam::{Vec2, Vec3};
+use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant};
 
 use super::breed::{BiomorphRun, BreedSettings, evolve_biomorphs, largest_biomass};
-use super::garden::{Garden, GardenError, Sowing, StepRecord, records_csv};
+use super::garden::{Garden, GardenError, Sowing, StepRecord};
 use super::genome::LSystemGenome;
 
 /// Why a simulation could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum ExperimentError {
-    /// A genome file could not be read.
-    #[error("cannot read {path}: {error}")]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        error: std::io::Error,
-    },
-    /// A genome file is not a valid L-system genome.
-    #[error("{path}:{line}:{column}: {message}")]
-    Genome {
-        /// The file.
-        path: PathBuf,
-        /// Line of the error.
-        line: usize,
-        /// Column of the error.
-        column: usize,
-        /// What is wrong.
-        message: String,
+    /// The genomes given do not match the files the experiment names.
+    #[error("the experiment needs {expected} genomes (its genome files), got {given}")]
+    Genomes {
+        /// Genome files the experiment names.
+        expected: usize,
+        /// Genomes given.
+        given: usize,
     },
     /// A setting is out of range.
     #[error("{0}")]
@@ -56,20 +45,6 @@ pub enum ExperimentError {
     /// The garden refused to grow.
     #[error(transparent)]
     Garden(#[from] GardenError),
-}
-
-/// Reads an L-system genome file.
-pub fn load_genome(path: &Path) -> Result<LSystemGenome, ExperimentError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ExperimentError::Read {
-        path: path.to_owned(),
-        error,
-    })?;
-    LSystemGenome::from_json(&text).map_err(|e| ExperimentError::Genome {
-        path: path.to_owned(),
-        line: e.line,
-        column: e.column,
-        message: e.message,
-    })
 }
 
 /// A world with its light set to `light`, everything else from `world`.
@@ -82,6 +57,8 @@ fn with_light(world: &EnvironmentSettings, light: LightSettings) -> EnvironmentS
 pub struct PlacedPlant {
     /// A name for pictures and exports (`tree`, `herb 3`, ...).
     pub label: String,
+    /// The genome it grew from.
+    pub genome: LSystemGenome,
     /// Its foot, world coordinates.
     pub position: Vec3,
     /// Its geometry, foot at the origin.
@@ -97,6 +74,7 @@ fn placed(garden: &Garden, labels: &[String]) -> Vec<PlacedPlant> {
         .zip(labels)
         .map(|(p, label)| PlacedPlant {
             label: label.clone(),
+            genome: p.genome().clone(),
             position: p.position(),
             plant: p.plant().clone(),
             biomass: p.biomass(),
@@ -253,18 +231,13 @@ impl Default for HerbsUnderTree {
 }
 
 impl HerbsUnderTree {
-    /// Loads the genomes (relative to `base`) and runs.
-    pub fn run(&self, base: &Path) -> Result<HerbsUnderTreeOutcome, ExperimentError> {
-        let tree = load_genome(&base.join(&self.tree))?;
-        let herb = load_genome(&base.join(&self.herb))?;
-        self.run_with(&tree, &herb)
-    }
-
-    /// Runs with genomes already loaded.
-    pub fn run_with(
+    /// Runs with the tree's and the herbs' genomes; each plant's share of a step runs on
+    /// `pool`.
+    pub fn run(
         &self,
         tree: &LSystemGenome,
         herb: &LSystemGenome,
+        pool: &Pool,
     ) -> Result<HerbsUnderTreeOutcome, ExperimentError> {
         if !(1..=64).contains(&self.herbs_per_ring) {
             return Err(ExperimentError::Config(format!(
@@ -289,7 +262,7 @@ impl HerbsUnderTree {
         }
         let world = with_light(&self.world, vertical());
         let mut garden = Garden::new(world, sowings)?;
-        garden.run(self.head_start + self.steps)?;
+        garden.run(self.head_start + self.steps, pool)?;
         let herbs: Vec<HerbOutcome> = garden.plants()[1..]
             .iter()
             .enumerate()
@@ -400,14 +373,12 @@ impl LateralLightOutcome {
 }
 
 impl LateralLight {
-    /// Loads the genome (relative to `base`) and runs.
-    pub fn run(&self, base: &Path) -> Result<LateralLightOutcome, ExperimentError> {
-        let tree = load_genome(&base.join(&self.tree))?;
-        self.run_with(&tree)
-    }
-
-    /// Runs with the genome already loaded.
-    pub fn run_with(&self, tree: &LSystemGenome) -> Result<LateralLightOutcome, ExperimentError> {
+    /// Runs with the trees' genome; each plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        tree: &LSystemGenome,
+        pool: &Pool,
+    ) -> Result<LateralLightOutcome, ExperimentError> {
         let source = self.world.light.towards_source();
         let towards = Vec2::new(source.x, source.z);
         if towards.length() < 1e-3 {
@@ -423,7 +394,7 @@ impl LateralLight {
                 Sowing::new(tree.clone(), across),
             ];
             let mut garden = Garden::new(world, sowings)?;
-            garden.run(self.steps)?;
+            garden.run(self.steps, pool)?;
             Ok(garden)
         };
         let lateral = grow(self.world)?;
@@ -491,17 +462,13 @@ pub struct EmptyRulesOutcome {
 }
 
 impl EmptyRules {
-    /// Loads the start genome if any (relative to `base`) and runs.
-    pub fn run(&self, base: &Path) -> Result<EmptyRulesOutcome, ExperimentError> {
-        let start = match &self.start {
-            Some(p) => load_genome(&base.join(p))?,
-            None => LSystemGenome::empty(),
-        };
-        self.run_with(&start)
-    }
-
-    /// Runs from a genome already loaded.
-    pub fn run_with(&self, start: &LSystemGenome) -> Result<EmptyRulesOutcome, ExperimentError> {
+    /// Runs from `start` (the genome of `self.start`, or [`LSystemGenome::empty`]); each
+    /// plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        start: &LSystemGenome,
+        pool: &Pool,
+    ) -> Result<EmptyRulesOutcome, ExperimentError> {
         if !(1..=10_000).contains(&self.generations) {
             return Err(ExperimentError::Config(format!(
                 "`generations` must be 1 to 10000, got {}",
@@ -514,6 +481,7 @@ impl EmptyRules {
             self.generations,
             self.seed,
             largest_biomass,
+            pool,
         )?;
         let plants = run
             .last
@@ -526,6 +494,7 @@ impl EmptyRules {
                 } else {
                     format!("child {i}")
                 },
+                genome: s.genome.clone(),
                 position: Vec3::new(s.position.x, 0.0, s.position.y),
                 plant: s.plant.clone(),
                 biomass: s.stats.biomass,
@@ -568,73 +537,46 @@ pub enum SimulationOutcome {
 }
 
 impl Simulation {
-    /// Runs the experiment; genome paths are relative to `base` (the config's folder).
-    pub fn run(&self, base: &Path) -> Result<SimulationOutcome, ExperimentError> {
+    /// The genome files the experiment names, relative to its config file, in the order
+    /// [`Simulation::run`] takes their genomes.
+    pub fn genome_files(&self) -> Vec<&std::path::Path> {
+        match self {
+            Simulation::HerbsUnderTree(c) => vec![c.tree.as_path(), c.herb.as_path()],
+            Simulation::LateralLight(c) => vec![c.tree.as_path()],
+            Simulation::EmptyRules(c) => c.start.as_deref().into_iter().collect(),
+        }
+    }
+
+    /// Runs the experiment with the genomes of [`Simulation::genome_files`], in order; each
+    /// plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        genomes: &[LSystemGenome],
+        pool: &Pool,
+    ) -> Result<SimulationOutcome, ExperimentError> {
+        let expected = self.genome_files().len();
+        if genomes.len() != expected {
+            return Err(ExperimentError::Genomes {
+                expected,
+                given: genomes.len(),
+            });
+        }
         Ok(match self {
-            Simulation::HerbsUnderTree(c) => SimulationOutcome::HerbsUnderTree(c.run(base)?),
-            Simulation::LateralLight(c) => SimulationOutcome::LateralLight(c.run(base)?),
-            Simulation::EmptyRules(c) => SimulationOutcome::EmptyRules(c.run(base)?),
+            Simulation::HerbsUnderTree(c) => {
+                SimulationOutcome::HerbsUnderTree(c.run(&genomes[0], &genomes[1], pool)?)
+            }
+            Simulation::LateralLight(c) => {
+                SimulationOutcome::LateralLight(c.run(&genomes[0], pool)?)
+            }
+            Simulation::EmptyRules(c) => {
+                let empty = LSystemGenome::empty();
+                SimulationOutcome::EmptyRules(c.run(genomes.first().unwrap_or(&empty), pool)?)
+            }
         })
     }
 }
 
 impl SimulationOutcome {
-    /// The measured outcome, one figure a line.
-    pub fn report(&self) -> String {
-        let mut out = String::new();
-        match self {
-            SimulationOutcome::HerbsUnderTree(o) => {
-                let _ = writeln!(out, "tree crown radius: {:.2} m", o.crown.radius);
-                let _ = writeln!(out, "shaded herbs, mean biomass: {:.3} g", o.shaded_biomass);
-                let _ = writeln!(out, "open herbs, mean biomass: {:.3} g", o.open_biomass);
-                let _ = writeln!(out, "biomass ratio shaded/open: {:.3}", o.biomass_ratio);
-                let _ = writeln!(out, "light ratio shaded/open: {:.3}", o.light_ratio);
-            }
-            SimulationOutcome::LateralLight(o) => {
-                for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
-                    for (i, s) in shapes.iter().enumerate() {
-                        let _ = writeln!(
-                            out,
-                            "{name} light, tree {}: height {:.2} m, crown radius {:.2} m, \
-                             leaves offset towards the light {:.2} m, asymmetry {:.3}",
-                            i + 1,
-                            s.height,
-                            s.radius,
-                            s.offset,
-                            s.asymmetry
-                        );
-                    }
-                }
-                let _ = writeln!(
-                    out,
-                    "mean asymmetry: lateral {:.3}, vertical {:.3}",
-                    o.lateral_asymmetry(),
-                    o.vertical_asymmetry()
-                );
-            }
-            SimulationOutcome::EmptyRules(o) => {
-                for g in &o.run.generations {
-                    let _ = writeln!(
-                        out,
-                        "generation {}: chose {} (biomass {:.3} g, {} leaves, {} fine roots), \
-                         {} of the garden germinated",
-                        g.generation,
-                        g.chosen,
-                        g.stats.biomass,
-                        g.stats.modules[0],
-                        g.stats.modules[2],
-                        g.germinated
-                    );
-                }
-                let _ = match o.leaves_and_roots_at {
-                    Some(g) => writeln!(out, "leaves and fine roots from generation {g}"),
-                    None => writeln!(out, "no plant with leaves and fine roots yet"),
-                };
-            }
-        }
-        out
-    }
-
     /// The grown plants, placed in the world.
     pub fn plants(&self) -> &[PlacedPlant] {
         match self {
@@ -644,12 +586,12 @@ impl SimulationOutcome {
         }
     }
 
-    /// Per plant and step records as CSV.
-    pub fn csv(&self) -> String {
+    /// Per plant and step records (of the lateral-light run, of the last breeding garden).
+    pub fn records(&self) -> &[StepRecord] {
         match self {
-            SimulationOutcome::HerbsUnderTree(o) => records_csv(&o.records),
-            SimulationOutcome::LateralLight(o) => records_csv(&o.records),
-            SimulationOutcome::EmptyRules(o) => records_csv(&o.run.last.records),
+            SimulationOutcome::HerbsUnderTree(o) => &o.records,
+            SimulationOutcome::LateralLight(o) => &o.records,
+            SimulationOutcome::EmptyRules(o) => &o.run.last.records,
         }
     }
 }

@@ -14,16 +14,16 @@
 //! 7. minerals diffuse; one [`StepRecord`] per plant is kept.
 //!
 //! No plant sees another's changes of the same step, so the order of plants does not bias
-//! the outcome. Steps 3 and 5 run in parallel (rayon) when there are several plants; every
+//! the outcome. Steps 3 and 5 run on the caller's [`Pool`] (in parallel if it has threads); every
 //! sum over plants is taken in plant order, so the result is the same bytes for any number
 //! of threads.
 
 use std::fmt::Write as _;
 
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sylva_core::environment::{Environment, EnvironmentError, EnvironmentSettings, Uptake};
 use sylva_core::glam::{Vec2, Vec3};
+use sylva_core::par::Pool;
 use sylva_core::{Plant, PlantError};
 
 use super::genome::LSystemGenome;
@@ -229,21 +229,21 @@ impl Garden {
             .filter(|(_, b)| b.any())
     }
 
-    /// Runs `steps` steps.
-    pub fn run(&mut self, steps: u32) -> Result<(), GardenError> {
+    /// Runs `steps` steps; each plant's share of a step runs on `pool`.
+    pub fn run(&mut self, steps: u32, pool: &Pool) -> Result<(), GardenError> {
         if u64::from(self.step) + u64::from(steps) > u64::from(MAX_STEPS) {
             return Err(GardenError::TooManySteps(
                 u64::from(self.step) + u64::from(steps),
             ));
         }
         for _ in 0..steps {
-            self.step()?;
+            self.step(pool)?;
         }
         Ok(())
     }
 
-    /// One step (see the [module documentation](self)).
-    pub fn step(&mut self) -> Result<(), GardenError> {
+    /// One step (see the [module documentation](self)); each plant's share runs on `pool`.
+    pub fn step(&mut self, pool: &Pool) -> Result<(), GardenError> {
         if self.step >= MAX_STEPS {
             return Err(GardenError::TooManySteps(u64::from(self.step) + 1));
         }
@@ -258,12 +258,7 @@ impl Garden {
         self.env.update_light();
 
         let env = &self.env;
-        let parallel = self.plants.len() > 1;
-        if parallel {
-            self.plants.par_iter_mut().for_each(|p| p.gather(env));
-        } else {
-            self.plants.iter_mut().for_each(|p| p.gather(env));
-        }
+        pool.map_mut(&mut self.plants, |p| p.gather(env));
         self.uptake.clear();
         for p in &self.plants {
             p.demand(&mut self.uptake);
@@ -275,15 +270,10 @@ impl Garden {
 
         let env = &self.env;
         let step = now + 1;
-        let results: Vec<Result<(), PlantError>> = if parallel {
-            self.plants
-                .par_iter_mut()
-                .map(|p| p.grow(env, step))
-                .collect()
-        } else {
-            self.plants.iter_mut().map(|p| p.grow(env, step)).collect()
-        };
-        results.into_iter().collect::<Result<Vec<()>, _>>()?;
+        let results = pool.map_mut(&mut self.plants, |p| p.grow(env, step));
+        results
+            .into_iter()
+            .collect::<Result<Vec<()>, PlantError>>()?;
         for p in &mut self.plants {
             p.settle(&mut self.env);
         }

@@ -34,6 +34,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::Plant;
 use sylva_core::hash::stable_hash;
+use sylva_core::par::Pool;
 use sylva_evolve::Mutate;
 
 use super::garden::{Garden, GrowSettings, Sowing};
@@ -399,7 +400,7 @@ impl LSystemGenome {
             settings.world,
             vec![Sowing::new(self.clone(), sylva_core::glam::Vec2::ZERO)],
         )?;
-        garden.run(settings.steps)?;
+        garden.run(settings.steps, &Pool::Serial)?;
         let mut plant = garden.into_plants().swap_remove(0);
         plant.meta.seed = seed;
         Ok(plant)
@@ -487,7 +488,7 @@ mod tests {
     #[test]
     fn mutation_keeps_parameters_in_range() {
         let mut g = LSystemGenome::bush();
-        let mut rng = sylva_evolve::rng::seeded(3);
+        let mut rng = sylva_core::rng::seeded(3);
         for _ in 0..500 {
             mutate_parameter(&mut g, 0.5, &mut rng);
         }

@@ -251,7 +251,7 @@ mod tests {
     proptest! {
         #[test]
         fn operators_keep_rules_well_formed(seed in any::<u64>(), rounds in 1usize..40) {
-            let mut rng = sylva_evolve::rng::seeded(seed);
+            let mut rng = sylva_core::rng::seeded(seed);
             for compartment in [Compartment::Shoot, Compartment::Root] {
                 let mut set = RuleSet::default();
                 for _ in 0..rounds {
@@ -268,7 +268,7 @@ mod tests {
 
     #[test]
     fn evolution_can_start_from_empty_rules() {
-        let mut rng = sylva_evolve::rng::seeded(5);
+        let mut rng = sylva_core::rng::seeded(5);
         let mut set = RuleSet::default();
         let mut grew = false;
         for _ in 0..50 {

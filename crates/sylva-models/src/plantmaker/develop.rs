@@ -56,7 +56,7 @@
 //! is blended between the two colours in 16 steps, which bounds the materials.
 //!
 //! **Randomness.** Every draw comes from one ChaCha8 stream seeded by the `seed` argument
-//! ([`sylva_evolve::rng::seeded`]), in a fixed order: stem, then each expressed
+//! ([`sylva_core::rng::seeded`]), in a fixed order: stem, then each expressed
 //! inflorescence and its fans' branches in order. Orphan segments draw nothing, so they never
 //! change the plant.
 //!
@@ -494,7 +494,7 @@ impl PlantMaker {
         plant.materials.clear();
         let mut b = Builder {
             plant,
-            rng: sylva_evolve::rng::seeded(seed),
+            rng: sylva_core::rng::seeded(seed),
             keys: Vec::new(),
             cones: Vec::with_capacity(128),
         };

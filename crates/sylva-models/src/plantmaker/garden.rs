@@ -214,7 +214,7 @@ pub fn place(
     };
     let mut grid: Vec<Vec<usize>> = vec![Vec::new(); cols * rows];
     let mut out = vec![(Vec2::ZERO, 0.0f32); radii.len()];
-    let mut rng = sylva_evolve::rng::seeded(seed);
+    let mut rng = sylva_core::rng::seeded(seed);
     for (placed, &i) in order.iter().enumerate() {
         let r = radii[i].max(0.0);
         let (hx, hz) = (0.5 * width - r, 0.5 * depth - r);
@@ -287,7 +287,7 @@ impl Garden {
     /// the genome's index.
     pub fn add(&mut self, genome: PlantMaker, count: usize) {
         let group = self.plants.len() as u32;
-        let mut rng = sylva_evolve::rng::stream(self.placement_seed, 1, group);
+        let mut rng = sylva_core::rng::stream(self.placement_seed, 1, group);
         let seeds = (0..count).map(|_| rng.random()).collect();
         self.plants.push(GardenPlants { genome, seeds });
     }

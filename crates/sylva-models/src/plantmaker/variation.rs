@@ -552,7 +552,7 @@ mod tests {
                 dominance: -1.0,
             },
         ];
-        let mut rng = sylva_evolve::rng::seeded(0);
+        let mut rng = sylva_core::rng::seeded(0);
         assert!(matches!(
             crossover(&parents, Level::High, &mut rng),
             Err(VariationError::BadDominance { parent: 1, .. })

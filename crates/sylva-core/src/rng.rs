@@ -1,9 +1,10 @@
-//! Where every random number of a run comes from.
+//! Where every random number comes from: a plant's growth, a garden's layout, a run.
 //!
-//! One portable generator, ChaCha8, keyed by the run seed. Each individual's work in a
-//! generation reads its own stream, numbered by `(generation, slot)`, so what an individual
-//! gets does not depend on which thread made it or in what order: results are identical for
-//! any number of threads.
+//! One portable generator, ChaCha8, keyed by a seed. [`seeded`] gives the stream of a seed
+//! (a model's own randomness from a genome's seed); [`stream`] numbers streams by
+//! `(generation, slot)`, so in an evolution run each individual's work reads its own stream
+//! and what it gets does not depend on which thread made it or in what order: results are
+//! identical for any number of threads. There is no global or thread-local generator.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
