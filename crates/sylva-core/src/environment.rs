@@ -66,8 +66,6 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::ranged_number;
-
 /// Most voxels a world may hold (about 16.8 million).
 pub const MAX_VOXELS: u64 = 1 << 24;
 
@@ -92,10 +90,10 @@ pub struct LightSettings {
     pub extinction: f64,
 }
 
-ranged_number!(elevation, "elevation", 0.0, 90.0, " degrees");
-ranged_number!(azimuth, "azimuth", -360.0, 360.0, " degrees");
-ranged_number!(intensity, "intensity", 0.0, 100.0, "");
-ranged_number!(extinction, "extinction", 0.0, 50.0, "");
+crate::ranged!(elevation: f64, "elevation", 0.0, 90.0, " degrees");
+crate::ranged!(azimuth: f64, "azimuth", -360.0, 360.0, " degrees");
+crate::ranged!(intensity: f64, "intensity", 0.0, 100.0, "");
+crate::ranged!(extinction: f64, "extinction", 0.0, 50.0, "");
 
 impl Default for LightSettings {
     fn default() -> Self {
@@ -141,9 +139,9 @@ pub struct MineralSettings {
     pub max_uptake: f64,
 }
 
-ranged_number!(concentration, "concentration", 0.0, 1e6, " g/m³");
-ranged_number!(diffusion, "diffusion", 0.0, 100.0, " m² per step");
-ranged_number!(max_uptake, "max_uptake", 0.01, 1.0, "");
+crate::ranged!(concentration: f64, "concentration", 0.0, 1e6, " g/m³");
+crate::ranged!(diffusion: f64, "diffusion", 0.0, 100.0, " m² per step");
+crate::ranged!(max_uptake: f64, "max_uptake", 0.01, 1.0, "");
 
 impl Default for MineralSettings {
     fn default() -> Self {
@@ -176,22 +174,11 @@ pub struct EnvironmentSettings {
     pub minerals: MineralSettings,
 }
 
-ranged_number!(voxel_size, "voxel_size", 0.01, 10.0, " m");
+crate::ranged!(voxel_size: f64, "voxel_size", 0.01, 10.0, " m");
 
-fn grid_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[u32; 3], D::Error> {
-    let size = <[u32; 3]>::deserialize(d)?;
-    if size.iter().all(|s| (2..=1024).contains(s)) {
-        Ok(size)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "`size` must be three whole numbers from 2 to 1024, got {size:?}"
-        )))
-    }
-}
+crate::ranged!(grid_size: [u32; 3], "size", 2, 1024);
 
-fn soil_layers<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    crate::ranged::integer(d, "soil_layers", 1, 1023)
-}
+crate::ranged!(soil_layers: u32, "soil_layers", 1, 1023);
 
 impl Default for EnvironmentSettings {
     fn default() -> Self {

@@ -14,9 +14,9 @@
 
 use serde::{Deserialize, Serialize};
 pub use sylva_core::TreeMeasures;
-use sylva_core::ranged_number;
+use sylva_core::ranged;
 
-ranged_number!(weight, "weight", -1e6, 1e6, "");
+ranged!(weight: f64, "weight", -1e6, 1e6, "");
 
 /// Names of the six terms, in the order [`SusinnoScore::terms`] holds them.
 pub const TERM_NAMES: [&str; 8] = [

@@ -124,7 +124,7 @@ fn typical(c: &mut Criterion) {
 
 fn helix(c: &mut Criterion) {
     let genome = AutomataGenome::from_json(HELIX).unwrap();
-    let (sem, o) = (genome.semantics(), genome.grow_options());
+    let (sem, o) = (genome.growth.semantics(), genome.growth.grow_options());
     let mut work = Work::new();
     let steps = work.grow(&genome.program, &sem, &o, Detail::Full);
     let mut group = c.benchmark_group("helix");

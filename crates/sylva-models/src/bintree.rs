@@ -31,7 +31,7 @@ use sylva_core::measures::{fork_symmetry, spread_ratio};
 use sylva_core::{Frame, Plant, PlantMeta, SegmentId, TreeMeasures, hash::stable_hash};
 use sylva_evolve::bits::{BitString, Quantized};
 
-use sylva_core::ranged_number;
+use sylva_core::ranged;
 
 use crate::DevelopError;
 use crate::tag::{FormatV1, model_tag};
@@ -114,16 +114,14 @@ pub struct BinTree {
     pub min_radius: f64,
 }
 
-ranged_number!(lower_radius, "lower_radius", 0.001, 5.0, " m");
-ranged_number!(upper_radius, "upper_radius", 0.001, 5.0, " m");
-ranged_number!(length, "length", 0.01, 50.0, " m");
-ranged_number!(length_ratio, "length_ratio", 0.1, 1.5, "");
-ranged_number!(min_radius, "min_radius", 0.001, 1.0, " m");
-ranged_number!(angle, "rotation angle", -360.0, 360.0, " degrees");
+ranged!(lower_radius: f64, "lower_radius", 0.001, 5.0, " m");
+ranged!(upper_radius: f64, "upper_radius", 0.001, 5.0, " m");
+ranged!(length: f64, "length", 0.01, 50.0, " m");
+ranged!(length_ratio: f64, "length_ratio", 0.1, 1.5, "");
+ranged!(min_radius: f64, "min_radius", 0.001, 1.0, " m");
+ranged!(angle: f64, "rotation angle", -360.0, 360.0, " degrees");
 
-fn depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "depth", 1, MAX_DEPTH)
-}
+sylva_core::ranged!(depth: u32, "depth", 1, MAX_DEPTH);
 
 /// Reads an axis inside the array's own visitor, so an error points at the array (checks
 /// made after the array is read would point at the end of the enclosing object).

@@ -93,9 +93,14 @@ fn branches_leave_at_seventy_degrees_and_bend_down() {
 #[test]
 fn chords_keep_the_tips_with_few_segments() {
     let (genome, full) = helix();
-    let program = Program::compile(&genome.program, &genome.semantics());
+    let program = Program::compile(&genome.program, &genome.growth.semantics());
     let mut plant = Plant::new(PlantMeta::default());
-    let report = Simulator::new().run(&program, &genome.grow_options(), Detail::Chords, &mut plant);
+    let report = Simulator::new().run(
+        &program,
+        &genome.growth.grow_options(),
+        Detail::Chords,
+        &mut plant,
+    );
     assert_eq!(report.segments as usize, plant.segments.len());
     // Trunk: 15 runs between 14 branch points; one per branch.
     assert_eq!(plant.segments.len(), 15 + 14);

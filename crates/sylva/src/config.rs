@@ -146,15 +146,9 @@ impl Default for RunConfig {
     }
 }
 
-fn generations<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "generations", 0, 1_000_000)
-}
-fn population<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "population", 1, 1_000_000)
-}
-fn threads<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "threads", 0, 1024)
-}
+sylva_core::ranged!(generations: u32, "generations", 0, 1_000_000);
+sylva_core::ranged!(population: u32, "population", 1, 1_000_000);
+sylva_core::ranged!(threads: u32, "threads", 0, 1024);
 
 /// How binary trees are crossed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -198,9 +192,9 @@ impl Default for BinTreeConfig {
     }
 }
 
-sylva_core::ranged_number!(checkpoint_seconds, "checkpoint_seconds", 0.0, 3600.0, " s");
-sylva_core::ranged_number!(min_radius, "min_radius", 0.001, 1.0, " m");
-sylva_core::ranged_number!(mutation_rate, "mutation_rate", 0.0, 1.0, "");
+sylva_core::ranged!(checkpoint_seconds: f64, "checkpoint_seconds", 0.0, 3600.0, " s");
+sylva_core::ranged!(min_radius: f64, "min_radius", 0.001, 1.0, " m");
+sylva_core::ranged!(mutation_rate: f64, "mutation_rate", 0.0, 1.0, "");
 
 /// The automata model's GP run (Poncin): tree shape limits, breeding, growth and fitness.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -224,7 +218,7 @@ pub struct AutomataConfig {
     /// Tournament selection and the 88 / 10 / 2 operator rates.
     pub breeding: sylva_evolve::GenerationalSettings,
     /// How programs grow.
-    pub growth: GrowthConfig,
+    pub growth: sylva_models::automata::Growth,
     /// Poncin's fitness: target shape, counts, spread, thickness and density grid.
     pub fitness: sylva_fitness::PoncinFitness,
 }
@@ -238,111 +232,16 @@ impl Default for AutomataConfig {
             max_depth: 17,
             max_size: 500,
             breeding: sylva_evolve::GenerationalSettings::default(),
-            growth: GrowthConfig::default(),
+            growth: sylva_models::automata::Growth::default(),
             fitness: sylva_fitness::PoncinFitness::default(),
         }
     }
 }
 
-fn automata_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "automata", 1, 8)
-}
-fn init_depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "init depth", 1, 16)
-}
-fn max_depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "max_depth", 2, 64)
-}
-fn max_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "max_size", 20, 5000)
-}
-fn iterations<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "iterations", 1, 100_000)
-}
-sylva_core::ranged_number!(root_length, "root_length", 0.0, 1000.0, " units");
-sylva_core::ranged_number!(growth_unit, "unit", 1e-6, 1000.0, " m");
-sylva_core::ranged_number!(gravity, "gravity", 0.0, 90.0, " degrees per step");
-sylva_core::ranged_number!(degrees_per_unit, "degrees_per_unit", 0.0, 36.0, " degrees");
-sylva_core::ranged_number!(growth_radius, "radius", 0.0, 1000.0, " units");
-sylva_core::ranged_number!(leaf_length, "leaf_length", 0.0, 1000.0, " units");
-
-/// How evolved programs grow; the same settings go into `best.json`. See the automata
-/// model's genome fields for what each means.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct GrowthConfig {
-    /// Iteration limit, 1 to 100,000. Default 100.
-    #[serde(deserialize_with = "iterations")]
-    pub iterations: u32,
-    /// The root automaton's starting Length, paper units per step. Default 1.
-    #[serde(deserialize_with = "root_length")]
-    pub root_length: f64,
-    /// Metres per paper unit. Default 0.1.
-    #[serde(deserialize_with = "growth_unit")]
-    pub unit: f64,
-    /// Gravity bending, degrees per step at a horizontal heading. Default 0.
-    #[serde(deserialize_with = "gravity")]
-    pub gravity: f64,
-    /// Degrees per unit of a rotation value. Default 10.
-    #[serde(deserialize_with = "degrees_per_unit")]
-    pub degrees_per_unit: f64,
-    /// Radius at thickness 1, paper units. Default 3.
-    #[serde(deserialize_with = "growth_radius")]
-    pub radius: f64,
-    /// Leaf length, paper units. Default 4.
-    #[serde(deserialize_with = "leaf_length")]
-    pub leaf_length: f64,
-    /// What an If's else branch does when it ends. Default rejoin.
-    pub else_end: sylva_models::automata::ElseEnd,
-    /// What an automaton does at its end. Default die.
-    pub at_end: sylva_models::automata::AtEnd,
-    /// Runaway bounds.
-    pub limits: sylva_models::automata::Limits,
-}
-
-impl Default for GrowthConfig {
-    fn default() -> Self {
-        let g = sylva_models::automata::AutomataGenome::new(
-            "(Top (Wait))"
-                .parse()
-                .expect("a one-automaton tree that only waits is valid"),
-        );
-        GrowthConfig {
-            iterations: g.iterations,
-            root_length: g.root_length,
-            unit: g.unit,
-            gravity: g.gravity,
-            degrees_per_unit: g.degrees_per_unit,
-            radius: g.radius,
-            leaf_length: g.leaf_length,
-            else_end: g.else_end,
-            at_end: g.at_end,
-            limits: g.limits,
-        }
-    }
-}
-
-impl GrowthConfig {
-    /// The genome file of a program grown with these settings.
-    pub fn genome(
-        &self,
-        program: sylva_models::automata::GpTree,
-    ) -> sylva_models::automata::AutomataGenome {
-        let mut g = sylva_models::automata::AutomataGenome::new(program);
-        g.iterations = self.iterations;
-        g.root_length = self.root_length;
-        g.unit = self.unit;
-        g.gravity = self.gravity;
-        g.degrees_per_unit = self.degrees_per_unit;
-        g.radius = self.radius;
-        g.leaf_length = self.leaf_length;
-        g.else_end = self.else_end;
-        g.at_end = self.at_end;
-        g.limits = self.limits;
-        g
-    }
-}
-
+sylva_core::ranged!(automata_count: u32, "automata", 1, 8);
+sylva_core::ranged!(init_depth: u32, "init depth", 1, 16);
+sylva_core::ranged!(max_depth: u32, "max_depth", 2, 64);
+sylva_core::ranged!(max_size: u32, "max_size", 20, 5000);
 /// PlantMaker evolution without a person: genome sizes, breeding and a fitness from the
 /// shared terms (by default: endpoints on a 1 m sphere centred 1.2 m up, about 30 branch
 /// endpoints, spread; lengths in metres, so `fitness.unit` is 1).
@@ -376,10 +275,8 @@ pub struct PlantMakerConfig {
     pub fitness: sylva_fitness::PoncinFitness,
 }
 
-fn segment_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "segment count", 1, 32)
-}
-sylva_core::ranged_number!(mutation_spread, "mutation_spread", 0.0, 1.0, "");
+sylva_core::ranged!(segment_count: u32, "segment count", 1, 32);
+sylva_core::ranged!(mutation_spread: f64, "mutation_spread", 0.0, 1.0, "");
 
 impl Default for PlantMakerConfig {
     fn default() -> Self {
@@ -429,9 +326,7 @@ pub struct LSystemConfig {
     pub breeding: sylva_evolve::GenerationalSettings,
 }
 
-fn random_rounds<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "random_rounds", 0, 1000)
-}
+sylva_core::ranged!(random_rounds: u32, "random_rounds", 0, 1000);
 
 impl Default for LSystemConfig {
     fn default() -> Self {
@@ -476,12 +371,8 @@ impl Default for OutputConfig {
     }
 }
 
-fn image_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "image_size", 64, 4096)
-}
-fn sheet_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "sheet_size", 1, 400)
-}
+sylva_core::ranged!(image_size: u32, "image_size", 64, 4096);
+sylva_core::ranged!(sheet_size: u32, "sheet_size", 1, 400);
 
 mod view_name {
     use serde::{Deserialize, Deserializer, Serializer, de::Error};

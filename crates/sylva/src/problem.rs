@@ -12,11 +12,11 @@ use sylva_evolve::Generational;
 use sylva_fitness::poncin::{PoncinContext, TERM_NAMES as PONCIN_TERMS, TargetShape};
 use sylva_fitness::{PoncinFitness, PoncinScore, PoncinScratch};
 use sylva_models::automata::{
-    Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator, SubtreeCrossover,
-    SubtreeMutation,
+    AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
+    SubtreeCrossover, SubtreeMutation,
 };
 
-use crate::config::{AutomataConfig, GrowthConfig, LSystemConfig, PlantMakerConfig};
+use crate::config::{AutomataConfig, LSystemConfig, PlantMakerConfig};
 use crate::guides::{box_wire, ellipsoid_wire, guide_plant};
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
@@ -127,7 +127,7 @@ pub struct AutomataProblem {
     /// Initialisation and breeding limits.
     pub gp: GpConfig,
     /// How programs grow (also written into `best.json`).
-    pub growth: GrowthConfig,
+    pub growth: sylva_models::automata::Growth,
     /// The fitness.
     pub fitness: PoncinFitness,
     semantics: Semantics,
@@ -165,17 +165,12 @@ impl AutomataProblem {
             max_size: config.max_size,
             ..GpConfig::default()
         };
-        let template = config.growth.genome(
-            "(Top (Wait))"
-                .parse()
-                .expect("a tree that only waits is valid"),
-        );
         AutomataProblem {
             gp,
             growth: config.growth.clone(),
             fitness: config.fitness.clone(),
-            semantics: template.semantics(),
-            grow: template.grow_options(),
+            semantics: config.growth.semantics(),
+            grow: config.growth.grow_options(),
             steps: Arc::default(),
         }
     }
@@ -289,7 +284,10 @@ impl Problem for AutomataProblem {
 
 impl ModelProblem for AutomataProblem {
     fn genome_file(&self, tree: &GpTree) -> Genome {
-        Genome::Automata(Box::new(self.growth.genome(tree.clone())))
+        Genome::Automata(Box::new(AutomataGenome::with_growth(
+            tree.clone(),
+            self.growth.clone(),
+        )))
     }
 
     fn title(&self) -> &'static str {

@@ -38,10 +38,8 @@
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
-use sylva_core::{OrganKind, Plant, ranged_number};
+use sylva_core::{OrganKind, Plant, ranged};
 use thiserror::Error;
-
-use super::checked::{ranged_u32, ranged_vec3, uint3};
 
 /// F_grid's maximum: its value while gated off, and its cap.
 pub const GRID_MAX: f64 = 100.0;
@@ -52,17 +50,12 @@ pub const PAPER_TARGET: u32 = 15;
 /// Most cells a grid may have.
 pub const MAX_CELLS: usize = 1 << 20;
 
-ranged_vec3!(corner, "grid corner", -1e6, 1e6, " paper units");
-ranged_number!(weight, "weight", -1e6, 1e6, "");
-ranged_u32!(target, "target", 1, 1_000_000);
+sylva_core::ranged!(corner: DVec3, "grid corner", -1e6, 1e6, " paper units");
+ranged!(weight: f64, "weight", -1e6, 1e6, "");
+sylva_core::ranged!(target: u32, "target", 1, 1_000_000);
 
-fn divisions<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[u32; 3], D::Error> {
-    uint3(d, "divisions", 1, 1024)
-}
-
-fn cell_index<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[u32; 3], D::Error> {
-    uint3(d, "cell index", 0, 1023)
-}
+sylva_core::ranged!(divisions: [u32; 3], "divisions", 1, 1024);
+sylva_core::ranged!(cell_index: [u32; 3], "cell index", 0, 1023);
 
 fn some_target<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     target(d).map(Some)

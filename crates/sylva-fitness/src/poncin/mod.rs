@@ -64,7 +64,6 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod checked;
 pub mod endpoints;
 pub mod grid;
 pub mod pairs;
@@ -75,7 +74,7 @@ use std::fmt;
 use glam::DVec3;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
-use sylva_core::{OrganKind, Plant, ranged_number};
+use sylva_core::{OrganKind, Plant, ranged};
 
 pub use endpoints::{Endpoint, EndpointRule, PoncinScratch};
 pub use grid::{
@@ -85,20 +84,14 @@ pub use grid::{
 pub use pairs::{PairMode, PairOptions, Spread, WORST_PAIR};
 pub use shape::TargetShape;
 
-ranged_number!(unit, "unit", 1e-6, 1e6, " metres per paper unit");
-ranged_number!(weight, "weight", 0.0, 1e6, "");
-ranged_number!(gate, "grid_gate", 0.0, 1e15, "");
-ranged_number!(
-    radius_per_thickness,
-    "radius_per_thickness",
-    1e-6,
-    1e3,
-    " metres"
-);
-ranged_number!(penalty, "negative_penalty", 0.0, 1e6, "");
+ranged!(unit: f64, "unit", 1e-6, 1e6, " metres per paper unit");
+ranged!(weight: f64, "weight", 0.0, 1e6, "");
+ranged!(gate: f64, "grid_gate", 0.0, 1e15, "");
+ranged!(radius_per_thickness: f64, "radius_per_thickness", 1e-6, 1e3, " metres");
+ranged!(penalty: f64, "negative_penalty", 0.0, 1e6, "");
 
 fn references<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
-    checked::list(d, "references", 0.0, 1.0, MAX_LEVELS)
+    sylva_core::ranged::list(d, "references", 0.0, 1.0, MAX_LEVELS)
 }
 
 /// Most branch levels a per-level list may name.

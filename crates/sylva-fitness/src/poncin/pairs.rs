@@ -31,15 +31,14 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::checked::ranged_u32;
 use super::endpoints::PoncinScratch;
 
 /// The value of either term for coincident endpoints, and with fewer than two.
 pub const WORST_PAIR: f64 = 200.0 / 5.0;
 
-ranged_u32!(exact_up_to, "exact_up_to", 0, 100_000);
-ranged_u32!(per_endpoint, "per_endpoint", 1, 10_000);
-ranged_u32!(min_pairs, "min_pairs", 1, 10_000_000);
+sylva_core::ranged!(exact_up_to: u32, "exact_up_to", 0, 100_000);
+sylva_core::ranged!(per_endpoint: u32, "per_endpoint", 1, 10_000);
+sylva_core::ranged!(min_pairs: u32, "min_pairs", 1, 10_000_000);
 
 /// How pairs of endpoints are chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

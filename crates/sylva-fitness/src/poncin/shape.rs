@@ -18,16 +18,14 @@
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
-use sylva_core::ranged_number;
+use sylva_core::ranged;
 
-use super::checked::ranged_vec3;
-
-ranged_vec3!(center, "center", -1e6, 1e6, " paper units");
-ranged_vec3!(base, "base", -1e6, 1e6, " paper units");
-ranged_vec3!(radii, "radii", 1e-6, 1e6, " paper units");
-ranged_vec3!(size, "size", 0.0, 2e6, " paper units");
-ranged_number!(radius, "radius", 0.0, 1e6, " paper units");
-ranged_number!(height, "height", -1e6, 1e6, " paper units");
+sylva_core::ranged!(center: DVec3, "center", -1e6, 1e6, " paper units");
+sylva_core::ranged!(base: DVec3, "base", -1e6, 1e6, " paper units");
+sylva_core::ranged!(radii: DVec3, "radii", 1e-6, 1e6, " paper units");
+sylva_core::ranged!(size: DVec3, "size", 0.0, 2e6, " paper units");
+ranged!(radius: f64, "radius", 0.0, 1e6, " paper units");
+ranged!(height: f64, "height", -1e6, 1e6, " paper units");
 
 /// Bisection steps the ellipsoid distance may take; f64 bisection stops sooner (about 60).
 pub const MAX_BISECTIONS: usize = 200;

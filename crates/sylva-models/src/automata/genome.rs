@@ -15,8 +15,10 @@
 //! }
 //! ```
 
+use serde::de::value::MapAccessDeserializer;
+use serde::de::{self, DeserializeSeed, Error as _, IntoDeserializer, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use sylva_core::{Plant, PlantMeta, hash::stable_hash, ranged_number};
+use sylva_core::{Plant, PlantMeta, hash::stable_hash, ranged};
 
 use super::compile::{AtEnd, ElseEnd, Program, Semantics};
 use super::sim::{ChildVariables, Detail, GrowOptions, GrowthReport, Limits, Simulator};
@@ -33,151 +35,91 @@ model_tag!(
     MODEL
 );
 
-/// An `automata` genome. Lengths are paper units (see `unit`), angles degrees.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// An `automata` genome: a program and how it grows. Lengths are paper units (see
+/// [`Growth::unit`]), angles degrees. In the file, the growth settings stand beside
+/// `program` (one flat object).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct AutomataGenome {
     /// Always `"automata"`.
     pub model: AutomataTag,
     /// Always 1.
     pub format: FormatV1,
     /// The GP tree, as an S-expression (see [`super::sexpr`]).
-    #[serde(serialize_with = "write_program", deserialize_with = "read_program")]
+    #[serde(serialize_with = "write_program")]
     pub program: GpTree,
+    /// How the program grows.
+    #[serde(flatten)]
+    pub growth: Growth,
+}
+
+/// How a program grows: every field of an `automata` genome file but the program. Evolution
+/// configs hold one too (`[automata.growth]`), and it goes into every evolved genome.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Growth {
     /// Iteration limit, 1 to 100 000. Default 100.
-    #[serde(default = "d_iterations", deserialize_with = "iterations")]
+    #[serde(deserialize_with = "iterations")]
     pub iterations: u32,
     /// The root automaton's starting Length, paper units per step, 0 to 1000. Default 1.
-    #[serde(default = "d_root_length", deserialize_with = "root_length")]
+    #[serde(deserialize_with = "root_length")]
     pub root_length: f64,
     /// Metres per paper unit, 0.000001 to 1000. Default 0.1.
-    #[serde(default = "d_unit", deserialize_with = "unit")]
+    #[serde(deserialize_with = "unit")]
     pub unit: f64,
     /// Gravity bending, degrees per step at a horizontal heading, 0 to 90. Default 0.
-    #[serde(default, deserialize_with = "gravity")]
+    #[serde(deserialize_with = "gravity")]
     pub gravity: f64,
     /// Degrees per unit of a rotation value, 0 to 36. Default 10.
-    #[serde(default = "d_degrees", deserialize_with = "degrees_per_unit")]
+    #[serde(deserialize_with = "degrees_per_unit")]
     pub degrees_per_unit: f64,
     /// Radius at thickness 1, paper units, 0 to 1000. Default 3.
-    #[serde(default = "d_radius", deserialize_with = "radius")]
+    #[serde(deserialize_with = "radius")]
     pub radius: f64,
     /// Leaf length, paper units, 0 to 1000. Default 4.
-    #[serde(default = "d_organ", deserialize_with = "leaf_length")]
+    #[serde(deserialize_with = "leaf_length")]
     pub leaf_length: f64,
     /// Flower diameter, paper units, 0 to 1000. Default 4.
-    #[serde(default = "d_organ", deserialize_with = "flower_size")]
+    #[serde(deserialize_with = "flower_size")]
     pub flower_size: f64,
     /// Leaves near horizontal. Default true.
-    #[serde(default = "d_true")]
     pub horizontal_leaves: bool,
     /// `"rejoin"` (default) or `"end"`: see [`ElseEnd`].
-    #[serde(default)]
     pub else_end: ElseEnd,
     /// `"die"` (default) or `"restart"`: see [`AtEnd`].
-    #[serde(default)]
     pub at_end: AtEnd,
     /// `IfEqual` tolerance, 0 to 10. Default 0.5.
-    #[serde(default = "d_tolerance", deserialize_with = "equal_tolerance")]
+    #[serde(deserialize_with = "equal_tolerance")]
     pub equal_tolerance: f64,
     /// `"length_thickness"` (default), `"all"` or `"fresh"`: see [`ChildVariables`].
-    #[serde(default)]
     pub child_variables: ChildVariables,
     /// Runaway bounds; each field defaults as in [`Limits`].
-    #[serde(default)]
     pub limits: Limits,
 }
 
-fn d_iterations() -> u32 {
-    100
-}
-fn d_root_length() -> f64 {
-    1.0
-}
-fn d_unit() -> f64 {
-    0.1
-}
-fn d_degrees() -> f64 {
-    10.0
-}
-fn d_radius() -> f64 {
-    3.0
-}
-fn d_organ() -> f64 {
-    4.0
-}
-fn d_true() -> bool {
-    true
-}
-fn d_tolerance() -> f64 {
-    0.5
-}
-
-fn iterations<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "iterations", 1, 100_000)
-}
-ranged_number!(root_length, "root_length", 0.0, 1000.0, " units");
-ranged_number!(unit, "unit", 1e-6, 1000.0, " m");
-ranged_number!(gravity, "gravity", 0.0, 90.0, " degrees per step");
-ranged_number!(degrees_per_unit, "degrees_per_unit", 0.0, 36.0, " degrees");
-ranged_number!(radius, "radius", 0.0, 1000.0, " units");
-ranged_number!(leaf_length, "leaf_length", 0.0, 1000.0, " units");
-ranged_number!(flower_size, "flower_size", 0.0, 1000.0, " units");
-ranged_number!(equal_tolerance, "equal_tolerance", 0.0, 10.0, "");
-
-fn write_program<S: Serializer>(tree: &GpTree, s: S) -> Result<S::Ok, S::Error> {
-    s.collect_str(tree)
-}
-
-fn read_program<'de, D: Deserializer<'de>>(d: D) -> Result<GpTree, D::Error> {
-    let text = String::deserialize(d)?;
-    GpTree::parse(&text).map_err(|e| {
-        serde::de::Error::custom(format!(
-            "`program`: at line {}, column {} of the program (byte {}): expected {}, found {}",
-            e.line, e.column, e.offset, e.expected, e.found
-        ))
-    })
-}
-
-impl AutomataGenome {
-    /// A genome with every setting at its default.
-    pub fn new(program: GpTree) -> AutomataGenome {
+impl Default for Growth {
+    fn default() -> Self {
         let g = GrowOptions::default();
         let s = Semantics::default();
-        AutomataGenome {
-            model: AutomataTag,
-            format: FormatV1,
-            program,
-            iterations: d_iterations(),
-            root_length: d_root_length(),
-            unit: d_unit(),
+        Growth {
+            iterations: 100,
+            root_length: 1.0,
+            unit: 0.1,
             gravity: 0.0,
-            degrees_per_unit: d_degrees(),
-            radius: d_radius(),
-            leaf_length: d_organ(),
-            flower_size: d_organ(),
-            horizontal_leaves: d_true(),
+            degrees_per_unit: 10.0,
+            radius: 3.0,
+            leaf_length: 4.0,
+            flower_size: 4.0,
+            horizontal_leaves: true,
             else_end: s.else_end,
             at_end: s.at_end,
-            equal_tolerance: d_tolerance(),
+            equal_tolerance: 0.5,
             child_variables: g.child_variables,
             limits: g.limits,
         }
     }
+}
 
-    /// Parses a genome file (an `automata` one).
-    pub fn from_json(text: &str) -> Result<AutomataGenome, GenomeError> {
-        Ok(serde_json::from_str(text)?)
-    }
-
-    /// The genome as pretty JSON, ending with a newline.
-    pub fn to_json(&self) -> String {
-        let mut s = serde_json::to_string_pretty(self)
-            .expect("genomes hold only finite numbers and strings");
-        s.push('\n');
-        s
-    }
-
+impl Growth {
     /// The compile-time choices.
     pub fn semantics(&self) -> Semantics {
         Semantics {
@@ -203,6 +145,160 @@ impl AutomataGenome {
             limits: self.limits,
         }
     }
+}
+
+ranged!(iterations: u32, "iterations", 1, 100_000);
+ranged!(root_length: f64, "root_length", 0.0, 1000.0, " units");
+ranged!(unit: f64, "unit", 1e-6, 1000.0, " m");
+ranged!(gravity: f64, "gravity", 0.0, 90.0, " degrees per step");
+ranged!(degrees_per_unit: f64, "degrees_per_unit", 0.0, 36.0, " degrees");
+ranged!(radius: f64, "radius", 0.0, 1000.0, " units");
+ranged!(leaf_length: f64, "leaf_length", 0.0, 1000.0, " units");
+ranged!(flower_size: f64, "flower_size", 0.0, 1000.0, " units");
+ranged!(equal_tolerance: f64, "equal_tolerance", 0.0, 10.0, "");
+
+fn write_program<S: Serializer>(tree: &GpTree, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(tree)
+}
+
+fn read_program<'de, D: Deserializer<'de>>(d: D) -> Result<GpTree, D::Error> {
+    let text = String::deserialize(d)?;
+    GpTree::parse(&text).map_err(|e| {
+        serde::de::Error::custom(format!(
+            "`program`: at line {}, column {} of the program (byte {}): expected {}, found {}",
+            e.line, e.column, e.offset, e.expected, e.found
+        ))
+    })
+}
+
+/// Reads the flat genome object: `model`, `format` and `program` here, every other field
+/// through [`Growth`]'s own reader, so its range checks, defaults and unknown-field errors
+/// (with their positions) are the ones of the config's `[automata.growth]`.
+impl<'de> Deserialize<'de> for AutomataGenome {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_map(GenomeVisitor)
+    }
+}
+
+struct GenomeVisitor;
+
+impl<'de> Visitor<'de> for GenomeVisitor {
+    type Value = AutomataGenome;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an automata genome object")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<AutomataGenome, A::Error> {
+        let mut header = Header::default();
+        let growth = Growth::deserialize(MapAccessDeserializer::new(HeaderFields {
+            map,
+            header: &mut header,
+        }))?;
+        Ok(AutomataGenome {
+            model: header
+                .model
+                .ok_or_else(|| A::Error::missing_field("model"))?,
+            format: header
+                .format
+                .ok_or_else(|| A::Error::missing_field("format"))?,
+            program: header
+                .program
+                .ok_or_else(|| A::Error::missing_field("program"))?,
+            growth,
+        })
+    }
+}
+
+/// The genome's own fields, taken out of the map as it is read.
+#[derive(Default)]
+struct Header {
+    model: Option<AutomataTag>,
+    format: Option<FormatV1>,
+    program: Option<GpTree>,
+}
+
+/// A map that reads the header fields itself and shows only the others.
+struct HeaderFields<'h, A> {
+    map: A,
+    header: &'h mut Header,
+}
+
+impl<'de, A: MapAccess<'de>> MapAccess<'de> for HeaderFields<'_, A> {
+    type Error = A::Error;
+
+    fn next_key_seed<K: DeserializeSeed<'de>>(
+        &mut self,
+        seed: K,
+    ) -> Result<Option<K::Value>, A::Error> {
+        fn once<T, E: de::Error>(
+            slot: &mut Option<T>,
+            value: T,
+            name: &'static str,
+        ) -> Result<(), E> {
+            match slot.replace(value) {
+                Some(_) => Err(E::duplicate_field(name)),
+                None => Ok(()),
+            }
+        }
+        while let Some(key) = self.map.next_key::<String>()? {
+            let h = &mut *self.header;
+            match key.as_str() {
+                "model" => once(&mut h.model, self.map.next_value()?, "model")?,
+                "format" => once(&mut h.format, self.map.next_value()?, "format")?,
+                "program" => once(
+                    &mut h.program,
+                    self.map.next_value_seed(ProgramSeed)?,
+                    "program",
+                )?,
+                _ => return seed.deserialize(key.into_deserializer()).map(Some),
+            }
+        }
+        Ok(None)
+    }
+
+    fn next_value_seed<V: DeserializeSeed<'de>>(&mut self, seed: V) -> Result<V::Value, A::Error> {
+        self.map.next_value_seed(seed)
+    }
+}
+
+struct ProgramSeed;
+
+impl<'de> DeserializeSeed<'de> for ProgramSeed {
+    type Value = GpTree;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<GpTree, D::Error> {
+        read_program(d)
+    }
+}
+
+impl AutomataGenome {
+    /// A genome with every setting at its default.
+    pub fn new(program: GpTree) -> AutomataGenome {
+        AutomataGenome::with_growth(program, Growth::default())
+    }
+
+    /// A genome of `program` grown with `growth`.
+    pub fn with_growth(program: GpTree, growth: Growth) -> AutomataGenome {
+        AutomataGenome {
+            model: AutomataTag,
+            format: FormatV1,
+            program,
+            growth,
+        }
+    }
+
+    /// Parses a genome file (an `automata` one).
+    pub fn from_json(text: &str) -> Result<AutomataGenome, GenomeError> {
+        Ok(serde_json::from_str(text)?)
+    }
+
+    /// The genome as pretty JSON, ending with a newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self)
+            .expect("genomes hold only finite numbers and strings");
+        s.push('\n');
+        s
+    }
 
     /// Grows the plant at full detail. The model is deterministic: `seed` is only recorded
     /// in the plant's metadata.
@@ -218,8 +314,13 @@ impl AutomataGenome {
             genome_hash: stable_hash(&json),
             seed,
         });
-        let program = Program::compile(&self.program, &self.semantics());
-        let report = Simulator::new().run(&program, &self.grow_options(), Detail::Full, &mut plant);
+        let program = Program::compile(&self.program, &self.growth.semantics());
+        let report = Simulator::new().run(
+            &program,
+            &self.growth.grow_options(),
+            Detail::Full,
+            &mut plant,
+        );
         Ok((plant, report))
     }
 }
@@ -270,5 +371,37 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("`limits.automata`"), "{}", e.message);
+    }
+
+    #[test]
+    fn growth_fields_and_header_fields_keep_their_positions() {
+        let text = "{\n \"model\": \"automata\",\n \"format\": 1,\n \"gravity\": 100,\n \"program\": \"(Top (Wait))\"\n}";
+        let e = AutomataGenome::from_json(text).unwrap_err();
+        assert!(e.message.contains("`gravity` must be"), "{}", e.message);
+        assert_eq!(e.line, 4);
+        let e = AutomataGenome::from_json("{\"model\": \"automata\", \"format\": 1}").unwrap_err();
+        assert!(
+            e.message.contains("missing field `program`"),
+            "{}",
+            e.message
+        );
+        let e = AutomataGenome::from_json(
+            r#"{"model": "automata", "format": 1, "program": "(Top (Wait))", "program": "(Top (Wait))"}"#,
+        )
+        .unwrap_err();
+        assert!(
+            e.message.contains("duplicate field `program`"),
+            "{}",
+            e.message
+        );
+        let e = AutomataGenome::from_json(r#"{"model": "bintree", "format": 1}"#).unwrap_err();
+        assert!(e.message.contains("`model` must be"), "{}", e.message);
+        // A genome whose growth fields sit before the program reads the same.
+        let g = AutomataGenome::from_json(
+            r#"{"iterations": 7, "model": "automata", "format": 1, "program": "(Top (Wait))"}"#,
+        )
+        .unwrap();
+        assert_eq!(g.growth.iterations, 7);
+        assert_eq!(AutomataGenome::from_json(&g.to_json()).unwrap(), g);
     }
 }

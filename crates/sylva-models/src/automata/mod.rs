@@ -97,7 +97,7 @@ pub mod sim;
 pub mod tree;
 
 pub use compile::{AtEnd, ElseEnd, Program, Semantics};
-pub use genome::{AutomataGenome, AutomataTag, MODEL};
+pub use genome::{AutomataGenome, AutomataTag, Growth, MODEL};
 pub use gp::{GpConfig, SubtreeCrossover, SubtreeMutation, Weights};
 pub use sexpr::ParseError;
 pub use sim::{

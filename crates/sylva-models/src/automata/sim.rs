@@ -122,28 +122,11 @@ pub struct Limits {
     pub organs: u32,
 }
 
-fn states_per_step<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "limits.states_per_step", 1, 1_000_000)
-}
-fn automata<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "limits.automata", 1, 1_000_000)
-}
-fn points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "limits.points", 1, 100_000_000)
-}
-fn organs<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "limits.organs", 0, 10_000_000)
-}
-fn total_states<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
-    let v = i64::deserialize(d)?;
-    if (1..=10_000_000_000).contains(&v) {
-        Ok(v as u64)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "`limits.states` must be a whole number from 1 to 10000000000, got {v}"
-        )))
-    }
-}
+sylva_core::ranged!(states_per_step: u32, "limits.states_per_step", 1, 1_000_000);
+sylva_core::ranged!(automata: u32, "limits.automata", 1, 1_000_000);
+sylva_core::ranged!(points: u32, "limits.points", 1, 100_000_000);
+sylva_core::ranged!(organs: u32, "limits.organs", 0, 10_000_000);
+sylva_core::ranged!(total_states: u64, "limits.states", 1, 10_000_000_000);
 
 impl Default for Limits {
     fn default() -> Self {

@@ -25,8 +25,8 @@ pub struct ModuleShape {
     pub radius: f64,
 }
 
-sylva_core::ranged_number!(module_length, "length", 0.005, 2.0, " m");
-sylva_core::ranged_number!(module_radius, "radius", 0.001, 0.5, " m");
+sylva_core::ranged!(module_length: f64, "length", 0.005, 2.0, " m");
+sylva_core::ranged!(module_radius: f64, "radius", 0.001, 0.5, " m");
 
 /// The three rotation angles, degrees.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -43,7 +43,7 @@ pub struct Angles {
     pub roll: f64,
 }
 
-sylva_core::ranged_number!(angle, "angle", -180.0, 180.0, " degrees");
+sylva_core::ranged!(angle: f64, "angle", -180.0, 180.0, " degrees");
 
 /// Where an apex sits after interpretation.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -72,7 +72,7 @@
 //! either is refused and counted (the garden reports it).
 
 use serde::{Deserialize, Serialize};
-use sylva_core::ranged_number;
+use sylva_core::ranged;
 
 /// Shoot, index 0 of the per-compartment arrays.
 pub const SHOOT: usize = 0;
@@ -165,33 +165,27 @@ pub struct Physiology {
     pub max_modules: u32,
 }
 
-ranged_number!(seed_biomass, "seed_biomass", 1e-4, 10.0, " g");
-ranged_number!(seed_carbon, "seed_carbon", 0.0, 100.0, " g");
-ranged_number!(seed_minerals, "seed_minerals", 0.0, 100.0, " g");
-ranged_number!(carbon_content, "carbon_content", 0.01, 1.0, "");
-ranged_number!(mineral_content, "mineral_content", 0.001, 1.0, "");
-ranged_number!(photosynthesis, "photosynthesis", 0.0, 100.0, " g");
-ranged_number!(uptake, "uptake", 0.0, 100.0, " m");
-ranged_number!(inhibition, "inhibition", 1e-4, 1e4, " g/g");
-ranged_number!(growth_rate, "growth_rate", 0.0, 1e4, " per step");
-ranged_number!(resistance, "resistance", 1.0, 1000.0, "");
-ranged_number!(growth_loss, "growth_loss", 0.0, 0.9, "");
-ranged_number!(maintenance, "maintenance", 0.0, 1.0, " g/g");
-ranged_number!(module_density, "module_density", 1.0, 1e6, " g/m³");
-ranged_number!(min_cost, "min_cost", 1e-5, 100.0, " g");
-ranged_number!(apex_capacity, "apex_capacity", 1e-4, 1e3, " g");
-ranged_number!(allocation_exponent, "allocation_exponent", 0.0, 8.0, "");
-ranged_number!(allocation_floor, "allocation_floor", 0.0, 1.0, "");
+ranged!(seed_biomass: f64, "seed_biomass", 1e-4, 10.0, " g");
+ranged!(seed_carbon: f64, "seed_carbon", 0.0, 100.0, " g");
+ranged!(seed_minerals: f64, "seed_minerals", 0.0, 100.0, " g");
+ranged!(carbon_content: f64, "carbon_content", 0.01, 1.0, "");
+ranged!(mineral_content: f64, "mineral_content", 0.001, 1.0, "");
+ranged!(photosynthesis: f64, "photosynthesis", 0.0, 100.0, " g");
+ranged!(uptake: f64, "uptake", 0.0, 100.0, " m");
+ranged!(inhibition: f64, "inhibition", 1e-4, 1e4, " g/g");
+ranged!(growth_rate: f64, "growth_rate", 0.0, 1e4, " per step");
+ranged!(resistance: f64, "resistance", 1.0, 1000.0, "");
+ranged!(growth_loss: f64, "growth_loss", 0.0, 0.9, "");
+ranged!(maintenance: f64, "maintenance", 0.0, 1.0, " g/g");
+ranged!(module_density: f64, "module_density", 1.0, 1e6, " g/m³");
+ranged!(min_cost: f64, "min_cost", 1e-5, 100.0, " g");
+ranged!(apex_capacity: f64, "apex_capacity", 1e-4, 1e3, " g");
+ranged!(allocation_exponent: f64, "allocation_exponent", 0.0, 8.0, "");
+ranged!(allocation_floor: f64, "allocation_floor", 0.0, 1.0, "");
 
-fn life_span<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "life_span", 1, 1_000_000)
-}
-fn max_symbols<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "max_symbols", 8, 1_000_000)
-}
-fn max_modules<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "max_modules", 1, 1_000_000)
-}
+sylva_core::ranged!(life_span: u32, "life_span", 1, 1_000_000);
+sylva_core::ranged!(max_symbols: u32, "max_symbols", 8, 1_000_000);
+sylva_core::ranged!(max_modules: u32, "max_modules", 1, 1_000_000);
 
 impl Default for Physiology {
     fn default() -> Self {

@@ -52,22 +52,9 @@ fn default_tries() -> u32 {
     DEFAULT_TRIES
 }
 
-fn max_tries<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    sylva_core::ranged::integer(d, "max_tries", 1, 1_000_000)
-}
+sylva_core::ranged!(max_tries: u32, "max_tries", 1, 1_000_000);
 
-fn area<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    let v = <[f64; 2]>::deserialize(d)?;
-    if v.iter()
-        .all(|x| x.is_finite() && (0.1..=100_000.0).contains(x))
-    {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "`area` is [width, depth] in metres, each from 0.1 to 100000, got {v:?}"
-        )))
-    }
-}
+sylva_core::ranged!(area: [f64; 2], "area", 0.1, 100_000.0, " m (width and depth)");
 
 /// A garden file: genomes with their seeds, the plot, and the placement seed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

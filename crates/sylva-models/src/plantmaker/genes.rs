@@ -368,26 +368,31 @@ impl Serialize for Tenths {
     }
 }
 
-/// Reads a multiple of 0.1 in `min..=max` tenths.
-fn tenths<'de, D: serde::Deserializer<'de>>(
-    d: D,
-    field: &str,
-    min: u8,
-    max: u8,
-) -> Result<Tenths, D::Error> {
-    let v = f64::deserialize(d)?;
-    let code = (v * 10.0).round();
-    if v.is_finite()
-        && (v * 10.0 - code).abs() < 1e-6
-        && (f64::from(min)..=f64::from(max)).contains(&code)
-    {
-        Ok(Tenths(code as u8))
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "`{field}` must be a multiple of 0.1 from {} to {}, got {v}",
-            f64::from(min) / 10.0,
-            f64::from(max) / 10.0
-        )))
+/// A multiple of 0.1, read with its range in tenths (`ranged!(f: Tenths, "f", 1, 30)` is 0.1
+/// to 3.0).
+impl sylva_core::ranged::Ranged for Tenths {
+    type Bound = u8;
+    fn read<'de, D: serde::Deserializer<'de>>(
+        d: D,
+        field: &str,
+        min: u8,
+        max: u8,
+        _unit: &str,
+    ) -> Result<Tenths, D::Error> {
+        let v = f64::deserialize(d)?;
+        let code = (v * 10.0).round();
+        if v.is_finite()
+            && (v * 10.0 - code).abs() < 1e-6
+            && (f64::from(min)..=f64::from(max)).contains(&code)
+        {
+            Ok(Tenths(code as u8))
+        } else {
+            Err(serde::de::Error::custom(format!(
+                "`{field}` must be a multiple of 0.1 from {} to {}, got {v}",
+                f64::from(min) / 10.0,
+                f64::from(max) / 10.0
+            )))
+        }
     }
 }
 
@@ -462,56 +467,35 @@ impl<'de> Deserialize<'de> for FanSet {
     }
 }
 
-/// Declares readers of whole numbers in a range, named after their field.
-macro_rules! ranged_ints {
-    ($($fn_name:ident: $ty:ty = $field:literal, $min:expr, $max:expr;)+) => {
-        $(
-            fn $fn_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
-                sylva_core::ranged::integer(d, $field, $min, $max).map(|v| v as $ty)
-            }
-        )+
-    };
-}
+sylva_core::ranged!(min_x_angle: u16, "min_x_angle", 0, 360);
+sylva_core::ranged!(max_x_angle: u16, "max_x_angle", 0, 360);
+sylva_core::ranged!(min_y_angle: u16, "min_y_angle", 0, 360);
+sylva_core::ranged!(max_y_angle: u16, "max_y_angle", 0, 360);
+sylva_core::ranged!(waves: u8, "waves", 1, 16);
+sylva_core::ranged!(min_segments: u8, "min_segments", 1, 128);
+sylva_core::ranged!(max_segments: u8, "max_segments", 1, 128);
+sylva_core::ranged!(min_base_thickness: u8, "min_base_thickness", 1, 250);
+sylva_core::ranged!(max_base_thickness: u8, "max_base_thickness", 1, 250);
+sylva_core::ranged!(min_apex_thickness: u8, "min_apex_thickness", 1, 250);
+sylva_core::ranged!(max_apex_thickness: u8, "max_apex_thickness", 1, 250);
+sylva_core::ranged!(min_length: u8, "min_length", 1, 30);
+sylva_core::ranged!(max_length: u8, "max_length", 1, 30);
+sylva_core::ranged!(min_noise_x_angle: u16, "min_noise_x_angle", 0, 360);
+sylva_core::ranged!(max_noise_x_angle: u16, "max_noise_x_angle", 0, 360);
+sylva_core::ranged!(min_noise_y_angle: u16, "min_noise_y_angle", 0, 360);
+sylva_core::ranged!(max_noise_y_angle: u16, "max_noise_y_angle", 0, 360);
+sylva_core::ranged!(fan_branch: u8, "branch", 1, MAX_BRANCHES as u8);
+sylva_core::ranged!(fan_count: u8, "count", 1, 72);
+sylva_core::ranged!(min_angle: u16, "min_angle", 0, 360);
+sylva_core::ranged!(max_angle: u16, "max_angle", 0, 360);
+sylva_core::ranged!(texture: u8, "texture", 0, 127);
+sylva_core::ranged!(start_angle: u16, "start_angle", 0, 360);
+sylva_core::ranged!(position: u8, "position", 0, 100);
 
-ranged_ints! {
-    min_x_angle: u16 = "min_x_angle", 0, 360;
-    max_x_angle: u16 = "max_x_angle", 0, 360;
-    min_y_angle: u16 = "min_y_angle", 0, 360;
-    max_y_angle: u16 = "max_y_angle", 0, 360;
-    waves: u8 = "waves", 1, 16;
-    min_segments: u8 = "min_segments", 1, 128;
-    max_segments: u8 = "max_segments", 1, 128;
-    min_base_thickness: u8 = "min_base_thickness", 1, 250;
-    max_base_thickness: u8 = "max_base_thickness", 1, 250;
-    min_apex_thickness: u8 = "min_apex_thickness", 1, 250;
-    max_apex_thickness: u8 = "max_apex_thickness", 1, 250;
-    min_length: u8 = "min_length", 1, 30;
-    max_length: u8 = "max_length", 1, 30;
-    min_noise_x_angle: u16 = "min_noise_x_angle", 0, 360;
-    max_noise_x_angle: u16 = "max_noise_x_angle", 0, 360;
-    min_noise_y_angle: u16 = "min_noise_y_angle", 0, 360;
-    max_noise_y_angle: u16 = "max_noise_y_angle", 0, 360;
-    fan_branch: u8 = "branch", 1, MAX_BRANCHES as u32;
-    fan_count: u8 = "count", 1, 72;
-    min_angle: u16 = "min_angle", 0, 360;
-    max_angle: u16 = "max_angle", 0, 360;
-    texture: u8 = "texture", 0, 127;
-    start_angle: u16 = "start_angle", 0, 360;
-    position: u8 = "position", 0, 100;
-}
-
-fn min_length_factor<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Tenths, D::Error> {
-    tenths(d, "min_length_factor", 1, 30)
-}
-fn max_length_factor<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Tenths, D::Error> {
-    tenths(d, "max_length_factor", 1, 30)
-}
-fn min_thickness_factor<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Tenths, D::Error> {
-    tenths(d, "min_thickness_factor", 1, 50)
-}
-fn max_thickness_factor<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Tenths, D::Error> {
-    tenths(d, "max_thickness_factor", 1, 50)
-}
+sylva_core::ranged!(min_length_factor: Tenths, "min_length_factor", 1, 30);
+sylva_core::ranged!(max_length_factor: Tenths, "max_length_factor", 1, 30);
+sylva_core::ranged!(min_thickness_factor: Tenths, "min_thickness_factor", 1, 50);
+sylva_core::ranged!(max_thickness_factor: Tenths, "max_thickness_factor", 1, 50);
 
 /// A branch prototype (Table 1): a chain of connected cones. Lengths are in centimetres
 /// per cone, thicknesses in millimetres of diameter, angles in degrees.
