@@ -84,7 +84,7 @@ impl Plant {
     /// from. A plant without segments has none.
     pub fn tips(&self) -> impl Iterator<Item = Vec3> + '_ {
         let counts = self.child_counts();
-        self.segments
+        self.segments()
             .iter()
             .zip(counts)
             .filter(|(_, children)| *children == 0)
@@ -94,7 +94,7 @@ impl Plant {
     /// Highest point of the skeleton above y = 0 (segment centre lines; radii ignored).
     /// Zero for a plant without segments.
     pub fn height(&self) -> f32 {
-        self.segments
+        self.segments()
             .iter()
             .map(|s| s.start.y.max(s.end.y))
             .fold(0.0, f32::max)
@@ -103,11 +103,11 @@ impl Plant {
     /// Bounds of everything visible: segments with their radii and organs with their sizes.
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
-        for s in &self.segments {
+        for s in self.segments() {
             b.grow(s.start, s.start_radius);
             b.grow(s.end, s.end_radius);
         }
-        for o in &self.organs {
+        for o in self.organs() {
             b.grow(o.position, o.size.x.max(o.size.y));
         }
         b
@@ -115,7 +115,7 @@ impl Plant {
 
     /// Sum of the segments' lateral frustum areas, square metres.
     pub fn surface_area(&self) -> f32 {
-        self.segments
+        self.segments()
             .iter()
             .map(|s| frustum_area(s.start_radius, s.end_radius, s.length()))
             .sum()
@@ -123,7 +123,7 @@ impl Plant {
 
     /// Sum of the segments' frustum volumes, cubic metres.
     pub fn volume(&self) -> f32 {
-        self.segments
+        self.segments()
             .iter()
             .map(|s| frustum_volume(s.start_radius, s.end_radius, s.length()))
             .sum()
@@ -131,7 +131,7 @@ impl Plant {
 
     /// Total length of the skeleton, metres.
     pub fn total_length(&self) -> f32 {
-        self.segments.iter().map(|s| s.length()).sum()
+        self.segments().iter().map(|s| s.length()).sum()
     }
 }
 
@@ -168,10 +168,10 @@ impl TreeMeasures {
     /// Reads the six measures off a plant.
     pub fn of_plant(plant: &Plant) -> TreeMeasures {
         let dir = |s: &crate::Segment| s.vector().as_dvec3().normalize_or_zero();
-        let mut children: Vec<[Option<u32>; 2]> = vec![[None; 2]; plant.segments.len()];
+        let mut children: Vec<[Option<u32>; 2]> = vec![[None; 2]; plant.segments().len()];
         let counts = plant.child_counts();
         let (mut deviation, mut with_parent) = (0.0, 0usize);
-        for (i, s) in plant.segments.iter().enumerate() {
+        for (i, s) in plant.segments().iter().enumerate() {
             if let Some(p) = s.parent {
                 let parent = plant.segment(p);
                 deviation += dir(parent).dot(dir(s)).clamp(-1.0, 1.0).acos();
@@ -188,9 +188,9 @@ impl TreeMeasures {
         for (i, pair) in children.iter().enumerate() {
             if let ([Some(a), Some(b)], 2) = (pair, counts[i]) {
                 let (p, c1, c2) = (
-                    &plant.segments[i],
-                    &plant.segments[*a as usize],
-                    &plant.segments[*b as usize],
+                    &plant.segments()[i],
+                    &plant.segments()[*a as usize],
+                    &plant.segments()[*b as usize],
                 );
                 symmetry += fork_symmetry(dir(p), dir(c1), dir(c2));
                 forks += 1;
@@ -205,7 +205,7 @@ impl TreeMeasures {
             }
         }
         let roundness = crown_roundness(plant);
-        let (radii, lengths) = plant.segments.iter().fold((0.0, 0.0), |(r, l), s| {
+        let (radii, lengths) = plant.segments().iter().fold((0.0, 0.0), |(r, l), s| {
             (
                 r + 0.5 * f64::from(s.start_radius + s.end_radius),
                 l + f64::from(s.length()),
@@ -229,11 +229,11 @@ impl TreeMeasures {
 /// the ends of all segments.
 fn crown_roundness(plant: &Plant) -> f64 {
     let points = plant
-        .segments
+        .segments()
         .iter()
         .filter(|s| s.parent.is_none())
         .map(|s| s.start)
-        .chain(plant.segments.iter().map(|s| s.end))
+        .chain(plant.segments().iter().map(|s| s.end))
         .map(|p| p.as_dvec3());
     let (mut n, mut sx, mut sz, mut sxx, mut szz, mut sxz) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     for p in points {

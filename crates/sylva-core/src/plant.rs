@@ -9,6 +9,13 @@
 //! segment starts a new axis (a branch) from its parent. Meshing joins the segments of an
 //! axis into one tube.
 //!
+//! A `Plant` owns its rules: segments, organs and materials go in only through checked
+//! methods ([`Plant::add_segment`], [`Plant::add_organ`], [`Plant::add_material`]), and its
+//! parts are read through accessors. Every plant therefore holds only finite coordinates
+//! within ±[`MAX_COORD`] metres, non-negative sizes, unit orientations, parents stored
+//! before their children and materials that exist, so meshing, fitness and export can
+//! trust any plant they are given.
+//!
 //! Units are metres; Y is up.
 
 use glam::{Quat, Vec2, Vec3};
@@ -178,7 +185,11 @@ pub struct PlantMeta {
     pub seed: u64,
 }
 
-/// Why a segment or organ was refused.
+/// Coordinates and sizes beyond this many metres are refused: products of them would
+/// overflow to infinity.
+pub const MAX_COORD: f32 = 1e12;
+
+/// Why a segment, organ or material was refused.
 #[derive(Debug, Error, PartialEq)]
 pub enum PlantError {
     /// A coordinate, radius or size is NaN or infinite.
@@ -194,6 +205,33 @@ pub enum PlantError {
         what: &'static str,
         /// The value given.
         value: f32,
+    },
+    /// A coordinate or size is beyond ±[`MAX_COORD`] metres.
+    #[error("{what} is beyond {MAX_COORD} m ({value})")]
+    TooFar {
+        /// Which value.
+        what: &'static str,
+        /// The value given.
+        value: f32,
+    },
+    /// An organ's orientation is not a unit quaternion.
+    #[error("organ orientation is not a unit quaternion")]
+    BadOrientation,
+    /// A material colour is not three numbers from 0 to 1.
+    #[error("material `{name}` has colour {color:?}; each channel must be from 0 to 1")]
+    BadColor {
+        /// The material's name.
+        name: String,
+        /// The colour given.
+        color: [f32; 3],
+    },
+    /// The organ does not exist.
+    #[error("organ {organ} does not exist (the plant has {len} organs)")]
+    NoSuchOrgan {
+        /// The organ asked for.
+        organ: usize,
+        /// Organs so far.
+        len: usize,
     },
     /// The parent does not exist yet.
     #[error("parent segment {parent} does not exist (the plant has {len} segments)")]
@@ -214,35 +252,48 @@ pub enum PlantError {
     TooManyMaterials,
 }
 
-/// A grown plant: skeleton, organs, materials and origin.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// A grown plant: skeleton, organs, materials and origin. See the [module docs](self) for
+/// the rules it keeps.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Plant {
-    /// The skeleton, parents first.
-    pub segments: Vec<Segment>,
-    /// Leaves, flowers and root tips.
-    pub organs: Vec<Organ>,
-    /// Materials referenced by segments and organs.
-    pub materials: Vec<Material>,
-    /// Origin.
-    pub meta: PlantMeta,
+    segments: Vec<Segment>,
+    organs: Vec<Organ>,
+    materials: Vec<Material>,
+    meta: PlantMeta,
 }
 
-fn finite3(v: Vec3, what: &'static str) -> Result<(), PlantError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(PlantError::NotFinite { what })
+/// A point: finite and within ±[`MAX_COORD`].
+fn point(v: Vec3, what: &'static str) -> Result<(), PlantError> {
+    if !v.is_finite() {
+        return Err(PlantError::NotFinite { what });
     }
+    let value = v.abs().max_element();
+    if value > MAX_COORD {
+        return Err(PlantError::TooFar { what, value });
+    }
+    Ok(())
 }
 
-fn non_negative(value: f32, what: &'static str) -> Result<(), PlantError> {
+/// A size: finite, non-negative and at most [`MAX_COORD`].
+fn size(value: f32, what: &'static str) -> Result<(), PlantError> {
     if !value.is_finite() {
         Err(PlantError::NotFinite { what })
     } else if value < 0.0 {
         Err(PlantError::Negative { what, value })
+    } else if value > MAX_COORD {
+        Err(PlantError::TooFar { what, value })
     } else {
         Ok(())
     }
+}
+
+/// The three materials of [`Plant::new`].
+fn default_materials() -> Vec<Material> {
+    vec![
+        Material::of_kind(MaterialKind::Bark),
+        Material::of_kind(MaterialKind::Leaf),
+        Material::of_kind(MaterialKind::Flower),
+    ]
 }
 
 impl Plant {
@@ -252,13 +303,72 @@ impl Plant {
         Plant {
             segments: Vec::new(),
             organs: Vec::new(),
-            materials: vec![
-                Material::of_kind(MaterialKind::Bark),
-                Material::of_kind(MaterialKind::Leaf),
-                Material::of_kind(MaterialKind::Flower),
-            ],
+            materials: default_materials(),
             meta,
         }
+    }
+
+    /// An empty plant with no materials yet (add them with [`Plant::add_material`]).
+    pub fn bare(meta: PlantMeta) -> Self {
+        Plant {
+            meta,
+            ..Plant::default()
+        }
+    }
+
+    /// The skeleton, parents first.
+    #[inline]
+    pub fn segments(&self) -> &[Segment] {
+        &self.segments
+    }
+
+    /// Leaves, flowers and root tips.
+    #[inline]
+    pub fn organs(&self) -> &[Organ] {
+        &self.organs
+    }
+
+    /// Materials referenced by segments and organs.
+    #[inline]
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Where the plant came from.
+    #[inline]
+    pub fn meta(&self) -> &PlantMeta {
+        &self.meta
+    }
+
+    /// Where the plant came from, to change (it holds no rule).
+    #[inline]
+    pub fn meta_mut(&mut self) -> &mut PlantMeta {
+        &mut self.meta
+    }
+
+    /// Removes every segment and organ, keeping the materials, the metadata and the buffers'
+    /// capacity (so a plant can be regrown without allocating).
+    pub fn clear(&mut self) {
+        self.segments.clear();
+        self.organs.clear();
+    }
+
+    /// [`Plant::clear`], and the three materials of [`Plant::new`] back unless the first
+    /// three already are bark, leaf and flower.
+    pub fn clear_to_defaults(&mut self) {
+        self.clear();
+        let kinds = [MaterialKind::Bark, MaterialKind::Leaf, MaterialKind::Flower];
+        let ok =
+            self.materials.len() >= 3 && self.materials.iter().zip(kinds).all(|(m, k)| m.kind == k);
+        if !ok {
+            self.materials = default_materials();
+        }
+    }
+
+    /// Room for `segments` more segments and `organs` more organs.
+    pub fn reserve(&mut self, segments: usize, organs: usize) {
+        self.segments.reserve(segments);
+        self.organs.reserve(organs);
     }
 
     /// The default bark material of [`Plant::new`].
@@ -268,15 +378,43 @@ impl Plant {
     /// The default flower material of [`Plant::new`].
     pub const FLOWER: MaterialId = MaterialId(2);
 
-    /// Adds a material and returns its id.
+    /// Adds a material after checking its colour, and returns its id.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, PlantError> {
+        check_color(&material)?;
         let id = u16::try_from(self.materials.len()).map_err(|_| PlantError::TooManyMaterials)?;
         self.materials.push(material);
         Ok(MaterialId(id))
     }
 
-    /// Adds a segment after checking it: finite, non-negative radii, an existing parent and
-    /// material. Order is derived: the parent's order, plus one when `lateral`.
+    /// Gives a material a texture id (or none).
+    pub fn set_texture(&mut self, id: MaterialId, texture: Option<u16>) -> Result<(), PlantError> {
+        let slot = self
+            .materials
+            .get_mut(id.index())
+            .ok_or(PlantError::NoSuchMaterial(id.0))?;
+        slot.texture = texture;
+        Ok(())
+    }
+
+    /// Replaces a material after checking it.
+    pub fn replace_material(
+        &mut self,
+        id: MaterialId,
+        material: Material,
+    ) -> Result<(), PlantError> {
+        check_color(&material)?;
+        let slot = self
+            .materials
+            .get_mut(id.index())
+            .ok_or(PlantError::NoSuchMaterial(id.0))?;
+        *slot = material;
+        Ok(())
+    }
+
+    /// Adds a segment after checking it: points and radii finite and within range, radii
+    /// non-negative, an existing parent and material. Order is derived: the parent's order,
+    /// plus one when `lateral`.
+    #[inline(always)]
     pub fn add_segment(
         &mut self,
         start: Vec3,
@@ -286,27 +424,30 @@ impl Plant {
         lateral: bool,
         material: MaterialId,
     ) -> Result<SegmentId, PlantError> {
-        finite3(start, "segment start")?;
-        finite3(end, "segment end")?;
-        non_negative(radii.0, "segment start radius")?;
-        non_negative(radii.1, "segment end radius")?;
-        if material.index() >= self.materials.len() {
-            return Err(PlantError::NoSuchMaterial(material.0));
-        }
+        // One pass of comparisons on the path every segment takes (NaN fails them all);
+        // which rule was broken is worked out only when one was.
+        let near =
+            |v: Vec3| v.x.abs() <= MAX_COORD && v.y.abs() <= MAX_COORD && v.z.abs() <= MAX_COORD;
+        let sized = |r: f32| (0.0..=MAX_COORD).contains(&r);
         let order = match parent {
-            None => 0,
-            Some(p) => {
-                let parent = self
-                    .segments
-                    .get(p.index())
-                    .ok_or(PlantError::NoSuchParent {
-                        parent: p.0,
-                        len: self.segments.len(),
-                    })?;
-                parent.order.saturating_add(u16::from(lateral))
-            }
+            None => Some(0),
+            Some(p) => self
+                .segments
+                .get(p.index())
+                .map(|s| s.order.saturating_add(u16::from(lateral))),
         };
-        let id = u32::try_from(self.segments.len()).map_err(|_| PlantError::TooManySegments)?;
+        let id = u32::try_from(self.segments.len()).ok();
+        let (Some(order), Some(id)) = (order, id) else {
+            return Err(self.segment_error(start, end, radii, parent, material));
+        };
+        if !(near(start)
+            && near(end)
+            && sized(radii.0)
+            && sized(radii.1)
+            && material.index() < self.materials.len())
+        {
+            return Err(self.segment_error(start, end, radii, parent, material));
+        }
         self.segments.push(Segment {
             start,
             end,
@@ -320,16 +461,45 @@ impl Plant {
         Ok(SegmentId(id))
     }
 
-    /// Adds an organ after checking it is finite with a non-negative size.
-    pub fn add_organ(&mut self, organ: Organ) -> Result<(), PlantError> {
-        finite3(organ.position, "organ position")?;
-        if !organ.orientation.is_finite() || !organ.orientation.is_normalized() {
-            return Err(PlantError::NotFinite {
-                what: "organ orientation",
-            });
+    /// Why [`Plant::add_segment`] refused a segment.
+    #[cold]
+    #[inline(never)]
+    fn segment_error(
+        &self,
+        start: Vec3,
+        end: Vec3,
+        radii: (f32, f32),
+        parent: Option<SegmentId>,
+        material: MaterialId,
+    ) -> PlantError {
+        let checks = point(start, "segment start")
+            .and(point(end, "segment end"))
+            .and(size(radii.0, "segment start radius"))
+            .and(size(radii.1, "segment end radius"));
+        if let Err(e) = checks {
+            return e;
         }
-        non_negative(organ.size.x, "organ length")?;
-        non_negative(organ.size.y, "organ width")?;
+        if material.index() >= self.materials.len() {
+            return PlantError::NoSuchMaterial(material.0);
+        }
+        match parent {
+            Some(p) if p.index() >= self.segments.len() => PlantError::NoSuchParent {
+                parent: p.0,
+                len: self.segments.len(),
+            },
+            _ => PlantError::TooManySegments,
+        }
+    }
+
+    /// Adds an organ after checking it: a point within range, a unit orientation, sizes
+    /// within range, an existing material and parent.
+    pub fn add_organ(&mut self, organ: Organ) -> Result<(), PlantError> {
+        point(organ.position, "organ position")?;
+        if !organ.orientation.is_finite() || !organ.orientation.is_normalized() {
+            return Err(PlantError::BadOrientation);
+        }
+        size(organ.size.x, "organ length")?;
+        size(organ.size.y, "organ width")?;
         if material_missing(organ.material, &self.materials) {
             return Err(PlantError::NoSuchMaterial(organ.material.0));
         }
@@ -342,6 +512,29 @@ impl Plant {
             });
         }
         self.organs.push(organ);
+        Ok(())
+    }
+
+    /// Attaches organ `organ` (its index) to a segment, or to none.
+    pub fn set_organ_parent(
+        &mut self,
+        organ: usize,
+        parent: Option<SegmentId>,
+    ) -> Result<(), PlantError> {
+        if let Some(p) = parent
+            && p.index() >= self.segments.len()
+        {
+            return Err(PlantError::NoSuchParent {
+                parent: p.0,
+                len: self.segments.len(),
+            });
+        }
+        let len = self.organs.len();
+        let o = self
+            .organs
+            .get_mut(organ)
+            .ok_or(PlantError::NoSuchOrgan { organ, len })?;
+        o.parent = parent;
         Ok(())
     }
 
@@ -405,6 +598,17 @@ impl Plant {
 
 fn material_missing(id: MaterialId, materials: &[Material]) -> bool {
     id.index() >= materials.len()
+}
+
+fn check_color(material: &Material) -> Result<(), PlantError> {
+    if material.color.iter().all(|c| (0.0..=1.0).contains(c)) {
+        Ok(())
+    } else {
+        Err(PlantError::BadColor {
+            name: material.name.clone(),
+            color: material.color,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -492,5 +696,86 @@ mod tests {
             Err(PlantError::NoSuchMaterial(9))
         ));
         assert!(p.segments.is_empty());
+    }
+
+    #[test]
+    fn refuses_far_points_big_sizes_bad_organs_and_colours() {
+        let mut p = Plant::new(PlantMeta::default());
+        let far = Vec3::new(2e12, 0.0, 0.0);
+        assert!(matches!(
+            p.add_segment(Vec3::ZERO, far, (0.1, 0.1), None, false, Plant::BARK),
+            Err(PlantError::TooFar { .. })
+        ));
+        assert!(matches!(
+            p.add_segment(Vec3::ZERO, Vec3::Y, (0.1, 1e13), None, false, Plant::BARK),
+            Err(PlantError::TooFar { .. })
+        ));
+        let leaf = Organ {
+            kind: OrganKind::Leaf,
+            position: Vec3::Y,
+            orientation: Quat::IDENTITY,
+            size: Vec2::new(0.1, 0.05),
+            material: Plant::LEAF,
+            parent: None,
+        };
+        let squashed = Organ {
+            orientation: Quat::from_xyzw(0.0, 0.0, 0.0, 0.5),
+            ..leaf
+        };
+        assert_eq!(p.add_organ(squashed), Err(PlantError::BadOrientation));
+        let nan = Organ {
+            orientation: Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0),
+            ..leaf
+        };
+        assert_eq!(p.add_organ(nan), Err(PlantError::BadOrientation));
+        let wide = Organ {
+            size: Vec2::new(0.1, -1.0),
+            ..leaf
+        };
+        assert!(matches!(
+            p.add_organ(wide),
+            Err(PlantError::Negative { .. })
+        ));
+        p.add_organ(leaf).unwrap();
+        assert!(matches!(
+            p.set_organ_parent(0, Some(SegmentId(0))),
+            Err(PlantError::NoSuchParent { .. })
+        ));
+        assert!(matches!(
+            p.set_organ_parent(3, None),
+            Err(PlantError::NoSuchOrgan { organ: 3, len: 1 })
+        ));
+        let s = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        p.set_organ_parent(0, Some(s)).unwrap();
+        assert_eq!(p.organs()[0].parent, Some(s));
+        let odd = Material {
+            color: [0.5, f32::NAN, 0.5],
+            ..Material::of_kind(MaterialKind::Root)
+        };
+        assert!(matches!(
+            p.add_material(odd.clone()),
+            Err(PlantError::BadColor { .. })
+        ));
+        assert!(matches!(
+            p.replace_material(Plant::BARK, odd),
+            Err(PlantError::BadColor { .. })
+        ));
+        assert_eq!(p.materials().len(), 3);
+    }
+
+    #[test]
+    fn clearing_keeps_or_restores_the_default_materials() {
+        let mut p = Plant::bare(PlantMeta::default());
+        p.add_material(Material::of_kind(MaterialKind::Root))
+            .unwrap();
+        p.clear_to_defaults();
+        assert_eq!(p.materials(), Plant::new(PlantMeta::default()).materials());
+        p.add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        p.clear();
+        assert!(p.segments().is_empty());
+        assert_eq!(p.materials().len(), 3);
     }
 }

@@ -185,7 +185,7 @@ fn the_taper_measure_rewards_thinning_gradually_from_the_foot() {
     // A branch from the foot counts its path from the foot too: a level-1 tip farthest out
     // sets the reference to 1/9 there.
     let mut forked = even.clone();
-    let top = forked.segments[3].end;
+    let top = forked.segments()[3].end;
     let tip = top + Vec3::X * 4.0;
     let r = (0.3 * at(4.0) as f32, 0.3 / 9.0);
     let last = Some(SegmentId(3));

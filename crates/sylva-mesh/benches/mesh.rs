@@ -21,8 +21,8 @@ fn mesh_tree(c: &mut Criterion) {
         .expect("the bench tree meshes");
     eprintln!(
         "bench tree: {} segments, {} organs, {} vertices, {} triangles",
-        plant.segments.len(),
-        plant.organs.len(),
+        plant.segments().len(),
+        plant.organs().len(),
         stats.vertices,
         stats.triangles
     );

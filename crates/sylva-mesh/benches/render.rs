@@ -8,6 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use sylva_core::MaterialId;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::render::{RenderOptions, Renderer};
 use sylva_mesh::{Scene, SceneNode};
@@ -49,8 +50,10 @@ fn render(c: &mut Criterion) {
     }
     // The same tree with bark, leaf and petal textures (made once, kept by the renderer).
     let mut textured = plant;
-    for (m, id) in textured.materials.iter_mut().zip([0, 3, 6]) {
-        m.texture = Some(id);
+    for (m, id) in [0, 3, 6].into_iter().enumerate() {
+        textured
+            .set_texture(MaterialId(m as u16), Some(id))
+            .unwrap();
     }
     let textured = mesh_plant(&textured, &MeshOptions::default()).unwrap();
     let scene = Scene::single(SceneNode::new("tree", &textured));

@@ -69,14 +69,15 @@
 //!   at the tip; both sides alike. Petals: the same per petal (base `(½, 0)`, sides `(0, ½)`
 //!   and `(1, ½)`, tip `(½, 1)`). Root tips: their local XY plane, `v` base to tip.
 //! - **Output.** One [`Primitive`] per material that has triangles, in material order;
-//!   `mesh.materials` is a copy of `plant.materials`. Vertices come axis by axis in segment
+//!   `mesh.materials` is a copy of `plant.materials()`. Vertices come axis by axis in segment
 //!   order, then organs in order, so the same plant always gives the same mesh.
 //!
-//! Degenerate input is handled without NaN: a zero-length segment borrows the direction of
-//! its neighbours, a zero radius gives a collapsed tube with valid normals, and values that
-//! are not finite (possible since `Plant`'s fields are public) are refused with
-//! [`MeshError::NotFinite`]. The triangle count is computed exactly before anything is
-//! allocated and checked against [`MeshOptions::max_triangles`].
+//! The mesher trusts its [`Plant`]: a plant holds only finite coordinates within range,
+//! non-negative sizes, unit orientations, parents before children and materials that exist
+//! (it refuses anything else when it is built). Degenerate geometry is handled without NaN:
+//! a zero-length segment borrows the direction of its neighbours and a zero radius gives a
+//! collapsed tube with valid normals. The triangle count is computed exactly before
+//! anything is allocated and checked against [`MeshOptions::max_triangles`].
 
 use std::f32::consts::{PI, TAU};
 
@@ -150,49 +151,6 @@ pub enum MeshError {
         /// What the plant needs.
         needed: u64,
     },
-    /// A coordinate, radius, size or orientation is NaN or infinite.
-    #[error("{what} of {owner} {index} is not finite")]
-    NotFinite {
-        /// `"segment"` or `"organ"`.
-        owner: &'static str,
-        /// Its index.
-        index: usize,
-        /// Which value.
-        what: &'static str,
-    },
-    /// A value is finite but unusable: a negative radius or size, a coordinate beyond
-    /// ±1e12 m, or a zero orientation quaternion.
-    #[error("{what} of {owner} {index} is out of range ({value})")]
-    OutOfRange {
-        /// `"segment"` or `"organ"`.
-        owner: &'static str,
-        /// Its index.
-        index: usize,
-        /// Which value.
-        what: &'static str,
-        /// The value found.
-        value: f32,
-    },
-    /// A segment or organ refers to a material the plant does not have.
-    #[error("{owner} {index} uses material {material}, but the plant has {len} materials")]
-    NoSuchMaterial {
-        /// `"segment"` or `"organ"`.
-        owner: &'static str,
-        /// Its index.
-        index: usize,
-        /// The material asked for.
-        material: u16,
-        /// Materials in the plant.
-        len: usize,
-    },
-    /// A segment's parent does not come before it (segments must be stored parents first).
-    #[error("segment {segment} has parent {parent}, which does not come before it")]
-    BadParent {
-        /// The segment.
-        segment: usize,
-        /// Its parent.
-        parent: u32,
-    },
 }
 
 /// What a call to [`Mesher::mesh_into`] produced.
@@ -208,9 +166,6 @@ pub struct MeshStats {
 const MAX_BEND_STRETCH: f32 = 2.0;
 /// Squared lengths below this are treated as zero (lengths below a picometre).
 const TINY_SQ: f32 = 1e-24;
-/// Coordinates and sizes beyond this many metres are refused; they would overflow to
-/// infinity in products.
-const MAX_COORD: f32 = 1e12;
 /// The taper slope used for normals is clamped to this (a cone of about 83°).
 const MAX_SLOPE: f32 = 8.0;
 /// Petals rise this far (radians) from the flower's plane towards its axis.
@@ -398,7 +353,7 @@ impl Mesher {
     /// Meshes `plant` into `out`, replacing its contents but reusing its buffers' capacity.
     /// On error `out` is left unchanged.
     pub fn mesh_into(&mut self, plant: &Plant, out: &mut Mesh) -> Result<MeshStats, MeshError> {
-        self.validate(plant)?;
+        self.link(plant);
         let (vertices, triangles) = self.count(plant)?;
 
         out.positions.clear();
@@ -407,13 +362,14 @@ impl Mesher {
         out.positions.reserve(vertices);
         out.normals.reserve(vertices);
         out.uvs.reserve(vertices);
-        out.materials.clone_from(&plant.materials);
+        out.materials.clear();
+        out.materials.extend_from_slice(plant.materials());
         // Reversed, so popping hands each material back the buffer it had last time.
         for p in out.primitives.drain(..).rev() {
             self.pool.push(p.indices);
         }
         self.slots.clear();
-        self.slots.resize(plant.materials.len(), NONE);
+        self.slots.resize(plant.materials().len(), NONE);
         for (m, &tris) in self.material_triangles.iter().enumerate() {
             if tris > 0 {
                 let mut indices = self.pool.pop().unwrap_or_default();
@@ -427,7 +383,7 @@ impl Mesher {
             }
         }
 
-        for start in 0..plant.segments.len() {
+        for start in 0..plant.segments().len() {
             if self.starts_axis(plant, start) {
                 self.tube(plant, start, out);
             }
@@ -449,68 +405,18 @@ impl Mesher {
         Ok(out)
     }
 
-    /// Checks every value the mesher reads and links each segment to its continuation.
-    fn validate(&mut self, plant: &Plant) -> Result<(), MeshError> {
-        let materials = plant.materials.len();
+    /// Links each segment to its continuation (the first child that is not lateral).
+    fn link(&mut self, plant: &Plant) {
         self.next.clear();
-        self.next.resize(plant.segments.len(), NONE);
-        for (i, s) in plant.segments.iter().enumerate() {
-            let owner = "segment";
-            check_point(owner, i, "start", s.start)?;
-            check_point(owner, i, "end", s.end)?;
-            check_size(owner, i, "start radius", s.start_radius)?;
-            check_size(owner, i, "end radius", s.end_radius)?;
-            if s.material.index() >= materials {
-                return Err(MeshError::NoSuchMaterial {
-                    owner,
-                    index: i,
-                    material: s.material.0,
-                    len: materials,
-                });
-            }
-            if let Some(p) = s.parent {
-                if p.index() >= i {
-                    return Err(MeshError::BadParent {
-                        segment: i,
-                        parent: p.0,
-                    });
-                }
-                if !s.lateral && self.next[p.index()] == NONE {
-                    self.next[p.index()] = i as u32;
-                }
+        self.next.resize(plant.segments().len(), NONE);
+        for (i, s) in plant.segments().iter().enumerate() {
+            if let Some(p) = s.parent
+                && !s.lateral
+                && self.next[p.index()] == NONE
+            {
+                self.next[p.index()] = i as u32;
             }
         }
-        for (i, o) in plant.organs.iter().enumerate() {
-            let owner = "organ";
-            check_point(owner, i, "position", o.position)?;
-            check_size(owner, i, "length", o.size.x)?;
-            check_size(owner, i, "width", o.size.y)?;
-            if !o.orientation.is_finite() {
-                return Err(MeshError::NotFinite {
-                    owner,
-                    index: i,
-                    what: "orientation",
-                });
-            }
-            let length = o.orientation.length();
-            if length <= 1e-6 {
-                return Err(MeshError::OutOfRange {
-                    owner,
-                    index: i,
-                    what: "orientation",
-                    value: length,
-                });
-            }
-            if o.material.index() >= materials {
-                return Err(MeshError::NoSuchMaterial {
-                    owner,
-                    index: i,
-                    material: o.material.0,
-                    len: materials,
-                });
-            }
-        }
-        Ok(())
     }
 
     /// Exact vertex and triangle counts (and triangles per material), checked against the
@@ -519,9 +425,9 @@ impl Mesher {
         let r = u64::from(self.options.radial_segments);
         let caps = self.options.cap_ends;
         self.material_triangles.clear();
-        self.material_triangles.resize(plant.materials.len(), 0);
+        self.material_triangles.resize(plant.materials().len(), 0);
         let (mut vertices, mut triangles) = (0u64, 0u64);
-        for (i, s) in plant.segments.iter().enumerate() {
+        for (i, s) in plant.segments().iter().enumerate() {
             let mut tris = 2 * r;
             vertices += r + 1;
             if self.starts_axis(plant, i) {
@@ -540,7 +446,7 @@ impl Mesher {
         }
         let n = u64::from(self.options.leaf_stations);
         let p = u64::from(self.options.flower_petals);
-        for o in &plant.organs {
+        for o in plant.organs() {
             let (v, t) = match o.kind {
                 OrganKind::Leaf => (4 * n + 4, 4 * n),
                 OrganKind::Flower => (8 * p, 4 * p),
@@ -566,7 +472,7 @@ impl Mesher {
     /// Whether segment `i` begins an axis (see the module docs).
     #[inline]
     fn starts_axis(&self, plant: &Plant, i: usize) -> bool {
-        let s = &plant.segments[i];
+        let s = &plant.segments()[i];
         match s.parent {
             None => true,
             Some(p) => s.lateral || self.next[p.index()] != i as u32,
@@ -575,7 +481,7 @@ impl Mesher {
 
     /// Meshes the axis beginning at segment `start`: rings, quads and caps.
     fn tube(&self, plant: &Plant, start: usize, out: &mut Mesh) {
-        let segs = &plant.segments;
+        let segs = &plant.segments();
         let r = self.options.radial_segments;
         let first = &segs[start];
 
@@ -657,7 +563,7 @@ impl Mesher {
     /// The direction of the first span of the axis at `start` that has a length; if none has,
     /// the parent's direction, and failing that +Y.
     fn first_tangent(&self, plant: &Plant, start: usize, x0: Vec3) -> Vec3 {
-        let segs = &plant.segments;
+        let segs = &plant.segments();
         let (mut from, mut cur) = (x0, start as u32);
         while cur != NONE {
             let s = &segs[cur as usize];
@@ -739,8 +645,8 @@ impl Mesher {
 
     /// Appends every organ.
     fn organs(&self, plant: &Plant, out: &mut Mesh) {
-        for o in &plant.organs {
-            // validate() refused zero and non-finite quaternions.
+        for o in plant.organs() {
+            // A plant's orientations are unit quaternions; normalising removes rounding.
             let q = o.orientation.normalize();
             let slot = self.slots[o.material.index()] as usize;
             let base = out.positions.len() as u32;
@@ -983,47 +889,6 @@ fn check_range(
     }
 }
 
-fn check_point(
-    owner: &'static str,
-    index: usize,
-    what: &'static str,
-    p: Vec3,
-) -> Result<(), MeshError> {
-    if !p.is_finite() {
-        return Err(MeshError::NotFinite { owner, index, what });
-    }
-    let value = p.abs().max_element();
-    if value > MAX_COORD {
-        return Err(MeshError::OutOfRange {
-            owner,
-            index,
-            what,
-            value,
-        });
-    }
-    Ok(())
-}
-
-fn check_size(
-    owner: &'static str,
-    index: usize,
-    what: &'static str,
-    value: f32,
-) -> Result<(), MeshError> {
-    if !value.is_finite() {
-        Err(MeshError::NotFinite { owner, index, what })
-    } else if !(0.0..=MAX_COORD).contains(&value) {
-        Err(MeshError::OutOfRange {
-            owner,
-            index,
-            what,
-            value,
-        })
-    } else {
-        Ok(())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1206,7 +1071,7 @@ mod tests {
         let m = mesh_of(&p);
         assert_eq!(m.vertex_count(), 0);
         assert!(m.primitives.is_empty());
-        assert_eq!(m.materials, p.materials);
+        assert_eq!(m.materials, p.materials());
     }
 
     #[test]
@@ -1506,63 +1371,6 @@ mod tests {
     }
 
     #[test]
-    fn bad_values_are_typed_errors() {
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y], 0.1);
-        p.segments[0].end.x = f32::NAN;
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::NotFinite {
-                owner: "segment",
-                index: 0,
-                ..
-            })
-        ));
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y], 0.1);
-        p.segments[0].end_radius = -1.0;
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::OutOfRange { .. })
-        ));
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y], 0.1);
-        p.segments[0].start.y = 1e30;
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::OutOfRange { .. })
-        ));
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y], 0.1);
-        p.segments[0].material = sylva_core::MaterialId(9);
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::NoSuchMaterial { material: 9, .. })
-        ));
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y, Vec3::X], 0.1);
-        p.segments[0].parent = Some(SegmentId(1));
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::BadParent {
-                segment: 0,
-                parent: 1
-            })
-        ));
-        let mut p = plant();
-        p.organs.push(organ(
-            OrganKind::Leaf,
-            Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
-            Vec2::ONE,
-            Plant::LEAF,
-        ));
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::OutOfRange { owner: "organ", .. })
-        ));
-        p.organs[0].orientation = Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0);
-        assert!(matches!(
-            mesh_plant(&p, &MeshOptions::default()),
-            Err(MeshError::NotFinite { owner: "organ", .. })
-        ));
-    }
-
-    #[test]
     fn too_many_triangles_is_an_error_and_leaves_out_alone() {
         let p = chain(&[Vec3::ZERO, Vec3::Y, Vec3::Y * 2.0], 0.1);
         let options = MeshOptions {
@@ -1620,7 +1428,7 @@ mod tests {
         assert_double_sided(&m, &m.primitives[0].indices);
         assert_eq!(winding_agreement(&m), 1.0);
         // Base, tip, length and width as documented.
-        let o = p.organs[0];
+        let o = p.organs()[0];
         let local = |v: [f32; 3]| q.inverse() * (Vec3::from_array(v) - o.position);
         let tip = local(m.positions[9]);
         assert!((tip - Vec3::new(0.0, 0.4, 0.0)).length() < 1e-6, "{tip}");
@@ -1649,7 +1457,7 @@ mod tests {
         let (lo, hi) = u.fold((1.0f32, 0.0f32), |(lo, hi), u| (lo.min(u), hi.max(u)));
         assert!(lo < 0.02 && hi > 0.98, "{lo}..{hi}");
         // u − ½ is the offset across over the width, v the height over the length.
-        let o = p.organs[0];
+        let o = p.organs()[0];
         for (pos, uv) in m.positions.iter().zip(&m.uvs) {
             let local = q.inverse() * (Vec3::from_array(*pos) - o.position);
             assert!(
@@ -1762,7 +1570,7 @@ mod tests {
         let reach = m
             .positions
             .iter()
-            .map(|v| (Vec3::from_array(*v) - p.organs[0].position).length())
+            .map(|v| (Vec3::from_array(*v) - p.organs()[0].position).length())
             .fold(0.0, f32::max);
         assert!(
             (reach - 0.1).abs() < 1e-6,
@@ -1814,25 +1622,23 @@ mod tests {
             p.add_organ(organ(kind, Quat::IDENTITY, Vec2::ZERO, Plant::LEAF))
                 .unwrap();
         }
-        // An orientation that is not normalised is normalised.
-        p.organs.push(organ(
-            OrganKind::Leaf,
-            Quat::from_xyzw(0.0, 0.0, 0.0, 3.0),
-            Vec2::ONE,
-            Plant::LEAF,
-        ));
         mesh_of(&p);
     }
 
     #[test]
     fn one_primitive_per_used_material_and_deterministic() {
-        let mut p = chain(&[Vec3::ZERO, Vec3::Y, Vec3::new(0.3, 2.0, 0.1)], 0.1);
+        let mut p = plant();
         let root = p
             .add_material(sylva_core::Material::of_kind(
                 sylva_core::MaterialKind::Root,
             ))
             .unwrap();
-        p.segments[1].material = root;
+        let trunk = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        let top = Vec3::new(0.3, 2.0, 0.1);
+        p.add_segment(Vec3::Y, top, (0.1, 0.1), Some(trunk), false, root)
+            .unwrap();
         p.add_organ(organ(
             OrganKind::Leaf,
             Quat::IDENTITY,
@@ -1843,7 +1649,7 @@ mod tests {
         let m = mesh_of(&p);
         let used: Vec<usize> = m.primitives.iter().map(|p| p.material).collect();
         assert_eq!(used, [0, 1, 3]);
-        assert_eq!(m.materials, p.materials);
+        assert_eq!(m.materials, p.materials());
         assert_eq!(mesh_of(&p), m);
         // Reusing an output that held a bigger mesh gives the same result.
         let mut mesher = Mesher::new(MeshOptions::default()).unwrap();
@@ -1903,7 +1709,7 @@ mod tests {
             check_invariants(&m);
             prop_assert_eq!(stats.vertices, m.vertex_count());
             prop_assert_eq!(stats.triangles, m.triangle_count());
-            prop_assert!(m.triangle_count() >= 2 * radial as usize * p.segments.len());
+            prop_assert!(m.triangle_count() >= 2 * radial as usize * p.segments().len());
         }
     }
 }

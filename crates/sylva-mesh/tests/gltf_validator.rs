@@ -13,7 +13,7 @@ use std::process::Command;
 
 use serde_json::json;
 use sylva_core::glam::{Quat, Vec2, Vec3};
-use sylva_core::{Material, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
+use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
 use sylva_mesh::export::write_scene;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::{Mesh, Scene, SceneNode};
@@ -144,13 +144,13 @@ fn written_glbs_pass_the_khronos_validator() {
     // designs; the two plants share the leaf texture.
     let mut textured = tree_with_organs();
     let textures = [Some(0), Some(3), Some(3), Some(1)];
-    for (m, t) in textured.materials.iter_mut().zip(textures) {
-        m.texture = t;
+    for (m, t) in textures.into_iter().enumerate() {
+        textured.set_texture(MaterialId(m as u16), t).unwrap();
     }
     let textured = mesh(&textured);
     let mut other = common::binary_tree(2, 3);
-    other.materials[1].texture = Some(3);
-    other.materials[2].texture = Some(16);
+    other.set_texture(Plant::LEAF, Some(3)).unwrap();
+    other.set_texture(Plant::FLOWER, Some(16)).unwrap();
     let other = mesh(&other);
     assert!(other.materials[0].texture.is_none());
     let mut second = SceneNode::new("other", &other);

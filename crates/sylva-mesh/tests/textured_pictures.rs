@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use image::{GrayImage, imageops};
 use sylva_core::glam::{Quat, Vec2, Vec3};
-use sylva_core::{Material, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
+use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::render::{
     self, RenderOptions, SheetCell, SheetOptions, View, contact_sheet, write_png,
@@ -107,8 +107,8 @@ fn write_textured_pictures() {
     let trees: Vec<(String, Mesh)> = (0..3)
         .map(|k| {
             let mut plant = common::binary_tree(4, 6);
-            for (m, id) in plant.materials.iter_mut().zip([k, 3 + k, 6 + k]) {
-                m.texture = Some(id);
+            for (m, id) in [k, 3 + k, 6 + k].into_iter().enumerate() {
+                plant.set_texture(MaterialId(m as u16), Some(id)).unwrap();
             }
             let label = format!("textures {k}, {}, {}", 3 + k, 6 + k);
             (label, mesh_plant(&plant, &MeshOptions::default()).unwrap())
@@ -140,7 +140,7 @@ fn write_textured_pictures() {
                         .unwrap(),
                 );
             }
-            plant.materials[0].texture = Some(id);
+            plant.set_texture(MaterialId(0), Some(id)).unwrap();
             mesh_plant(&plant, &MeshOptions::default()).unwrap()
         })
         .collect();

@@ -45,8 +45,8 @@ fn grow_and_mesh(c: &mut Criterion) {
         let stats = mesher.mesh_into(&plant, &mut mesh).unwrap();
         eprintln!(
             "{name}: {} segments, {} organs, {} triangles",
-            plant.segments.len(),
-            plant.organs.len(),
+            plant.segments().len(),
+            plant.organs().len(),
             stats.triangles
         );
         group.bench_function(format!("develop/{name}"), |b| {

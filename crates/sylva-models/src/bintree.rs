@@ -411,7 +411,7 @@ impl BinTree {
             genome_hash: stable_hash(&json),
             seed,
         });
-        plant.segments.reserve(self.cylinder_count());
+        plant.reserve(self.cylinder_count(), 0);
         let rotations = [self.rotation1, self.rotation2]
             .map(|r| (r.unit_axis().as_vec3(), r.angle.to_radians() as f32));
         // Explicit stack: (foot, frame, level, parent, lateral).
@@ -507,11 +507,11 @@ mod tests {
     fn develop_counts_and_orders() {
         let t = BinTree::default();
         let p = t.develop(0).unwrap();
-        assert_eq!(p.segments.len(), 255);
+        assert_eq!(p.segments().len(), 255);
         assert_eq!(p.tips().count(), 128);
-        assert_eq!(p.segments[0].start, Vec3::ZERO);
-        assert_eq!(p.segments.iter().map(|s| s.order).max(), Some(7));
-        assert!(p.segments.iter().all(|s| s.start_radius >= s.end_radius));
+        assert_eq!(p.segments()[0].start, Vec3::ZERO);
+        assert_eq!(p.segments().iter().map(|s| s.order).max(), Some(7));
+        assert!(p.segments().iter().all(|s| s.start_radius >= s.end_radius));
     }
 
     #[test]
@@ -522,7 +522,11 @@ mod tests {
             ..BinTree::default()
         };
         let p = t.develop(0).unwrap();
-        let thinnest = p.segments.iter().map(|s| s.end_radius).fold(1.0, f32::min);
+        let thinnest = p
+            .segments()
+            .iter()
+            .map(|s| s.end_radius)
+            .fold(1.0, f32::min);
         assert!((thinnest - 0.01).abs() < 1e-6, "{thinnest}");
     }
 

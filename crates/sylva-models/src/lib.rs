@@ -12,7 +12,7 @@
 //! let text = genome.to_json();
 //! assert_eq!(Genome::from_json(&text)?, genome);
 //! let plant = genome.develop(0)?;
-//! assert_eq!(plant.segments.len(), 255);
+//! assert_eq!(plant.segments().len(), 255);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 

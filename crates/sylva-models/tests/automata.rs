@@ -71,7 +71,7 @@ fn options(seed: u64) -> GrowOptions {
 /// Rebuilds the plant through `Plant`'s checked constructors: every part must be accepted.
 fn assert_valid(plant: &Plant) {
     let mut copy = Plant::new(PlantMeta::default());
-    for s in &plant.segments {
+    for s in plant.segments() {
         let id = copy
             .add_segment(
                 s.start,
@@ -88,10 +88,10 @@ fn assert_valid(plant: &Plant) {
             assert!(p.index() < id.index(), "parents first");
         }
     }
-    for o in &plant.organs {
+    for o in plant.organs() {
         copy.add_organ(*o).unwrap();
     }
-    assert_eq!(&copy.segments, &plant.segments);
+    assert_eq!(&copy.segments(), &plant.segments());
 }
 
 fn assert_within(report: &GrowthReport, o: &GrowOptions, plant: &Plant) {
@@ -102,12 +102,12 @@ fn assert_within(report: &GrowthReport, o: &GrowOptions, plant: &Plant) {
     assert!(report.points <= l.points);
     assert!(report.leaves + report.flowers <= l.organs);
     assert!(report.iterations <= o.iterations);
-    assert_eq!(report.segments as usize, plant.segments.len());
+    assert_eq!(report.segments as usize, plant.segments().len());
     assert_eq!(
         (report.leaves + report.flowers) as usize,
-        plant.organs.len()
+        plant.organs().len()
     );
-    assert!(plant.segments.len() <= (report.points + report.automata) as usize);
+    assert!(plant.segments().len() <= (report.points + report.automata) as usize);
     assert_eq!(report.bounds.points, report.stop == Stop::Points);
     assert_eq!(report.bounds.states, report.stop == Stop::States);
     if report.stop == Stop::AllDead {
@@ -140,13 +140,13 @@ proptest! {
         let r2 = sim.run(&program, &o, Detail::Chords, &mut chords);
         assert_valid(&chords);
         prop_assert_eq!(GrowthReport { segments: 0, ..r2 }, GrowthReport { segments: 0, ..report });
-        prop_assert!(chords.segments.len() <= full.segments.len());
-        prop_assert_eq!(&chords.organs.iter().map(|o| (o.position, o.kind)).collect::<Vec<_>>(),
-            &full.organs.iter().map(|o| (o.position, o.kind)).collect::<Vec<_>>());
+        prop_assert!(chords.segments().len() <= full.segments().len());
+        prop_assert_eq!(&chords.organs().iter().map(|o| (o.position, o.kind)).collect::<Vec<_>>(),
+            &full.organs().iter().map(|o| (o.position, o.kind)).collect::<Vec<_>>());
         prop_assert_eq!(sorted(chords.tips()), sorted(full.tips()));
         let ends = |p: &Plant| {
             let counts = p.child_counts();
-            let mut v: Vec<(u16, u32, [f32; 3])> = p.segments.iter().zip(counts)
+            let mut v: Vec<(u16, u32, [f32; 3])> = p.segments().iter().zip(counts)
                 .filter(|(_, c)| *c == 0)
                 .map(|(s, _)| (s.order, s.end_radius.to_bits(), s.end.to_array()))
                 .collect();
@@ -300,7 +300,7 @@ fn creating_every_step_hits_the_automata_bound() {
     assert!(report.bounds.automata_refused > 0, "{report:?}");
     assert!(report.bounds.any());
     assert!(report.peak_live <= o.limits.automata);
-    assert!(plant.segments.iter().map(|s| s.order).max() == Some(2));
+    assert!(plant.segments().iter().map(|s| s.order).max() == Some(2));
 }
 
 #[test]
@@ -310,7 +310,7 @@ fn nested_repeats_without_wait_are_killed_and_reported() {
     assert_eq!(report.bounds.state_limit_kills, 1);
     assert_eq!(report.max_states_per_step, 1000);
     assert_eq!(report.stop, Stop::AllDead);
-    assert_eq!(plant.segments.len(), 1, "it moved once, then looped");
+    assert_eq!(plant.segments().len(), 1, "it moved once, then looped");
     // Restarting at the end with no Wait loops for ever: the same bound stops it.
     let restart = Semantics {
         at_end: AtEnd::Restart,
@@ -318,7 +318,7 @@ fn nested_repeats_without_wait_are_killed_and_reported() {
     };
     let (plant, report) = grow("(Top (RotateU 1))", &GrowOptions::default(), &restart);
     assert_eq!(report.bounds.state_limit_kills, 1);
-    assert!(plant.segments.is_empty());
+    assert!(plant.segments().is_empty());
 }
 
 #[test]
@@ -332,7 +332,7 @@ fn points_states_organs_and_values_are_bounded() {
     let (plant, report) = grow(long, &o, &Semantics::default());
     assert_eq!((report.points, report.stop), (50, Stop::Points));
     assert!(report.bounds.points);
-    assert_eq!(plant.segments.len(), 50);
+    assert_eq!(plant.segments().len(), 50);
     o.limits = Limits {
         states: 100,
         organs: 7,
@@ -341,14 +341,46 @@ fn points_states_organs_and_values_are_bounded() {
     let (plant, report) = grow(long, &o, &Semantics::default());
     assert_eq!(report.stop, Stop::States);
     assert!(report.states >= 100 && report.states < 110);
-    assert_eq!(plant.organs.len(), 7);
+    assert_eq!(plant.organs().len(), 7);
     assert!(report.bounds.organs_refused > 0);
     // Length multiplied by 10 every step: clamped, and positions stay finite.
     let runaway = "(Top (Repeat 10 (Repeat 10 (Seq (Multiply Length 10) (Wait)))))";
     let (plant, report) = grow(runaway, &GrowOptions::default(), &Semantics::default());
     assert!(report.bounds.clamped_values > 0);
-    assert!(plant.segments.iter().all(|s| s.end.is_finite()));
+    assert!(plant.segments().iter().all(|s| s.end.is_finite()));
     assert_eq!(report.points, 100);
+}
+
+#[test]
+fn a_plant_that_outgrows_the_world_stops_at_the_extent_bound() {
+    // Length 10^6 units (clamped) at 1000 m a unit: 10^9 m a step, past 10^12 m within
+    // 1000 steps. Growth stops there, every part kept is legal, and the bound is reported.
+    let far = "(Top (Seq (Repeat 7 (Multiply Length 10)) \
+               (Repeat 10 (Repeat 10 (Repeat 10 (Repeat 10 (Wait)))))))";
+    let o = GrowOptions {
+        iterations: 20_000,
+        unit: 1000.0,
+        ..GrowOptions::default()
+    };
+    for detail in [Detail::Full, Detail::Chords] {
+        let program = Program::compile(&GpTree::parse(far).unwrap(), &Semantics::default());
+        let mut plant = Plant::new(PlantMeta::default());
+        let report = Simulator::new().run(&program, &o, detail, &mut plant);
+        assert_eq!(report.stop, Stop::Extent, "{detail:?}: {report:?}");
+        assert!(report.bounds.extent && report.bounds.any());
+        assert_valid(&plant);
+        let reach = plant
+            .segments()
+            .iter()
+            .map(|s| s.end.y.abs())
+            .fold(0.0, f32::max);
+        assert!(reach <= sylva_core::plant::MAX_COORD, "{reach}");
+        if detail == Detail::Full {
+            // A segment a step: growth stops at the step that left the world.
+            assert!(report.points > 900 && report.points < 1100, "{report:?}");
+            assert!(reach > 1e11, "{reach}");
+        }
+    }
 }
 
 #[test]
@@ -361,7 +393,7 @@ fn the_root_starts_with_its_configured_length() {
     let (plant, _) = grow(text, &o, &Semantics::default());
     let top = |lateral: bool| {
         plant
-            .segments
+            .segments()
             .iter()
             .filter(|s| s.order == u16::from(lateral))
             .map(|s| s.end.y)
@@ -389,9 +421,9 @@ fn push_pop_with_moves_draws_a_fork() {
             (top - 0.4).abs() < 1e-5,
             "the main path goes on from the fork: {top}"
         );
-        assert!(plant.segments.iter().all(|s| s.order == 0 && !s.lateral));
+        assert!(plant.segments().iter().all(|s| s.order == 0 && !s.lateral));
         if detail == Detail::Chords {
-            assert_eq!(plant.segments.len(), 3);
+            assert_eq!(plant.segments().len(), 3);
         }
     }
 }
@@ -405,9 +437,9 @@ fn children_start_at_the_creator_with_its_frame_and_next_iteration() {
     // Iteration 1: the root creates and moves; 2: the root ends, the child moves for the
     // first time; 3: the child ends.
     assert_eq!((report.iterations, report.automaton_steps), (3, 4));
-    let stub = plant.segments[0];
+    let stub = plant.segments()[0];
     assert_eq!(stub.length(), 0.0);
-    let child = plant.segments.iter().find(|s| s.lateral).unwrap();
+    let child = plant.segments().iter().find(|s| s.lateral).unwrap();
     assert_eq!(child.order, 1);
     assert_eq!(child.start, stub.end);
     assert!((child.vector().normalize() - sylva_core::glam::Vec3::Z).length() < 1e-5);
@@ -419,11 +451,11 @@ fn the_last_automaton_adds_organs_where_it_stands() {
                 (Seq (Wait) (Seq (CreateAutomaton Leaf) (Seq (Wait) (CreateAutomaton Flower)))))";
     let (plant, report) = grow(text, &GrowOptions::default(), &Semantics::default());
     assert_eq!((report.leaves, report.flowers), (1, 1));
-    let leaf = plant.organs[0];
+    let leaf = plant.organs()[0];
     assert!((leaf.position.y - 0.4).abs() < 1e-5);
     let up = leaf.orientation * sylva_core::glam::Vec3::Z;
     assert!(up.y > 0.95, "near horizontal, face up: {up}");
-    assert!(leaf.parent.is_some() && plant.organs[1].parent.is_some());
+    assert!(leaf.parent.is_some() && plant.organs()[1].parent.is_some());
 }
 
 #[test]
@@ -468,7 +500,7 @@ fn random_individuals_look_like_the_paper_s() {
             &mut plant,
         );
         drawn += usize::from(report.points > 0);
-        branched += usize::from(plant.segments.iter().any(|s| s.lateral));
+        branched += usize::from(plant.segments().iter().any(|s| s.lateral));
     }
     eprintln!("of 500 random trees: {drawn} draw, {branched} branch");
     assert!(drawn > 250 && branched > 25, "{drawn} {branched}");

@@ -22,19 +22,19 @@ fn helix() -> (AutomataGenome, Plant) {
 fn the_helix_has_a_trunk_and_fourteen_branches() {
     let (_, plant) = helix();
     // 1000 / 70: branches start at steps 70, 140, ..., 980.
-    let branches: Vec<usize> = (0..plant.segments.len())
-        .filter(|&i| plant.segments[i].lateral)
+    let branches: Vec<usize> = (0..plant.segments().len())
+        .filter(|&i| plant.segments()[i].lateral)
         .collect();
     assert_eq!(branches.len(), 14);
-    assert!(plant.segments.iter().all(|s| s.order <= 1));
+    assert!(plant.segments().iter().all(|s| s.order <= 1));
     // The trunk: 1000 steps of 1 unit (0.01 m), straight up.
-    let trunk: Vec<_> = plant.segments.iter().filter(|s| s.order == 0).collect();
+    let trunk: Vec<_> = plant.segments().iter().filter(|s| s.order == 0).collect();
     assert_eq!(trunk.len(), 1000);
     let top = trunk.last().unwrap().end;
     assert!((top - Vec3::new(0.0, 10.0, 0.0)).length() < 1e-3, "{top}");
     // Branch points at heights 0.69, 1.39, ... m.
     for (k, &b) in branches.iter().enumerate() {
-        let start = plant.segments[b].start;
+        let start = plant.segments()[b].start;
         // Created during the 70th step, before that step's move.
         let want = 0.7 * (k + 1) as f32 - 0.01;
         assert!(
@@ -43,14 +43,14 @@ fn the_helix_has_a_trunk_and_fourteen_branches() {
         );
     }
     assert_eq!(plant.tips().count(), 15);
-    assert!(plant.organs.is_empty());
+    assert!(plant.organs().is_empty());
 }
 
 #[test]
 fn branches_leave_at_seventy_degrees_and_bend_down() {
     let (_, plant) = helix();
     let mut azimuths = Vec::new();
-    for (i, s) in plant.segments.iter().enumerate() {
+    for (i, s) in plant.segments().iter().enumerate() {
         if !s.lateral {
             continue;
         }
@@ -61,13 +61,13 @@ fn branches_leave_at_seventy_degrees_and_bend_down() {
         // Follow the axis to its tip.
         let mut last = i;
         while let Some(next) = plant
-            .segments
+            .segments()
             .iter()
             .position(|c| c.parent.map(|p| p.index()) == Some(last) && !c.lateral)
         {
             last = next;
         }
-        let tip = plant.segments[last];
+        let tip = plant.segments()[last];
         // Full-length branches (the first six are not cut by the iteration limit) end
         // pointing down.
         if azimuths.len() <= 6 {
@@ -101,9 +101,9 @@ fn chords_keep_the_tips_with_few_segments() {
         Detail::Chords,
         &mut plant,
     );
-    assert_eq!(report.segments as usize, plant.segments.len());
+    assert_eq!(report.segments as usize, plant.segments().len());
     // Trunk: 15 runs between 14 branch points; one per branch.
-    assert_eq!(plant.segments.len(), 15 + 14);
+    assert_eq!(plant.segments().len(), 15 + 14);
     let mut a: Vec<[f32; 3]> = full.tips().map(|p| p.to_array()).collect();
     let mut b: Vec<[f32; 3]> = plant.tips().map(|p| p.to_array()).collect();
     a.sort_by(|x, y| x.partial_cmp(y).unwrap());

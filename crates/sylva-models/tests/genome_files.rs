@@ -51,7 +51,7 @@ proptest! {
         {
             // Growing may refuse (an error, never a panic); what grows is finite.
             if let Ok(plant) = genome.develop(0) {
-                prop_assert!(plant.segments.iter().all(|s| s.start.is_finite() && s.end.is_finite()));
+                prop_assert!(plant.segments().iter().all(|s| s.start.is_finite() && s.end.is_finite()));
             }
         }
     }
@@ -71,5 +71,5 @@ fn the_example_parses_and_grows() {
     let genome = Genome::from_json(OAK).unwrap();
     assert_eq!(genome.model(), "bintree");
     let plant = genome.develop(0).unwrap();
-    assert_eq!(plant.segments.len(), 1023);
+    assert_eq!(plant.segments().len(), 1023);
 }

@@ -89,20 +89,20 @@ fn example_configs_read() {
 #[test]
 fn empty_rules_do_not_germinate() {
     let plant = LSystemGenome::empty().develop_with(&small(), 7).unwrap();
-    assert!(plant.segments.is_empty());
-    assert_eq!(plant.meta.model, "lsystem");
-    assert_eq!(plant.meta.seed, 7);
+    assert!(plant.segments().is_empty());
+    assert_eq!(plant.meta().model, "lsystem");
+    assert_eq!(plant.meta().seed, 7);
     // An empty successor is a rule too, but grows nothing.
     let mut g = LSystemGenome::empty();
     g.shoot = LSystem::parse("[A]", &["A -> "], Compartment::Shoot).unwrap();
-    assert!(g.develop_with(&small(), 0).unwrap().segments.is_empty());
+    assert!(g.develop_with(&small(), 0).unwrap().segments().is_empty());
 }
 
 #[test]
 fn the_bush_grows_shoot_and_root() {
     let plant = example("bush.json").develop_with(&small(), 0).unwrap();
-    let above = plant.segments.iter().filter(|s| s.end.y > 0.0).count();
-    let below = plant.segments.iter().filter(|s| s.end.y < 0.0).count();
+    let above = plant.segments().iter().filter(|s| s.end.y > 0.0).count();
+    let below = plant.segments().iter().filter(|s| s.end.y < 0.0).count();
     assert!(above > 10 && below > 3, "{above} above, {below} below");
 }
 
@@ -327,6 +327,6 @@ proptest! {
             steps: 15,
         };
         let plant = g.develop_with(&settings, seed).unwrap();
-        prop_assert!(plant.segments.len() <= 400);
+        prop_assert!(plant.segments().len() <= 400);
     }
 }

@@ -142,9 +142,9 @@ proptest! {
         let g = random_genome(seed);
         match g.develop(seed) {
             Ok(plant) => {
-                prop_assert!(!plant.segments.is_empty());
-                prop_assert!(plant.segments.len() + plant.organs.len() <= sylva_models::plantmaker::MAX_PARTS);
-                prop_assert!(plant.segments.iter().all(|s| s.start.is_finite() && s.end.is_finite()));
+                prop_assert!(!plant.segments().is_empty());
+                prop_assert!(plant.segments().len() + plant.organs().len() <= sylva_models::plantmaker::MAX_PARTS);
+                prop_assert!(plant.segments().iter().all(|s| s.start.is_finite() && s.end.is_finite()));
             }
             Err(DevelopError::TooLarge { .. }) => {}
             Err(e) => prop_assert!(false, "{e}"),
@@ -310,7 +310,7 @@ fn seeds_give_similar_but_different_plants() {
     for (i, p) in plants.iter().enumerate() {
         assert_eq!(p, &g.develop(i as u64).unwrap(), "same seed, same plant");
         for q in &plants[..i] {
-            assert_ne!(p.segments, q.segments);
+            assert_ne!(p.segments(), q.segments());
         }
         // Similar: same materials kinds, heights within a factor of 1.5 of the first.
         let ratio = p.height() / plants[0].height();
@@ -323,8 +323,8 @@ fn golden_plant() {
     // Locks development: a change here changes every stored plant.
     let plant = PlantMaker::default().develop(1).unwrap();
     let bytes = serde_json::to_vec(&plant).unwrap();
-    assert_eq!(plant.segments.len(), 91);
-    assert_eq!(plant.organs.len(), 15);
+    assert_eq!(plant.segments().len(), 91);
+    assert_eq!(plant.organs().len(), 15);
     assert_eq!(stable_hash(&bytes), GOLDEN, "{:#x}", stable_hash(&bytes));
 }
 const GOLDEN: u64 = 0x55f6_6c41_cc6a_2137;
@@ -336,7 +336,7 @@ fn examples_are_canonical_and_grow_as_named() {
         assert_eq!(g.to_json(), text, "{name} is written as Sylva writes it");
         assert_eq!(PlantMaker::from_packed(&g.to_packed()).unwrap(), g);
         let p = g.develop(g.seed).unwrap();
-        let kinds: Vec<MaterialKind> = p.materials.iter().map(|m| m.kind).collect();
+        let kinds: Vec<MaterialKind> = p.materials().iter().map(|m| m.kind).collect();
         let height = p.height();
         match name {
             "tulip" => {
@@ -388,7 +388,7 @@ fn gardens_recreate_their_scene() {
         }
     }
     // Seeds differ, so plants differ.
-    assert_ne!(a.plants[0].segments, a.plants[1].segments);
+    assert_ne!(a.plants[0].segments(), a.plants[1].segments());
 
     let crowded = Garden::new(example("palm"), 40, [10.0, 10.0], 1);
     assert!(matches!(

@@ -55,9 +55,9 @@ fn example_pictures() {
         let b = plant.bounds();
         eprintln!(
             "{name}: {} segments, {} organs, {} materials, {:.2} m tall, {:.2} x {:.2} m",
-            plant.segments.len(),
-            plant.organs.len(),
-            plant.materials.len(),
+            plant.segments().len(),
+            plant.organs().len(),
+            plant.materials().len(),
             b.max.y,
             b.max.x - b.min.x,
             b.max.z - b.min.z

@@ -310,8 +310,8 @@ where
     );
     println!(
         "best plant: {} segments, {} organs, {} triangles; wrote {}/{{stats.csv, best.json, best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
-        grown.plant.segments.len(),
-        grown.plant.organs.len(),
+        grown.plant.segments().len(),
+        grown.plant.organs().len(),
         grown.mesh.triangle_count(),
         out.display()
     );
@@ -401,8 +401,8 @@ pub fn grow(args: &GrowArgs) -> anyhow::Result<()> {
     println!(
         "wrote {}: {} segments, {} organs, {} vertices, {} triangles",
         args.output.display(),
-        grown.plant.segments.len(),
-        grown.plant.organs.len(),
+        grown.plant.segments().len(),
+        grown.plant.organs().len(),
         grown.mesh.vertex_count(),
         grown.mesh.triangle_count()
     );

@@ -99,11 +99,11 @@ mod tests {
     fn wires_have_the_expected_segments() {
         let (mut p, m) = guide_plant([0.5; 3]).unwrap();
         box_wire(&mut p, Vec3::ZERO, Vec3::ONE, 0.01, m).unwrap();
-        assert_eq!(p.segments.len(), 12);
+        assert_eq!(p.segments().len(), 12);
         let (mut p, m) = guide_plant([0.5; 3]).unwrap();
         ellipsoid_wire(&mut p, Vec3::Y * 2.0, Vec3::splat(1.5), 0.01, m).unwrap();
-        assert_eq!(p.segments.len(), 11 * 48);
-        for s in &p.segments {
+        assert_eq!(p.segments().len(), 11 * 48);
+        for s in p.segments() {
             let d = (s.start - Vec3::Y * 2.0).length();
             assert!((d - 1.5).abs() < 1e-4);
         }

@@ -69,7 +69,7 @@ impl PoncinScratch {
     /// Reads the plant's endpoints by `rule`, positions divided by `unit` (metres per paper
     /// unit). Segments whose parent is not an earlier segment are treated as roots.
     pub fn read(&mut self, plant: &Plant, unit: f64, rule: EndpointRule) -> &[Endpoint] {
-        let segments = &plant.segments;
+        let segments = &plant.segments();
         self.has_child.clear();
         self.has_child.resize(segments.len(), false);
         self.axis.clear();
@@ -122,7 +122,7 @@ impl PoncinScratch {
     /// with path length from the foot, from 1 there to the farthest tip's level reference.
     /// 0 for a plant without length.
     pub fn taper_deviation(&mut self, plant: &Plant, thick: &super::ThickOptions) -> f64 {
-        let segments = &plant.segments;
+        let segments = &plant.segments();
         self.along.clear();
         let (mut farthest, mut far_level) = (0.0, 0u16);
         for (i, s) in segments.iter().enumerate() {

@@ -391,7 +391,7 @@ impl DensityGrid {
         counts.clear();
         counts.resize(self.len(), 0);
         let mut inside = 0;
-        for organ in plant.organs.iter().filter(|o| o.kind == OrganKind::Leaf) {
+        for organ in plant.organs().iter().filter(|o| o.kind == OrganKind::Leaf) {
             if let Some(i) = self.cell_of(organ.position.as_dvec3() / unit) {
                 counts[i] += 1;
                 inside += 1;

@@ -517,7 +517,7 @@ impl PoncinFitness {
         let mut s = PoncinScore {
             branches: ends.len(),
             leaves: plant
-                .organs
+                .organs()
                 .iter()
                 .filter(|o| o.kind == OrganKind::Leaf)
                 .count(),

@@ -341,9 +341,9 @@ mod tests {
         );
         assert_eq!(AutomataGenome::from_json(&g.to_json()).unwrap(), g);
         let plant = g.develop(7).unwrap();
-        assert_eq!(plant.segments.len(), 1);
-        assert_eq!(plant.meta.model, "automata");
-        assert_eq!(plant.meta.seed, 7);
+        assert_eq!(plant.segments().len(), 1);
+        assert_eq!(plant.meta().model, "automata");
+        assert_eq!(plant.meta().seed, 7);
     }
 
     #[test]

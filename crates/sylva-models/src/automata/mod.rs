@@ -22,12 +22,12 @@
 //! let mut plant = Plant::new(PlantMeta::default());
 //! let report = sim.run(&program, &GrowOptions::default(), Detail::Full, &mut plant);
 //! assert_eq!((report.automata, report.points), (4, 35 + 3 * 8));
-//! assert_eq!(plant.segments.len(), 59);
+//! assert_eq!(plant.segments().len(), 59);
 //! assert_eq!(plant.tips().count(), 4);
 //! assert!(!report.bounds.any());
 //! // For fitness: the same tips from far fewer segments (4 trunk runs, 3 branches).
 //! sim.run(&program, &GrowOptions::default(), Detail::Chords, &mut plant);
-//! assert_eq!(plant.segments.len(), 7);
+//! assert_eq!(plant.segments().len(), 7);
 //! assert_eq!(plant.tips().count(), 4);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

@@ -51,7 +51,7 @@
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
-use sylva_core::{Frame, MaterialKind, Organ, OrganKind, Plant, PlantMeta, Segment, SegmentId};
+use sylva_core::{Frame, Organ, OrganKind, Plant, SegmentId};
 
 use super::compile::{Op, Program, State};
 use super::tree::{VARIABLES, Var};
@@ -252,6 +252,9 @@ pub enum Stop {
     Points,
     /// [`Limits::states`] was reached.
     States,
+    /// A position went beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD) metres, which
+    /// no plant may hold.
+    Extent,
 }
 
 /// Which bounds were hit, and how often.
@@ -270,6 +273,9 @@ pub struct BoundsHit {
     pub points: bool,
     /// Growth stopped at [`Limits::states`].
     pub states: bool,
+    /// Growth stopped at a position beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD)
+    /// metres.
+    pub extent: bool,
 }
 
 impl BoundsHit {
@@ -281,6 +287,7 @@ impl BoundsHit {
             || self.clamped_values > 0
             || self.points
             || self.states
+            || self.extent
     }
 }
 
@@ -388,6 +395,8 @@ struct Memory {
     stack: Vec<Saved>,
     counters: Vec<u8>,
     organ_next: Vec<u32>,
+    /// The plant refused a part (a position beyond its range): growth stops.
+    refused: bool,
     /// Instances created during the current step, moved into `insts` after it.
     newborn: Vec<Inst>,
 }
@@ -445,15 +454,6 @@ fn leaf_rotation(frame: &Frame, horizontal: bool, index: u32) -> Quat {
     if q.is_finite() { q } else { Quat::IDENTITY }
 }
 
-fn reset_materials(plant: &mut Plant) {
-    let kinds = [MaterialKind::Bark, MaterialKind::Leaf, MaterialKind::Flower];
-    let ok =
-        plant.materials.len() >= 3 && plant.materials.iter().zip(kinds).all(|(m, k)| m.kind == k);
-    if !ok {
-        plant.materials = Plant::new(PlantMeta::default()).materials;
-    }
-}
-
 impl Simulator {
     /// An empty simulator.
     pub fn new() -> Simulator {
@@ -478,9 +478,7 @@ impl Simulator {
             radius_scale: options.radius * options.unit,
             gravity: options.gravity.to_radians(),
         };
-        plant.segments.clear();
-        plant.organs.clear();
-        reset_materials(plant);
+        plant.clear_to_defaults();
         let Simulator { insts, live, mem } = self;
         insts.clear();
         live.clear();
@@ -488,6 +486,7 @@ impl Simulator {
         mem.counters.clear();
         mem.organ_next.clear();
         mem.newborn.clear();
+        mem.refused = false;
         let mut rep = GrowthReport::default();
         if program.automata().is_empty() {
             return rep;
@@ -530,6 +529,11 @@ impl Simulator {
             live.copy_within(read..len, write);
             live.truncate(write + len - read);
             rep.peak_live = rep.peak_live.max(live.len() as u32);
+            // A refused part ends growth at the end of its iteration (checked here, off the
+            // per-automaton path).
+            if mem.refused && stop.is_none() {
+                stop = Some(Stop::Extent);
+            }
             if stop.is_some() {
                 break;
             }
@@ -541,11 +545,12 @@ impl Simulator {
         };
         rep.bounds.points = rep.stop == Stop::Points;
         rep.bounds.states = rep.stop == Stop::States;
+        rep.bounds.extent = rep.stop == Stop::Extent;
         rep.live_at_end = live.len() as u32;
         for &id in live.iter() {
             mem.finish(&mut insts[id as usize], &cx, plant);
         }
-        rep.segments = plant.segments.len() as u32;
+        rep.segments = plant.segments().len() as u32;
         rep
     }
 }
@@ -846,7 +851,7 @@ impl Memory {
         if me.chord_moves == 0 {
             return;
         }
-        let id = segment(me, me.chord_start, me.chord_radius, cx, plant);
+        let id = self.segment(me, me.chord_start, me.chord_radius, cx, plant);
         me.seg = id;
         me.chord_start = me.pos;
         me.chord_radius = me.radius;
@@ -859,7 +864,8 @@ impl Memory {
         let parent = (seg != NONE).then_some(SegmentId(seg));
         let mut o = me.pending;
         while o != NONE {
-            plant.organs[o as usize].parent = parent;
+            // The parent was just drawn and the organ added: neither can be missing.
+            self.refused |= plant.set_organ_parent(o as usize, parent).is_err();
             o = self.organ_next[o as usize];
         }
         me.pending = NONE;
@@ -888,7 +894,7 @@ impl Memory {
         // The creation point becomes a segment boundary of the creator.
         self.close_chord(me, cx, plant);
         if me.seg == NONE {
-            me.seg = segment(me, me.pos, me.radius, cx, plant);
+            me.seg = self.segment(me, me.pos, me.radius, cx, plant);
         }
         let vars = match cx.options.child_variables {
             ChildVariables::All => me.vars,
@@ -951,42 +957,54 @@ impl Memory {
                 Plant::FLOWER,
             )
         };
-        plant.organs.push(Organ {
+        let organ = Organ {
             kind,
             position: me.pos * unit,
             orientation,
             size,
             material,
             parent: None,
-        });
+        };
+        if plant.add_organ(organ).is_err() {
+            self.refused = true;
+            return;
+        }
         self.organ_next.push(me.pending);
-        me.pending = (plant.organs.len() - 1) as u32;
+        me.pending = (plant.organs().len() - 1) as u32;
     }
-}
 
-/// Appends the segment from `start` to the instance's position.
-fn segment(me: &Inst, start: Vec3, start_radius: f32, cx: &Cx, plant: &mut Plant) -> u32 {
-    let (parent, lateral) = if me.seg != NONE {
-        (me.seg, false)
-    } else {
-        (me.attach, me.attach != NONE)
-    };
-    let parent = (parent != NONE).then_some(SegmentId(parent));
-    let order = parent.map_or(0, |p| {
-        plant.segments[p.index()]
-            .order
-            .saturating_add(u16::from(lateral))
-    });
-    let unit = cx.options.unit;
-    plant.segments.push(Segment {
-        start: start * unit,
-        end: me.pos * unit,
-        start_radius: start_radius * cx.radius_scale,
-        end_radius: me.radius * cx.radius_scale,
-        order,
-        parent,
-        lateral,
-        material: Plant::BARK,
-    });
-    (plant.segments.len() - 1) as u32
+    /// Draws the segment from `start` to the instance's position; [`NONE`] (and growth
+    /// stops) if the plant refuses it.
+    #[inline(always)]
+    fn segment(
+        &mut self,
+        me: &Inst,
+        start: Vec3,
+        start_radius: f32,
+        cx: &Cx,
+        plant: &mut Plant,
+    ) -> u32 {
+        let (parent, lateral) = if me.seg != NONE {
+            (me.seg, false)
+        } else {
+            (me.attach, me.attach != NONE)
+        };
+        let parent = (parent != NONE).then_some(SegmentId(parent));
+        let unit = cx.options.unit;
+        let radii = (start_radius * cx.radius_scale, me.radius * cx.radius_scale);
+        match plant.add_segment(
+            start * unit,
+            me.pos * unit,
+            radii,
+            parent,
+            lateral,
+            Plant::BARK,
+        ) {
+            Ok(id) => id.0,
+            Err(_) => {
+                self.refused = true;
+                NONE
+            }
+        }
+    }
 }

@@ -103,10 +103,10 @@ impl CrownShape {
         let towards = towards.normalize_or_zero();
         let mut shape = CrownShape::default();
         let mut sum = Vec2::ZERO;
-        for s in &plant.segments {
+        for s in plant.segments() {
             shape.height = shape.height.max(s.end.y).max(s.start.y);
             let leaf = plant
-                .materials
+                .materials()
                 .get(s.material.index())
                 .is_some_and(|m| m.kind == MaterialKind::Leaf);
             if !leaf {

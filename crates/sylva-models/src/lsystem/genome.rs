@@ -402,7 +402,7 @@ impl LSystemGenome {
         )?;
         garden.run(settings.steps, &Pool::Serial)?;
         let mut plant = garden.into_plants().swap_remove(0);
-        plant.meta.seed = seed;
+        plant.meta_mut().seed = seed;
         Ok(plant)
     }
 }

@@ -333,7 +333,7 @@ impl GrowingPlant {
 
     fn world_segments(&self) -> impl Iterator<Item = (Module, Vec3, Vec3)> + '_ {
         self.plant
-            .segments
+            .segments()
             .iter()
             .zip(&self.layout.modules)
             .map(|(s, &m)| (m, s.start + self.position, s.end + self.position))
@@ -580,8 +580,7 @@ impl GrowingPlant {
 
     /// Interprets both strings into the plant, foot at the origin.
     fn interpret(&mut self) -> Result<(), PlantError> {
-        self.plant.segments.clear();
-        self.plant.organs.clear();
+        self.plant.clear();
         self.layout.apexes.clear();
         self.layout.modules.clear();
         for (x, foot) in [(SHOOT, Vec3::ZERO), (ROOT, Vec3::ZERO)] {

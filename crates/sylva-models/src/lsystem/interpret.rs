@@ -227,7 +227,7 @@ mod tests {
         assert_eq!(layout.apexes.len(), 9 + 9);
         // The three first branches lean out in directions 120 degrees apart.
         let firsts: Vec<Vec3> = plant
-            .segments
+            .segments()
             .iter()
             .filter(|s| s.parent.is_none())
             .map(|s| Vec3::new(s.vector().x, 0.0, s.vector().z).normalize())
@@ -256,9 +256,9 @@ mod tests {
             &mut layout,
         )
         .unwrap();
-        assert_eq!(plant.segments.len(), 3);
-        assert!(plant.segments.iter().all(|s| s.end.y < 0.0));
-        assert!(plant.segments[1].lateral && !plant.segments[2].lateral);
-        assert_eq!(plant.segments[2].parent, Some(SegmentId(0)));
+        assert_eq!(plant.segments().len(), 3);
+        assert!(plant.segments().iter().all(|s| s.end.y < 0.0));
+        assert!(plant.segments()[1].lateral && !plant.segments()[2].lateral);
+        assert_eq!(plant.segments()[2].parent, Some(SegmentId(0)));
     }
 }

@@ -22,8 +22,8 @@
 //!     steps: 30,
 //! };
 //! let plant = bush.develop_with(&small, 0)?;
-//! assert!(plant.segments.len() > 10);
-//! assert!(LSystemGenome::empty().develop_with(&small, 0)?.segments.is_empty());
+//! assert!(plant.segments().len() > 10);
+//! assert!(LSystemGenome::empty().develop_with(&small, 0)?.segments().is_empty());
 //! # Ok::<(), sylva_models::DevelopError>(())
 //! ```
 

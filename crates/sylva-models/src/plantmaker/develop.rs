@@ -217,7 +217,7 @@ struct Placed<'a> {
 struct Builder {
     plant: Plant,
     rng: ChaCha8Rng,
-    /// (kind, colour, texture) of each material, indexed like `plant.materials`.
+    /// (kind, colour, texture) of each material, indexed like `plant.materials()`.
     keys: Vec<(MaterialKind, Rgb, Option<u16>)>,
     /// Scratch: the cones of the branch being grown.
     cones: Vec<Cone>,
@@ -335,7 +335,7 @@ impl Builder {
     }
 
     fn check_room(&self, parts: usize) -> Result<(), DevelopError> {
-        if self.plant.segments.len() + self.plant.organs.len() + parts > MAX_PARTS {
+        if self.plant.segments().len() + self.plant.organs().len() + parts > MAX_PARTS {
             Err(DevelopError::TooLarge { limit: MAX_PARTS })
         } else {
             Ok(())
@@ -486,12 +486,11 @@ impl PlantMaker {
     /// See the [module docs](self) for how each gene is read.
     pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
         let json = serde_json::to_vec(self)?;
-        let mut plant = Plant::new(PlantMeta {
+        let plant = Plant::bare(PlantMeta {
             model: MODEL.to_owned(),
             genome_hash: stable_hash(&json),
             seed,
         });
-        plant.materials.clear();
         let mut b = Builder {
             plant,
             rng: sylva_core::rng::seeded(seed),
@@ -636,10 +635,10 @@ mod tests {
         let a = g.develop(3).unwrap();
         assert_eq!(a, g.develop(3).unwrap());
         assert_ne!(a, g.develop(4).unwrap());
-        assert!(!a.organs.is_empty());
-        assert!(a.materials.iter().any(|m| m.kind == MaterialKind::Leaf));
-        assert!(a.materials.iter().any(|m| m.kind == MaterialKind::Bark));
-        assert_eq!(a.segments[0].start, Vec3::ZERO);
+        assert!(!a.organs().is_empty());
+        assert!(a.materials().iter().any(|m| m.kind == MaterialKind::Leaf));
+        assert!(a.materials().iter().any(|m| m.kind == MaterialKind::Bark));
+        assert_eq!(a.segments()[0].start, Vec3::ZERO);
         // 10 cones of 12 cm.
         assert!((a.height() - 1.2).abs() < 0.3, "{}", a.height());
     }
@@ -652,8 +651,8 @@ mod tests {
         h.fans[4].count = 70;
         h.inflorescences[4].position = 3;
         let (a, b) = (g.develop(9).unwrap(), h.develop(9).unwrap());
-        assert_eq!(a.segments, b.segments);
-        assert_eq!(a.organs, b.organs);
+        assert_eq!(a.segments(), b.segments());
+        assert_eq!(a.organs(), b.organs());
     }
 
     #[test]
@@ -669,7 +668,7 @@ mod tests {
                 .iter_mut()
                 .for_each(|i| i.expressed = false);
             let p = g.develop(0).unwrap();
-            assert_eq!(p.segments.len(), 10 * per, "{pattern:?}");
+            assert_eq!(p.segments().len(), 10 * per, "{pattern:?}");
         }
     }
 

@@ -244,11 +244,11 @@ pub fn place(
 pub fn footprint(plant: &Plant) -> f32 {
     let reach = |p: Vec3, extra: f32| p.x.hypot(p.z) + extra;
     let segments = plant
-        .segments
+        .segments()
         .iter()
         .map(|s| reach(s.start, s.start_radius).max(reach(s.end, s.end_radius)));
     let organs = plant
-        .organs
+        .organs()
         .iter()
         .map(|o| reach(o.position, o.size.x.max(o.size.y)));
     segments.chain(organs).fold(0.0, f32::max)
