@@ -9,7 +9,7 @@
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
 //! - [`par`]: the one seam where work goes parallel ([`par::Pool`]).
-//! - [`ranged`]: range-checked fields for genome and config files.
+//! - [`ranged`](mod@ranged): range-checked fields for genome and config files.
 //! - [`rng`]: ChaCha8 streams from a seed, the only source of randomness.
 //!
 //! Conventions: Y is up, right-handed, metres; angles are radians in code.

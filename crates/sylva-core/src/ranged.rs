@@ -1,7 +1,7 @@
 //! Field validation during deserialisation, so a bad value's error carries the line and
 //! column where it stands (serde_json and toml attach positions to errors raised while
 //! reading a field). Genomes and configs use these through `#[serde(deserialize_with)]`;
-//! [`ranged!`](crate::ranged) declares such a reader in one line, for any [`Ranged`] type:
+//! [`ranged!`](macro@crate::ranged) declares such a reader in one line, for any [`Ranged`] type:
 //! floats and whole numbers, and arrays and vectors of them.
 //!
 //! ```

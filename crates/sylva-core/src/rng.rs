@@ -7,7 +7,7 @@
 //! identical for any number of threads. There is no global or thread-local generator.
 
 use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
+pub use rand_chacha::ChaCha8Rng;
 
 /// SplitMix64 step: spreads a 64-bit seed over the 256-bit ChaCha key.
 fn splitmix64(state: &mut u64) -> u64 {

@@ -7,7 +7,7 @@
 //!
 //! ```
 //! use sylva_fitness::{SusinnoWeights, TreeMeasures};
-//! use sylva_models::bintree::BinTree;
+//! use sylva_bintree::BinTree;
 //!
 //! let plant = BinTree::default().develop(0)?;
 //! let measures = TreeMeasures::of_plant(&plant);

@@ -2,9 +2,9 @@
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use proptest::prelude::*;
+use sylva_bintree::{BITS, BinTree, Bits};
 use sylva_core::rng;
 use sylva_fitness::TreeMeasures;
-use sylva_models::bintree::{BITS, BinTree, Bits};
 
 fn close(a: f64, b: f64, what: &str) -> Result<(), TestCaseError> {
     let tol = 1e-4 * a.abs().max(b.abs()).max(1e-3);

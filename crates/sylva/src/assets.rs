@@ -2,13 +2,13 @@
 
 use std::path::Path;
 
+use crate::genome::Genome;
 use anyhow::Context;
 use sylva_core::Plant;
 use sylva_mesh::export::{self, Format};
 use sylva_mesh::mesher::{MeshOptions, Mesher, mesh_plant};
 use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::{Mesh, Scene, SceneNode};
-use sylva_models::Genome;
 
 use crate::error::InputError;
 
@@ -102,7 +102,7 @@ pub fn origin_extras(genome: serde_json::Value, seed: u64) -> serde_json::Value 
 /// ends), so their tubes end in domes; every other model uses the defaults.
 pub fn mesh_options(model: &str) -> MeshOptions {
     MeshOptions {
-        round_caps: model == sylva_models::lsystem::genome::MODEL,
+        round_caps: model == sylva_lsystem::genome::MODEL,
         ..MeshOptions::default()
     }
 }

@@ -3,13 +3,13 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use crate::genome::Genome;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use sylva_core::io::write_atomic;
 use sylva_evolve::{Checkpoint, Pool, Run, RunSettings, Strategy};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
-use sylva_models::Genome;
 
 use crate::assets::{
     Grown, asset_format, check_png, genome_from_text, load_genome, mesh_all, mesh_options,
@@ -113,7 +113,7 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
                         .into());
                     }
                 },
-                None => sylva_models::lsystem::LSystemGenome::empty(),
+                None => sylva_lsystem::LSystemGenome::empty(),
             };
             let (problem, strategy) = lsystem_run(&config.lsystem, start).map_err(|e| {
                 InputError::new(config_name(args), format!("[lsystem.breeding]: {e}"))
@@ -134,7 +134,7 @@ pub fn evolve(args: &EvolveArgs) -> anyhow::Result<()> {
 fn plantmaker_start(
     config: &EvolveConfig,
     base: &Path,
-) -> anyhow::Result<Vec<sylva_models::plantmaker::PlantMaker>> {
+) -> anyhow::Result<Vec<sylva_plantmaker::PlantMaker>> {
     use sylva_evolve::Mutate;
     let pm = &config.plantmaker;
     let mut chosen = Vec::new();
@@ -157,7 +157,7 @@ fn plantmaker_start(
     if chosen.is_empty() {
         return Ok(chosen);
     }
-    let mutation = sylva_models::plantmaker::Mutation {
+    let mutation = sylva_plantmaker::Mutation {
         rate: pm.mutation_rate,
         spread: pm.mutation_spread,
     };
@@ -470,7 +470,7 @@ pub struct GardenArgs {
 /// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
 /// scene (one node per plant, each carrying its genome and seed) and the garden file.
 pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
-    use sylva_models::plantmaker::Garden;
+    use sylva_plantmaker::Garden;
     asset_format(&args.output)?;
     if let Some(png) = &args.png {
         check_png(png)?;
@@ -533,10 +533,7 @@ pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
     let grown = garden
         .grow()
         .map_err(|e| InputError::new(shown(first), e.to_string()))?;
-    let meshes = mesh_all(
-        &grown.plants,
-        &mesh_options(sylva_models::plantmaker::MODEL),
-    )?;
+    let meshes = mesh_all(&grown.plants, &mesh_options(sylva_plantmaker::MODEL))?;
     let mut scene = sylva_mesh::Scene::default();
     for ((placement, mesh), i) in grown.placements.iter().zip(&meshes).zip(0..) {
         let genome = &garden.plants[placement.group].genome;
@@ -569,7 +566,7 @@ pub fn garden(args: &GardenArgs) -> anyhow::Result<()> {
 /// `sylva simulate`: runs an L-system experiment and writes its report, per-step records,
 /// the grown garden as a GLB and a picture.
 pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
-    use sylva_models::lsystem::experiments::Simulation;
+    use sylva_lsystem::experiments::Simulation;
     let text = read_text(config)?;
     let simulation: Simulation = toml::from_str(&text).map_err(|e| match e.span() {
         Some(span) => InputError::spanned(config, &text, span, e.message().to_owned()),
@@ -610,11 +607,11 @@ pub fn simulate(config: &Path, out: Option<&Path>) -> anyhow::Result<()> {
     write("report.txt", report.as_bytes())?;
     write(
         "records.csv",
-        sylva_models::lsystem::garden::records_csv(outcome.records()).as_bytes(),
+        sylva_lsystem::garden::records_csv(outcome.records()).as_bytes(),
     )?;
     let meshes = mesh_all(
         outcome.plants().iter().map(|p| &p.plant),
-        &mesh_options(sylva_models::lsystem::genome::MODEL),
+        &mesh_options(sylva_lsystem::genome::MODEL),
     )?;
     let mut scene = sylva_mesh::Scene::default();
     for (placed, mesh) in outcome.plants().iter().zip(&meshes) {
@@ -644,7 +641,7 @@ pub fn breed(
     seed: u64,
     hide_roots: bool,
 ) -> anyhow::Result<()> {
-    use sylva_models::lsystem::breed::{BreedSettings, breed_garden};
+    use sylva_lsystem::breed::{BreedSettings, breed_garden};
     let genome = match load_genome(mother)? {
         Genome::LSystem(g) => *g,
         other => {
@@ -675,7 +672,7 @@ pub fn breed(
         }
     };
     let plants: Vec<sylva_core::Plant> = garden.specimens.iter().map(|s| shown(&s.plant)).collect();
-    let meshes = mesh_all(&plants, &mesh_options(sylva_models::lsystem::genome::MODEL))?;
+    let meshes = mesh_all(&plants, &mesh_options(sylva_lsystem::genome::MODEL))?;
     let mut scene = sylva_mesh::Scene::default();
     let mut cells = Vec::new();
     let mut table =

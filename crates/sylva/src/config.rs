@@ -218,7 +218,7 @@ pub struct AutomataConfig {
     /// Tournament selection and the 88 / 10 / 2 operator rates.
     pub breeding: sylva_evolve::GenerationalSettings,
     /// How programs grow.
-    pub growth: sylva_models::automata::Growth,
+    pub growth: sylva_automata::Growth,
     /// Poncin's fitness: target shape, counts, spread, thickness and density grid.
     pub fitness: sylva_fitness::PoncinFitness,
 }
@@ -232,7 +232,7 @@ impl Default for AutomataConfig {
             max_depth: 17,
             max_size: 500,
             breeding: sylva_evolve::GenerationalSettings::default(),
-            growth: sylva_models::automata::Growth::default(),
+            growth: sylva_automata::Growth::default(),
             fitness: sylva_fitness::PoncinFitness::default(),
         }
     }
@@ -258,7 +258,7 @@ pub struct PlantMakerConfig {
     #[serde(deserialize_with = "segment_count")]
     pub inflorescences: u32,
     /// Crossover level: low, medium or high. Default medium.
-    pub crossover: sylva_models::plantmaker::Level,
+    pub crossover: sylva_plantmaker::Level,
     /// Probability that a variable changes in a mutation, 0 to 1. Default 0.1.
     #[serde(deserialize_with = "mutation_rate")]
     pub mutation_rate: f64,
@@ -292,7 +292,7 @@ impl Default for PlantMakerConfig {
             branches: 5,
             fans: 5,
             inflorescences: 5,
-            crossover: sylva_models::plantmaker::Level::Medium,
+            crossover: sylva_plantmaker::Level::Medium,
             mutation_rate: 0.1,
             mutation_spread: 0.15,
             start: Vec::new(),
@@ -312,15 +312,15 @@ pub struct LSystemConfig {
     /// empty rules (the paper's start, which does not germinate).
     pub start: Option<std::path::PathBuf>,
     /// What to select for: `"biomass"` or `"light"`. Default biomass.
-    pub score: sylva_models::lsystem::breed::Score,
+    pub score: sylva_lsystem::breed::Score,
     /// Rounds of mutation that make a first-generation genome from the start, 0 to 1000.
     /// Default 10.
     #[serde(deserialize_with = "random_rounds")]
     pub random_rounds: u32,
     /// Mutation probabilities (section 3.3).
-    pub rates: sylva_models::lsystem::mutate::MutationRates,
+    pub rates: sylva_lsystem::mutate::MutationRates,
     /// World and time each genome grows in.
-    pub grow: sylva_models::lsystem::garden::GrowSettings,
+    pub grow: sylva_lsystem::garden::GrowSettings,
     /// Tournament selection and operator rates. Default: no crossover, 20% reproduction,
     /// 80% mutation, elitism 1.
     pub breeding: sylva_evolve::GenerationalSettings,
@@ -332,10 +332,10 @@ impl Default for LSystemConfig {
     fn default() -> Self {
         LSystemConfig {
             start: None,
-            score: sylva_models::lsystem::breed::Score::Biomass,
+            score: sylva_lsystem::breed::Score::Biomass,
             random_rounds: 10,
-            rates: sylva_models::lsystem::mutate::MutationRates::default(),
-            grow: sylva_models::lsystem::garden::GrowSettings::default(),
+            rates: sylva_lsystem::mutate::MutationRates::default(),
+            grow: sylva_lsystem::garden::GrowSettings::default(),
             breeding: sylva_evolve::GenerationalSettings {
                 crossover: 0.0,
                 reproduction: 0.2,

@@ -12,6 +12,7 @@ pub mod assets;
 pub mod commands;
 pub mod config;
 pub mod error;
+pub mod genome;
 pub mod guides;
 pub mod problem;
 pub mod report;

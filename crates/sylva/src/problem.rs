@@ -6,26 +6,26 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rand::Rng;
+use sylva_automata::{
+    AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
+    SubtreeCrossover, SubtreeMutation,
+};
 use sylva_core::glam::Vec3;
 use sylva_core::{Material, MaterialKind, Plant};
 use sylva_evolve::Generational;
 use sylva_fitness::poncin::{PoncinContext, TERM_NAMES as PONCIN_TERMS, TargetShape};
 use sylva_fitness::{PoncinFitness, PoncinScore, PoncinScratch};
-use sylva_models::automata::{
-    AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
-    SubtreeCrossover, SubtreeMutation,
-};
 
 use crate::config::{AutomataConfig, LSystemConfig, PlantMakerConfig};
+use crate::genome::Genome;
 use crate::guides::{box_wire, ellipsoid_wire, guide_plant};
+use sylva_bintree::{BITS, BinTree, Bits};
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
-use sylva_models::Genome;
-use sylva_models::bintree::{BITS, BinTree, Bits};
-use sylva_models::lsystem::breed::LSystemProblem;
-use sylva_models::lsystem::{CompartmentCrossover, LSystemGenome, LSystemMutation};
-use sylva_models::plantmaker::{Mutation as PlantMakerMutation, PlantMaker, PlantMakerCrossover};
+use sylva_lsystem::breed::LSystemProblem;
+use sylva_lsystem::{CompartmentCrossover, LSystemGenome, LSystemMutation};
+use sylva_plantmaker::{Mutation as PlantMakerMutation, PlantMaker, PlantMakerCrossover};
 
 use crate::config::{BinTreeConfig, CrossoverKind};
 
@@ -127,7 +127,7 @@ pub struct AutomataProblem {
     /// Initialisation and breeding limits.
     pub gp: GpConfig,
     /// How programs grow (also written into `best.json`).
-    pub growth: sylva_models::automata::Growth,
+    pub growth: sylva_automata::Growth,
     /// The fitness.
     pub fitness: PoncinFitness,
     semantics: Semantics,

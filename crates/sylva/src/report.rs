@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use plotters::prelude::*;
 use sylva_evolve::GenerationStats;
-use sylva_models::lsystem::experiments::SimulationOutcome;
+use sylva_lsystem::experiments::SimulationOutcome;
 
 /// `stats.csv`: `generation,best,mean,<term...>,evals_per_s`, one row per generation.
 /// Numbers are written in Rust's shortest round-trip form, so equal runs give equal bytes

@@ -28,8 +28,8 @@
 
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use sylva_core::rng::ChaCha8Rng;
 
 use super::endpoints::PoncinScratch;
 

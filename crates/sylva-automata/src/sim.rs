@@ -1,0 +1,1010 @@
+//! The simulator of section 2.2: automata instances step in parallel and draw the plant.
+//!
+//! ```text
+//! for each iteration:
+//!     for each automaton still alive (in creation order):
+//!         run states until Wait; Killme or the end of the automaton kills it
+//!         (a killed automaton does not move)
+//!         move one step of Length along H; record the position and the Thickness
+//! ```
+//!
+//! [`Simulator::run`] follows this exactly and writes the [`Plant`] as it goes. The
+//! simulator keeps its buffers between runs and refills the caller's plant, so evaluating a
+//! population allocates nothing once the buffers have grown.
+//!
+//! # Drawing
+//!
+//! - Positions are paper units; the plant is in metres: `position × unit`.
+//! - Each automaton instance draws one axis (`lateral = false` from segment to segment). A
+//!   created instance's first segment is lateral, and its parent is the creator's segment
+//!   ending at the creation point: the creator's current run is cut there
+//!   ([`Detail::Chords`]) so that branch points are always segment boundaries. An instance
+//!   that creates before it has drawn anything first draws a zero-length stub at its
+//!   position, so the child still hangs from a segment of the creator's level.
+//! - A Push/Pop that moved the turtle in between draws a fork: the path drawn inside ends
+//!   (an endpoint), and the automaton continues from the saved point, as a second
+//!   non-lateral child of the segment ending there (same branch level).
+//! - Radii: `radius × map(Thickness) × unit`, with `map` the remapping of section 5.2
+//!   ([`map_thickness`]): Thickness is clamped to 0.001..=1, then mapped linearly onto
+//!   0.1..=1, so even a vanishing branch stays visible.
+//! - `CreateAutomaton Leaf` and `Flower` add an organ at the current position (leaves near
+//!   horizontal by default, section 4.5); an organ's parent is the segment of its axis that
+//!   next leaves its position (or the last one, if the automaton never moves again).
+//!
+//! # Bounds
+//!
+//! Every runaway is bounded by [`Limits`] and counted in the [`GrowthReport`]; none panics
+//! and none is silent: an automaton running more than `states_per_step` states in one
+//! iteration is killed; creations beyond `automata` instances and organs beyond `organs`
+//! are skipped; growth stops once `points` positions or `states` states in total are
+//! reached; variables are clamped to ±[`VARIABLE_LIMIT`], so positions stay finite.
+//!
+//! # Speed
+//!
+//! Evolution grows tens of thousands of individuals a second, so: states are 20 bytes with
+//! rotations' sines and cosines precomputed; instances are stepped in place (children wait
+//! in a side buffer until the step ends); a frame is renormalised only when it moves after
+//! 16 turns, by one Newton step instead of square roots; [`Detail::Chords`]
+//! writes a segment only at branch points and tips; and no buffer is freed between runs
+//! (`tests/automata_alloc.rs` checks that a warm run allocates nothing).
+//! `benches/automata.rs` measures it.
+
+use glam::{Mat3, Quat, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+use sylva_core::{Frame, Organ, OrganKind, Plant, SegmentId};
+
+use crate::compile::{Op, Program, State};
+use crate::tree::{VARIABLES, Var};
+
+/// Variables are clamped to `±VARIABLE_LIMIT` after each `Add` or `Multiply`.
+pub const VARIABLE_LIMIT: f32 = 1e6;
+
+const NONE: u32 = u32::MAX;
+const LENGTH: usize = 0;
+const THICKNESS: usize = 1;
+/// A frame is made orthonormal again when it moves after this many turns (or when anything
+/// else may have disturbed it). One turn with exact sine and cosine moves the vectors off
+/// unit length by about one ulp, so 16 turns stay within 1e-6 and each move costs a few
+/// multiplications instead of a renormalisation.
+const RENORMALISE: u8 = 16;
+/// The golden angle, radians: successive leaves turn by it about the vertical.
+const GOLDEN_ANGLE: f32 = 2.399_963_2;
+/// Leaves droop this far below horizontal, radians (10°).
+const LEAF_DROOP: f32 = 0.174_532_93;
+
+/// How finely the plant is drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Detail {
+    /// Every recorded step is a segment: for meshing and pictures.
+    #[default]
+    Full,
+    /// One segment per run between branch points (creations, Push/Pop forks) and to each
+    /// tip: the same tips, leaves, levels and end thicknesses as [`Detail::Full`], far fewer
+    /// segments. Leaves and flowers keep their position and size but not their orientation
+    /// (left at identity: no fitness term reads it, and it costs more than the rest of an
+    /// organ). For fitness evaluation.
+    Chords,
+}
+
+/// The variables a created automaton starts with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChildVariables {
+    /// The creator's Length and Thickness; general variables 0. Default: a branch continues
+    /// at the thickness of its junction, and its counters start fresh like the helix's.
+    #[default]
+    LengthThickness,
+    /// All of the creator's variables.
+    All,
+    /// The root's start: Length 1, Thickness 1, general variables 0.
+    Fresh,
+}
+
+/// Bounds on a run. Every field says its default and the range a genome file may give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Limits {
+    /// States one automaton may run in one iteration before it is killed. Default 1000;
+    /// 1 to 1 000 000.
+    #[serde(deserialize_with = "states_per_step")]
+    pub states_per_step: u32,
+    /// States in the whole run; growth stops when reached. Default 2 000 000; 1 to 10^10.
+    #[serde(deserialize_with = "total_states")]
+    pub states: u64,
+    /// Automata instances in the whole run, the root included. Default 2000; 1 to 1 000 000.
+    #[serde(deserialize_with = "automata")]
+    pub automata: u32,
+    /// Recorded positions; growth stops when reached. Default 200 000; 1 to 10^8.
+    #[serde(deserialize_with = "points")]
+    pub points: u32,
+    /// Leaves and flowers. Default 20 000; 0 to 10^7.
+    #[serde(deserialize_with = "organs")]
+    pub organs: u32,
+}
+
+sylva_core::ranged!(states_per_step: u32, "limits.states_per_step", 1, 1_000_000);
+sylva_core::ranged!(automata: u32, "limits.automata", 1, 1_000_000);
+sylva_core::ranged!(points: u32, "limits.points", 1, 100_000_000);
+sylva_core::ranged!(organs: u32, "limits.organs", 0, 10_000_000);
+sylva_core::ranged!(total_states: u64, "limits.states", 1, 10_000_000_000);
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            states_per_step: 1000,
+            states: 2_000_000,
+            automata: 2000,
+            points: 200_000,
+            organs: 20_000,
+        }
+    }
+}
+
+/// How a program grows. Every field says its default; [`Simulator::run`] replaces a value
+/// that is not finite, or is out of its range, by the nearest legal one (the default for NaN).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GrowOptions {
+    /// Iteration limit. Default 100 (section 5.1).
+    pub iterations: u32,
+    /// The root automaton's Length when it starts, paper units per step. Default 1; range
+    /// 0..=1e3. The paper does not give it; with 100 iterations, a Length of 2 to 3 lets
+    /// a tree reach across its 300-unit sphere, which evolution finds far more often than
+    /// learning to raise Length (see `examples/automata/sphere.toml`).
+    pub root_length: f32,
+    /// Metres per paper unit. Default 0.1, so the paper's sphere of radius 150 centred 200
+    /// up is 15 m wide and a 100-step trunk of Length 1 is 10 m tall. Range 1e-6..=1e3.
+    pub unit: f32,
+    /// Tropism towards the ground, degrees per step for a horizontal heading (scaled by
+    /// the sine of the angle to vertical, as in *The Algorithmic Beauty of Plants*).
+    /// Default 0 (off); Figure 17's pine bends. Range 0..=90.
+    pub gravity: f32,
+    /// Radius at mapped thickness 1, paper units. Default 3 (0.3 m at the default unit).
+    /// Range 0..=1e3.
+    pub radius: f32,
+    /// Leaf length, paper units (width 0.4 of it). Default 4.
+    pub leaf_length: f32,
+    /// Flower diameter, paper units. Default 4.
+    pub flower_size: f32,
+    /// Turn leaves near horizontal, face up (section 4.5). Default true; otherwise a leaf
+    /// points along the turtle's U.
+    pub horizontal_leaves: bool,
+    /// A created automaton's variables. Default [`ChildVariables::LengthThickness`].
+    pub child_variables: ChildVariables,
+    /// Runaway bounds.
+    pub limits: Limits,
+}
+
+impl Default for GrowOptions {
+    fn default() -> Self {
+        GrowOptions {
+            iterations: 100,
+            root_length: 1.0,
+            unit: 0.1,
+            gravity: 0.0,
+            radius: 3.0,
+            leaf_length: 4.0,
+            flower_size: 4.0,
+            horizontal_leaves: true,
+            child_variables: ChildVariables::LengthThickness,
+            limits: Limits::default(),
+        }
+    }
+}
+
+fn legal(value: f32, min: f32, max: f32, default: f32) -> f32 {
+    if value.is_nan() {
+        default
+    } else {
+        value.clamp(min, max)
+    }
+}
+
+impl GrowOptions {
+    /// The options with every value brought into its legal range.
+    pub fn sanitized(&self) -> GrowOptions {
+        let d = GrowOptions::default();
+        GrowOptions {
+            root_length: legal(self.root_length, 0.0, 1e3, d.root_length),
+            unit: legal(self.unit, 1e-6, 1e3, d.unit),
+            gravity: legal(self.gravity, 0.0, 90.0, d.gravity),
+            radius: legal(self.radius, 0.0, 1e3, d.radius),
+            leaf_length: legal(self.leaf_length, 0.0, 1e3, d.leaf_length),
+            flower_size: legal(self.flower_size, 0.0, 1e3, d.flower_size),
+            limits: Limits {
+                states_per_step: self.limits.states_per_step.max(1),
+                ..self.limits
+            },
+            ..*self
+        }
+    }
+
+    /// Radius in metres of a recorded Thickness.
+    pub fn radius_of(&self, thickness: f32) -> f32 {
+        map_thickness(thickness) * self.radius * self.unit
+    }
+
+    /// The mapped thickness (0.1..=1) of a segment radius in metres: the inverse of
+    /// [`GrowOptions::radius_of`] on mapped values, for fitness terms that read thickness
+    /// back from a [`Plant`].
+    pub fn thickness_of_radius(&self, radius: f32) -> f32 {
+        let scale = self.radius * self.unit;
+        if scale > 0.0 { radius / scale } else { 0.0 }
+    }
+}
+
+/// Section 5.2's remapping: Thickness clamped to 0.001..=1, then mapped linearly onto
+/// 0.1..=1.
+#[inline]
+pub fn map_thickness(thickness: f32) -> f32 {
+    0.1 + (0.9 / 0.999) * (thickness.clamp(0.001, 1.0) - 0.001)
+}
+
+/// Why growth ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// Every automaton died.
+    #[default]
+    AllDead,
+    /// The iteration limit was reached with automata alive.
+    Iterations,
+    /// [`Limits::points`] was reached.
+    Points,
+    /// [`Limits::states`] was reached.
+    States,
+    /// A position went beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD) metres, which
+    /// no plant may hold.
+    Extent,
+}
+
+/// Which bounds were hit, and how often.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+pub struct BoundsHit {
+    /// Automata killed for running more than [`Limits::states_per_step`] states in one
+    /// iteration.
+    pub state_limit_kills: u32,
+    /// Creations skipped at [`Limits::automata`].
+    pub automata_refused: u32,
+    /// Leaves and flowers skipped at [`Limits::organs`].
+    pub organs_refused: u32,
+    /// Variable values clamped to ±[`VARIABLE_LIMIT`].
+    pub clamped_values: u32,
+    /// Growth stopped at [`Limits::points`].
+    pub points: bool,
+    /// Growth stopped at [`Limits::states`].
+    pub states: bool,
+    /// Growth stopped at a position beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD)
+    /// metres.
+    pub extent: bool,
+}
+
+impl BoundsHit {
+    /// Whether any bound was hit.
+    pub fn any(&self) -> bool {
+        self.state_limit_kills > 0
+            || self.automata_refused > 0
+            || self.organs_refused > 0
+            || self.clamped_values > 0
+            || self.points
+            || self.states
+            || self.extent
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+pub struct GrowthReport {
+    /// Iterations run.
+    pub iterations: u32,
+    /// Why growth ended.
+    pub stop: Stop,
+    /// Automata instances created, the root included.
+    pub automata: u32,
+    /// Most automata alive at the end of an iteration.
+    pub peak_live: u32,
+    /// Automata alive when growth ended.
+    pub live_at_end: u32,
+    /// Automaton-steps: one automaton running one iteration.
+    pub automaton_steps: u64,
+    /// States run in total.
+    pub states: u64,
+    /// Most states one automaton ran in one iteration.
+    pub max_states_per_step: u32,
+    /// Positions recorded (steps moved).
+    pub points: u32,
+    /// Segments drawn.
+    pub segments: u32,
+    /// Leaves added.
+    pub leaves: u32,
+    /// Flowers added.
+    pub flowers: u32,
+    /// Positions recorded with a negative Thickness (drawn at the minimum; fitness may
+    /// penalise them, section 4.4.2).
+    pub negative_thickness: u32,
+    /// Bounds hit.
+    pub bounds: BoundsHit,
+}
+
+/// One live or dead automaton instance.
+#[derive(Clone, Copy, Debug)]
+struct Inst {
+    pos: Vec3,
+    frame: Frame,
+    vars: [f32; VARIABLES],
+    /// Next state to run.
+    pc: u32,
+    automaton: u8,
+    /// Turns since the frame was last made orthonormal (see [`RENORMALISE`]).
+    turns: u8,
+    stack_len: u16,
+    /// The segment ending at `pos` (`NONE` before the first).
+    seg: u32,
+    /// The creator's segment this one's first segment hangs from (`NONE` for the root).
+    attach: u32,
+    /// Where the undrawn run starts, and its mapped thickness there.
+    chord_start: Vec3,
+    chord_radius: f32,
+    chord_moves: u32,
+    /// Mapped thickness recorded at `pos`.
+    radius: f32,
+    /// Steps moved.
+    moves: u32,
+    /// Birth rank among its creator's children (the root is 0).
+    index: u32,
+    children: u32,
+    /// First organ waiting for its parent segment (a list through `organ_next`).
+    pending: u32,
+    counter_base: u32,
+    stack_base: u32,
+}
+
+/// A Push's saved state.
+#[derive(Clone, Copy, Debug, Default)]
+struct Saved {
+    pos: Vec3,
+    frame: Frame,
+    vars: [f32; VARIABLES],
+    seg: u32,
+    radius: f32,
+    /// The automaton's `moves` when pushed: equal means it has not moved since.
+    moves: u32,
+}
+
+/// Per-run constants.
+struct Cx<'a> {
+    program: &'a Program,
+    options: GrowOptions,
+    full: bool,
+    /// Metres per unit of mapped thickness.
+    radius_scale: f32,
+    gravity: f32,
+}
+
+/// Runs compiled programs; keeps its buffers between runs.
+#[derive(Clone, Debug, Default)]
+pub struct Simulator {
+    insts: Vec<Inst>,
+    live: Vec<u32>,
+    mem: Memory,
+}
+
+/// Everything an instance's step touches besides the instance itself, so the instance can be
+/// stepped in place (it is 140 bytes: copying it in and out cost more than its states).
+#[derive(Clone, Debug, Default)]
+struct Memory {
+    stack: Vec<Saved>,
+    counters: Vec<u8>,
+    organ_next: Vec<u32>,
+    /// The plant refused a part (a position beyond its range): growth stops.
+    refused: bool,
+    /// Instances created during the current step, moved into `insts` after it.
+    newborn: Vec<Inst>,
+}
+
+/// Turns the pair `(a, b)`: `a` moves towards `b`.
+#[inline(always)]
+fn turn(a: &mut Vec3, b: &mut Vec3, sin: f32, cos: f32) {
+    let (x, y) = (*a, *b);
+    *a = x * cos + y * sin;
+    *b = y * cos - x * sin;
+}
+
+/// Makes the frame orthonormal again after rotations. Rotations keep the vectors within a
+/// few ulps of unit length, so one Newton step (`v × (3 - |v|²) / 2`) restores it without a
+/// square root; a frame that drifted further (never seen) is normalised exactly.
+#[inline]
+fn orthonormalise(f: &mut Frame) {
+    let h = f.heading;
+    let hh = h.length_squared();
+    let l = f.left - h * h.dot(f.left);
+    let ll = l.length_squared();
+    if (hh - 1.0).abs() < 1e-3 && (ll - 1.0).abs() < 1e-3 {
+        f.heading = h * (1.5 - 0.5 * hh);
+        let l = f.left - f.heading * f.heading.dot(f.left);
+        f.left = l * (1.5 - 0.5 * l.length_squared());
+    } else {
+        f.heading = h.normalize_or(Vec3::Y);
+        f.left = (f.left - f.heading * f.heading.dot(f.left))
+            .try_normalize()
+            .unwrap_or_else(|| f.heading.any_orthonormal_vector());
+    }
+    f.up = f.heading.cross(f.left);
+}
+
+/// A leaf's orientation. Horizontal leaves are also turned about the vertical by the golden
+/// angle times the leaf's index: leaves an automaton adds at one spot (`(Repeat 5
+/// (CreateAutomaton Leaf))` is common in evolved trees) fan out instead of lying on top of
+/// each other, and the "randomly generated" leaves of section 4.5 stay deterministic.
+fn leaf_rotation(frame: &Frame, horizontal: bool, index: u32) -> Quat {
+    let m = if horizontal {
+        let flat = [frame.up, frame.left, frame.heading]
+            .into_iter()
+            .map(|v| Vec3::new(v.x, 0.0, v.z))
+            .find(|v| v.length_squared() > 1e-4)
+            .map_or(Vec3::X, Vec3::normalize);
+        let (s, c) = LEAF_DROOP.sin_cos();
+        let along = (flat * c - Vec3::Y * s).normalize();
+        let face = (Vec3::Y - along * along.y).normalize();
+        let fan = Mat3::from_rotation_y(GOLDEN_ANGLE * (index % 1024) as f32);
+        fan * Mat3::from_cols(along.cross(face), along, face)
+    } else {
+        Mat3::from_cols(-frame.left, frame.up, -frame.heading)
+    };
+    let q = Quat::from_mat3(&m).normalize();
+    if q.is_finite() { q } else { Quat::IDENTITY }
+}
+
+impl Simulator {
+    /// An empty simulator.
+    pub fn new() -> Simulator {
+        Simulator::default()
+    }
+
+    /// Grows `program` into `plant` (its segments and organs are replaced; its metadata is
+    /// left as it is; its materials are reset to [`Plant::new`]'s if they are not bark,
+    /// leaf, flower) and reports what happened.
+    pub fn run(
+        &mut self,
+        program: &Program,
+        options: &GrowOptions,
+        detail: Detail,
+        plant: &mut Plant,
+    ) -> GrowthReport {
+        let options = options.sanitized();
+        let cx = Cx {
+            program,
+            options,
+            full: detail == Detail::Full,
+            radius_scale: options.radius * options.unit,
+            gravity: options.gravity.to_radians(),
+        };
+        plant.clear_to_defaults();
+        let Simulator { insts, live, mem } = self;
+        insts.clear();
+        live.clear();
+        mem.stack.clear();
+        mem.counters.clear();
+        mem.organ_next.clear();
+        mem.newborn.clear();
+        mem.refused = false;
+        let mut rep = GrowthReport::default();
+        if program.automata().is_empty() {
+            return rep;
+        }
+        let mut vars = [0.0; VARIABLES];
+        vars[LENGTH] = options.root_length;
+        vars[THICKNESS] = 1.0;
+        mem.spawn(&cx, 0, Vec3::ZERO, Frame::UPRIGHT, vars, NONE, 0);
+        adopt(insts, live, &mut mem.newborn);
+        rep.automata = 1;
+        let mut stop = None;
+        for _ in 0..options.iterations {
+            if live.is_empty() {
+                break;
+            }
+            rep.iterations += 1;
+            let n = live.len();
+            let (mut read, mut write) = (0, 0);
+            while read < n {
+                let id = live[read];
+                read += 1;
+                if mem.step(&mut insts[id as usize], &cx, plant, &mut rep) {
+                    live[write] = id;
+                    write += 1;
+                }
+                if !mem.newborn.is_empty() {
+                    adopt(insts, live, &mut mem.newborn);
+                }
+                if rep.points >= options.limits.points {
+                    stop = Some(Stop::Points);
+                } else if rep.states >= options.limits.states {
+                    stop = Some(Stop::States);
+                }
+                if stop.is_some() {
+                    break;
+                }
+            }
+            // Keep what was not run and the newborn, in order, after the survivors.
+            let len = live.len();
+            live.copy_within(read..len, write);
+            live.truncate(write + len - read);
+            rep.peak_live = rep.peak_live.max(live.len() as u32);
+            // A refused part ends growth at the end of its iteration (checked here, off the
+            // per-automaton path).
+            if mem.refused && stop.is_none() {
+                stop = Some(Stop::Extent);
+            }
+            if stop.is_some() {
+                break;
+            }
+        }
+        rep.stop = match stop {
+            Some(s) => s,
+            None if live.is_empty() => Stop::AllDead,
+            None => Stop::Iterations,
+        };
+        rep.bounds.points = rep.stop == Stop::Points;
+        rep.bounds.states = rep.stop == Stop::States;
+        rep.bounds.extent = rep.stop == Stop::Extent;
+        rep.live_at_end = live.len() as u32;
+        for &id in live.iter() {
+            mem.finish(&mut insts[id as usize], &cx, plant);
+        }
+        rep.segments = plant.segments().len() as u32;
+        rep
+    }
+}
+
+/// Moves the newborn into the instances, live from the next iteration.
+fn adopt(insts: &mut Vec<Inst>, live: &mut Vec<u32>, newborn: &mut Vec<Inst>) {
+    for inst in newborn.drain(..) {
+        live.push(insts.len() as u32);
+        insts.push(inst);
+    }
+}
+
+impl Memory {
+    /// Adds an instance of automaton `automaton` (0-based) to the newborn.
+    #[allow(clippy::too_many_arguments)]
+    fn spawn(
+        &mut self,
+        cx: &Cx,
+        automaton: usize,
+        pos: Vec3,
+        frame: Frame,
+        vars: [f32; VARIABLES],
+        attach: u32,
+        index: u32,
+    ) {
+        let code = cx.program.automata()[automaton];
+        let radius = map_thickness(vars[THICKNESS]);
+        self.newborn.push(Inst {
+            pos,
+            frame,
+            vars,
+            pc: code.entry,
+            automaton: automaton as u8,
+            turns: RENORMALISE,
+            stack_len: 0,
+            seg: NONE,
+            attach,
+            chord_start: pos,
+            chord_radius: radius,
+            chord_moves: 0,
+            radius,
+            moves: 0,
+            index,
+            children: 0,
+            pending: NONE,
+            counter_base: self.counters.len() as u32,
+            stack_base: self.stack.len() as u32,
+        });
+        self.counters
+            .resize(self.counters.len() + usize::from(code.counters), 0);
+        self.stack.resize(
+            self.stack.len() + usize::from(code.push_depth),
+            Saved::default(),
+        );
+    }
+
+    /// Runs an instance for one iteration; `false` when it died.
+    fn step(&mut self, me: &mut Inst, cx: &Cx, plant: &mut Plant, rep: &mut GrowthReport) -> bool {
+        let states = cx.program.states();
+        let limit = cx.options.limits.states_per_step;
+        let mut pc = me.pc as usize;
+        let mut budget = limit;
+        let alive = loop {
+            if budget == 0 {
+                rep.bounds.state_limit_kills += 1;
+                break false;
+            }
+            budget -= 1;
+            let here = pc;
+            let s = &states[here];
+            pc = s.next as usize;
+            match s.op {
+                Op::Wait => break true,
+                Op::End => {
+                    if cx.program.restarts() {
+                        pc = cx.program.automata()[usize::from(me.automaton)].entry as usize;
+                    } else {
+                        break false;
+                    }
+                }
+                Op::Kill => break false,
+                Op::RotateH => {
+                    turn(&mut me.frame.left, &mut me.frame.up, s.x, s.y);
+                    me.turns = me.turns.saturating_add(1);
+                }
+                Op::RotateL => {
+                    turn(&mut me.frame.heading, &mut me.frame.up, s.x, s.y);
+                    me.turns = me.turns.saturating_add(1);
+                }
+                Op::RotateU => {
+                    turn(&mut me.frame.heading, &mut me.frame.left, s.x, s.y);
+                    me.turns = me.turns.saturating_add(1);
+                }
+                Op::Assign => me.vars[usize::from(s.arg)] = s.x,
+                Op::Add | Op::Multiply => {
+                    let v = &mut me.vars[usize::from(s.arg)];
+                    let r = if s.op == Op::Add { *v + s.x } else { *v * s.x };
+                    if r.abs() > VARIABLE_LIMIT {
+                        rep.bounds.clamped_values += 1;
+                        *v = r.clamp(-VARIABLE_LIMIT, VARIABLE_LIMIT);
+                    } else {
+                        *v = r;
+                    }
+                }
+                Op::IfLess => {
+                    if me.vars[usize::from(s.arg)] >= s.x {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::IfGreater => {
+                    if me.vars[usize::from(s.arg)] <= s.x {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::IfEqual => {
+                    if (me.vars[usize::from(s.arg)] - s.x).abs() > s.y {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::Push => self.push(me, cx),
+                Op::Pop => self.pop(me, cx, plant),
+                Op::RepeatInit | Op::RepeatIndexInit => {
+                    // The entry and the first test: two states.
+                    if budget == 0 {
+                        rep.bounds.state_limit_kills += 1;
+                        break false;
+                    }
+                    budget -= 1;
+                    pc = self.enter_loop(me, s);
+                }
+                Op::RepeatTest => {
+                    let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
+                    if *c > 0 {
+                        *c -= 1;
+                    } else {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::RepeatNest => {
+                    let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
+                    if *c > 0 {
+                        *c -= 1;
+                        // The body is a loop entry (two states): run it here.
+                        if budget < 2 {
+                            rep.bounds.state_limit_kills += 1;
+                            break false;
+                        }
+                        budget -= 2;
+                        pc = self.enter_loop(me, &states[pc]);
+                    } else {
+                        pc = s.alt as usize;
+                    }
+                }
+                Op::RepeatWait => {
+                    let c = &mut self.counters[(me.counter_base + u32::from(s.slot)) as usize];
+                    if *c > 0 {
+                        // The test and its body's Wait: two states, the Wait resuming here.
+                        if budget == 0 {
+                            rep.bounds.state_limit_kills += 1;
+                            break false;
+                        }
+                        budget -= 1;
+                        *c -= 1;
+                        pc = here;
+                        break true;
+                    }
+                    pc = s.alt as usize;
+                }
+                Op::Create => self.create(me, usize::from(s.arg), cx, plant, rep),
+                Op::Leaf => self.organ(me, OrganKind::Leaf, cx, plant, rep),
+                Op::Flower => self.organ(me, OrganKind::Flower, cx, plant, rep),
+            }
+        };
+        me.pc = pc as u32;
+        let run = limit - budget;
+        rep.states += u64::from(run);
+        rep.max_states_per_step = rep.max_states_per_step.max(run);
+        rep.automaton_steps += 1;
+        if alive {
+            self.advance(me, cx, plant, rep);
+        } else {
+            self.finish(me, cx, plant);
+        }
+        alive
+    }
+
+    /// Enters the loop whose entry is `entry` (a `RepeatInit` or `RepeatIndexInit`): sets its
+    /// counter and runs its first test; returns the next state.
+    #[inline(always)]
+    fn enter_loop(&mut self, me: &Inst, entry: &State) -> usize {
+        let count = if entry.op == Op::RepeatInit {
+            entry.x as u8
+        } else {
+            (entry.x - me.index.min(255) as f32).max(0.0) as u8
+        };
+        if count > 0 {
+            self.counters[(me.counter_base + u32::from(entry.slot)) as usize] = count - 1;
+            entry.next as usize
+        } else {
+            entry.alt as usize
+        }
+    }
+
+    /// Moves one step along H and records the position.
+    fn advance(&mut self, me: &mut Inst, cx: &Cx, plant: &mut Plant, rep: &mut GrowthReport) {
+        if cx.gravity > 0.0 {
+            let h = me.frame.heading;
+            // Turn H towards -Y about H × (-Y), by gravity × sin(angle to vertical).
+            let axis = Vec3::new(h.z, 0.0, -h.x);
+            let sin = axis.length();
+            if sin > 1e-6 {
+                let angle = (cx.gravity * sin).min(sin.atan2(-h.y));
+                let q = Quat::from_axis_angle(axis / sin, angle);
+                me.frame.heading = q * h;
+                me.frame.left = q * me.frame.left;
+                me.turns = me.turns.saturating_add(1);
+            }
+        }
+        if me.turns >= RENORMALISE {
+            orthonormalise(&mut me.frame);
+            me.turns = 0;
+        }
+        // Pushes since the last move: the point they saved becomes a segment boundary.
+        let top = usize::from(me.stack_len);
+        if top > 0 {
+            let base = me.stack_base as usize;
+            if self.stack[base + top - 1].moves == me.moves {
+                self.close_chord(me, cx, plant);
+                for saved in self.stack[base..base + top].iter_mut().rev() {
+                    if saved.moves != me.moves {
+                        break;
+                    }
+                    saved.seg = me.seg;
+                }
+            }
+        }
+        me.pos += me.frame.heading * me.vars[LENGTH];
+        me.moves += 1;
+        me.chord_moves += 1;
+        let thickness = me.vars[THICKNESS];
+        if thickness < 0.0 {
+            rep.negative_thickness += 1;
+        }
+        me.radius = map_thickness(thickness);
+        rep.points += 1;
+        if cx.full {
+            self.close_chord(me, cx, plant);
+        }
+    }
+
+    /// Saves position, frame and variables.
+    #[inline(never)]
+    fn push(&mut self, me: &mut Inst, cx: &Cx) {
+        let code = cx.program.automata()[usize::from(me.automaton)];
+        // Always true for compiled programs; a guard, not a bound.
+        if me.stack_len < code.push_depth {
+            self.stack[(me.stack_base + u32::from(me.stack_len)) as usize] = Saved {
+                pos: me.pos,
+                frame: me.frame,
+                vars: me.vars,
+                seg: me.seg,
+                radius: me.radius,
+                moves: me.moves,
+            };
+            me.stack_len += 1;
+        }
+    }
+
+    /// Restores the last Push.
+    #[inline(never)]
+    fn pop(&mut self, me: &mut Inst, cx: &Cx, plant: &mut Plant) {
+        if me.stack_len == 0 {
+            return;
+        }
+        me.stack_len -= 1;
+        let saved = self.stack[(me.stack_base + u32::from(me.stack_len)) as usize];
+        me.frame = saved.frame;
+        me.vars = saved.vars;
+        me.turns = RENORMALISE;
+        if saved.moves == me.moves {
+            // Not moved since the Push: nothing was drawn, the position is the same.
+            return;
+        }
+        // The path drawn since the Push ends here; continue from the saved point.
+        self.close_chord(me, cx, plant);
+        let seg = me.seg;
+        self.patch_organs(me, plant, seg);
+        me.pos = saved.pos;
+        me.seg = saved.seg;
+        me.radius = saved.radius;
+        me.chord_start = saved.pos;
+        me.chord_radius = saved.radius;
+        me.chord_moves = 0;
+    }
+
+    /// Draws the run since the last segment, if the automaton moved.
+    fn close_chord(&mut self, me: &mut Inst, cx: &Cx, plant: &mut Plant) {
+        if me.chord_moves == 0 {
+            return;
+        }
+        let id = self.segment(me, me.chord_start, me.chord_radius, cx, plant);
+        me.seg = id;
+        me.chord_start = me.pos;
+        me.chord_radius = me.radius;
+        me.chord_moves = 0;
+        self.patch_organs(me, plant, id);
+    }
+
+    /// Gives the waiting organs their parent segment.
+    fn patch_organs(&mut self, me: &mut Inst, plant: &mut Plant, seg: u32) {
+        let parent = (seg != NONE).then_some(SegmentId(seg));
+        let mut o = me.pending;
+        while o != NONE {
+            // The parent was just drawn and the organ added: neither can be missing.
+            self.refused |= plant.set_organ_parent(o as usize, parent).is_err();
+            o = self.organ_next[o as usize];
+        }
+        me.pending = NONE;
+    }
+
+    /// The end of an automaton (death, or the end of growth).
+    fn finish(&mut self, me: &mut Inst, cx: &Cx, plant: &mut Plant) {
+        self.close_chord(me, cx, plant);
+        let seg = if me.seg != NONE { me.seg } else { me.attach };
+        self.patch_organs(me, plant, seg);
+    }
+
+    #[inline(never)]
+    fn create(
+        &mut self,
+        me: &mut Inst,
+        automaton: usize,
+        cx: &Cx,
+        plant: &mut Plant,
+        rep: &mut GrowthReport,
+    ) {
+        if rep.automata >= cx.options.limits.automata || automaton >= cx.program.automata().len() {
+            rep.bounds.automata_refused += 1;
+            return;
+        }
+        // The creation point becomes a segment boundary of the creator.
+        self.close_chord(me, cx, plant);
+        if me.seg == NONE {
+            me.seg = self.segment(me, me.pos, me.radius, cx, plant);
+        }
+        let vars = match cx.options.child_variables {
+            ChildVariables::All => me.vars,
+            ChildVariables::LengthThickness => {
+                let mut v = [0.0; VARIABLES];
+                v[LENGTH] = me.vars[Var::LENGTH.index()];
+                v[THICKNESS] = me.vars[Var::THICKNESS.index()];
+                v
+            }
+            ChildVariables::Fresh => {
+                let mut v = [0.0; VARIABLES];
+                v[LENGTH] = 1.0;
+                v[THICKNESS] = 1.0;
+                v
+            }
+        };
+        self.spawn(cx, automaton, me.pos, me.frame, vars, me.seg, me.children);
+        me.children += 1;
+        rep.automata += 1;
+    }
+
+    #[inline(never)]
+    fn organ(
+        &mut self,
+        me: &mut Inst,
+        kind: OrganKind,
+        cx: &Cx,
+        plant: &mut Plant,
+        rep: &mut GrowthReport,
+    ) {
+        if rep.leaves + rep.flowers >= cx.options.limits.organs {
+            rep.bounds.organs_refused += 1;
+            return;
+        }
+        let unit = cx.options.unit;
+        let mut frame = me.frame;
+        if cx.full && me.turns > 0 {
+            orthonormalise(&mut frame);
+        }
+        let (orientation, size, material) = if kind == OrganKind::Leaf {
+            rep.leaves += 1;
+            let len = cx.options.leaf_length * unit;
+            let q = if cx.full {
+                leaf_rotation(&frame, cx.options.horizontal_leaves, rep.leaves)
+            } else {
+                Quat::IDENTITY
+            };
+            (q, Vec2::new(len, 0.4 * len), Plant::LEAF)
+        } else {
+            rep.flowers += 1;
+            let size = cx.options.flower_size * unit;
+            let q = if cx.full {
+                frame.rotation()
+            } else {
+                Quat::IDENTITY
+            };
+            (
+                if q.is_finite() { q } else { Quat::IDENTITY },
+                Vec2::new(size, 0.35 * size),
+                Plant::FLOWER,
+            )
+        };
+        let organ = Organ {
+            kind,
+            position: me.pos * unit,
+            orientation,
+            size,
+            material,
+            parent: None,
+        };
+        if plant.add_organ(organ).is_err() {
+            self.refused = true;
+            return;
+        }
+        self.organ_next.push(me.pending);
+        me.pending = (plant.organs().len() - 1) as u32;
+    }
+
+    /// Draws the segment from `start` to the instance's position; [`NONE`] (and growth
+    /// stops) if the plant refuses it.
+    #[inline(always)]
+    fn segment(
+        &mut self,
+        me: &Inst,
+        start: Vec3,
+        start_radius: f32,
+        cx: &Cx,
+        plant: &mut Plant,
+    ) -> u32 {
+        let (parent, lateral) = if me.seg != NONE {
+            (me.seg, false)
+        } else {
+            (me.attach, me.attach != NONE)
+        };
+        let parent = (parent != NONE).then_some(SegmentId(parent));
+        let unit = cx.options.unit;
+        let radii = (start_radius * cx.radius_scale, me.radius * cx.radius_scale);
+        match plant.add_segment(
+            start * unit,
+            me.pos * unit,
+            radii,
+            parent,
+            lateral,
+            Plant::BARK,
+        ) {
+            Ok(id) => id.0,
+            Err(_) => {
+                self.refused = true;
+                NONE
+            }
+        }
+    }
+}

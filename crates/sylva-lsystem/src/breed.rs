@@ -1,0 +1,377 @@
+//! Biomorph breeding (section 4.1) and a [`Problem`] for runs without a person.
+//!
+//! [`breed_garden`] builds the paper's design-loop garden: at most nine specimens on a 3 × 3
+//! grid, the mother's seed in one corner and her mutated children at even distances, grown
+//! together for a fixed time in one world (so they compete, as in the paper's Figure 7).
+//! The caller — a person, or [`largest_biomass`] — picks the next mother from the returned
+//! [`Specimen`]s. Evolution may start from [`LSystemGenome::empty`], which does not
+//! germinate; mutations add rules until plants with leaves and roots appear
+//! ([`evolve_biomorphs`] runs that loop with a chooser).
+//!
+//! [`LSystemProblem`] scores a genome grown alone (biomass, or light absorbed), for the
+//! generic engine's runs.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use sylva_core::Plant;
+use sylva_core::glam::Vec2;
+use sylva_core::par::Pool;
+use sylva_evolve::{Fitness, Mutate, Problem};
+
+use crate::garden::{Garden, GardenError, GrowSettings, Sowing, StepRecord};
+use crate::genome::{LSystemGenome, LSystemMutation};
+use crate::grammar::Module;
+use crate::growth::{BoundsHit, GrowingPlant};
+use crate::mutate::MutationRates;
+
+/// Most specimens in a breeding garden, as in the paper.
+pub const MAX_SPECIMENS: usize = 9;
+
+/// How a breeding garden is laid out and grown.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BreedSettings {
+    /// World and growing time. Default [`GrowSettings::default`] (64³ voxels of 0.125 m,
+    /// 150 steps).
+    pub grow: GrowSettings,
+    /// Distance between neighbouring seeds, metres. Default 2.5.
+    pub spacing: f32,
+    /// Children sown with the mother, 0 to 8. Default 8.
+    pub children: usize,
+    /// Mutation probabilities. Default [`MutationRates::default`].
+    pub rates: MutationRates,
+}
+
+impl Default for BreedSettings {
+    fn default() -> Self {
+        BreedSettings {
+            grow: GrowSettings::default(),
+            spacing: 2.5,
+            children: 8,
+            rates: MutationRates::default(),
+        }
+    }
+}
+
+/// One grown specimen of a garden.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Specimen {
+    /// Its genome.
+    pub genome: LSystemGenome,
+    /// True for the mother's own seed.
+    pub is_mother: bool,
+    /// Where it grew, `(x, z)` metres.
+    pub position: Vec2,
+    /// Its geometry, foot at the origin.
+    pub plant: Plant,
+    /// The figures it ended with.
+    pub stats: SpecimenStats,
+}
+
+/// What a specimen achieved.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SpecimenStats {
+    /// Biomass (dry mass: structure and pools) at the end, grams.
+    pub biomass: f64,
+    /// Light absorbed over its life.
+    pub light: f64,
+    /// Minerals taken up over its life, grams.
+    pub uptake: f64,
+    /// Modules of each kind: leaves, branches, fine roots, root branches.
+    pub modules: [u32; 4],
+    /// Rewrites refused by the bounds.
+    pub bounds: BoundsHit,
+}
+
+impl SpecimenStats {
+    /// Stats of a growing plant.
+    pub fn of(p: &GrowingPlant) -> SpecimenStats {
+        SpecimenStats {
+            biomass: p.biomass(),
+            light: p.totals().light,
+            uptake: p.totals().uptake,
+            modules: p.counts(),
+            bounds: *p.bounds(),
+        }
+    }
+
+    /// Leaves it has.
+    pub fn leaves(&self) -> u32 {
+        self.modules[Module::Leaf.index()]
+    }
+
+    /// Fine roots it has.
+    pub fn fine_roots(&self) -> u32 {
+        self.modules[Module::FineRoot.index()]
+    }
+
+    /// True when it grew at least one module.
+    pub fn germinated(&self) -> bool {
+        self.modules.iter().any(|&m| m > 0)
+    }
+
+    /// True when it has both leaves and fine roots: it can feed itself.
+    pub fn has_leaves_and_roots(&self) -> bool {
+        self.leaves() > 0 && self.fine_roots() > 0
+    }
+}
+
+/// A grown breeding garden.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BredGarden {
+    /// The specimens; the mother first.
+    pub specimens: Vec<Specimen>,
+    /// Per plant and step records.
+    pub records: Vec<StepRecord>,
+}
+
+/// Position of grid cell `i` (0 to 8, row by row) with the grid centred on the origin;
+/// cell 0 is a corner.
+pub fn grid_position(i: usize, spacing: f32) -> Vec2 {
+    let (row, col) = ((i / 3) as f32, (i % 3) as f32);
+    Vec2::new((col - 1.0) * spacing, (row - 1.0) * spacing)
+}
+
+/// Grows the given genomes together on the breeding grid (the first in the corner); each
+/// plant's share of a step runs on `pool`.
+pub fn grow_together(
+    genomes: Vec<LSystemGenome>,
+    settings: &BreedSettings,
+    pool: &Pool,
+) -> Result<BredGarden, GardenError> {
+    if genomes.len() > MAX_SPECIMENS {
+        return Err(GardenError::TooManyPlants(genomes.len()));
+    }
+    let sowings = genomes
+        .into_iter()
+        .enumerate()
+        .map(|(i, g)| Sowing::new(g, grid_position(i, settings.spacing)))
+        .collect();
+    let mut garden = Garden::new(settings.grow.world, sowings)?;
+    garden.run(settings.grow.steps, pool)?;
+    let records = garden.records().to_vec();
+    let specimens = garden
+        .plants()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Specimen {
+            genome: p.genome().clone(),
+            is_mother: i == 0,
+            position: Vec2::new(p.position().x, p.position().z),
+            plant: p.plant().clone(),
+            stats: SpecimenStats::of(p),
+        })
+        .collect();
+    Ok(BredGarden { specimens, records })
+}
+
+/// The paper's design-loop garden: the mother in a corner and `settings.children` mutated
+/// children, grown together.
+pub fn breed_garden<R: Rng + ?Sized>(
+    mother: &LSystemGenome,
+    settings: &BreedSettings,
+    rng: &mut R,
+    pool: &Pool,
+) -> Result<BredGarden, GardenError> {
+    let mutation = LSystemMutation {
+        rates: settings.rates,
+        parameter_scale: 0.0,
+    };
+    let children = settings.children.min(MAX_SPECIMENS - 1);
+    let mut genomes = Vec::with_capacity(children + 1);
+    genomes.push(mother.clone());
+    for _ in 0..children {
+        let mut child = mother.clone();
+        mutation.mutate(&mut child, rng);
+        genomes.push(child);
+    }
+    grow_together(genomes, settings, pool)
+}
+
+/// The chooser of runs without a person: the specimen with the largest biomass. On a tie
+/// the child is preferred to the mother (the last of the tied children), so evolution can
+/// drift through neutral changes — from empty rules, most first steps change nothing.
+pub fn largest_biomass(garden: &BredGarden) -> usize {
+    let mut best = 0;
+    for (i, s) in garden.specimens.iter().enumerate() {
+        if s.stats.biomass >= garden.specimens[best].stats.biomass {
+            best = i;
+        }
+    }
+    best
+}
+
+/// One generation of a biomorph run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BiomorphGeneration {
+    /// Generation, from 1.
+    pub generation: u32,
+    /// Index of the chosen specimen.
+    pub chosen: usize,
+    /// The chosen specimen's figures.
+    pub stats: SpecimenStats,
+    /// Specimens that grew at least one module.
+    pub germinated: usize,
+}
+
+/// A biomorph run: each generation's choice, and the last garden.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BiomorphRun {
+    /// One entry per generation.
+    pub generations: Vec<BiomorphGeneration>,
+    /// The mother chosen last.
+    pub mother: LSystemGenome,
+    /// The last garden grown.
+    pub last: BredGarden,
+}
+
+impl BiomorphRun {
+    /// The first generation whose chosen plant had leaves and fine roots, if any.
+    pub fn first_with_leaves_and_roots(&self) -> Option<u32> {
+        self.generations
+            .iter()
+            .find(|g| g.stats.has_leaves_and_roots())
+            .map(|g| g.generation)
+    }
+}
+
+/// Runs `generations` rounds of the design loop from `start`, letting `choose` pick each
+/// next mother. Generation `g`'s mutations read stream `(seed, g, 0)`, so a run is
+/// repeatable.
+pub fn evolve_biomorphs(
+    start: &LSystemGenome,
+    settings: &BreedSettings,
+    generations: u32,
+    seed: u64,
+    mut choose: impl FnMut(&BredGarden) -> usize,
+    pool: &Pool,
+) -> Result<BiomorphRun, GardenError> {
+    let mut mother = start.clone();
+    let mut record = Vec::new();
+    let mut last = None;
+    for generation in 1..=generations {
+        let mut rng = sylva_core::rng::stream(seed, generation, 0);
+        let garden = breed_garden(&mother, settings, &mut rng, pool)?;
+        let chosen = choose(&garden).min(garden.specimens.len().saturating_sub(1));
+        let specimen = &garden.specimens[chosen];
+        record.push(BiomorphGeneration {
+            generation,
+            chosen,
+            stats: specimen.stats,
+            germinated: garden
+                .specimens
+                .iter()
+                .filter(|s| s.stats.germinated())
+                .count(),
+        });
+        mother = specimen.genome.clone();
+        last = Some(garden);
+    }
+    let last = match last {
+        Some(g) => g,
+        None => grow_together(vec![mother.clone()], settings, pool)?,
+    };
+    Ok(BiomorphRun {
+        generations: record,
+        mother,
+        last,
+    })
+}
+
+/// What [`LSystemProblem`] selects for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Score {
+    /// Biomass (dry mass: structure and pools) at the end.
+    #[default]
+    Biomass,
+    /// Light absorbed over the plant's life.
+    Light,
+}
+
+/// Evolving L-system plants without a person: each genome is grown alone and scored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LSystemProblem {
+    /// World and time each genome grows in.
+    pub grow: GrowSettings,
+    /// What the total is.
+    pub score: Score,
+    /// Where random genomes start from ([`LSystemGenome::empty`] in the paper).
+    pub start: LSystemGenome,
+    /// How random genomes are made from `start`: this many rounds of mutation.
+    pub random_rounds: u32,
+    /// The operators used to make random genomes.
+    pub mutation: LSystemMutation,
+}
+
+impl Default for LSystemProblem {
+    fn default() -> Self {
+        LSystemProblem {
+            grow: GrowSettings::default(),
+            score: Score::Biomass,
+            start: LSystemGenome::empty(),
+            random_rounds: 10,
+            mutation: LSystemMutation::default(),
+        }
+    }
+}
+
+impl LSystemProblem {
+    /// Grows `genome` alone; `None` when it cannot grow (bad physiology or world).
+    pub fn grow(&self, genome: &LSystemGenome) -> Option<SpecimenStats> {
+        let mut garden = Garden::new(
+            self.grow.world,
+            vec![Sowing::new(genome.clone(), Vec2::ZERO)],
+        )
+        .ok()?;
+        garden.run(self.grow.steps, &Pool::Serial).ok()?;
+        Some(SpecimenStats::of(&garden.plants()[0]))
+    }
+}
+
+impl Problem for LSystemProblem {
+    type Genome = LSystemGenome;
+
+    fn term_names(&self) -> Vec<String> {
+        [
+            "biomass",
+            "light",
+            "uptake",
+            "leaves",
+            "fine_roots",
+            "modules",
+        ]
+        .map(String::from)
+        .to_vec()
+    }
+
+    fn evaluate(&self, genome: &LSystemGenome) -> Fitness {
+        let Some(s) = self.grow(genome) else {
+            return Fitness::new(f64::NEG_INFINITY, &[]);
+        };
+        let total = match self.score {
+            Score::Biomass => s.biomass,
+            Score::Light => s.light,
+        };
+        let modules: u32 = s.modules.iter().sum();
+        Fitness::new(
+            total,
+            &[
+                s.biomass,
+                s.light,
+                s.uptake,
+                f64::from(s.modules[Module::Leaf.index()]),
+                f64::from(s.modules[Module::FineRoot.index()]),
+                f64::from(modules),
+            ],
+        )
+    }
+
+    fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> LSystemGenome {
+        let mut g = self.start.clone();
+        for _ in 0..self.random_rounds {
+            self.mutation.mutate(&mut g, rng);
+        }
+        g
+    }
+}

@@ -1,0 +1,597 @@
+//! The paper's simulations (section 4) as library entry points with TOML configs.
+//!
+//! - [`HerbsUnderTree`] (Figure 8): herbs sown in two rings around a tree under vertical
+//!   light; the inner ring lies under the crown. Outcome: the herbs' biomass and light, and
+//!   the ratio of shaded to unshaded biomass (the paper: shaded herbs "grow poorly").
+//! - [`LateralLight`] (Figure 9): two trees of one genome under lateral light, against the
+//!   same pair under vertical light. Outcome: crown asymmetry (the horizontal offset of the
+//!   leaves' centroid towards the light over the crown radius) and height and width.
+//! - [`EmptyRules`] (section 4.1): biomorph breeding from empty rules, choosing the largest
+//!   biomass each generation, until plants have leaves and fine roots.
+//!
+//! A config file holds one of them as its only table, `[herbs-under-tree]`,
+//! `[lateral-light]` or `[empty-rules]` ([`Simulation`]); it names genome files relative to
+//! itself ([`Simulation::genome_files`]). The model reads no files: the caller loads those
+//! genomes and passes them to [`Simulation::run`]. Each outcome holds its measured figures,
+//! the grown plants placed in the world with their genomes ([`SimulationOutcome::plants`])
+//! and the per-step records ([`SimulationOutcome::records`]).
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+use sylva_core::environment::{EnvironmentSettings, LightSettings};
+use sylva_core::glam::{Vec2, Vec3};
+use sylva_core::par::Pool;
+use sylva_core::{MaterialKind, Plant};
+
+use crate::breed::{BiomorphRun, BreedSettings, evolve_biomorphs, largest_biomass};
+use crate::garden::{Garden, GardenError, Sowing, StepRecord};
+use crate::genome::LSystemGenome;
+
+/// Why a simulation could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    /// The genomes given do not match the files the experiment names.
+    #[error("the experiment needs {expected} genomes (its genome files), got {given}")]
+    Genomes {
+        /// Genome files the experiment names.
+        expected: usize,
+        /// Genomes given.
+        given: usize,
+    },
+    /// A setting is out of range.
+    #[error("{0}")]
+    Config(String),
+    /// The garden refused to grow.
+    #[error(transparent)]
+    Garden(#[from] GardenError),
+}
+
+/// A world with its light set to `light`, everything else from `world`.
+fn with_light(world: &EnvironmentSettings, light: LightSettings) -> EnvironmentSettings {
+    EnvironmentSettings { light, ..*world }
+}
+
+/// A grown plant placed in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlacedPlant {
+    /// A name for pictures and exports (`tree`, `herb 3`, ...).
+    pub label: String,
+    /// The genome it grew from.
+    pub genome: LSystemGenome,
+    /// Its foot, world coordinates.
+    pub position: Vec3,
+    /// Its geometry, foot at the origin.
+    pub plant: Plant,
+    /// Biomass (dry mass: structure and pools) at the end, grams.
+    pub biomass: f64,
+}
+
+fn placed(garden: &Garden, labels: &[String]) -> Vec<PlacedPlant> {
+    garden
+        .plants()
+        .iter()
+        .zip(labels)
+        .map(|(p, label)| PlacedPlant {
+            label: label.clone(),
+            genome: p.genome().clone(),
+            position: p.position(),
+            plant: p.plant().clone(),
+            biomass: p.biomass(),
+        })
+        .collect()
+}
+
+/// Horizontal shape of a plant's leaves, measured from its foot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CrownShape {
+    /// Highest point of the shoot, metres.
+    pub height: f32,
+    /// Largest horizontal distance of a leaf from the foot, metres.
+    pub radius: f32,
+    /// Horizontal offset of the leaves' centroid along `towards`, metres.
+    pub offset: f32,
+    /// `offset / radius`: 0 for a symmetric crown, up to 1 for a one-sided one.
+    pub asymmetry: f32,
+    /// Leaves.
+    pub leaves: usize,
+}
+
+impl CrownShape {
+    /// Measures `plant`'s leaves; `towards` is a horizontal direction (the light's).
+    pub fn of(plant: &Plant, towards: Vec2) -> CrownShape {
+        let towards = towards.normalize_or_zero();
+        let mut shape = CrownShape::default();
+        let mut sum = Vec2::ZERO;
+        for s in plant.segments() {
+            shape.height = shape.height.max(s.end.y).max(s.start.y);
+            let leaf = plant
+                .materials()
+                .get(s.material.index())
+                .is_some_and(|m| m.kind == MaterialKind::Leaf);
+            if !leaf {
+                continue;
+            }
+            let mid = (s.start + s.end) * 0.5;
+            let h = Vec2::new(mid.x, mid.z);
+            shape.radius = shape.radius.max(h.length());
+            sum += h;
+            shape.leaves += 1;
+        }
+        if shape.leaves > 0 {
+            shape.offset = (sum / shape.leaves as f32).dot(towards);
+            if shape.radius > 0.0 {
+                shape.asymmetry = shape.offset / shape.radius;
+            }
+        }
+        shape
+    }
+}
+
+fn vertical() -> LightSettings {
+    LightSettings {
+        elevation: 90.0,
+        ..LightSettings::default()
+    }
+}
+
+// ----- herbs under a tree -----
+
+/// Herbs sown around a tree under vertical light (Figure 8).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HerbsUnderTree {
+    /// The tree's genome file, relative to the config.
+    pub tree: PathBuf,
+    /// The herbs' genome file, relative to the config.
+    pub herb: PathBuf,
+    /// The world; its light is made vertical. Default [`EnvironmentSettings::default`].
+    #[serde(default)]
+    pub world: EnvironmentSettings,
+    /// Steps the tree grows alone before the herbs are sown. Default 120.
+    #[serde(default = "default_head_start")]
+    pub head_start: u32,
+    /// Steps everything then grows together. Default 60.
+    #[serde(default = "default_herb_steps")]
+    pub steps: u32,
+    /// Radius of the ring of herbs under the crown, metres. Default 0.8.
+    #[serde(default = "default_inner")]
+    pub inner_radius: f32,
+    /// Radius of the ring of herbs in the open, metres. Default 3.2.
+    #[serde(default = "default_outer")]
+    pub outer_radius: f32,
+    /// Herbs in each ring, 1 to 64. Default 6.
+    #[serde(default = "default_per_ring")]
+    pub herbs_per_ring: u32,
+}
+
+fn default_head_start() -> u32 {
+    120
+}
+fn default_herb_steps() -> u32 {
+    60
+}
+fn default_inner() -> f32 {
+    0.8
+}
+fn default_outer() -> f32 {
+    3.2
+}
+fn default_per_ring() -> u32 {
+    6
+}
+
+/// One herb's outcome.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct HerbOutcome {
+    /// Where it grew, `(x, z)`.
+    pub position: Vec2,
+    /// True for the inner ring (under the crown).
+    pub shaded: bool,
+    /// Biomass (dry mass: structure and pools) at the end, grams.
+    pub biomass: f64,
+    /// Light absorbed over its life.
+    pub light: f64,
+}
+
+/// What [`HerbsUnderTree`] measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HerbsUnderTreeOutcome {
+    /// Every herb.
+    pub herbs: Vec<HerbOutcome>,
+    /// The tree's crown at the end.
+    pub crown: CrownShape,
+    /// Mean biomass of the shaded herbs, grams.
+    pub shaded_biomass: f64,
+    /// Mean biomass of the herbs in the open, grams.
+    pub open_biomass: f64,
+    /// `shaded_biomass / open_biomass`: below 1 when shade slows growth.
+    pub biomass_ratio: f64,
+    /// Mean light absorbed by a shaded herb over the light of one in the open.
+    pub light_ratio: f64,
+    /// The tree first, then the herbs.
+    pub plants: Vec<PlacedPlant>,
+    /// Per plant and step records (plant 0 is the tree).
+    pub records: Vec<StepRecord>,
+}
+
+impl Default for HerbsUnderTree {
+    fn default() -> Self {
+        HerbsUnderTree {
+            tree: "tree.json".into(),
+            herb: "herb.json".into(),
+            world: EnvironmentSettings::default(),
+            head_start: default_head_start(),
+            steps: default_herb_steps(),
+            inner_radius: default_inner(),
+            outer_radius: default_outer(),
+            herbs_per_ring: default_per_ring(),
+        }
+    }
+}
+
+impl HerbsUnderTree {
+    /// Runs with the tree's and the herbs' genomes; each plant's share of a step runs on
+    /// `pool`.
+    pub fn run(
+        &self,
+        tree: &LSystemGenome,
+        herb: &LSystemGenome,
+        pool: &Pool,
+    ) -> Result<HerbsUnderTreeOutcome, ExperimentError> {
+        if !(1..=64).contains(&self.herbs_per_ring) {
+            return Err(ExperimentError::Config(format!(
+                "`herbs_per_ring` must be 1 to 64, got {}",
+                self.herbs_per_ring
+            )));
+        }
+        let mut sowings = vec![Sowing::new(tree.clone(), Vec2::ZERO)];
+        let mut labels = vec!["tree".to_owned()];
+        let n = self.herbs_per_ring;
+        for (ring, radius) in [(0, self.inner_radius), (1, self.outer_radius)] {
+            for i in 0..n {
+                // Offset the rings by half a step so no herb stands behind another.
+                let a = std::f32::consts::TAU * (i as f32 + 0.5 * ring as f32) / n as f32;
+                sowings.push(Sowing {
+                    genome: herb.clone(),
+                    position: Vec2::new(a.cos(), a.sin()) * radius,
+                    sown_at: self.head_start,
+                });
+                labels.push(format!("herb {}", labels.len()));
+            }
+        }
+        let world = with_light(&self.world, vertical());
+        let mut garden = Garden::new(world, sowings)?;
+        garden.run(self.head_start + self.steps, pool)?;
+        let herbs: Vec<HerbOutcome> = garden.plants()[1..]
+            .iter()
+            .enumerate()
+            .map(|(i, p)| HerbOutcome {
+                position: Vec2::new(p.position().x, p.position().z),
+                shaded: (i as u32) < n,
+                biomass: p.biomass(),
+                light: p.totals().light,
+            })
+            .collect();
+        let mean = |shaded: bool, f: fn(&HerbOutcome) -> f64| {
+            let v: Vec<f64> = herbs.iter().filter(|h| h.shaded == shaded).map(f).collect();
+            v.iter().sum::<f64>() / v.len().max(1) as f64
+        };
+        let shaded_biomass = mean(true, |h| h.biomass);
+        let open_biomass = mean(false, |h| h.biomass);
+        let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { f64::NAN };
+        Ok(HerbsUnderTreeOutcome {
+            crown: CrownShape::of(garden.plants()[0].plant(), Vec2::X),
+            biomass_ratio: ratio(shaded_biomass, open_biomass),
+            light_ratio: ratio(mean(true, |h| h.light), mean(false, |h| h.light)),
+            shaded_biomass,
+            open_biomass,
+            herbs,
+            plants: placed(&garden, &labels),
+            records: garden.records().to_vec(),
+        })
+    }
+}
+
+// ----- lateral light -----
+
+/// Two trees of one genome under lateral light, against the same pair under vertical light
+/// (Figure 9).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LateralLight {
+    /// The trees' genome file, relative to the config.
+    pub tree: PathBuf,
+    /// The world, with its lateral light (`world.light`). Default: the default world with
+    /// light from +X at 30 degrees above the horizon.
+    #[serde(default = "default_lateral_world")]
+    pub world: EnvironmentSettings,
+    /// Steps to grow. Default 150.
+    #[serde(default = "default_lateral_steps")]
+    pub steps: u32,
+    /// Distance between the two trees, metres; they stand side by side across the light.
+    /// Default 3.
+    #[serde(default = "default_lateral_spacing")]
+    pub spacing: f32,
+}
+
+fn default_lateral_world() -> EnvironmentSettings {
+    EnvironmentSettings {
+        light: LightSettings {
+            elevation: 30.0,
+            azimuth: 0.0,
+            ..LightSettings::default()
+        },
+        ..EnvironmentSettings::default()
+    }
+}
+fn default_lateral_steps() -> u32 {
+    150
+}
+fn default_lateral_spacing() -> f32 {
+    3.0
+}
+
+impl Default for LateralLight {
+    fn default() -> Self {
+        LateralLight {
+            tree: "tree.json".into(),
+            world: default_lateral_world(),
+            steps: default_lateral_steps(),
+            spacing: default_lateral_spacing(),
+        }
+    }
+}
+
+/// What [`LateralLight`] measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LateralLightOutcome {
+    /// Horizontal direction towards the lateral light.
+    pub towards_light: Vec2,
+    /// The two trees under lateral light.
+    pub lateral: [CrownShape; 2],
+    /// The same two under vertical light (measured along the same direction).
+    pub vertical: [CrownShape; 2],
+    /// The lateral-light trees.
+    pub plants: Vec<PlacedPlant>,
+    /// The vertical-light trees.
+    pub control: Vec<PlacedPlant>,
+    /// Per plant and step records of the lateral run.
+    pub records: Vec<StepRecord>,
+}
+
+impl LateralLightOutcome {
+    /// Mean asymmetry of the two lateral-light trees.
+    pub fn lateral_asymmetry(&self) -> f32 {
+        0.5 * (self.lateral[0].asymmetry + self.lateral[1].asymmetry)
+    }
+
+    /// Mean asymmetry of the two vertical-light trees.
+    pub fn vertical_asymmetry(&self) -> f32 {
+        0.5 * (self.vertical[0].asymmetry + self.vertical[1].asymmetry)
+    }
+}
+
+impl LateralLight {
+    /// Runs with the trees' genome; each plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        tree: &LSystemGenome,
+        pool: &Pool,
+    ) -> Result<LateralLightOutcome, ExperimentError> {
+        let source = self.world.light.towards_source();
+        let towards = Vec2::new(source.x, source.z);
+        if towards.length() < 1e-3 {
+            return Err(ExperimentError::Config(
+                "lateral-light needs a light below 90 degrees of elevation".into(),
+            ));
+        }
+        // Side by side across the light.
+        let across = Vec2::new(-towards.y, towards.x).normalize() * (0.5 * self.spacing);
+        let grow = |world: EnvironmentSettings| -> Result<Garden, ExperimentError> {
+            let sowings = vec![
+                Sowing::new(tree.clone(), -across),
+                Sowing::new(tree.clone(), across),
+            ];
+            let mut garden = Garden::new(world, sowings)?;
+            garden.run(self.steps, pool)?;
+            Ok(garden)
+        };
+        let lateral = grow(self.world)?;
+        let control = grow(with_light(&self.world, vertical()))?;
+        let shapes = |g: &Garden| [0, 1].map(|i| CrownShape::of(g.plants()[i].plant(), towards));
+        let labels = ["tree 1".to_owned(), "tree 2".to_owned()];
+        Ok(LateralLightOutcome {
+            towards_light: towards.normalize(),
+            lateral: shapes(&lateral),
+            vertical: shapes(&control),
+            plants: placed(&lateral, &labels),
+            control: placed(&control, &labels),
+            records: lateral.records().to_vec(),
+        })
+    }
+}
+
+// ----- evolution from empty rules -----
+
+/// Biomorph breeding from empty rules, choosing the largest biomass (section 4.1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EmptyRules {
+    /// The breeding garden: world, steps, spacing, children, mutation rates.
+    #[serde(default)]
+    pub breed: BreedSettings,
+    /// Generations, 1 to 10000. Default 30.
+    #[serde(default = "default_generations")]
+    pub generations: u32,
+    /// Seed of the mutations. Default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// A starting genome file, relative to the config; the empty genome when absent.
+    #[serde(default)]
+    pub start: Option<PathBuf>,
+}
+
+fn default_generations() -> u32 {
+    30
+}
+fn default_seed() -> u64 {
+    1
+}
+
+impl Default for EmptyRules {
+    fn default() -> Self {
+        EmptyRules {
+            breed: BreedSettings::default(),
+            generations: default_generations(),
+            seed: default_seed(),
+            start: None,
+        }
+    }
+}
+
+/// What [`EmptyRules`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmptyRulesOutcome {
+    /// The run.
+    pub run: BiomorphRun,
+    /// The first generation whose chosen plant had leaves and fine roots.
+    pub leaves_and_roots_at: Option<u32>,
+    /// The last garden's plants.
+    pub plants: Vec<PlacedPlant>,
+}
+
+impl EmptyRules {
+    /// Runs from `start` (the genome of `self.start`, or [`LSystemGenome::empty`]); each
+    /// plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        start: &LSystemGenome,
+        pool: &Pool,
+    ) -> Result<EmptyRulesOutcome, ExperimentError> {
+        if !(1..=10_000).contains(&self.generations) {
+            return Err(ExperimentError::Config(format!(
+                "`generations` must be 1 to 10000, got {}",
+                self.generations
+            )));
+        }
+        let run = evolve_biomorphs(
+            start,
+            &self.breed,
+            self.generations,
+            self.seed,
+            largest_biomass,
+            pool,
+        )?;
+        let plants = run
+            .last
+            .specimens
+            .iter()
+            .enumerate()
+            .map(|(i, s)| PlacedPlant {
+                label: if s.is_mother {
+                    "mother".to_owned()
+                } else {
+                    format!("child {i}")
+                },
+                genome: s.genome.clone(),
+                position: Vec3::new(s.position.x, 0.0, s.position.y),
+                plant: s.plant.clone(),
+                biomass: s.stats.biomass,
+            })
+            .collect();
+        Ok(EmptyRulesOutcome {
+            leaves_and_roots_at: run.first_with_leaves_and_roots(),
+            run,
+            plants,
+        })
+    }
+}
+
+// ----- configs and outcomes -----
+
+/// A simulation config: one experiment, named by its table.
+// Read once per run; boxing the larger variants would only complicate the config type.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Simulation {
+    /// `[herbs-under-tree]`.
+    HerbsUnderTree(HerbsUnderTree),
+    /// `[lateral-light]`.
+    LateralLight(LateralLight),
+    /// `[empty-rules]`.
+    EmptyRules(EmptyRules),
+}
+
+/// What a simulation measured.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+pub enum SimulationOutcome {
+    /// Herbs under a tree.
+    HerbsUnderTree(HerbsUnderTreeOutcome),
+    /// Trees under lateral light.
+    LateralLight(LateralLightOutcome),
+    /// Breeding from empty rules.
+    EmptyRules(EmptyRulesOutcome),
+}
+
+impl Simulation {
+    /// The genome files the experiment names, relative to its config file, in the order
+    /// [`Simulation::run`] takes their genomes.
+    pub fn genome_files(&self) -> Vec<&std::path::Path> {
+        match self {
+            Simulation::HerbsUnderTree(c) => vec![c.tree.as_path(), c.herb.as_path()],
+            Simulation::LateralLight(c) => vec![c.tree.as_path()],
+            Simulation::EmptyRules(c) => c.start.as_deref().into_iter().collect(),
+        }
+    }
+
+    /// Runs the experiment with the genomes of [`Simulation::genome_files`], in order; each
+    /// plant's share of a step runs on `pool`.
+    pub fn run(
+        &self,
+        genomes: &[LSystemGenome],
+        pool: &Pool,
+    ) -> Result<SimulationOutcome, ExperimentError> {
+        let expected = self.genome_files().len();
+        if genomes.len() != expected {
+            return Err(ExperimentError::Genomes {
+                expected,
+                given: genomes.len(),
+            });
+        }
+        Ok(match self {
+            Simulation::HerbsUnderTree(c) => {
+                SimulationOutcome::HerbsUnderTree(c.run(&genomes[0], &genomes[1], pool)?)
+            }
+            Simulation::LateralLight(c) => {
+                SimulationOutcome::LateralLight(c.run(&genomes[0], pool)?)
+            }
+            Simulation::EmptyRules(c) => {
+                let empty = LSystemGenome::empty();
+                SimulationOutcome::EmptyRules(c.run(genomes.first().unwrap_or(&empty), pool)?)
+            }
+        })
+    }
+}
+
+impl SimulationOutcome {
+    /// The grown plants, placed in the world.
+    pub fn plants(&self) -> &[PlacedPlant] {
+        match self {
+            SimulationOutcome::HerbsUnderTree(o) => &o.plants,
+            SimulationOutcome::LateralLight(o) => &o.plants,
+            SimulationOutcome::EmptyRules(o) => &o.plants,
+        }
+    }
+
+    /// Per plant and step records (of the lateral-light run, of the last breeding garden).
+    pub fn records(&self) -> &[StepRecord] {
+        match self {
+            SimulationOutcome::HerbsUnderTree(o) => &o.records,
+            SimulationOutcome::LateralLight(o) => &o.records,
+            SimulationOutcome::EmptyRules(o) => &o.run.last.records,
+        }
+    }
+}

@@ -1,0 +1,353 @@
+//! The seam every Sylva model plugs into.
+//!
+//! A model is a type that implements [`Model`]: its name, its genome type, how a genome
+//! grows into a [`Plant`], and its own variation operators (random genomes, mutation,
+//! crossover of two or more parents with dominance weights). A model that can also be
+//! evolved without a person implements [`Evolve`]: its section of an evolution config, the
+//! engine's [`Problem`] and [`Strategy`] that config describes, and how an evolved genome
+//! becomes a genome file. Everything else (files, meshes, pictures, the command line, the
+//! studio, Python) reaches models through these two traits; the library layer (the `sylva`
+//! crate) keeps the one registry that lists them.
+//!
+//! - [`file`](mod@file): genome files ([`GenomeError`], [`FormatV1`], [`model_tag!`]).
+//!
+//! ```
+//! use rand::{Rng, RngExt};
+//! use sylva_core::{Plant, glam::Vec3};
+//! use sylva_model::{Bred, DevelopError, Model, Parent, VariationError, plant_meta};
+//!
+//! /// A plant of one cylinder, `height` metres tall.
+//! #[derive(Clone, Copy, Debug, Default)]
+//! struct Stick;
+//!
+//! #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+//! struct StickGenome {
+//!     height: f32,
+//! }
+//!
+//! impl Model for Stick {
+//!     type Genome = StickGenome;
+//!     type Variation = ();
+//!     const NAME: &'static str = "stick";
+//!     const TITLE: &'static str = "Sticks";
+//!
+//!     fn develop(&self, g: &StickGenome, seed: u64) -> Result<Plant, DevelopError> {
+//!         let mut plant = Plant::new(plant_meta::<Self>(g, seed)?);
+//!         plant.add_segment(Vec3::ZERO, Vec3::Y * g.height, (0.1, 0.05), None, false, Plant::BARK)?;
+//!         Ok(plant)
+//!     }
+//!
+//!     fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> StickGenome {
+//!         StickGenome { height: rng.random_range(0.5..3.0) }
+//!     }
+//!
+//!     fn mutate<R: Rng + ?Sized>(&self, g: &StickGenome, _: &(), rng: &mut R) -> StickGenome {
+//!         StickGenome { height: (g.height * rng.random_range(0.8..1.25)).clamp(0.1, 10.0) }
+//!     }
+//!
+//!     fn cross<R: Rng + ?Sized>(
+//!         &self,
+//!         parents: &[Parent<'_, StickGenome>],
+//!         _: &(),
+//!         _: &mut R,
+//!     ) -> Result<Bred<StickGenome>, VariationError> {
+//!         let (a, b) = sylva_model::two_most_dominant(parents)?;
+//!         let height = 0.5 * (parents[a].genome.height + parents[b].genome.height);
+//!         Ok(Bred { genome: StickGenome { height }, parents: vec![a, b] })
+//!     }
+//! }
+//!
+//! let plant = Stick.develop(&StickGenome { height: 2.0 }, 7)?;
+//! assert_eq!(plant.meta().model, "stick");
+//! assert_eq!(plant.segments().len(), 1);
+//! # Ok::<(), DevelopError>(())
+//! ```
+
+pub mod file;
+
+use std::fmt::Debug;
+use std::path::PathBuf;
+
+use rand::Rng;
+use serde::{Serialize, de::DeserializeOwned};
+use sylva_core::{Plant, PlantError, PlantMeta, hash::stable_hash};
+use sylva_evolve::{Problem, Strategy};
+
+pub use file::{FormatV1, GenomeError};
+
+/// A plant model: a genome type, how it grows, and its own variation operators.
+///
+/// Models are values (usually unit structs), so that a registry can hold them and a genome
+/// can remember which model it belongs to. Every method is deterministic: the same genome,
+/// settings and random stream give the same result.
+pub trait Model: Clone + Debug + Send + Sync + 'static {
+    /// What a genome file of this model holds.
+    type Genome: Clone + Debug + PartialEq + Send + Sync + Serialize + DeserializeOwned + 'static;
+    /// Settings of the model's variation operators (rates, levels, sizes of random
+    /// genomes); `Default` is what a person breeding by hand starts with.
+    type Variation: Clone
+        + Debug
+        + Default
+        + PartialEq
+        + Send
+        + Sync
+        + Serialize
+        + DeserializeOwned
+        + 'static;
+
+    /// The model's name in files (`"model": "..."`).
+    const NAME: &'static str;
+    /// A short title for plots and pages, e.g. "Binary trees (Susinno)".
+    const TITLE: &'static str;
+
+    /// Grows a genome into a plant. `seed` drives the model's own random choices, if it has
+    /// any, and is recorded in the plant ([`plant_meta`]).
+    fn develop(&self, genome: &Self::Genome, seed: u64) -> Result<Plant, DevelopError>;
+
+    /// A random genome.
+    fn random<R: Rng + ?Sized>(&self, variation: &Self::Variation, rng: &mut R) -> Self::Genome;
+
+    /// A mutated copy of `genome`.
+    fn mutate<R: Rng + ?Sized>(
+        &self,
+        genome: &Self::Genome,
+        variation: &Self::Variation,
+        rng: &mut R,
+    ) -> Self::Genome;
+
+    /// A child of two or more parents. Where a model's crossover mixes two parents, it
+    /// crosses the two most dominant ([`two_most_dominant`]); a model may use every weight.
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        parents: &[Parent<'_, Self::Genome>],
+        variation: &Self::Variation,
+        rng: &mut R,
+    ) -> Result<Bred<Self::Genome>, VariationError>;
+
+    /// Reads a genome file's text. The default is serde's reader, which refuses unknown
+    /// fields and reports the line and column of any error.
+    fn parse(&self, text: &str) -> Result<Self::Genome, GenomeError> {
+        file::parse(text)
+    }
+
+    /// The genome file's text: pretty JSON ending with a newline.
+    fn write(&self, genome: &Self::Genome) -> String {
+        file::pretty(genome)
+    }
+
+    /// The seed a genome grows with when none is given: 0, or the genome's own seed for
+    /// models whose genomes carry one.
+    fn default_seed(&self, _genome: &Self::Genome) -> u64 {
+        0
+    }
+
+    /// How the model's plants are best meshed.
+    fn mesh_hint(&self) -> MeshHint {
+        MeshHint::default()
+    }
+}
+
+/// How a model's plants are best meshed: facts about the model's shapes, which the library
+/// turns into mesh options (so meshing never asks which model a plant came from).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshHint {
+    /// The model's tubes are sphylls (cylinders with spherical ends): round their caps.
+    pub round_caps: bool,
+}
+
+/// A parent of a crossover and its dominance weight (any finite number of at least 0; the
+/// more, the more genes it gives).
+#[derive(Clone, Copy, Debug)]
+pub struct Parent<'a, G> {
+    /// The genome.
+    pub genome: &'a G,
+    /// Its weight.
+    pub dominance: f64,
+}
+
+/// A child and the parents that gave it genes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bred<G> {
+    /// The child.
+    pub genome: G,
+    /// Indices (into the parents given) of the parents that gave it genes, ascending.
+    pub parents: Vec<usize>,
+}
+
+/// Why parents could not be crossed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum VariationError {
+    /// Crossover needs two or more parents.
+    #[error("crossover needs two or more parents, got {0}")]
+    TooFewParents(usize),
+    /// A dominance weight is negative or not finite.
+    #[error("parent {parent}'s dominance must be a finite number of at least 0, got {value}")]
+    BadDominance {
+        /// Index of the parent.
+        parent: usize,
+        /// Its weight.
+        value: f64,
+    },
+}
+
+/// Checks the parents of a crossover: two or more, each weight finite and at least 0.
+pub fn check_parents<G>(parents: &[Parent<'_, G>]) -> Result<(), VariationError> {
+    if parents.len() < 2 {
+        return Err(VariationError::TooFewParents(parents.len()));
+    }
+    match parents
+        .iter()
+        .position(|p| !(p.dominance.is_finite() && p.dominance >= 0.0))
+    {
+        Some(i) => Err(VariationError::BadDominance {
+            parent: i,
+            value: parents[i].dominance,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The two most dominant parents (ties go to the first given), in the order given, after
+/// [`check_parents`]: what a two-parent crossover crosses.
+pub fn two_most_dominant<G>(parents: &[Parent<'_, G>]) -> Result<(usize, usize), VariationError> {
+    check_parents(parents)?;
+    let mut order: Vec<usize> = (0..parents.len()).collect();
+    order.sort_by(|&a, &b| parents[b].dominance.total_cmp(&parents[a].dominance));
+    let (a, b) = (order[0].min(order[1]), order[0].max(order[1]));
+    Ok((a, b))
+}
+
+/// Why a genome could not be grown.
+#[derive(Debug, thiserror::Error)]
+pub enum DevelopError {
+    /// The plant refused a part (a NaN, negative or far value slipped through).
+    #[error("invalid plant part: {0}")]
+    Plant(#[from] PlantError),
+    /// The genome could not be serialised for its fingerprint.
+    #[error("genome could not be serialised: {0}")]
+    Serialize(#[from] serde_json::Error),
+    /// The genome asks for a larger plant than the model allows.
+    #[error("the plant would have more than {limit} parts (segments and organs)")]
+    TooLarge {
+        /// The limit, in segments plus organs.
+        limit: usize,
+    },
+    /// A model's own reason (an L-system world that cannot be built, say).
+    #[error(transparent)]
+    Model(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// Where a plant of model `M` grown from `genome` with `seed` came from: the model's name,
+/// the stable hash of the genome's compact JSON and the seed.
+pub fn plant_meta<M: Model>(genome: &M::Genome, seed: u64) -> Result<PlantMeta, DevelopError> {
+    let json = serde_json::to_vec(genome)?;
+    Ok(PlantMeta {
+        model: M::NAME.to_owned(),
+        genome_hash: stable_hash(&json),
+        seed,
+    })
+}
+
+/// A model that can be evolved without a person (`sylva evolve`).
+///
+/// The engine may evolve another representation than the genome file (a bit string for the
+/// binary tree, a bare GP tree for automata); [`Evolve::genome_file`] turns an evolved
+/// genome back into the model's genome.
+pub trait Evolve: Model {
+    /// The model's section of an evolution config (`[name]` in TOML), with documented
+    /// defaults; unknown fields are refused and numbers range-checked while read.
+    type Config: Clone + Debug + Default + PartialEq + Send + Sync + Serialize + DeserializeOwned;
+    /// The problem the engine solves.
+    type Problem: Problem<Genome: Serialize + DeserializeOwned> + Clone + 'static;
+    /// How one generation becomes the next.
+    type Strategy: Strategy<Self::Problem> + 'static;
+
+    /// Genome files the config names (relative to the config file), read by the caller and
+    /// given to [`Evolve::setup`] as `start`.
+    fn start_files(&self, _config: &Self::Config) -> Vec<PathBuf> {
+        Vec::new()
+    }
+
+    /// The problem, its breeding and the first members of generation 0 (the rest is
+    /// random) that `config` describes. `start` holds the genomes of
+    /// [`Evolve::start_files`]; `seed` and `population` are the run's.
+    fn setup(
+        &self,
+        config: &Self::Config,
+        start: Vec<Self::Genome>,
+        seed: u64,
+        population: usize,
+    ) -> Result<Setup<Self>, ConfigError>;
+
+    /// The genome file an evolved genome stands for.
+    fn genome_file(
+        &self,
+        problem: &Self::Problem,
+        evolved: &<Self::Problem as Problem>::Genome,
+    ) -> Self::Genome;
+
+    /// Guides drawn beside plants in pictures (a target surface, forbidden cells).
+    fn guides(&self, _problem: &Self::Problem) -> Option<Plant> {
+        None
+    }
+}
+
+/// What [`Evolve::setup`] makes.
+pub struct Setup<M: Evolve> {
+    /// The problem.
+    pub problem: M::Problem,
+    /// Its breeding.
+    pub strategy: M::Strategy,
+    /// The first members of generation 0; the rest is random.
+    pub first: Vec<<M::Problem as Problem>::Genome>,
+}
+
+/// A config section that cannot make a run: which field (relative to the model's section,
+/// like `breeding`) and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("`{field}`: {message}")]
+pub struct ConfigError {
+    /// The field, relative to the model's section.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ConfigError {
+    /// An error about `field`.
+    pub fn new(field: impl Into<String>, message: impl ToString) -> Self {
+        ConfigError {
+            field: field.into(),
+            message: message.to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_two_most_dominant_parents_are_crossed() {
+        let g = [1, 2, 3];
+        let parents = |w: [f64; 3]| {
+            [0, 1, 2].map(|i| Parent {
+                genome: &g[i],
+                dominance: w[i],
+            })
+        };
+        assert_eq!(two_most_dominant(&parents([1.0, 5.0, 3.0])), Ok((1, 2)));
+        assert_eq!(two_most_dominant(&parents([1.0, 1.0, 1.0])), Ok((0, 1)));
+        assert_eq!(
+            two_most_dominant(&parents([1.0, -1.0, 1.0])),
+            Err(VariationError::BadDominance {
+                parent: 1,
+                value: -1.0
+            })
+        );
+        assert_eq!(
+            two_most_dominant(&parents([1.0, 1.0, 1.0])[..1]),
+            Err(VariationError::TooFewParents(1))
+        );
+    }
+}
