@@ -18,7 +18,7 @@
 use serde::de::value::MapAccessDeserializer;
 use serde::de::{self, DeserializeSeed, Error as _, IntoDeserializer, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use sylva_core::{Plant, PlantMeta, hash::stable_hash, ranged};
+use sylva_core::{Plant, ranged};
 
 use crate::compile::{AtEnd, ElseEnd, Program, Semantics};
 use crate::sim::{ChildVariables, Detail, GrowOptions, GrowthReport, Limits, Simulator};
@@ -308,12 +308,7 @@ impl AutomataGenome {
 
     /// Grows the plant and says what the simulator did.
     pub fn develop_with_report(&self, seed: u64) -> Result<(Plant, GrowthReport), DevelopError> {
-        let json = serde_json::to_vec(self)?;
-        let mut plant = Plant::new(PlantMeta {
-            model: MODEL.to_owned(),
-            genome_hash: stable_hash(&json),
-            seed,
-        });
+        let mut plant = Plant::new(sylva_model::plant_meta::<crate::AutomataModel>(self, seed));
         let program = Program::compile(&self.program, &self.growth.semantics());
         let report = Simulator::new().run(
             &program,

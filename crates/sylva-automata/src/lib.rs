@@ -6,7 +6,8 @@
 //! pseudo-code says (section 2.2) and draws a [`Plant`](sylva_core::Plant). Trees print and
 //! parse as lilgp-style S-expressions ([`sexpr`]); [`gp`] holds ramped half-and-half
 //! initialisation and the typed subtree crossover and mutation; [`AutomataGenome`] is the
-//! genome file.
+//! genome file; [`problem`] is Poncin's GP run as an evolution problem; [`AutomataModel`]
+//! is the model as Sylva's [`Model`] and [`Evolve`].
 //!
 //! ```
 //! use sylva_core::{Plant, PlantMeta};
@@ -92,6 +93,7 @@
 pub mod compile;
 pub mod genome;
 pub mod gp;
+pub mod problem;
 pub mod sexpr;
 pub mod sim;
 pub mod tree;
@@ -99,9 +101,97 @@ pub mod tree;
 pub use compile::{AtEnd, ElseEnd, Program, Semantics};
 pub use genome::{AutomataGenome, AutomataTag, Growth, MODEL};
 pub use gp::{GpConfig, SubtreeCrossover, SubtreeMutation, Weights};
+pub use problem::{AutomataProblem, AutomataSettings, AutomataStrategy};
 pub use sexpr::ParseError;
 pub use sim::{
     BoundsHit, ChildVariables, Detail, GrowOptions, GrowthReport, Limits, Simulator, Stop,
     map_thickness,
 };
 pub use tree::{GpTree, Node, Target, TreeError, Type, Var};
+
+use rand::Rng;
+use sylva_core::Plant;
+use sylva_evolve::{Crossover, Mutate};
+use sylva_model::{
+    Bred, ConfigError, DevelopError, Evolve, Model, Parent, Setup, VariationError,
+    two_most_dominant,
+};
+
+/// Poncin's automata as a Sylva model.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct AutomataModel;
+
+impl Model for AutomataModel {
+    type Genome = AutomataGenome;
+    type Settings = AutomataSettings;
+    const NAME: &'static str = MODEL;
+    const TITLE: &'static str = "Automata trees (Poncin)";
+
+    fn develop(&self, genome: &AutomataGenome, seed: u64) -> Result<Plant, DevelopError> {
+        genome.develop(seed)
+    }
+
+    /// A ramped half-and-half program grown with the settings' growth.
+    fn random<R: Rng + ?Sized>(&self, s: &AutomataSettings, rng: &mut R) -> AutomataGenome {
+        AutomataGenome::with_growth(s.gp().random_tree(rng), s.growth.clone())
+    }
+
+    /// Subtree mutation of the program; the growth settings stay the genome's.
+    fn mutate<R: Rng + ?Sized>(
+        &self,
+        genome: &AutomataGenome,
+        s: &AutomataSettings,
+        rng: &mut R,
+    ) -> AutomataGenome {
+        let mut child = genome.clone();
+        SubtreeMutation { config: s.gp() }.mutate(&mut child.program, rng);
+        child
+    }
+
+    /// Typed subtree crossover of the two most dominant parents' programs; the child grows
+    /// with the first one's growth settings.
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        parents: &[Parent<'_, AutomataGenome>],
+        s: &AutomataSettings,
+        rng: &mut R,
+    ) -> Result<Bred<AutomataGenome>, VariationError> {
+        let (a, b) = two_most_dominant(parents)?;
+        let (ga, gb) = (parents[a].genome, parents[b].genome);
+        let program = SubtreeCrossover { config: s.gp() }.crossover(&ga.program, &gb.program, rng);
+        Ok(Bred {
+            genome: AutomataGenome::with_growth(program, ga.growth.clone()),
+            parents: vec![a, b],
+        })
+    }
+}
+
+impl Evolve for AutomataModel {
+    type Problem = AutomataProblem;
+    type Strategy = AutomataStrategy;
+
+    fn setup(
+        &self,
+        settings: &AutomataSettings,
+        _start: Vec<AutomataGenome>,
+        _seed: u64,
+        _population: usize,
+    ) -> Result<Setup<Self>, ConfigError> {
+        let problem = AutomataProblem::new(settings);
+        let strategy =
+            problem::strategy(&problem, settings).map_err(|e| ConfigError::new("breeding", e))?;
+        Ok(Setup {
+            problem,
+            strategy,
+            first: Vec::new(),
+        })
+    }
+
+    fn genome_file(&self, problem: &AutomataProblem, tree: &GpTree) -> AutomataGenome {
+        AutomataGenome::with_growth(tree.clone(), problem.growth.clone())
+    }
+
+    fn guides(&self, problem: &AutomataProblem) -> Option<Plant> {
+        sylva_fitness::poncin::guides::of(&problem.fitness)
+    }
+}

@@ -1,553 +1,104 @@
 //! Susinno's recursive binary tree (*Deciduous Evolution in 3D*, 2000).
 //!
 //! One cylinder, then at its top two rotated copies of the whole tree, down to a recursion
-//! depth. The paper's parameter vector is: lower and upper cylinder radius, cylinder length,
-//! two rotations (an angle about an axis each), and the depth. Read as the paper's OpenGL
-//! code would draw it, every cylinder would be the same size; Sylva makes one choice so that
-//! the recursion grows a tree rather than a lattice of equal sticks, and says so:
+//! depth; evolved by a bit-string genetic algorithm towards a weighted fitness of six tree
+//! measures.
 //!
-//! - **Taper carries on.** A child starts with its parent's upper radius and tapers by the same
-//!   ratio `upper / lower` (at most 1), so level `k` runs from `lower·t^k` to `lower·t^(k+1)`;
-//!   no radius falls below `min_radius`, the paper's "minimum radius imposed on all trees".
-//! - **Length ratio** (a Sylva addition; 1.0 is the paper): level `k` is `length·ratio^k` long.
-//! - **Siblings rotate from the parent's frame.** Each child's frame is the parent's frame
-//!   turned by its own rotation, as `glPushMatrix`/`glPopMatrix` around each recursive call
-//!   would do. Axes are in the parent's local frame: x right, y along the branch, z up.
-//! - The first child continues the parent's axis, the second starts a branch (meshing joins
-//!   the first into one tube).
+//! - [`genome`]: [`BinTree`], how it grows, its analytic [`TreeMeasures`](sylva_core::TreeMeasures)
+//!   and the bit layout of the genetic algorithm ([`LAYOUT`]).
+//! - [`problem`]: the genetic algorithm as an evolution problem: the model's settings (the
+//!   `[bintree]` config), Susinno's weighted fitness and his mean-replacement step.
+//! - [`BinTreeModel`]: the model as Sylva's [`Model`] and [`Evolve`].
 //!
-//! [`BinTree::measures`] computes the paper's six tree measures analytically (no plant is
-//! built, which keeps evolution fast); [`TreeMeasures::of_plant`] computes them from any grown
-//! plant, and tests check that the two agree.
+//! ```
+//! use sylva_bintree::{BinTree, BinTreeModel};
+//! use sylva_model::Model;
 //!
-//! The genetic algorithm's bit encoding is [`BinTree::decode`] / [`BinTree::encode`], laid
-//! out in [`LAYOUT`].
+//! let plant = BinTreeModel.develop(&BinTree::default(), 0)?;
+//! assert_eq!(plant.segments().len(), 255);
+//! # Ok::<(), sylva_model::DevelopError>(())
+//! ```
 
-use std::f64::consts::PI;
+pub mod genome;
+pub mod problem;
 
-use glam::{DMat3, DVec3, Vec3};
-use serde::{Deserialize, Serialize};
-use sylva_core::measures::{fork_symmetry, spread_ratio};
-use sylva_core::{Frame, Plant, PlantMeta, SegmentId, TreeMeasures, hash::stable_hash};
-use sylva_evolve::bits::{BitString, Quantized};
+pub use genome::{BITS, BinTree, Bits, Field, LAYOUT, MAX_DEPTH, MODEL, Rotation};
+pub use problem::{BinTreeProblem, BinTreeSettings, BinTreeStrategy, BitCrossover, CrossoverKind};
 
-use sylva_core::ranged;
-
-use sylva_model::DevelopError;
-use sylva_model::{FormatV1, model_tag};
-
-/// Model name in genome files.
-pub const MODEL: &str = "bintree";
-
-model_tag!(
-    /// The `"model": "bintree"` header field.
-    BinTreeTag,
-    MODEL
-);
-/// Deepest recursion a genome may ask for: `2^14 - 1` = 16383 cylinders.
-pub const MAX_DEPTH: u32 = 14;
-
-/// The bit string the genetic algorithm evolves (73 bits used).
-pub type Bits = BitString<2>;
-
-/// A rotation: an angle about an axis in the parent's local frame.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Rotation {
-    /// Degrees, -360 to 360.
-    #[serde(deserialize_with = "angle")]
-    pub angle: f64,
-    /// Axis (x right, y along the branch, z up); any non-zero length, each component in -1..=1.
-    #[serde(deserialize_with = "axis")]
-    pub axis: [f64; 3],
-}
-
-impl Rotation {
-    /// The unit axis (the axes of valid genomes are never zero).
-    fn unit_axis(&self) -> DVec3 {
-        DVec3::from_array(self.axis)
-            .try_normalize()
-            .unwrap_or(DVec3::X)
-    }
-
-    /// The rotation as a matrix in the parent's local frame.
-    fn matrix(&self) -> DMat3 {
-        DMat3::from_axis_angle(self.unit_axis(), self.angle.to_radians())
-    }
-
-    /// Where it turns the parent's heading (local +y).
-    fn direction(&self) -> DVec3 {
-        self.matrix() * DVec3::Y
-    }
-}
-
-/// A binary-tree genome: the paper's parameter vector plus Sylva's length ratio and the
-/// minimum radius. Lengths are metres, angles degrees.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BinTree {
-    /// Always `"bintree"`.
-    pub model: BinTreeTag,
-    /// Always 1.
-    pub format: FormatV1,
-    /// Levels of cylinders, 1 to 14 (`2^depth - 1` cylinders).
-    #[serde(deserialize_with = "depth")]
-    pub depth: u32,
-    /// Radius at the foot of the trunk, metres.
-    #[serde(deserialize_with = "lower_radius")]
-    pub lower_radius: f64,
-    /// Radius at the top of the trunk, metres; `upper / lower` is the taper of every level.
-    #[serde(deserialize_with = "upper_radius")]
-    pub upper_radius: f64,
-    /// Trunk length, metres.
-    #[serde(deserialize_with = "length")]
-    pub length: f64,
-    /// Each level is this much as long as its parent (1.0 in the paper).
-    #[serde(deserialize_with = "length_ratio")]
-    pub length_ratio: f64,
-    /// Turns the first child (which continues the axis).
-    pub rotation1: Rotation,
-    /// Turns the second child (a new branch).
-    pub rotation2: Rotation,
-    /// No cylinder is thinner than this, metres.
-    #[serde(deserialize_with = "min_radius")]
-    pub min_radius: f64,
-}
-
-ranged!(lower_radius: f64, "lower_radius", 0.001, 5.0, " m");
-ranged!(upper_radius: f64, "upper_radius", 0.001, 5.0, " m");
-ranged!(length: f64, "length", 0.01, 50.0, " m");
-ranged!(length_ratio: f64, "length_ratio", 0.1, 1.5, "");
-ranged!(min_radius: f64, "min_radius", 0.001, 1.0, " m");
-ranged!(angle: f64, "rotation angle", -360.0, 360.0, " degrees");
-
-sylva_core::ranged!(depth: u32, "depth", 1, MAX_DEPTH);
-
-/// Reads an axis inside the array's own visitor, so an error points at the array (checks
-/// made after the array is read would point at the end of the enclosing object).
-fn axis<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
-    struct AxisVisitor;
-    impl<'de> serde::de::Visitor<'de> for AxisVisitor {
-        type Value = [f64; 3];
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("an axis: three numbers from -1 to 1, not all zero")
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<[f64; 3], A::Error> {
-            use serde::de::Error;
-            let mut v = [0.0f64; 3];
-            for (i, c) in v.iter_mut().enumerate() {
-                *c = seq
-                    .next_element()?
-                    .ok_or_else(|| A::Error::invalid_length(i, &self))?;
-            }
-            if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
-                return Err(A::Error::invalid_length(4, &self));
-            }
-            if v.iter().any(|c| !c.is_finite() || c.abs() > 1.0) {
-                return Err(A::Error::custom(format!(
-                    "`axis` components must be numbers from -1 to 1, got {v:?}"
-                )));
-            }
-            if DVec3::from_array(v).length() < 1e-6 {
-                return Err(A::Error::custom(
-                    "`axis` must not be the zero vector (a rotation needs a direction)",
-                ));
-            }
-            Ok(v)
-        }
-    }
-    d.deserialize_seq(AxisVisitor)
-}
-
-/// One GA field: its name, width and range.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Field {
-    /// The genome field it sets.
-    pub name: &'static str,
-    /// The encoding.
-    pub code: Quantized,
-}
-
-const fn field(name: &'static str, bits: u8, min: f64, max: f64) -> Field {
-    Field {
-        name,
-        code: Quantized { bits, min, max },
-    }
-}
-
-/// The bit layout of the genetic algorithm, in order (first bit least significant in each
-/// field). Ranges are what evolution explores; hand-written genomes may go wider (see the
-/// field docs of [`BinTree`]). The minimum radius is set by the run and takes no bits.
-///
-/// Each rotation axis is encoded by two angles rather than three components: an azimuth
-/// around the branch and an elevation towards it, `axis = (cos e·cos a, sin e, cos e·sin a)`.
-/// Three free components let evolution point the axis along the branch, where a rotation
-/// only rolls the child and never bends it; with the elevation within ±30° every rotation
-/// bends its child by at least 0.87 of its angle, so every tree branches.
-pub const LAYOUT: [Field; 11] = [
-    field("depth", 3, 3.0, 10.0),
-    field("lower_radius", 7, 0.05, 0.6),
-    field("upper_radius", 7, 0.02, 0.6),
-    field("length", 7, 0.3, 3.0),
-    field("length_ratio", 5, 0.55, 0.9),
-    field("rotation1.angle", 7, 15.0, 75.0),
-    field("rotation1.axis azimuth", 6, 0.0, 354.375),
-    field("rotation1.axis elevation", 5, -30.0, 30.0),
-    field("rotation2.angle", 7, 15.0, 75.0),
-    field("rotation2.axis azimuth", 6, 0.0, 354.375),
-    field("rotation2.axis elevation", 5, -30.0, 30.0),
-];
-
-/// Bits the layout uses.
-pub const BITS: usize = {
-    let mut n = 0;
-    let mut i = 0;
-    while i < LAYOUT.len() {
-        n += LAYOUT[i].code.bits as usize;
-        i += 1;
-    }
-    n
+use rand::Rng;
+use sylva_core::Plant;
+use sylva_evolve::bits::BitFlip;
+use sylva_evolve::{Crossover, Mutate};
+use sylva_model::{
+    Bred, ConfigError, DevelopError, Evolve, Model, Parent, Setup, VariationError,
+    two_most_dominant,
 };
 
-/// The unit axis with this azimuth and elevation (degrees).
-fn axis_from_angles(azimuth: f64, elevation: f64) -> [f64; 3] {
-    let (a, e) = (azimuth.to_radians(), elevation.to_radians());
-    [e.cos() * a.cos(), e.sin(), e.cos() * a.sin()]
-}
+/// Susinno's binary tree as a Sylva model.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BinTreeModel;
 
-/// Azimuth and elevation (-90 to 90) of an axis, degrees. The azimuth runs from minus half
-/// an azimuth code step to 360 less that, so an axis near 360° encodes as 0°, not as the
-/// largest code.
-fn angles_of_axis(axis: [f64; 3]) -> (f64, f64) {
-    let v = DVec3::from_array(axis).try_normalize().unwrap_or(DVec3::X);
-    let half_step = 0.5 * LAYOUT[6].code.step();
-    let azimuth = (v.z.atan2(v.x).to_degrees() + half_step).rem_euclid(360.0) - half_step;
-    (azimuth, v.y.clamp(-1.0, 1.0).asin().to_degrees())
-}
+impl Model for BinTreeModel {
+    type Genome = BinTree;
+    type Settings = BinTreeSettings;
+    const NAME: &'static str = MODEL;
+    const TITLE: &'static str = "Binary trees";
 
-impl BinTree {
-    /// Decodes a GA bit string (see [`LAYOUT`]); `min_radius` comes from the run.
-    pub fn decode(bits: &Bits, min_radius: f64) -> BinTree {
-        let mut values = [0.0; LAYOUT.len()];
-        let mut offset = 0;
-        for (v, f) in values.iter_mut().zip(&LAYOUT) {
-            let width = usize::from(f.code.bits);
-            *v = f.code.decode(bits.read(offset, width));
-            offset += width;
-        }
-        let [d, lr, ur, len, ratio, a1, az1, el1, a2, az2, el2] = values;
-        BinTree {
-            model: BinTreeTag,
-            format: FormatV1,
-            depth: d.round() as u32,
-            lower_radius: lr,
-            upper_radius: ur,
-            length: len,
-            length_ratio: ratio,
-            rotation1: Rotation {
-                angle: a1,
-                axis: axis_from_angles(az1, el1),
-            },
-            rotation2: Rotation {
-                angle: a2,
-                axis: axis_from_angles(az2, el2),
-            },
-            min_radius,
-        }
+    fn develop(&self, genome: &BinTree, seed: u64) -> Result<Plant, DevelopError> {
+        genome.develop(seed)
     }
 
-    /// The nearest bit string (values outside the GA's ranges are clamped to them).
-    pub fn encode(&self) -> Bits {
-        let values = [
-            f64::from(self.depth),
-            self.lower_radius,
-            self.upper_radius,
-            self.length,
-            self.length_ratio,
-            self.rotation1.angle,
-            angles_of_axis(self.rotation1.axis).0,
-            angles_of_axis(self.rotation1.axis).1,
-            self.rotation2.angle,
-            angles_of_axis(self.rotation2.axis).0,
-            angles_of_axis(self.rotation2.axis).1,
-        ];
-        let mut bits = Bits::zeros(BITS).expect("the layout fits in two words");
-        let mut offset = 0;
-        for (v, f) in values.iter().zip(&LAYOUT) {
-            let width = usize::from(f.code.bits);
-            bits.write(offset, width, f.code.encode(*v));
-            offset += width;
+    fn random<R: Rng + ?Sized>(&self, v: &BinTreeSettings, rng: &mut R) -> BinTree {
+        BinTreeProblem::new(v.min_radius).decode(&BinTreeProblem::random_bits(rng))
+    }
+
+    /// Flips the bits of the genome's encoding (values round to the layout's steps).
+    fn mutate<R: Rng + ?Sized>(&self, g: &BinTree, v: &BinTreeSettings, rng: &mut R) -> BinTree {
+        let mut bits = g.encode();
+        BitFlip {
+            rate: v.mutation_rate,
         }
-        bits
+        .mutate(&mut bits, rng);
+        BinTree::decode(&bits, g.min_radius)
     }
 
-    /// Number of cylinders, `2^depth - 1`.
-    pub fn cylinder_count(&self) -> usize {
-        (1usize << self.depth.min(MAX_DEPTH)) - 1
-    }
-
-    /// Per-level taper ratio: `upper / lower`, at most 1.
-    fn taper(&self) -> f64 {
-        (self.upper_radius / self.lower_radius).min(1.0)
-    }
-
-    /// Radius at the foot of level `k`.
-    fn radius_at(&self, k: u32) -> f64 {
-        (self.lower_radius * self.taper().powi(k as i32)).max(self.min_radius)
-    }
-
-    /// Length of level `k`.
-    fn length_at(&self, k: u32) -> f64 {
-        self.length * self.length_ratio.powi(k as i32)
-    }
-
-    /// The six measures, computed from the parameters without building a plant.
-    pub fn measures(&self) -> TreeMeasures {
-        let depth = self.depth.clamp(1, MAX_DEPTH);
-        let (mut area, mut volume, mut radii, mut lengths) = (0.0, 0.0, 0.0, 0.0);
-        for k in 0..depth {
-            let n = f64::from(1u32 << k);
-            let (r0, r1, len) = (self.radius_at(k), self.radius_at(k + 1), self.length_at(k));
-            area += n * PI * (r0 + r1) * ((r0 - r1).powi(2) + len * len).sqrt();
-            volume += n * PI * len * (r0 * r0 + r0 * r1 + r1 * r1) / 3.0;
-            radii += n * 0.5 * (r0 + r1);
-            lengths += n * len;
-        }
-        // Leonardo's rule at each fork of levels k and k+1: (2 r_{k+1}^2) / r_k^2 against 1.
-        let mut pipe_model = 0.0;
-        for k in 0..depth.saturating_sub(1) {
-            let q = 2.0 * (self.radius_at(k + 1) / self.radius_at(k)).powi(2);
-            pipe_model += f64::from(1u32 << k) * (1.0 - (q - 1.0).abs()).max(0.0);
-        }
-        pipe_model = if depth > 1 {
-            pipe_model / f64::from((1u32 << (depth - 1)) - 1)
-        } else {
-            1.0
-        };
-        let (height, roundness) = (self.extent(DVec3::Y), self.roundness());
-        let (d1, d2) = (self.rotation1.direction(), self.rotation2.direction());
-        let (symmetry, straightness) = if depth > 1 {
-            let deviation = 0.5 * (angle_between(DVec3::Y, d1) + angle_between(DVec3::Y, d2));
-            (fork_symmetry(DVec3::Y, d1, d2), 1.0 - deviation / PI)
-        } else {
-            (1.0, 1.0)
-        };
-        TreeMeasures {
-            height,
-            pipe_model,
-            roundness,
-            surface_area: area,
-            volume,
-            symmetry,
-            straightness,
-            radius_to_length: radii / lengths,
-        }
-    }
-
-    /// The largest `p · w` over the skeleton's points (the foot and every cylinder's top),
-    /// by a depth-first walk that tracks only `Mᵀw` for each frame `M` and skips subtrees
-    /// that cannot beat the best so far. With `w` = +Y it is the height.
-    fn extent(&self, w: DVec3) -> f64 {
-        let depth = self.depth.clamp(1, MAX_DEPTH);
-        // `below[k]`: total length of levels k.. to the tips, the most a subtree can reach.
-        let mut below = [0.0; MAX_DEPTH as usize + 1];
-        for k in (0..depth).rev() {
-            below[k as usize] = below[k as usize + 1] + self.length_at(k);
-        }
-        let walk = ExtentWalk {
-            rotations: [self.rotation1.matrix(), self.rotation2.matrix()],
-            lengths: std::array::from_fn(|k| self.length_at(k as u32)),
-            below,
-            depth,
-        };
-        let top = self.length * w.y;
-        let mut best = top.max(0.0);
-        walk.visit(w, top, 1, &mut best);
-        best
-    }
-
-    /// Crown roundness (see [`TreeMeasures::roundness`]) from the exact first and second
-    /// moments of the skeleton's points, summed level by level from the tips down: a subtree
-    /// of level `k` is its cylinder's top plus two rotated subtrees of level `k + 1`, so its
-    /// moments follow from theirs without visiting a single branch.
-    fn roundness(&self) -> f64 {
-        let depth = self.depth.clamp(1, MAX_DEPTH);
-        let rotations = [self.rotation1.matrix(), self.rotation2.matrix()];
-        // Moments of the subtree below level k, in its own frame with its foot at the origin:
-        // point count, sum of points, sum of outer products.
-        let (mut n, mut m1, mut m2) = (0.0f64, DVec3::ZERO, DMat3::ZERO);
-        for k in (0..depth).rev() {
-            let top = DVec3::Y * self.length_at(k);
-            let outer = |a: DVec3, b: DVec3| DMat3::from_cols(a * b.x, a * b.y, a * b.z);
-            let (mut n2, mut s1, mut s2) = (1.0, top, outer(top, top));
-            if n > 0.0 {
-                for r in &rotations {
-                    let c1 = *r * m1;
-                    n2 += n;
-                    s1 += top * n + c1;
-                    s2 += outer(top, top) * n
-                        + outer(top, c1)
-                        + outer(c1, top)
-                        + *r * m2 * r.transpose();
-                }
-            }
-            (n, m1, m2) = (n2, s1, s2);
-        }
-        // The foot of the trunk is a point too.
-        n += 1.0;
-        let mean = m1 / n;
-        let cxx = m2.x_axis.x / n - mean.x * mean.x;
-        let czz = m2.z_axis.z / n - mean.z * mean.z;
-        let cxz = m2.z_axis.x / n - mean.x * mean.z;
-        spread_ratio(cxx, czz, cxz)
-    }
-
-    /// Grows the tree into a plant.
-    pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
-        let depth = self.depth.clamp(1, MAX_DEPTH);
-        let json = serde_json::to_vec(self)?;
-        let mut plant = Plant::new(PlantMeta {
-            model: MODEL.to_owned(),
-            genome_hash: stable_hash(&json),
-            seed,
-        });
-        plant.reserve(self.cylinder_count(), 0);
-        let rotations = [self.rotation1, self.rotation2]
-            .map(|r| (r.unit_axis().as_vec3(), r.angle.to_radians() as f32));
-        // Explicit stack: (foot, frame, level, parent, lateral).
-        let mut stack: Vec<(Vec3, Frame, u32, Option<SegmentId>, bool)> =
-            vec![(Vec3::ZERO, Frame::UPRIGHT, 0, None, false)];
-        while let Some((foot, frame, k, parent, lateral)) = stack.pop() {
-            let top = foot + frame.heading * self.length_at(k) as f32;
-            let radii = (self.radius_at(k) as f32, self.radius_at(k + 1) as f32);
-            let id = plant.add_segment(foot, top, radii, parent, lateral, Plant::BARK)?;
-            if k + 1 < depth {
-                // Pushed in reverse so the first child is grown first.
-                for (child, &(axis, angle)) in rotations.iter().enumerate().rev() {
-                    let mut f = frame;
-                    f.rotate_local(axis, angle);
-                    stack.push((top, f, k + 1, Some(id), child == 1));
-                }
-            }
-        }
-        Ok(plant)
+    /// Crosses the encodings of the two most dominant parents (values round to the
+    /// layout's steps); the child keeps the first's minimum radius.
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        parents: &[Parent<'_, BinTree>],
+        v: &BinTreeSettings,
+        rng: &mut R,
+    ) -> Result<Bred<BinTree>, VariationError> {
+        let (a, b) = two_most_dominant(parents)?;
+        let (ga, gb) = (parents[a].genome, parents[b].genome);
+        let bits = BitCrossover(v.crossover).crossover(&ga.encode(), &gb.encode(), rng);
+        Ok(Bred {
+            genome: BinTree::decode(&bits, ga.min_radius),
+            parents: vec![a, b],
+        })
     }
 }
 
-impl Default for BinTree {
-    /// A small, upright, symmetric tree.
-    fn default() -> Self {
-        BinTree {
-            model: BinTreeTag,
-            format: FormatV1,
-            depth: 8,
-            lower_radius: 0.3,
-            upper_radius: 0.22,
-            length: 2.0,
-            length_ratio: 0.8,
-            rotation1: Rotation {
-                angle: 30.0,
-                axis: [0.0, 0.3, 1.0],
-            },
-            rotation2: Rotation {
-                angle: 30.0,
-                axis: [0.0, 0.3, -1.0],
-            },
-            min_radius: 0.01,
-        }
-    }
-}
+impl Evolve for BinTreeModel {
+    type Problem = BinTreeProblem;
+    type Strategy = BinTreeStrategy;
 
-fn angle_between(a: DVec3, b: DVec3) -> f64 {
-    a.dot(b).clamp(-1.0, 1.0).acos()
-}
-
-/// The state of [`BinTree::extent`]'s walk.
-struct ExtentWalk {
-    rotations: [DMat3; 2],
-    lengths: [f64; MAX_DEPTH as usize],
-    below: [f64; MAX_DEPTH as usize + 1],
-    depth: u32,
-}
-
-impl ExtentWalk {
-    /// Visits the children of a cylinder at level `k - 1` whose top has `p · w = reach` and
-    /// whose frame `M` has `Mᵀw = row`.
-    fn visit(&self, row: DVec3, reach: f64, k: u32, best: &mut f64) {
-        if k >= self.depth || reach + self.below[k as usize] <= *best {
-            return;
-        }
-        let len = self.lengths[k as usize];
-        let rows = self.rotations.map(|r| r.transpose() * row);
-        // Follow the child heading most along `w` first: it raises `best` sooner.
-        let order = if rows[0].y >= rows[1].y {
-            [0, 1]
-        } else {
-            [1, 0]
-        };
-        for i in order {
-            let top = reach + len * rows[i].y;
-            *best = best.max(top);
-            self.visit(rows[i], top, k + 1, best);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn layout_fits() {
-        assert_eq!(BITS, 65);
-        const { assert!(BITS <= Bits::CAPACITY) };
+    fn setup(
+        &self,
+        settings: &BinTreeSettings,
+        _start: Vec<BinTree>,
+        _seed: u64,
+        _population: usize,
+    ) -> Result<Setup<Self>, ConfigError> {
+        Ok(Setup {
+            problem: BinTreeProblem::from_settings(settings),
+            strategy: problem::strategy(settings),
+            first: Vec::new(),
+        })
     }
 
-    #[test]
-    fn develop_counts_and_orders() {
-        let t = BinTree::default();
-        let p = t.develop(0).unwrap();
-        assert_eq!(p.segments().len(), 255);
-        assert_eq!(p.tips().count(), 128);
-        assert_eq!(p.segments()[0].start, Vec3::ZERO);
-        assert_eq!(p.segments().iter().map(|s| s.order).max(), Some(7));
-        assert!(p.segments().iter().all(|s| s.start_radius >= s.end_radius));
-    }
-
-    #[test]
-    fn radii_respect_the_minimum() {
-        let t = BinTree {
-            depth: 12,
-            upper_radius: 0.05,
-            ..BinTree::default()
-        };
-        let p = t.develop(0).unwrap();
-        let thinnest = p
-            .segments()
-            .iter()
-            .map(|s| s.end_radius)
-            .fold(1.0, f32::min);
-        assert!((thinnest - 0.01).abs() < 1e-6, "{thinnest}");
-    }
-
-    #[test]
-    fn straight_pole() {
-        let t = BinTree {
-            rotation1: Rotation {
-                angle: 0.0,
-                axis: [1.0, 0.0, 0.0],
-            },
-            rotation2: Rotation {
-                angle: 0.0,
-                axis: [1.0, 0.0, 0.0],
-            },
-            length_ratio: 1.0,
-            depth: 4,
-            ..BinTree::default()
-        };
-        let m = t.measures();
-        assert!((m.height - 8.0).abs() < 1e-9);
-        assert_eq!(m.straightness, 1.0);
-        assert_eq!(m.symmetry, 1.0);
+    fn genome_file(&self, problem: &BinTreeProblem, bits: &Bits) -> BinTree {
+        problem.decode(bits)
     }
 }

@@ -19,6 +19,8 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+pub use rayon::ThreadPoolBuildError;
+
 /// Where parallel work runs.
 #[derive(Clone, Debug, Default)]
 pub enum Pool {
@@ -31,7 +33,7 @@ pub enum Pool {
 
 impl Pool {
     /// A pool of `threads` threads; 0 means one per core, 1 means serial.
-    pub fn with_threads(threads: usize) -> Result<Pool, rayon::ThreadPoolBuildError> {
+    pub fn with_threads(threads: usize) -> Result<Pool, ThreadPoolBuildError> {
         if threads == 1 {
             return Ok(Pool::Serial);
         }

@@ -214,14 +214,15 @@ pub fn list<'de, D: Deserializer<'de>, T: Number>(
 
 /// Declares `fn $name(d) -> Result<$type, _>` reading a [`Ranged`] value, for
 /// `#[serde(deserialize_with = "...")]`: `ranged!(depth: u32, "depth", 1, 14)` or, with a
-/// unit, `ranged!(radius: f64, "radius", 0.0, 5.0, " m")`.
+/// unit, `ranged!(radius: f64, "radius", 0.0, 5.0, " m")`; a visibility may lead
+/// (`ranged!(pub(crate) depth: ...)`).
 #[macro_export]
 macro_rules! ranged {
-    ($name:ident: $ty:ty, $field:literal, $min:expr, $max:expr) => {
-        $crate::ranged!($name: $ty, $field, $min, $max, "");
+    ($vis:vis $name:ident: $ty:ty, $field:literal, $min:expr, $max:expr) => {
+        $crate::ranged!($vis $name: $ty, $field, $min, $max, "");
     };
-    ($name:ident: $ty:ty, $field:literal, $min:expr, $max:expr, $unit:literal) => {
-        fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+    ($vis:vis $name:ident: $ty:ty, $field:literal, $min:expr, $max:expr, $unit:literal) => {
+        $vis fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
             <$ty as $crate::ranged::Ranged>::read(d, $field, $min, $max, $unit)
         }
     };

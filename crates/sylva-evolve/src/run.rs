@@ -303,6 +303,15 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
         &self.settings
     }
 
+    /// Keeps the last `generations` generations for browsing from now on (0 keeps none;
+    /// the current one is always there). Results do not depend on it.
+    pub fn set_keep_history(&mut self, generations: usize) {
+        self.settings.keep_history = generations;
+        while self.history.len() > generations {
+            self.history.pop_front();
+        }
+    }
+
     /// The population of `generation`, if it is the current one or still kept.
     pub fn generation_population(&self, generation: u32) -> Option<&[Individual<P::Genome>]> {
         if generation == self.generation {

@@ -1,4 +1,4 @@
-//! Biomorph breeding (section 4.1) and a [`Problem`] for runs without a person.
+//! Biomorph breeding (section 4.1).
 //!
 //! [`breed_garden`] builds the paper's design-loop garden: at most nine specimens on a 3 × 3
 //! grid, the mother's seed in one corner and her mutated children at even distances, grown
@@ -7,16 +7,13 @@
 //! [`Specimen`]s. Evolution may start from [`LSystemGenome::empty`], which does not
 //! germinate; mutations add rules until plants with leaves and roots appear
 //! ([`evolve_biomorphs`] runs that loop with a chooser).
-//!
-//! [`LSystemProblem`] scores a genome grown alone (biomass, or light absorbed), for the
-//! generic engine's runs.
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use sylva_core::Plant;
 use sylva_core::glam::Vec2;
 use sylva_core::par::Pool;
-use sylva_evolve::{Fitness, Mutate, Problem};
+use sylva_evolve::Mutate;
 
 use crate::garden::{Garden, GardenError, GrowSettings, Sowing, StepRecord};
 use crate::genome::{LSystemGenome, LSystemMutation};
@@ -276,102 +273,4 @@ pub fn evolve_biomorphs(
         mother,
         last,
     })
-}
-
-/// What [`LSystemProblem`] selects for.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Score {
-    /// Biomass (dry mass: structure and pools) at the end.
-    #[default]
-    Biomass,
-    /// Light absorbed over the plant's life.
-    Light,
-}
-
-/// Evolving L-system plants without a person: each genome is grown alone and scored.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LSystemProblem {
-    /// World and time each genome grows in.
-    pub grow: GrowSettings,
-    /// What the total is.
-    pub score: Score,
-    /// Where random genomes start from ([`LSystemGenome::empty`] in the paper).
-    pub start: LSystemGenome,
-    /// How random genomes are made from `start`: this many rounds of mutation.
-    pub random_rounds: u32,
-    /// The operators used to make random genomes.
-    pub mutation: LSystemMutation,
-}
-
-impl Default for LSystemProblem {
-    fn default() -> Self {
-        LSystemProblem {
-            grow: GrowSettings::default(),
-            score: Score::Biomass,
-            start: LSystemGenome::empty(),
-            random_rounds: 10,
-            mutation: LSystemMutation::default(),
-        }
-    }
-}
-
-impl LSystemProblem {
-    /// Grows `genome` alone; `None` when it cannot grow (bad physiology or world).
-    pub fn grow(&self, genome: &LSystemGenome) -> Option<SpecimenStats> {
-        let mut garden = Garden::new(
-            self.grow.world,
-            vec![Sowing::new(genome.clone(), Vec2::ZERO)],
-        )
-        .ok()?;
-        garden.run(self.grow.steps, &Pool::Serial).ok()?;
-        Some(SpecimenStats::of(&garden.plants()[0]))
-    }
-}
-
-impl Problem for LSystemProblem {
-    type Genome = LSystemGenome;
-
-    fn term_names(&self) -> Vec<String> {
-        [
-            "biomass",
-            "light",
-            "uptake",
-            "leaves",
-            "fine_roots",
-            "modules",
-        ]
-        .map(String::from)
-        .to_vec()
-    }
-
-    fn evaluate(&self, genome: &LSystemGenome) -> Fitness {
-        let Some(s) = self.grow(genome) else {
-            return Fitness::new(f64::NEG_INFINITY, &[]);
-        };
-        let total = match self.score {
-            Score::Biomass => s.biomass,
-            Score::Light => s.light,
-        };
-        let modules: u32 = s.modules.iter().sum();
-        Fitness::new(
-            total,
-            &[
-                s.biomass,
-                s.light,
-                s.uptake,
-                f64::from(s.modules[Module::Leaf.index()]),
-                f64::from(s.modules[Module::FineRoot.index()]),
-                f64::from(modules),
-            ],
-        )
-    }
-
-    fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> LSystemGenome {
-        let mut g = self.start.clone();
-        for _ in 0..self.random_rounds {
-            self.mutation.mutate(&mut g, rng);
-        }
-        g
-    }
 }

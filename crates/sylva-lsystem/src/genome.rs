@@ -33,7 +33,6 @@ use rand::{Rng, RngExt};
 use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::Plant;
-use sylva_core::hash::stable_hash;
 use sylva_core::par::Pool;
 use sylva_evolve::Mutate;
 
@@ -376,7 +375,7 @@ impl LSystemGenome {
 
     /// The stable fingerprint of the genome's JSON.
     pub fn hash(&self) -> u64 {
-        serde_json::to_vec(self).map_or(0, |bytes| stable_hash(&bytes))
+        sylva_model::genome_hash(self)
     }
 
     /// The rules of a compartment.

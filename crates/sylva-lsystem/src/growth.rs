@@ -22,9 +22,9 @@ use std::f64::consts::PI;
 
 use sylva_core::environment::{Environment, Uptake};
 use sylva_core::glam::Vec3;
-use sylva_core::{Plant, PlantError, PlantMeta};
+use sylva_core::{Plant, PlantError};
 
-use crate::genome::{LSystemGenome, MODEL};
+use crate::genome::LSystemGenome;
 use crate::grammar::{Compartment, Module, RuleSet, Symbol};
 use crate::interpret::{Layout, ModuleMaterials, ModuleShape, interpret};
 use crate::physiology::{Flows, Pools, ROOT, SHOOT};
@@ -185,11 +185,7 @@ impl GrowingPlant {
         let costs = [cost_of(&genome.shoot.rules), cost_of(&genome.root.rules)];
         let words = [genome.shoot.axiom.clone(), genome.root.axiom.clone()];
         let stores = [vec![0.0; words[0].len()], vec![0.0; words[1].len()]];
-        let mut plant = Plant::new(PlantMeta {
-            model: MODEL.to_owned(),
-            genome_hash: genome.hash(),
-            seed: 0,
-        });
+        let mut plant = Plant::new(sylva_model::plant_meta::<crate::LSystemModel>(&genome, 0));
         let materials = ModuleMaterials::add_to(&mut plant)?;
         let mut grown = GrowingPlant {
             genome,

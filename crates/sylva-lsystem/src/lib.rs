@@ -8,8 +8,9 @@
 //! - [`growth`]: one plant growing: apexes paying for their rules, rewriting, re-interpreting.
 //! - [`garden`]: plants growing together in a [`sylva_core::environment::Environment`].
 //! - [`genome`]: [`LSystemGenome`], its file format, `develop` and the mutation operator.
-//! - [`breed`]: the biomorph design loop and an [`sylva_evolve::Problem`] for runs without
-//!   a person.
+//! - [`breed`]: the biomorph design loop.
+//! - [`problem`]: runs without a person: the model's settings (the `[lsystem]` config) and
+//!   an [`sylva_evolve::Problem`] that grows each genome alone and scores it.
 //! - [`experiments`]: the paper's two simulations and the run from empty rules.
 //!
 //! ```
@@ -36,5 +37,105 @@ pub mod growth;
 pub mod interpret;
 pub mod mutate;
 pub mod physiology;
+pub mod problem;
 
 pub use genome::{CompartmentCrossover, LSystemGenome, LSystemMutation};
+pub use problem::{LSystemProblem, LSystemSettings, LSystemStrategy, Score};
+
+use rand::Rng;
+use sylva_core::Plant;
+use sylva_evolve::{Crossover, Mutate};
+use sylva_model::{
+    Bred, ConfigError, DevelopError, Evolve, MeshHint, Model, Parent, Setup, VariationError,
+    two_most_dominant,
+};
+
+/// Bornhofen and Lattaud's virtual plants as a Sylva model. A genome grows alone in the
+/// default world ([`garden::GrowSettings::default`]); its modules are sphylls.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LSystemModel;
+
+impl Model for LSystemModel {
+    type Genome = LSystemGenome;
+    type Settings = LSystemSettings;
+    const NAME: &'static str = genome::MODEL;
+    const TITLE: &'static str = "L-system plants (Bornhofen and Lattaud)";
+
+    fn develop(&self, genome: &LSystemGenome, seed: u64) -> Result<Plant, DevelopError> {
+        genome.develop(seed)
+    }
+
+    /// `random_rounds` mutations of the empty genome (the paper's start).
+    fn random<R: Rng + ?Sized>(&self, s: &LSystemSettings, rng: &mut R) -> LSystemGenome {
+        let mutation = s.mutation();
+        let mut g = LSystemGenome::empty();
+        for _ in 0..s.random_rounds {
+            mutation.mutate(&mut g, rng);
+        }
+        g
+    }
+
+    /// The paper's character and rule mutations at the settings' rates.
+    fn mutate<R: Rng + ?Sized>(
+        &self,
+        genome: &LSystemGenome,
+        s: &LSystemSettings,
+        rng: &mut R,
+    ) -> LSystemGenome {
+        let mut child = genome.clone();
+        s.mutation().mutate(&mut child, rng);
+        child
+    }
+
+    /// Compartment crossover of the two most dominant parents.
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        parents: &[Parent<'_, LSystemGenome>],
+        _s: &LSystemSettings,
+        rng: &mut R,
+    ) -> Result<Bred<LSystemGenome>, VariationError> {
+        let (a, b) = two_most_dominant(parents)?;
+        Ok(Bred {
+            genome: CompartmentCrossover.crossover(parents[a].genome, parents[b].genome, rng),
+            parents: vec![a, b],
+        })
+    }
+
+    fn mesh_hint(&self) -> MeshHint {
+        MeshHint { round_caps: true }
+    }
+}
+
+impl Evolve for LSystemModel {
+    type Problem = LSystemProblem;
+    type Strategy = LSystemStrategy;
+
+    fn start_files(&self, settings: &LSystemSettings) -> Vec<std::path::PathBuf> {
+        settings.start.iter().cloned().collect()
+    }
+
+    fn setup(
+        &self,
+        settings: &LSystemSettings,
+        start: Vec<LSystemGenome>,
+        _seed: u64,
+        _population: usize,
+    ) -> Result<Setup<Self>, ConfigError> {
+        let start = start
+            .into_iter()
+            .next()
+            .unwrap_or_else(LSystemGenome::empty);
+        let (problem, strategy) = settings
+            .run(start)
+            .map_err(|e| ConfigError::new("breeding", e))?;
+        Ok(Setup {
+            problem,
+            strategy,
+            first: Vec::new(),
+        })
+    }
+
+    fn genome_file(&self, _problem: &LSystemProblem, genome: &LSystemGenome) -> LSystemGenome {
+        genome.clone()
+    }
+}

@@ -8,9 +8,8 @@ use sylva_core::environment::EnvironmentSettings;
 use sylva_core::glam::Vec2;
 use sylva_core::par::Pool;
 use sylva_evolve::{Mutate, Problem};
-use sylva_lsystem::breed::{
-    BreedSettings, LSystemProblem, breed_garden, grid_position, largest_biomass,
-};
+use sylva_lsystem::LSystemProblem;
+use sylva_lsystem::breed::{BreedSettings, breed_garden, grid_position, largest_biomass};
 use sylva_lsystem::experiments::Simulation;
 use sylva_lsystem::garden::{Garden, GrowSettings, Sowing};
 use sylva_lsystem::genome::{LSystem, LSystemGenome, LSystemMutation, mutate_parameter};

@@ -21,6 +21,13 @@ pub struct GenomeError {
 
 impl From<serde_json::Error> for GenomeError {
     fn from(e: serde_json::Error) -> Self {
+        GenomeError::from_json(&e)
+    }
+}
+
+impl GenomeError {
+    /// The message and position of a serde_json error.
+    pub fn from_json(e: &serde_json::Error) -> Self {
         // serde_json appends " at line L column C"; keep the message without it.
         let text = e.to_string();
         let message = match text.rfind(" at line ") {

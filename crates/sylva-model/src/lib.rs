@@ -1,11 +1,12 @@
 //! The seam every Sylva model plugs into.
 //!
 //! A model is a type that implements [`Model`]: its name, its genome type, how a genome
-//! grows into a [`Plant`], and its own variation operators (random genomes, mutation,
-//! crossover of two or more parents with dominance weights). A model that can also be
-//! evolved without a person implements [`Evolve`]: its section of an evolution config, the
-//! engine's [`Problem`] and [`Strategy`] that config describes, and how an evolved genome
-//! becomes a genome file. Everything else (files, meshes, pictures, the command line, the
+//! grows into a [`Plant`], its settings, and its own variation operators (random genomes,
+//! mutation, crossover of two or more parents with dominance weights). A model that can
+//! also be evolved without a person implements [`Evolve`]: the engine's [`Problem`] and
+//! [`Strategy`] its settings describe, and how an evolved genome becomes a genome file. A
+//! model's settings are one type, the `[name]` section of an evolution config, so a run and
+//! a person breeding by hand vary genomes alike. Everything else (files, meshes, pictures, the command line, the
 //! studio, Python) reaches models through these two traits; the library layer (the `sylva`
 //! crate) keeps the one registry that lists them.
 //!
@@ -27,12 +28,12 @@
 //!
 //! impl Model for Stick {
 //!     type Genome = StickGenome;
-//!     type Variation = ();
+//!     type Settings = ();
 //!     const NAME: &'static str = "stick";
 //!     const TITLE: &'static str = "Sticks";
 //!
 //!     fn develop(&self, g: &StickGenome, seed: u64) -> Result<Plant, DevelopError> {
-//!         let mut plant = Plant::new(plant_meta::<Self>(g, seed)?);
+//!         let mut plant = Plant::new(plant_meta::<Self>(g, seed));
 //!         plant.add_segment(Vec3::ZERO, Vec3::Y * g.height, (0.1, 0.05), None, false, Plant::BARK)?;
 //!         Ok(plant)
 //!     }
@@ -83,9 +84,12 @@ pub use file::{FormatV1, GenomeError};
 pub trait Model: Clone + Debug + Send + Sync + 'static {
     /// What a genome file of this model holds.
     type Genome: Clone + Debug + PartialEq + Send + Sync + Serialize + DeserializeOwned + 'static;
-    /// Settings of the model's variation operators (rates, levels, sizes of random
-    /// genomes); `Default` is what a person breeding by hand starts with.
-    type Variation: Clone
+    /// The model's settings: how random genomes are made and genomes varied (rates,
+    /// levels, sizes) and, for a model that evolves, how a run breeds and scores them. It is
+    /// the `[name]` section of an evolution config: unknown fields refused, numbers
+    /// range-checked while read, every default documented. `Default` is what a person
+    /// breeding by hand starts with.
+    type Settings: Clone
         + Debug
         + Default
         + PartialEq
@@ -105,13 +109,13 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn develop(&self, genome: &Self::Genome, seed: u64) -> Result<Plant, DevelopError>;
 
     /// A random genome.
-    fn random<R: Rng + ?Sized>(&self, variation: &Self::Variation, rng: &mut R) -> Self::Genome;
+    fn random<R: Rng + ?Sized>(&self, settings: &Self::Settings, rng: &mut R) -> Self::Genome;
 
     /// A mutated copy of `genome`.
     fn mutate<R: Rng + ?Sized>(
         &self,
         genome: &Self::Genome,
-        variation: &Self::Variation,
+        settings: &Self::Settings,
         rng: &mut R,
     ) -> Self::Genome;
 
@@ -120,7 +124,7 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn cross<R: Rng + ?Sized>(
         &self,
         parents: &[Parent<'_, Self::Genome>],
-        variation: &Self::Variation,
+        settings: &Self::Settings,
         rng: &mut R,
     ) -> Result<Bred<Self::Genome>, VariationError>;
 
@@ -180,6 +184,9 @@ pub enum VariationError {
     /// Crossover needs two or more parents.
     #[error("crossover needs two or more parents, got {0}")]
     TooFewParents(usize),
+    /// Mutation takes exactly one parent.
+    #[error("mutation takes one parent, got {0}")]
+    NotOneParent(usize),
     /// A dominance weight is negative or not finite.
     #[error("parent {parent}'s dominance must be a finite number of at least 0, got {value}")]
     BadDominance {
@@ -223,9 +230,6 @@ pub enum DevelopError {
     /// The plant refused a part (a NaN, negative or far value slipped through).
     #[error("invalid plant part: {0}")]
     Plant(#[from] PlantError),
-    /// The genome could not be serialised for its fingerprint.
-    #[error("genome could not be serialised: {0}")]
-    Serialize(#[from] serde_json::Error),
     /// The genome asks for a larger plant than the model allows.
     #[error("the plant would have more than {limit} parts (segments and organs)")]
     TooLarge {
@@ -239,13 +243,18 @@ pub enum DevelopError {
 
 /// Where a plant of model `M` grown from `genome` with `seed` came from: the model's name,
 /// the stable hash of the genome's compact JSON and the seed.
-pub fn plant_meta<M: Model>(genome: &M::Genome, seed: u64) -> Result<PlantMeta, DevelopError> {
-    let json = serde_json::to_vec(genome)?;
-    Ok(PlantMeta {
+pub fn plant_meta<M: Model>(genome: &M::Genome, seed: u64) -> PlantMeta {
+    PlantMeta {
         model: M::NAME.to_owned(),
-        genome_hash: stable_hash(&json),
+        genome_hash: genome_hash(genome),
         seed,
-    })
+    }
+}
+
+/// The stable hash of a genome's compact JSON: its fingerprint in a plant's metadata.
+pub fn genome_hash<G: Serialize>(genome: &G) -> u64 {
+    // Genomes are structs of strings, numbers and lists, which serde_json always writes.
+    stable_hash(&serde_json::to_vec(genome).unwrap_or_default())
 }
 
 /// A model that can be evolved without a person (`sylva evolve`).
@@ -254,26 +263,23 @@ pub fn plant_meta<M: Model>(genome: &M::Genome, seed: u64) -> Result<PlantMeta, 
 /// binary tree, a bare GP tree for automata); [`Evolve::genome_file`] turns an evolved
 /// genome back into the model's genome.
 pub trait Evolve: Model {
-    /// The model's section of an evolution config (`[name]` in TOML), with documented
-    /// defaults; unknown fields are refused and numbers range-checked while read.
-    type Config: Clone + Debug + Default + PartialEq + Send + Sync + Serialize + DeserializeOwned;
     /// The problem the engine solves.
-    type Problem: Problem<Genome: Serialize + DeserializeOwned> + Clone + 'static;
+    type Problem: Problem<Genome: Serialize + DeserializeOwned> + Clone + Send + 'static;
     /// How one generation becomes the next.
-    type Strategy: Strategy<Self::Problem> + 'static;
+    type Strategy: Strategy<Self::Problem> + Send + 'static;
 
-    /// Genome files the config names (relative to the config file), read by the caller and
+    /// Genome files the settings name (relative to the config file), read by the caller and
     /// given to [`Evolve::setup`] as `start`.
-    fn start_files(&self, _config: &Self::Config) -> Vec<PathBuf> {
+    fn start_files(&self, _settings: &Self::Settings) -> Vec<PathBuf> {
         Vec::new()
     }
 
     /// The problem, its breeding and the first members of generation 0 (the rest is
-    /// random) that `config` describes. `start` holds the genomes of
+    /// random) that `settings` describe. `start` holds the genomes of
     /// [`Evolve::start_files`]; `seed` and `population` are the run's.
     fn setup(
         &self,
-        config: &Self::Config,
+        settings: &Self::Settings,
         start: Vec<Self::Genome>,
         seed: u64,
         population: usize,
@@ -302,8 +308,8 @@ pub struct Setup<M: Evolve> {
     pub first: Vec<<M::Problem as Problem>::Genome>,
 }
 
-/// A config section that cannot make a run: which field (relative to the model's section,
-/// like `breeding`) and why.
+/// Settings that cannot make a run: which field (relative to the model's section, like
+/// `breeding`) and why.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("`{field}`: {message}")]
 pub struct ConfigError {

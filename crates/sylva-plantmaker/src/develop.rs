@@ -65,14 +65,11 @@
 
 use rand::RngExt;
 use sylva_core::glam::{Vec2, Vec3};
-use sylva_core::hash::stable_hash;
 use sylva_core::rng::ChaCha8Rng;
-use sylva_core::{
-    Frame, Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta, SegmentId,
-};
+use sylva_core::{Frame, Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, SegmentId};
 
+use crate::PlantMaker;
 use crate::genes::{Amount, Branch, BranchShape, Progression, Rgb, SegmentPattern, Thickness};
-use crate::{MODEL, PlantMaker};
 use sylva_model::DevelopError;
 
 /// Metres per length unit: a centimetre.
@@ -485,12 +482,9 @@ impl PlantMaker {
     ///
     /// See the [module docs](self) for how each gene is read.
     pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
-        let json = serde_json::to_vec(self)?;
-        let plant = Plant::bare(PlantMeta {
-            model: MODEL.to_owned(),
-            genome_hash: stable_hash(&json),
-            seed,
-        });
+        let plant = Plant::bare(sylva_model::plant_meta::<crate::PlantMakerModel>(
+            self, seed,
+        ));
         let mut b = Builder {
             plant,
             rng: sylva_core::rng::seeded(seed),

@@ -13,6 +13,10 @@
 //! - [`develop`](mod@develop): genotype to phenotype, [`PlantMaker::develop`].
 //! - [`variation`]: the three crossovers with dominance, mutation, the depth control, lineage.
 //! - [`garden`]: many plants of one or more genomes placed on a plot without overlapping.
+//! - [`problem`]: evolution without a person: the model's settings (the `[plantmaker]`
+//!   config), Poncin's shared terms over the grown plant, generational breeding.
+//! - [`PlantMakerModel`]: the model as Sylva's [`Model`](sylva_model::Model) and
+//!   [`Evolve`](sylva_model::Evolve).
 //!
 //! ```
 //! use sylva_plantmaker::PlantMaker;
@@ -30,6 +34,7 @@ pub mod develop;
 pub mod garden;
 pub mod genes;
 pub mod packed;
+pub mod problem;
 pub mod variation;
 
 use rand::{Rng, RngExt};
@@ -42,6 +47,7 @@ pub use genes::{
     Tenths, Thickness,
 };
 pub use packed::PackedError;
+pub use problem::{PlantMakerProblem, PlantMakerSettings, PlantMakerStrategy};
 use sylva_model::GenomeError;
 use sylva_model::{FormatV1, model_tag};
 pub use variation::{Bred, Level, Mutation, Operator, Parent, PlantMakerCrossover, VariationError};
@@ -400,6 +406,92 @@ pub struct Orphans {
     pub fans: Vec<usize>,
     /// Inflorescences that are not expressed.
     pub inflorescences: Vec<usize>,
+}
+
+/// PlantMaker as a Sylva model. Genomes carry their own seed, which is the seed they grow
+/// with unless another is given.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PlantMakerModel;
+
+impl sylva_model::Model for PlantMakerModel {
+    type Genome = PlantMaker;
+    type Settings = PlantMakerSettings;
+    const NAME: &'static str = MODEL;
+    const TITLE: &'static str = "PlantMaker";
+
+    fn develop(
+        &self,
+        genome: &PlantMaker,
+        seed: u64,
+    ) -> Result<sylva_core::Plant, sylva_model::DevelopError> {
+        genome.develop(seed)
+    }
+
+    /// A random genome of the settings' sizes.
+    fn random<R: Rng + ?Sized>(&self, s: &PlantMakerSettings, rng: &mut R) -> PlantMaker {
+        s.random(rng)
+    }
+
+    /// The paper's mutation at the settings' rate and spread.
+    fn mutate<R: Rng + ?Sized>(
+        &self,
+        g: &PlantMaker,
+        s: &PlantMakerSettings,
+        rng: &mut R,
+    ) -> PlantMaker {
+        let mut child = g.clone();
+        sylva_evolve::Mutate::mutate(&s.mutation(), &mut child, rng);
+        child
+    }
+
+    /// The paper's crossover of every parent, by dominance, at the settings' level.
+    fn cross<R: Rng + ?Sized>(
+        &self,
+        parents: &[Parent<'_>],
+        s: &PlantMakerSettings,
+        rng: &mut R,
+    ) -> Result<sylva_model::Bred<PlantMaker>, VariationError> {
+        let bred = variation::crossover(parents, s.crossover, rng)?;
+        Ok(sylva_model::Bred {
+            genome: bred.genome,
+            parents: bred.parents,
+        })
+    }
+
+    fn default_seed(&self, genome: &PlantMaker) -> u64 {
+        genome.seed
+    }
+}
+
+impl sylva_model::Evolve for PlantMakerModel {
+    type Problem = PlantMakerProblem;
+    type Strategy = PlantMakerStrategy;
+
+    fn start_files(&self, settings: &PlantMakerSettings) -> Vec<std::path::PathBuf> {
+        settings.start.clone()
+    }
+
+    fn setup(
+        &self,
+        settings: &PlantMakerSettings,
+        start: Vec<PlantMaker>,
+        seed: u64,
+        population: usize,
+    ) -> Result<sylva_model::Setup<Self>, sylva_model::ConfigError> {
+        let strategy = problem::strategy(settings)
+            .map_err(|e| sylva_model::ConfigError::new("breeding", e))?;
+        Ok(sylva_model::Setup {
+            problem: PlantMakerProblem {
+                settings: settings.clone(),
+            },
+            strategy,
+            first: problem::first_generation(settings, start, seed, population),
+        })
+    }
+
+    fn genome_file(&self, _problem: &PlantMakerProblem, genome: &PlantMaker) -> PlantMaker {
+        genome.clone()
+    }
 }
 
 #[cfg(test)]

@@ -38,6 +38,7 @@ use std::borrow::Cow;
 
 use rand::{Rng, RngExt};
 use sylva_evolve::{Crossover, IndividualId, Mutate, Origin};
+pub use sylva_model::VariationError;
 
 use crate::PlantMaker;
 use crate::genes::{
@@ -57,33 +58,9 @@ pub enum Level {
     High,
 }
 
-/// A parent and its dominance weight (any finite non-negative number).
-#[derive(Clone, Copy, Debug)]
-pub struct Parent<'a> {
-    /// The genome.
-    pub genome: &'a PlantMaker,
-    /// The more, the more genes it gives.
-    pub dominance: f64,
-}
-
-/// Why parents could not be crossed.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum VariationError {
-    /// Crossover needs two or more parents.
-    #[error("crossover needs two or more parents, got {0}")]
-    TooFewParents(usize),
-    /// Mutation takes exactly one parent.
-    #[error("mutation takes one parent, got {0}")]
-    NotOneParent(usize),
-    /// A dominance weight is negative or not finite.
-    #[error("parent {parent}'s dominance must be a finite number of at least 0, got {value}")]
-    BadDominance {
-        /// Index of the parent.
-        parent: usize,
-        /// Its weight.
-        value: f64,
-    },
-}
+/// A parent and its dominance weight (any finite non-negative number; the more, the more
+/// genes it gives).
+pub type Parent<'a> = sylva_model::Parent<'a, PlantMaker>;
 
 /// Mutation: each variable changes with probability `rate`, by noise of `spread` times its
 /// range.
@@ -239,17 +216,7 @@ pub fn crossover<R: Rng + ?Sized>(
     level: Level,
     rng: &mut R,
 ) -> Result<Bred, VariationError> {
-    if parents.len() < 2 {
-        return Err(VariationError::TooFewParents(parents.len()));
-    }
-    for (parent, p) in parents.iter().enumerate() {
-        if !p.dominance.is_finite() || p.dominance < 0.0 {
-            return Err(VariationError::BadDominance {
-                parent,
-                value: p.dominance,
-            });
-        }
-    }
+    sylva_model::check_parents(parents)?;
     let mut picker = Picker {
         weights: parents.iter().map(|p| p.dominance).collect(),
         used: vec![false; parents.len()],

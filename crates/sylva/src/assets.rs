@@ -1,16 +1,70 @@
-//! From a genome to the files people use: a mesh with its origin, exported or pictured.
+//! From grown plants to the files people use: meshes carrying their origin, scenes of many
+//! plants, exported assets and pictures.
+//!
+//! [`Grown`] is one genome grown and meshed. [`Placed`] is a plant put somewhere in a
+//! scene, with the extras its node carries (usually its [`Origin`]: genome, seed, Sylva's
+//! version, and its parents when known); [`SceneAssets::mesh`] meshes many placed plants with one mesher per
+//! set of options, and [`SceneAssets::scene`] lends them out as a [`Scene`] to export or
+//! picture. Mesh options follow from each model's [`MeshHint`], never from its name.
 
 use std::path::Path;
 
-use crate::genome::Genome;
-use anyhow::Context;
-use sylva_core::Plant;
+use serde_json::json;
+use sylva_core::glam::{Quat, Vec3};
+use sylva_core::{MaterialKind, Plant};
+use sylva_evolve::IndividualId;
 use sylva_mesh::export::{self, Format};
-use sylva_mesh::mesher::{MeshOptions, Mesher, mesh_plant};
+use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::{Mesh, Scene, SceneNode};
+use sylva_model::MeshHint;
 
-use crate::error::InputError;
+use crate::error::{Error, InputError};
+use crate::genome::Genome;
+
+/// How plants of a model are meshed: the defaults, with the model's hints applied.
+pub fn mesh_options(hint: MeshHint) -> MeshOptions {
+    MeshOptions {
+        round_caps: hint.round_caps,
+        ..MeshOptions::default()
+    }
+}
+
+/// Where a plant came from: enough to grow or breed it again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Origin {
+    /// The genome, as its file's JSON.
+    pub genome: serde_json::Value,
+    /// The seed it grew with.
+    pub seed: u64,
+    /// The ids of its parents in the run or archive it came from, when known.
+    pub parents: Vec<IndividualId>,
+}
+
+impl Origin {
+    /// The origin of `genome` grown with `seed`.
+    pub fn of(genome: &Genome, seed: u64) -> Origin {
+        Origin {
+            genome: genome.to_value(),
+            seed,
+            parents: Vec::new(),
+        }
+    }
+
+    /// What an exported node's `extras` hold: `genome`, `seed`, `sylva_version`, and
+    /// `parents` when there are any.
+    pub fn extras(&self) -> serde_json::Value {
+        let mut extras = json!({
+            "genome": self.genome,
+            "seed": self.seed,
+            "sylva_version": env!("CARGO_PKG_VERSION"),
+        });
+        if !self.parents.is_empty() {
+            extras["parents"] = json!(self.parents.iter().map(|p| p.0).collect::<Vec<_>>());
+        }
+        extras
+    }
+}
 
 /// A grown genome: its plant and mesh.
 pub struct Grown {
@@ -25,22 +79,14 @@ pub struct Grown {
 }
 
 impl Grown {
-    /// Grows and meshes a genome.
-    pub fn new(genome: Genome, seed: u64) -> anyhow::Result<Grown> {
-        Self::with_roots(genome, seed, true)
-    }
-
     /// Grows and meshes a genome, leaving out the roots when `roots` is false (they stay
     /// out of the exported asset and the pictures).
-    pub fn with_roots(genome: Genome, seed: u64, roots: bool) -> anyhow::Result<Grown> {
-        let mut plant = genome
-            .develop(seed)
-            .with_context(|| format!("growing the {} genome", genome.model()))?;
+    pub fn new(genome: Genome, seed: u64, roots: bool) -> Result<Grown, Error> {
+        let mut plant = genome.develop(seed)?;
         if !roots {
-            plant = plant.without(sylva_core::MaterialKind::Root);
+            plant = plant.without(MaterialKind::Root);
         }
-        let mesh =
-            mesh_plant(&plant, &mesh_options(genome.model())).context("meshing the plant")?;
+        let mesh = Mesher::new(mesh_options(genome.mesh_hint()))?.mesh(&plant)?;
         Ok(Grown {
             genome,
             seed,
@@ -49,122 +95,140 @@ impl Grown {
         })
     }
 
-    /// What the asset carries to be grown again: genome, seed and Sylva version.
-    pub fn extras(&self) -> serde_json::Value {
-        origin_extras(self.genome.to_value(), self.seed)
-    }
-
-    /// A scene holding this plant at the origin.
+    /// A scene holding this plant at the origin, carrying its origin.
     pub fn scene(&self) -> Scene<'_> {
         let mut node = SceneNode::new(self.genome.model(), &self.mesh);
-        node.extras = Some(self.extras());
+        node.extras = Some(Origin::of(&self.genome, self.seed).extras());
         Scene::single(node)
     }
+}
 
-    /// Writes the asset; the format follows the extension.
-    pub fn export(&self, path: &Path) -> anyhow::Result<()> {
-        export::write_scene(path, &self.scene())
-            .with_context(|| format!("writing {}", path.display()))
-    }
+/// A plant put in a scene.
+#[derive(Clone, Debug)]
+pub struct Placed<'a> {
+    /// The node's name.
+    pub name: String,
+    /// The plant, its foot at its own origin.
+    pub plant: &'a Plant,
+    /// How its model's plants are meshed.
+    pub hint: MeshHint,
+    /// Where its foot stands, metres.
+    pub translation: Vec3,
+    /// How it is turned.
+    pub rotation: Quat,
+    /// What the node's extras hold: its [`Origin::extras`], and anything a front end adds.
+    pub extras: Option<serde_json::Value>,
+}
 
-    /// Renders and writes a picture.
-    pub fn picture(&self, path: &Path, view: View, size: (u32, u32)) -> anyhow::Result<()> {
-        self.picture_with(path, view, size, None)
-    }
-
-    /// Renders and writes a picture, with guides (a target surface, grid cells) beside the
-    /// plant.
-    pub fn picture_with(
-        &self,
-        path: &Path,
-        view: View,
-        size: (u32, u32),
-        guides: Option<&Mesh>,
-    ) -> anyhow::Result<()> {
-        let mut scene = self.scene();
-        if let Some(mesh) = guides {
-            scene.nodes.push(SceneNode::new("guides", mesh));
+impl<'a> Placed<'a> {
+    /// A plant at the world's origin, unturned, without extras.
+    pub fn new(name: impl Into<String>, plant: &'a Plant, hint: MeshHint) -> Self {
+        Placed {
+            name: name.into(),
+            plant,
+            hint,
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            extras: None,
         }
-        write_picture(&scene, path, view, size)
     }
 }
 
-/// What every exported plant carries to be grown again: its genome, seed and Sylva version.
-pub fn origin_extras(genome: serde_json::Value, seed: u64) -> serde_json::Value {
-    serde_json::json!({
-        "genome": genome,
-        "seed": seed,
-        "sylva_version": env!("CARGO_PKG_VERSION"),
-    })
+/// Meshes of placed plants, ready to be lent out as a scene.
+pub struct SceneAssets {
+    meshes: Vec<Mesh>,
+    nodes: Vec<(String, Vec3, Quat, Option<serde_json::Value>)>,
 }
 
-/// How plants of a model are meshed: L-system modules are sphylls (cylinders with spherical
-/// ends), so their tubes end in domes; every other model uses the defaults.
-pub fn mesh_options(model: &str) -> MeshOptions {
-    MeshOptions {
-        round_caps: model == sylva_lsystem::genome::MODEL,
-        ..MeshOptions::default()
+impl SceneAssets {
+    /// Meshes every plant (one mesher per set of options, its buffers reused).
+    pub fn mesh(placed: &[Placed<'_>]) -> Result<SceneAssets, Error> {
+        let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
+        let mut meshes = Vec::with_capacity(placed.len());
+        for p in placed {
+            let mesher = match meshers.iter().position(|(h, _)| *h == p.hint) {
+                Some(i) => &mut meshers[i].1,
+                None => {
+                    meshers.push((p.hint, Mesher::new(mesh_options(p.hint))?));
+                    &mut meshers.last_mut().expect("just pushed").1
+                }
+            };
+            meshes.push(mesher.mesh(p.plant)?);
+        }
+        let nodes = placed
+            .iter()
+            .map(|p| (p.name.clone(), p.translation, p.rotation, p.extras.clone()))
+            .collect();
+        Ok(SceneAssets { meshes, nodes })
+    }
+
+    /// The meshes, in the order the plants were given.
+    pub fn meshes(&self) -> &[Mesh] {
+        &self.meshes
+    }
+
+    /// The scene: one node per plant.
+    pub fn scene(&self) -> Scene<'_> {
+        let nodes = self
+            .meshes
+            .iter()
+            .zip(&self.nodes)
+            .map(|(mesh, (name, translation, rotation, extras))| {
+                let mut node = SceneNode::new(name.clone(), mesh);
+                node.translation = *translation;
+                node.rotation = *rotation;
+                node.extras = extras.clone();
+                node
+            })
+            .collect();
+        Scene { nodes }
     }
 }
 
-/// Meshes several plants with one mesher (its buffers are reused).
-pub fn mesh_all<'a>(
-    plants: impl IntoIterator<Item = &'a Plant>,
-    options: &MeshOptions,
-) -> anyhow::Result<Vec<Mesh>> {
-    let mut mesher = Mesher::new(options.clone()).context("mesh options")?;
-    plants
-        .into_iter()
-        .map(|p| mesher.mesh(p).context("meshing a plant"))
-        .collect()
-}
-
-/// Renders a scene and writes it as PNG.
-pub fn write_picture(
-    scene: &Scene,
-    path: &Path,
-    view: View,
-    size: (u32, u32),
-) -> anyhow::Result<()> {
-    let options = RenderOptions {
-        width: size.0,
-        height: size.1,
-        view,
-        ..RenderOptions::default()
+/// Meshes guide wires (a target surface, grid cells) thinly, for pictures.
+pub fn guide_mesh(plant: &Plant) -> Result<Mesh, Error> {
+    let options = MeshOptions {
+        radial_segments: 4,
+        cap_ends: false,
+        ..Default::default()
     };
-    let image = render::render(scene, &options).context("rendering")?;
-    render::write_png(path, &image).with_context(|| format!("writing {}", path.display()))
+    Ok(Mesher::new(options)?.mesh(plant)?)
 }
 
-/// Reads a genome file; errors point at the line and column.
-pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
-    let text = crate::config::read_text(path)?;
-    genome_from_text(path, &text)
-}
-
-/// Parses a genome file already read from `path`.
-pub fn genome_from_text(path: &Path, text: &str) -> Result<Genome, InputError> {
-    Genome::from_json(text).map_err(|e| {
-        if e.line == 0 {
-            InputError::new(path.display().to_string(), e.message)
-        } else {
-            InputError::at(path, text, e.line, e.column, e.message)
-        }
-    })
+/// Writes a scene as GLB, OBJ (with its MTL and textures) or VRML97, by the extension.
+pub fn export(scene: &Scene<'_>, path: &Path) -> Result<(), Error> {
+    Ok(export::write_scene(path, scene)?)
 }
 
 /// Checks an output path's extension before any work is done.
 pub fn asset_format(path: &Path) -> Result<Format, InputError> {
-    Format::from_path(path).map_err(|e| InputError::new(path.display().to_string(), e.to_string()))
+    Format::from_path(path).map_err(|e| InputError::file(path, e))
 }
 
 /// Checks that a picture path ends in `.png`.
 pub fn check_png(path: &Path) -> Result<(), InputError> {
     match path.extension().and_then(|e| e.to_str()) {
         Some(e) if e.eq_ignore_ascii_case("png") => Ok(()),
-        _ => Err(InputError::new(
-            path.display().to_string(),
+        _ => Err(InputError::file(
+            path,
             "pictures are written as PNG; use a .png file name",
         )),
     }
+}
+
+/// Renders a scene and writes it as PNG.
+pub fn write_picture(
+    scene: &Scene<'_>,
+    path: &Path,
+    view: View,
+    size: (u32, u32),
+) -> Result<(), Error> {
+    let options = RenderOptions {
+        width: size.0,
+        height: size.1,
+        view,
+        ..RenderOptions::default()
+    };
+    let image = render::render(scene, &options)?;
+    Ok(render::write_png(path, &image)?)
 }

@@ -1,76 +1,150 @@
-//! Errors the command line reports, and their exit codes.
+//! What can go wrong, as typed errors with their causes kept.
 //!
-//! [`InputError`] is anything wrong with what the user gave (a file, a flag's value): it
-//! names the file, line and column, says what was expected, shows the offending text, and
-//! exits with code 2. Everything else exits with code 1.
+//! [`InputError`] is anything wrong with what a user gave: a file (a genome, a config, a
+//! checkpoint), a value of a field or a flag. It names where (the file with its line and
+//! column, or the flag) and what was expected, and keeps the offending text so a front end
+//! can show it. Every other failure is an [`Error`] variant that says what Sylva was doing.
 
-use std::path::Path;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use miette::{Diagnostic, LabeledSpan, NamedSource, SourceCode, SourceSpan};
+use sylva_model::{DevelopError, GenomeError};
 
-/// Bad input: a malformed genome, config or flag value.
-#[derive(Debug, thiserror::Error)]
+/// Bad input: a malformed file, or a value a field or flag cannot take.
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 #[error("{location}: {message}")]
 pub struct InputError {
-    /// `path:line:column` (or just the path, or the flag).
+    /// `path:line:column`, the path alone, or the flag.
     pub location: String,
+    /// The file, if the input was one.
+    pub path: Option<PathBuf>,
+    /// 1-based line of the offending text; 0 when unknown.
+    pub line: usize,
+    /// 1-based column (in characters) of the offending text; 0 when unknown.
+    pub column: usize,
     /// What is wrong and what was expected.
     pub message: String,
-    /// The text and the offending span, shown under the message.
-    snippet: Option<Box<(NamedSource<String>, SourceSpan)>>,
-}
-
-impl Diagnostic for InputError {
-    fn source_code(&self) -> Option<&dyn SourceCode> {
-        self.snippet.as_ref().map(|s| &s.0 as &dyn SourceCode)
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        let span = self.snippet.as_ref()?.1;
-        Some(Box::new(std::iter::once(LabeledSpan::new_with_span(
-            Some("here".to_owned()),
-            span,
-        ))))
-    }
+    /// The text the error is in and the byte range of the offending part.
+    pub snippet: Option<(Arc<str>, Range<usize>)>,
 }
 
 impl InputError {
-    /// An error about a whole file or a flag, without a position.
-    pub fn new(location: impl Into<String>, message: impl Into<String>) -> Self {
+    /// An error about a whole file, a flag or a value, without a position.
+    pub fn new(location: impl Into<String>, message: impl ToString) -> Self {
         InputError {
             location: location.into(),
-            message: message.into(),
+            path: None,
+            line: 0,
+            column: 0,
+            message: message.to_string(),
             snippet: None,
+        }
+    }
+
+    /// An error about a whole file.
+    pub fn file(path: &Path, message: impl ToString) -> Self {
+        InputError {
+            path: Some(path.to_owned()),
+            ..InputError::new(path.display().to_string(), message)
         }
     }
 
     /// An error at 1-based `line` and `column` of `text`, read from `path`. Parsers such as
     /// serde_json report the position just past the offending token; the error is moved back
-    /// to the token's start and spans it.
+    /// to the token's start and spans it. Line 0 means the position is unknown.
     pub fn at(path: &Path, text: &str, line: usize, column: usize, message: String) -> Self {
+        if line == 0 {
+            return InputError::file(path, message);
+        }
         let end = offset_of(text, line, column);
         let start = token_start(text, end);
         Self::spanned(path, text, start..end, message)
     }
 
     /// An error over a byte range of `text`, read from `path`.
-    pub fn spanned(
-        path: &Path,
-        text: &str,
-        range: std::ops::Range<usize>,
-        message: String,
-    ) -> Self {
-        let start = range.start.min(text.len());
+    pub fn spanned(path: &Path, text: &str, range: Range<usize>, message: String) -> Self {
+        let start = text.floor_char_boundary(range.start.min(text.len()));
+        let end = text.floor_char_boundary(range.end.clamp(start, text.len()));
         let (line, column) = line_column(text, start);
-        let len = range.end.clamp(start, text.len()) - start;
         InputError {
             location: format!("{}:{line}:{column}", path.display()),
+            path: Some(path.to_owned()),
+            line,
+            column,
             message,
-            snippet: Some(Box::new((
-                NamedSource::new(path.display().to_string(), text.to_owned()),
-                SourceSpan::from((start, len.max(1).min(text.len() - start))),
-            ))),
+            snippet: Some((Arc::from(text), start..end)),
         }
+    }
+
+    /// A genome-file error found in `text`, read from `path`.
+    pub fn genome(path: &Path, text: &str, e: GenomeError) -> Self {
+        InputError::at(path, text, e.line, e.column, e.message)
+    }
+
+    /// A TOML error found in `text`, read from `path`.
+    pub fn toml(path: &Path, text: &str, e: &toml::de::Error) -> Self {
+        let message = e.message().to_owned();
+        match e.span() {
+            Some(span) => InputError::spanned(path, text, span, message),
+            None => InputError::file(path, message),
+        }
+    }
+
+    /// A JSON error found in `text`, read from `path`.
+    pub fn json(path: &Path, text: &str, e: &serde_json::Error) -> Self {
+        InputError::genome(path, text, GenomeError::from_json(e))
+    }
+}
+
+/// Why something Sylva was asked to do failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Bad input: the user's to fix.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// A file or folder could not be read, written or made.
+    #[error("{action} {}: {source}", path.display())]
+    Io {
+        /// `"reading"`, `"writing"` or `"creating"`.
+        action: &'static str,
+        /// The file or folder.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A genome could not grow.
+    #[error("growing the {model} genome: {source}")]
+    Develop {
+        /// The model.
+        model: &'static str,
+        /// Why.
+        #[source]
+        source: DevelopError,
+    },
+    /// A plant could not be meshed (too many triangles, bad options).
+    #[error("meshing: {0}")]
+    Mesh(#[from] sylva_mesh::mesher::MeshError),
+    /// A scene could not be written.
+    #[error(transparent)]
+    Export(#[from] sylva_mesh::export::ExportError),
+    /// A picture could not be drawn or written.
+    #[error("drawing a picture: {0}")]
+    Render(#[from] sylva_mesh::render::RenderError),
+    /// A plot could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::report::PlotError),
+    /// The worker threads could not start.
+    #[error("starting the worker threads: {0}")]
+    Threads(#[from] sylva_core::par::ThreadPoolBuildError),
+}
+
+impl Error {
+    /// Bad input, the user's to fix (exit code 2 on the command line), rather than a
+    /// failure of Sylva or the machine.
+    pub fn is_input(&self) -> bool {
+        matches!(self, Error::Input(_))
     }
 }
 
@@ -128,7 +202,10 @@ mod tests {
         let text = "{\n  \"a\": -0.5,\n}";
         let e = InputError::at(Path::new("g.json"), text, 2, 12, "bad".into());
         assert_eq!(e.location, "g.json:2:8");
+        assert_eq!((e.line, e.column), (2, 8));
         assert_eq!(token_start("x", 0), 0);
+        let e = InputError::at(Path::new("g.json"), text, 0, 0, "bad".into());
+        assert_eq!(e.location, "g.json");
     }
 
     #[test]

@@ -1,142 +1,273 @@
-//! Genome files: JSON with a `"model"` and a `"format"` field and named values.
+//! A genome of any model ([`Genome`]), read from files, grown, and varied by hand.
 //!
-//! [`Genome::from_json`] reads the header first, then the model's own fields, refusing
-//! unknown fields and out-of-range values. Every error carries the line and column it was
-//! found at, and names the field and what was expected.
+//! A `Genome` holds a model's typed genome and the model itself, behind one object-safe
+//! trait, so front ends handle genomes of any model alike while every operation runs the
+//! model's own code. [`Genome::get`] gives the typed genome back for model-specific work.
 
-use serde::Deserialize;
+use std::any::Any;
+use std::fmt;
+use std::path::Path;
+use std::sync::Arc;
+
 use sylva_core::Plant;
+use sylva_core::rng::ChaCha8Rng;
+use sylva_model::{Bred, DevelopError, GenomeError, MeshHint, Model, Parent, VariationError};
 
-use sylva_model::{DevelopError, GenomeError};
-use {
-    sylva_automata as automata, sylva_bintree as bintree, sylva_lsystem as lsystem,
-    sylva_plantmaker as plantmaker,
-};
+use crate::error::{Error, InputError};
+use crate::files::read_text;
+use crate::registry::Registry;
 
 /// A genome of any model.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Genome {
-    /// Susinno's recursive binary tree.
-    BinTree(bintree::BinTree),
-    /// Poncin's GP-programmed turtle automata.
-    Automata(Box<automata::AutomataGenome>),
-    /// PlantMaker's branch, fan and inflorescence genome (Gal, Mahal and Sipper).
-    PlantMaker(Box<plantmaker::PlantMaker>),
-    /// Bornhofen and Lattaud's L-system plants grown by their physiology.
-    LSystem(Box<lsystem::LSystemGenome>),
+#[derive(Clone)]
+pub struct Genome {
+    inner: Arc<dyn AnyGenome>,
 }
 
-/// The header every genome file starts with; other fields are read by the model.
-#[derive(Deserialize)]
-struct Header {
-    #[serde(deserialize_with = "model_name")]
-    model: String,
-    #[serde(deserialize_with = "format_version")]
-    format: u32,
+/// What every typed genome can do, object-safe. Implemented once, for [`Typed`].
+trait AnyGenome: Send + Sync {
+    fn model_name(&self) -> &'static str;
+    fn title(&self) -> &'static str;
+    fn as_any(&self) -> &dyn Any;
+    fn to_json(&self) -> String;
+    fn to_value(&self) -> serde_json::Value;
+    fn develop(&self, seed: u64) -> Result<Plant, DevelopError>;
+    fn default_seed(&self) -> u64;
+    fn mesh_hint(&self) -> MeshHint;
+    fn same(&self, other: &dyn AnyGenome) -> bool;
+    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError>;
+    fn cross(
+        &self,
+        parents: &[(&Genome, f64)],
+        settings: Settings<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<(Genome, Vec<usize>), Error>;
 }
 
-const MODELS: [&str; 4] = [
-    bintree::MODEL,
-    automata::MODEL,
-    plantmaker::MODEL,
-    lsystem::genome::MODEL,
-];
+/// A model's settings for breeding by hand, as JSON (a front end's form), or the model's
+/// defaults.
+pub type Settings<'a> = Option<&'a serde_json::Value>;
 
-fn model_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
-    let name = String::deserialize(d)?;
-    if MODELS.contains(&name.as_str()) {
-        Ok(name)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "unknown model `{name}`; expected one of: {}",
-            MODELS.join(", ")
-        )))
+/// A model's genome with the model it belongs to.
+struct Typed<M: Model> {
+    model: M,
+    genome: M::Genome,
+}
+
+impl<M: Model> Typed<M> {
+    fn settings(&self, settings: Settings<'_>) -> Result<M::Settings, InputError> {
+        match settings {
+            None => Ok(M::Settings::default()),
+            Some(v) => serde_json::from_value(v.clone())
+                .map_err(|e| InputError::new(format!("{} settings", M::NAME), e.to_string())),
+        }
     }
 }
 
-fn format_version<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    let v = u32::deserialize(d)?;
-    if v == 1 {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "unsupported genome `format` {v}; this version of Sylva reads format 1"
-        )))
+impl<M: Model> AnyGenome for Typed<M> {
+    fn model_name(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn title(&self) -> &'static str {
+        M::TITLE
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        &self.genome
+    }
+
+    fn to_json(&self) -> String {
+        self.model.write(&self.genome)
+    }
+
+    fn to_value(&self) -> serde_json::Value {
+        serde_json::to_value(&self.genome).unwrap_or(serde_json::Value::Null)
+    }
+
+    fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
+        self.model.develop(&self.genome, seed)
+    }
+
+    fn default_seed(&self) -> u64 {
+        self.model.default_seed(&self.genome)
+    }
+
+    fn mesh_hint(&self) -> MeshHint {
+        self.model.mesh_hint()
+    }
+
+    fn same(&self, other: &dyn AnyGenome) -> bool {
+        other.model_name() == M::NAME
+            && other
+                .as_any()
+                .downcast_ref::<M::Genome>()
+                .is_some_and(|g| *g == self.genome)
+    }
+
+    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError> {
+        let settings = self.settings(settings)?;
+        let child = self.model.mutate(&self.genome, &settings, rng);
+        Ok(Genome::new(self.model.clone(), child))
+    }
+
+    fn cross(
+        &self,
+        parents: &[(&Genome, f64)],
+        settings: Settings<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<(Genome, Vec<usize>), Error> {
+        let settings = self.settings(settings)?;
+        let mut typed = Vec::with_capacity(parents.len());
+        for (i, (g, dominance)) in parents.iter().enumerate() {
+            let genome = g.get::<M>().ok_or_else(|| {
+                InputError::new(
+                    format!("parent {i}"),
+                    format!(
+                        "a `{}` genome cannot be crossed with `{}` genomes",
+                        g.model(),
+                        M::NAME
+                    ),
+                )
+            })?;
+            typed.push(Parent {
+                genome,
+                dominance: *dominance,
+            });
+        }
+        let Bred { genome, parents } = self
+            .model
+            .cross(&typed, &settings, rng)
+            .map_err(|e: VariationError| InputError::new("parents", e))?;
+        Ok((Genome::new(self.model.clone(), genome), parents))
     }
 }
 
 impl Genome {
-    /// Parses a genome file.
-    pub fn from_json(text: &str) -> Result<Genome, GenomeError> {
-        let header: Header = serde_json::from_str(text)?;
-        let _ = header.format;
-        match header.model.as_str() {
-            bintree::MODEL => Ok(Genome::BinTree(serde_json::from_str(text)?)),
-            automata::MODEL => Ok(Genome::Automata(Box::new(serde_json::from_str(text)?))),
-            plantmaker::MODEL => Ok(Genome::PlantMaker(Box::new(
-                plantmaker::PlantMaker::from_json(text)?,
-            ))),
-            lsystem::genome::MODEL => Ok(Genome::LSystem(Box::new(
-                lsystem::LSystemGenome::from_json(text)?,
-            ))),
-            other => Err(GenomeError {
-                message: format!("unknown model `{other}`"),
-                line: 0,
-                column: 0,
-            }),
+    /// A genome of `model`.
+    pub fn new<M: Model>(model: M, genome: M::Genome) -> Genome {
+        Genome {
+            inner: Arc::new(Typed { model, genome }),
         }
     }
 
-    /// The genome as pretty JSON, ending with a newline. Parsing it gives the same genome.
-    pub fn to_json(&self) -> String {
-        let mut s = match self {
-            Genome::BinTree(g) => serde_json::to_string_pretty(g),
-            Genome::Automata(g) => serde_json::to_string_pretty(g),
-            Genome::PlantMaker(g) => return g.to_json(),
-            Genome::LSystem(g) => return g.to_json(),
-        }
-        .expect("genomes hold only finite numbers and strings");
-        s.push('\n');
-        s
-    }
-
-    /// The genome as a JSON value (for glTF extras).
-    pub fn to_value(&self) -> serde_json::Value {
-        match self {
-            Genome::BinTree(g) => serde_json::to_value(g),
-            Genome::Automata(g) => serde_json::to_value(g),
-            Genome::PlantMaker(g) => serde_json::to_value(g),
-            Genome::LSystem(g) => serde_json::to_value(g),
-        }
-        .expect("genomes hold only finite numbers and strings")
-    }
-
-    /// The model name.
+    /// The model's name in files.
     pub fn model(&self) -> &'static str {
-        match self {
-            Genome::BinTree(_) => bintree::MODEL,
-            Genome::Automata(_) => automata::MODEL,
-            Genome::PlantMaker(_) => plantmaker::MODEL,
-            Genome::LSystem(_) => lsystem::genome::MODEL,
-        }
+        self.inner.model_name()
     }
 
-    /// Grows the plant.
-    pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
-        match self {
-            Genome::BinTree(g) => g.develop(seed),
-            Genome::Automata(g) => g.develop(seed),
-            Genome::PlantMaker(g) => g.develop(seed),
-            Genome::LSystem(g) => g.develop(seed),
-        }
+    /// The model's title.
+    pub fn title(&self) -> &'static str {
+        self.inner.title()
     }
 
-    /// The seed a genome grows with when none is given: its own seed for PlantMaker
-    /// genomes (which carry one), 0 for the deterministic models.
+    /// The typed genome, if this is a genome of model `M`.
+    pub fn get<M: Model>(&self) -> Option<&M::Genome> {
+        if self.model() != M::NAME {
+            return None;
+        }
+        self.inner.as_any().downcast_ref::<M::Genome>()
+    }
+
+    /// The genome file's text: pretty JSON ending with a newline.
+    pub fn to_json(&self) -> String {
+        self.inner.to_json()
+    }
+
+    /// The genome as a JSON value (for the extras of exported assets).
+    pub fn to_value(&self) -> serde_json::Value {
+        self.inner.to_value()
+    }
+
+    /// Grows the plant with `seed`.
+    pub fn develop(&self, seed: u64) -> Result<Plant, Error> {
+        self.inner.develop(seed).map_err(|source| Error::Develop {
+            model: self.model(),
+            source,
+        })
+    }
+
+    /// The seed the genome grows with when none is given.
     pub fn default_seed(&self) -> u64 {
-        match self {
-            Genome::PlantMaker(g) => g.seed,
-            _ => 0,
-        }
+        self.inner.default_seed()
     }
+
+    /// How the model's plants are best meshed.
+    pub fn mesh_hint(&self) -> MeshHint {
+        self.inner.mesh_hint()
+    }
+
+    /// A mutated copy, made by the model's own mutation with `settings` (the model's
+    /// settings as JSON, or its defaults), drawing from the stream of `seed`.
+    pub fn mutate(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, Error> {
+        let mut rng = sylva_core::rng::seeded(seed);
+        Ok(self.inner.mutate(settings, &mut rng)?)
+    }
+
+    /// A child of two or more parents of one model, each with a dominance weight, made by
+    /// the model's own crossover with `settings`; also says which parents gave it genes.
+    pub fn cross(
+        parents: &[(&Genome, f64)],
+        settings: Settings<'_>,
+        seed: u64,
+    ) -> Result<(Genome, Vec<usize>), Error> {
+        let Some((first, _)) = parents.first() else {
+            return Err(InputError::new("parents", VariationError::TooFewParents(0)).into());
+        };
+        let mut rng = sylva_core::rng::seeded(seed);
+        first.inner.cross(parents, settings, &mut rng)
+    }
+}
+
+impl PartialEq for Genome {
+    fn eq(&self, other: &Genome) -> bool {
+        self.inner.same(other.inner.as_ref())
+    }
+}
+
+impl fmt::Debug for Genome {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Genome")
+            .field("model", &self.model())
+            .field("genome", &self.to_value())
+            .finish()
+    }
+}
+
+/// Reads a genome file of any model the standard registry knows; errors point at the line
+/// and column.
+pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
+    let text = read_text(path)?;
+    parse_genome(path, &text)
+}
+
+/// Parses a genome file already read from `path`.
+pub fn parse_genome(path: &Path, text: &str) -> Result<Genome, InputError> {
+    Registry::standard()
+        .parse_genome(text)
+        .map_err(|e: GenomeError| InputError::genome(path, text, e))
+}
+
+/// Reads a genome file that must be of model `M`; `purpose` says what it is for in the
+/// error (like "gardens grow").
+pub fn load_genome_of<M: Model>(path: &Path, purpose: &str) -> Result<M::Genome, InputError> {
+    let genome = load_genome(path)?;
+    expect_model::<M>(path, &genome, purpose)
+}
+
+/// The typed genome of model `M`, or an error naming `path` and the model it is.
+pub fn expect_model<M: Model>(
+    path: &Path,
+    genome: &Genome,
+    purpose: &str,
+) -> Result<M::Genome, InputError> {
+    genome.get::<M>().cloned().ok_or_else(|| {
+        InputError::file(
+            path,
+            format!(
+                "{purpose} `{}` genomes; this is a `{}` genome",
+                M::NAME,
+                genome.model()
+            ),
+        )
+    })
 }

@@ -1,18 +1,46 @@
-//! The runs behind the `sylva` command line.
+//! Sylva's library layer: the one API the command line, the studio and Python call to grow,
+//! mesh, export, picture, evolve and breed plants of any model.
 //!
-//! - [`config`]: the TOML config of `sylva evolve`, with documented defaults.
-//! - [`problem`]: the binary tree as an evolution problem (Susinno's GA).
-//! - [`commands`]: `evolve`, `grow` and `render`.
-//! - [`assets`]: a genome grown, meshed, exported and pictured.
-//! - [`report`]: `stats.csv` and `fitness.svg`.
-//! - [`error`]: bad-input errors that point at file, line and column (exit code 2).
-//! - [`guides`]: target surfaces and grid cells drawn beside plants in pictures.
+//! - [`registry`]: the one list of models ([`Registry::standard`]); genome files and
+//!   configs name their model and the registry hands them to it.
+//! - [`genome`]: [`Genome`], a genome of any model: read from files, grown, and varied by
+//!   hand with the model's own operators ([`Genome::mutate`], [`Genome::cross`]).
+//! - [`assets`]: grown plants as meshes carrying their origin, scenes of many plants,
+//!   exports (GLB, OBJ, VRML97) and pictures.
+//! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
+//!   step, browse, checkpoint, resume.
+//! - [`report`]: `stats.csv`, `fitness.svg` and experiment reports.
+//! - [`files`]: reading input with limits, writing output atomically.
+//! - [`error`]: typed errors; [`InputError`] names the file, line, column and what was
+//!   expected.
+//!
+//! ```
+//! use sylva::{Genome, Grown, Registry};
+//!
+//! // A genome file of any model, grown into a meshed plant.
+//! let text = r#"{"model": "bintree", "format": 1, "depth": 5, "lower_radius": 0.2,
+//!   "upper_radius": 0.15, "length": 1.5, "length_ratio": 0.8,
+//!   "rotation1": {"angle": 30, "axis": [1, 0, 0]},
+//!   "rotation2": {"angle": -30, "axis": [0, 0, 1]}, "min_radius": 0.02}"#;
+//! let genome: Genome = Registry::standard().parse_genome(text)?;
+//! let grown = Grown::new(genome.clone(), genome.default_seed(), true)?;
+//! assert_eq!(grown.plant.segments().len(), 31);
+//! // Bred by hand with the model's own operators.
+//! let child = genome.mutate(None, 7)?;
+//! assert_eq!(child.model(), "bintree");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod assets;
-pub mod commands;
-pub mod config;
 pub mod error;
+pub mod evolution;
+pub mod files;
 pub mod genome;
-pub mod guides;
-pub mod problem;
+pub mod registry;
 pub mod report;
+
+pub use assets::{Grown, Origin, Placed, SceneAssets};
+pub use error::{Error, InputError};
+pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
+pub use genome::{Genome, load_genome, parse_genome};
+pub use registry::{ModelEntry, Registry};

@@ -1,4 +1,5 @@
-//! Run reports people read: the statistics table (CSV) and the fitness plot (SVG).
+//! Reports people read: the statistics table (CSV), the fitness plot (SVG), and the outcome
+//! of an L-system experiment (text).
 
 use std::fmt::Write as _;
 

@@ -3,8 +3,8 @@
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use proptest::prelude::*;
-use sylva::genome::Genome;
-use sylva_bintree::{BITS, BinTree, Bits};
+use sylva::{Genome, Registry};
+use sylva_bintree::{BITS, BinTree, BinTreeModel, Bits};
 use sylva_core::rng;
 
 const OAK: &str = include_str!("../../../examples/bintree/oak.json");
@@ -17,16 +17,20 @@ const EXAMPLES: [&str; 4] = [
     include_str!("../../../examples/lsystem/herb.json"),
 ];
 
+fn parse(text: &str) -> Result<Genome, sylva_model::GenomeError> {
+    Registry::standard().parse_genome(text)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
     #[test]
     fn decoded_genomes_round_trip_through_json(seed in any::<u64>()) {
         let bits = Bits::random(BITS, &mut rng::seeded(seed)).unwrap();
-        let genome = Genome::BinTree(BinTree::decode(&bits, 0.02));
+        let genome = Genome::new(BinTreeModel, BinTree::decode(&bits, 0.02));
         let text = genome.to_json();
-        prop_assert_eq!(Genome::from_json(&text).unwrap(), genome.clone());
-        prop_assert_eq!(Genome::from_json(&text).unwrap().to_json(), text);
+        prop_assert_eq!(parse(&text).unwrap(), genome.clone());
+        prop_assert_eq!(parse(&text).unwrap().to_json(), text);
     }
 
     #[test]
@@ -47,7 +51,7 @@ proptest! {
             bytes[at] = byte;
         }
         if let Ok(text) = String::from_utf8(bytes)
-            && let Ok(genome) = Genome::from_json(&text)
+            && let Ok(genome) = parse(&text)
         {
             // Growing may refuse (an error, never a panic); what grows is finite.
             if let Ok(plant) = genome.develop(0) {
@@ -62,13 +66,13 @@ proptest! {
         // Any proper prefix (at a character boundary) of a JSON object is incomplete.
         let cut = cut.index(text.len());
         prop_assume!(text.is_char_boundary(cut));
-        prop_assert!(Genome::from_json(&text[..cut]).is_err());
+        prop_assert!(parse(&text[..cut]).is_err());
     }
 }
 
 #[test]
 fn the_example_parses_and_grows() {
-    let genome = Genome::from_json(OAK).unwrap();
+    let genome = parse(OAK).unwrap();
     assert_eq!(genome.model(), "bintree");
     let plant = genome.develop(0).unwrap();
     assert_eq!(plant.segments().len(), 1023);

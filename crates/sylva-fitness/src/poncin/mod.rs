@@ -26,6 +26,9 @@
 //! paper's constants (the sphere of radius 150 at (0, 200, 0), F_dist's `200 / (d + 5)`)
 //! apply verbatim and values compare with the paper's Table 2.
 //!
+//! **Guides.** [`guides::of`] draws a fitness's target surface and forbidden cells as wire
+//! frames, for pictures.
+//!
 //! **Gating.** F_grid counts only once the weighted sum of the other terms is below
 //! [`PoncinFitness::grid_gate`]; until then it is at its maximum, 100 (section 4.4.4).
 //!
@@ -66,6 +69,7 @@
 
 pub mod endpoints;
 pub mod grid;
+pub mod guides;
 pub mod pairs;
 pub mod shape;
 

@@ -4,24 +4,23 @@
 //! generations, the first included; copies keep their score, so evaluations are a little
 //! fewer); the evaluations and automaton-steps of one run are printed beside it.
 //!
-//! Run with `cargo bench -p sylva --bench automata`.
+//! Run with `cargo bench -p sylva-automata --bench evolve`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
 
 use std::path::Path;
 use std::time::Instant;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sylva::config::EvolveConfig;
-use sylva::problem::{AutomataProblem, automata_strategy};
+use sylva_automata::problem::{AutomataProblem, AutomataSettings, strategy};
 use sylva_evolve::{Pool, Run, RunSettings};
 
 const POPULATION: usize = 5000;
 const GENERATIONS: u32 = 100;
 
 /// Runs the typical run; returns its evaluations and automaton-steps.
-fn run(config: &EvolveConfig, evaluator: &Pool) -> (u64, u64) {
-    let problem = AutomataProblem::new(&config.automata);
-    let strategy = automata_strategy(&problem, &config.automata).unwrap();
+fn run(settings: &AutomataSettings, evaluator: &Pool) -> (u64, u64) {
+    let problem = AutomataProblem::new(settings);
+    let strategy = strategy(&problem, settings).unwrap();
     let settings = RunSettings {
         seed: 1,
         population: POPULATION,
@@ -35,7 +34,10 @@ fn run(config: &EvolveConfig, evaluator: &Pool) -> (u64, u64) {
 
 fn typical_run(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/automata/sphere.toml");
-    let config = EvolveConfig::load(&path).unwrap();
+    // The example's `[automata]` section: the model's settings.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let table: toml::Table = toml::from_str(&text).unwrap();
+    let config: AutomataSettings = table["automata"].clone().try_into().unwrap();
     let evaluator = Pool::with_threads(0).unwrap();
     let start = Instant::now();
     let (evaluations, steps) = run(&config, &evaluator);

@@ -1,12 +1,12 @@
 //! Susinno's GA on binary trees: population 1000 for 100 generations with the default config,
 //! on one thread and on all cores. Throughput is in evaluations.
 //!
-//! Run with `cargo bench -p sylva --bench ga`.
+//! Run with `cargo bench -p sylva-bintree --bench ga`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sylva::config::EvolveConfig;
-use sylva::problem::{BinTreeProblem, strategy};
+use sylva_bintree::problem::strategy;
+use sylva_bintree::{BinTreeProblem, BinTreeSettings};
 use sylva_evolve::{Pool, Run, RunSettings};
 
 const POPULATION: usize = 1000;
@@ -14,15 +14,15 @@ const GENERATIONS: u32 = 100;
 
 /// Runs the GA and returns how many evaluations it made.
 fn run(evaluator: &Pool) -> u64 {
-    let config = EvolveConfig::default();
+    let config = BinTreeSettings::default();
     let settings = RunSettings {
         seed: 1,
         population: POPULATION,
         keep_history: 0,
     };
     let mut run = Run::new(
-        BinTreeProblem::new(&config.bintree),
-        strategy(&config.bintree),
+        BinTreeProblem::from_settings(&config),
+        strategy(&config),
         evaluator.clone(),
         settings,
     )

@@ -1,11 +1,70 @@
-//! Guides drawn beside a plant in pictures: a target surface as a wire frame, and boxes of
-//! grid cells as outlines. They are built as plants of thin segments, so the ordinary mesher
-//! and renderer draw them; they never go into exported assets.
+//! Guides drawn beside a plant in pictures: a fitness's target surface as a wire frame, and
+//! its forbidden grid cells as red outlines ([`of`]). They are built as plants of thin
+//! segments, so the ordinary mesher and renderer draw them; they never go into exported
+//! assets.
 
 use std::f32::consts::TAU;
 
 use sylva_core::glam::Vec3;
 use sylva_core::{Material, MaterialId, MaterialKind, Plant, PlantError, PlantMeta};
+
+use super::{PoncinFitness, TargetShape};
+
+/// The target surface and the forbidden grid cells of `fitness`, as wire frames in metres.
+pub fn of(fitness: &PoncinFitness) -> Option<Plant> {
+    let unit = fitness.unit as f32;
+    let (mut plant, surface) = guide_plant([0.35, 0.42, 0.55]).ok()?;
+    let wire = 0.4 * unit;
+    match fitness.target {
+        TargetShape::Sphere { center, radius } => ellipsoid_wire(
+            &mut plant,
+            center.as_vec3() * unit,
+            Vec3::splat(radius as f32 * unit),
+            wire,
+            surface,
+        ),
+        TargetShape::Ellipsoid { center, radii } => ellipsoid_wire(
+            &mut plant,
+            center.as_vec3() * unit,
+            radii.as_vec3() * unit,
+            wire,
+            surface,
+        ),
+        TargetShape::Box { center, size } => box_wire(
+            &mut plant,
+            (center - size * 0.5).as_vec3() * unit,
+            (center + size * 0.5).as_vec3() * unit,
+            wire,
+            surface,
+        ),
+        _ => Ok(()),
+    }
+    .ok()?;
+    if let Some(grid) = &fitness.grid {
+        let forbidden = plant
+            .add_material(Material {
+                name: "forbidden".into(),
+                kind: MaterialKind::Bark,
+                color: [0.8, 0.08, 0.05],
+                texture: None,
+            })
+            .ok()?;
+        for i in 0..grid.len() {
+            if grid.weight(i) < 0.0 {
+                let (lo, hi) = grid.cell_bounds(i);
+                box_wire(
+                    &mut plant,
+                    lo.as_vec3() * unit,
+                    hi.as_vec3() * unit,
+                    wire,
+                    forbidden,
+                )
+                .ok()?;
+            }
+        }
+    }
+    Some(plant)
+}
 
 /// A plant to hold guide wires, with one material of the given colour.
 pub fn guide_plant(color: [f32; 3]) -> Result<(Plant, MaterialId), PlantError> {

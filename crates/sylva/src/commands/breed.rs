@@ -1,0 +1,156 @@
+//! `sylva breed`: one round of Bornhofen and Lattaud's design loop (section 4.1): the mother
+//! and her mutated children grow together in one voxel world; a person picks the next
+//! mother from the pictures and breeds again.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use sylva::assets::{Origin, Placed, SceneAssets, export, write_picture};
+use sylva::genome::load_genome_of;
+use sylva::{Genome, InputError};
+use sylva_core::glam::Vec3;
+use sylva_core::{MaterialKind, Plant};
+use sylva_lsystem::LSystemModel;
+use sylva_lsystem::breed::{BreedSettings, breed_garden};
+use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
+use sylva_mesh::{Scene, SceneNode};
+use sylva_model::Model;
+
+use super::{SCENE_PICTURE, write_in};
+
+/// Arguments of `sylva breed`.
+#[derive(clap::Args)]
+pub struct BreedArgs {
+    /// The mother's genome (an L-system genome file).
+    mother: PathBuf,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+    /// Children sown with the mother (at most 8: nine specimens in all).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=8))]
+    children: u32,
+    /// Seed of the mutations.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Leave the roots out of the picture and the GLB.
+    #[arg(long)]
+    hide_roots: bool,
+    /// Worker threads; 0 means one per core. Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
+    threads: u32,
+}
+
+/// `sylva breed`.
+pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
+    let mother = load_genome_of::<LSystemModel>(&args.mother, "breeding grows")?;
+    let settings = BreedSettings {
+        children: args.children as usize,
+        ..BreedSettings::default()
+    };
+    let pool = super::pool(args.threads)?;
+    let mut rng = sylva_core::rng::seeded(args.seed);
+    let garden = breed_garden(&mother, &settings, &mut rng, &pool)
+        .map_err(|e| InputError::file(&args.mother, e))?;
+    sylva::files::create_dir(&args.out)?;
+    let shown: Vec<Plant> = garden
+        .specimens
+        .iter()
+        .map(|s| match args.hide_roots {
+            true => s.plant.without(MaterialKind::Root),
+            false => s.plant.clone(),
+        })
+        .collect();
+    let names: Vec<String> = garden
+        .specimens
+        .iter()
+        .enumerate()
+        .map(|(i, s)| match s.is_mother {
+            true => "mother".to_owned(),
+            false => format!("child-{i}"),
+        })
+        .collect();
+    let hint = LSystemModel.mesh_hint();
+    let placed: Vec<Placed> = garden
+        .specimens
+        .iter()
+        .zip(&shown)
+        .zip(&names)
+        .map(|((specimen, plant), name)| {
+            let genome = Genome::new(LSystemModel, specimen.genome.clone());
+            Placed {
+                translation: Vec3::new(specimen.position.x, 0.0, specimen.position.y),
+                extras: Some(Origin::of(&genome, args.seed).extras()),
+                ..Placed::new(name.clone(), plant, hint)
+            }
+        })
+        .collect();
+    let assets = SceneAssets::mesh(&placed)?;
+
+    let mut table =
+        String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");
+    for (specimen, name) in garden.specimens.iter().zip(&names) {
+        let file = format!("{name}.json");
+        write_in(
+            &args.out,
+            &file,
+            LSystemModel.write(&specimen.genome).as_bytes(),
+        )?;
+        let s = &specimen.stats;
+        let _ = writeln!(
+            table,
+            "{name},{},{},{},{},{},{},{},{file}",
+            s.biomass,
+            s.light,
+            s.uptake,
+            s.leaves(),
+            s.fine_roots(),
+            s.germinated(),
+            s.bounds.symbols + s.bounds.modules
+        );
+    }
+    write_in(&args.out, "specimens.csv", table.as_bytes())?;
+    for (i, specimen) in garden.specimens.iter().enumerate() {
+        let b = specimen.stats.bounds;
+        if b.any() {
+            eprintln!(
+                "note: specimen {i} hit a growth bound from step {}: {} rewrites refused by the \
+                 symbol limit, {} by the module limit",
+                b.first_step.unwrap_or(0),
+                b.symbols,
+                b.modules
+            );
+        }
+    }
+    let scene = assets.scene();
+    export(&scene, &args.out.join("garden.glb"))?;
+    write_picture(
+        &scene,
+        &args.out.join("garden.png"),
+        View::Iso,
+        SCENE_PICTURE,
+    )?;
+    let cells: Vec<SheetCell> = assets
+        .meshes()
+        .iter()
+        .zip(&names)
+        .zip(&garden.specimens)
+        .map(|((mesh, name), specimen)| SheetCell {
+            scene: Scene::single(SceneNode::new(name.clone(), mesh)),
+            caption: format!("{name} {:.2} g", specimen.stats.biomass),
+        })
+        .collect();
+    let options = SheetOptions {
+        title: Some(format!("Mother and {} children", cells.len() - 1)),
+        ..SheetOptions::default()
+    };
+    let sheet = render::contact_sheet(&cells, &options, &pool).map_err(sylva::Error::from)?;
+    render::write_png(&args.out.join("specimens.png"), &sheet).map_err(sylva::Error::from)?;
+    print!("{table}");
+    println!(
+        "wrote {}/{{garden.glb, garden.png, specimens.png, specimens.csv, mother.json, \
+         child-*.json}}; pick one and breed it: sylva breed {}/child-N.json --out NEXT",
+        args.out.display(),
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,214 @@
+//! `sylva evolve`: a run of any model that evolves, with a progress bar, checkpoints while
+//! it runs, and every result file when it ends.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sylva::assets::{export, guide_mesh};
+use sylva::evolution::Member;
+use sylva::report::{fitness_svg, stats_csv};
+use sylva::{Config, Evolution, Grown, InputError};
+use sylva_mesh::SceneNode;
+use sylva_mesh::render::{self, SheetCell, SheetOptions};
+
+use super::write_in;
+
+const CHECKPOINT: &str = "checkpoint.json";
+
+/// Arguments of `sylva evolve`; a flag left out keeps the config's value.
+#[derive(clap::Args)]
+pub struct EvolveArgs {
+    /// TOML config; without one, the built-in default run (binary trees).
+    config: Option<PathBuf>,
+    /// Run directory [default: runs/<model>-seed<seed>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Generations to breed after the random first one (overrides the config).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+    generations: Option<u32>,
+    /// Individuals per generation (overrides the config).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    population: Option<u32>,
+    /// Seed of every random choice (overrides the config).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads; 0 means one per core. Results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1024))]
+    threads: Option<u32>,
+    /// Continue the run saved in the run directory's checkpoint.
+    #[arg(long)]
+    resume: bool,
+}
+
+/// `sylva evolve`.
+pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
+    let mut config = match &args.config {
+        Some(path) => Config::load(path)?,
+        None => Config::default(),
+    };
+    let run = config.run_mut();
+    run.generations = args.generations.unwrap_or(run.generations);
+    run.population = args.population.unwrap_or(run.population);
+    run.seed = args.seed.unwrap_or(run.seed);
+    run.threads = args.threads.unwrap_or(run.threads);
+    let out = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!("runs/{}-seed{}", config.model(), config.run().seed))
+    });
+    let pool = super::pool(config.run().threads)?;
+    let checkpoint = out.join(CHECKPOINT);
+    let mut evolution = if args.resume {
+        let text = sylva::files::read_text(&checkpoint)?;
+        Evolution::resume(&config, &checkpoint, &text, pool.clone())?
+    } else {
+        let base = args
+            .config
+            .as_ref()
+            .and_then(|p| p.parent())
+            .unwrap_or(Path::new("."));
+        let start = config.load_start(base)?;
+        Evolution::start(&config, start, pool.clone())?
+    };
+    sylva::files::create_dir(&out)?;
+    breed(&mut evolution, &config, &checkpoint)?;
+    write_results(&evolution, &config, &out, &pool)
+}
+
+/// Breeds up to the config's generation, showing progress and checkpointing as it goes.
+fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyhow::Result<()> {
+    let target = config.run().generations;
+    let bar = ProgressBar::new(u64::from(target)).with_style(
+        ProgressStyle::with_template(
+            "{spinner} generation {pos}/{len} {bar:30} best {msg} ({per_sec}, eta {eta})",
+        )
+        .expect("the template is valid"),
+    );
+    bar.set_position(u64::from(evolution.generation().min(target)));
+    let save = |evolution: &Evolution| -> anyhow::Result<()> {
+        sylva::files::write(checkpoint, evolution.checkpoint()?.as_bytes())?;
+        Ok(())
+    };
+    let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
+    let mut last_save = Instant::now();
+    while evolution.generation() < target {
+        let best = evolution.step().best;
+        bar.set_message(format!("{best:.4}"));
+        bar.set_position(u64::from(evolution.generation()));
+        if last_save.elapsed() >= every {
+            save(evolution)?;
+            last_save = Instant::now();
+        }
+    }
+    save(evolution)?;
+    bar.finish_and_clear();
+    Ok(())
+}
+
+/// Writes the config, statistics, plot, best genome with its asset and picture, and the
+/// contact sheet of the best members.
+fn write_results(
+    evolution: &Evolution,
+    config: &Config,
+    out: &Path,
+    pool: &sylva_core::par::Pool,
+) -> anyhow::Result<()> {
+    write_in(out, "config.toml", config.to_toml().as_bytes())?;
+    let stats = evolution.stats();
+    write_in(
+        out,
+        "stats.csv",
+        stats_csv(evolution.term_names(), stats).as_bytes(),
+    )?;
+    let title = format!("{}, seed {}", evolution.title(), config.run().seed);
+    write_in(out, "fitness.svg", fitness_svg(stats, &title)?.as_bytes())?;
+    let best = evolution.best();
+    write_in(out, "best.json", best.genome.to_json().as_bytes())?;
+    let seed = best.genome.default_seed();
+    let grown = Grown::new(best.genome.clone(), seed, true)?;
+    export(&grown.scene(), &out.join("best.glb"))?;
+    let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
+    let mut scene = grown.scene();
+    if let Some(mesh) = &guides {
+        scene.nodes.push(SceneNode::new("guides", mesh));
+    }
+    let size = config.output().image_size;
+    sylva::assets::write_picture(
+        &scene,
+        &out.join("best.png"),
+        config.output().view,
+        (size, size),
+    )?;
+    population_sheet(
+        evolution,
+        config.output().sheet_size as usize,
+        &out.join("population.png"),
+        pool,
+    )?;
+
+    let last = stats
+        .last()
+        .ok_or_else(|| InputError::new("run", "no statistics"))?;
+    let evaluations: u64 = stats.iter().map(|s| s.evaluations).sum();
+    let seconds: f64 = stats.iter().map(|s| s.seconds).sum();
+    println!(
+        "generation {}: best fitness {:.4} (individual #{}), mean {:.4}; {} evaluations, {:.0}/s",
+        last.generation,
+        last.best,
+        last.best_id.0,
+        last.mean,
+        evaluations,
+        evaluations as f64 / seconds.max(1e-9),
+    );
+    println!(
+        "best plant: {} segments, {} organs, {} triangles; wrote {}/{{stats.csv, best.json, \
+         best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
+        grown.plant.segments().len(),
+        grown.plant.organs().len(),
+        grown.mesh.triangle_count(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// A contact sheet of the best `count` members of the current population.
+fn population_sheet(
+    evolution: &Evolution,
+    count: usize,
+    path: &Path,
+    pool: &sylva_core::par::Pool,
+) -> anyhow::Result<()> {
+    let population = evolution.population();
+    let mut order: Vec<usize> = (0..population.len()).collect();
+    order.sort_by(|&a, &b| {
+        population[b]
+            .total()
+            .total_cmp(&population[a].total())
+            .then(a.cmp(&b))
+    });
+    order.truncate(count);
+    let chosen: Vec<&Member> = order.iter().map(|&i| &population[i]).collect();
+    let grown = chosen
+        .iter()
+        .map(|m| Grown::new(m.genome.clone(), m.genome.default_seed(), true))
+        .collect::<Result<Vec<_>, _>>()?;
+    let cells: Vec<SheetCell> = chosen
+        .iter()
+        .zip(&grown)
+        .map(|(m, g)| SheetCell {
+            scene: g.scene(),
+            caption: format!("#{} {:.3}", m.id.0, m.total()),
+        })
+        .collect();
+    let options = SheetOptions {
+        title: Some(format!(
+            "Generation {}: best {} of {}",
+            evolution.generation(),
+            cells.len(),
+            population.len()
+        )),
+        ..SheetOptions::default()
+    };
+    let image = render::contact_sheet(&cells, &options, pool).map_err(sylva::Error::from)?;
+    render::write_png(path, &image).map_err(sylva::Error::from)?;
+    Ok(())
+}

@@ -1,0 +1,122 @@
+//! `sylva garden`: many PlantMaker plants on one plot, in one scene, with the garden file
+//! that grows the same scene again.
+
+use std::path::PathBuf;
+
+use sylva::assets::{Origin, Placed, SceneAssets, asset_format, check_png, export, write_picture};
+use sylva::files::read_text;
+use sylva::genome::{expect_model, load_genome_of, parse_genome};
+use sylva::{Genome, InputError};
+use sylva_mesh::render::View;
+use sylva_model::Model;
+use sylva_plantmaker::garden::GARDEN_MODEL;
+use sylva_plantmaker::{Garden, PlantMakerModel};
+
+use super::SCENE_PICTURE;
+
+/// Arguments of `sylva garden`.
+#[derive(clap::Args)]
+pub struct GardenArgs {
+    /// PlantMaker genome files, or one garden file (`*.garden.json`).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Plants per genome.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    count: u32,
+    /// Plot size in metres, WIDTHxDEPTH, centred on the origin.
+    #[arg(long, default_value = "20x20", value_parser = super::parse_area)]
+    area: (f64, f64),
+    /// Seed of the plants' seeds, positions and turns.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output scene (.glb, .obj or .wrl).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also render a picture.
+    #[arg(long)]
+    png: Option<PathBuf>,
+}
+
+/// What gardens grow, for errors.
+const PURPOSE: &str = "gardens grow";
+
+/// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
+/// scene (one node per plant, each carrying its genome and seed) and the garden file.
+pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
+    asset_format(&args.output)?;
+    if let Some(png) = &args.png {
+        check_png(png)?;
+    }
+    let first = &args.inputs[0];
+    let text = read_text(first)?;
+    #[derive(serde::Deserialize)]
+    struct Header {
+        model: String,
+    }
+    let is_garden = serde_json::from_str::<Header>(&text).is_ok_and(|h| h.model == GARDEN_MODEL);
+    let garden = if is_garden {
+        if args.inputs.len() > 1 {
+            return Err(InputError::file(
+                first,
+                "a garden file is grown on its own; give either one garden file or genome files",
+            )
+            .into());
+        }
+        Garden::from_json(&text).map_err(|e| InputError::genome(first, &text, e))?
+    } else {
+        // The first file is already read.
+        let genome: Genome = parse_genome(first, &text)?;
+        let mut garden = Garden::new(
+            expect_model::<PlantMakerModel>(first, &genome, PURPOSE)?,
+            args.count as usize,
+            [args.area.0, args.area.1],
+            args.seed,
+        );
+        for path in &args.inputs[1..] {
+            garden.add(
+                load_genome_of::<PlantMakerModel>(path, PURPOSE)?,
+                args.count as usize,
+            );
+        }
+        garden
+    };
+    let grown = garden.grow().map_err(|e| InputError::file(first, e))?;
+    let hint = PlantMakerModel.mesh_hint();
+    let placed: Vec<Placed> = grown
+        .placements
+        .iter()
+        .zip(&grown.plants)
+        .enumerate()
+        .map(|(i, (placement, plant))| {
+            let genome = &garden.plants[placement.group].genome;
+            let origin = Origin::of(
+                &Genome::new(PlantMakerModel, genome.clone()),
+                placement.seed,
+            );
+            Placed {
+                translation: placement.translation,
+                rotation: placement.rotation(),
+                extras: Some(origin.extras()),
+                ..Placed::new(format!("plant-{i}"), plant, hint)
+            }
+        })
+        .collect();
+    let assets = SceneAssets::mesh(&placed)?;
+    let scene = assets.scene();
+    export(&scene, &args.output)?;
+    if !is_garden {
+        let garden_path = args.output.with_extension("garden.json");
+        sylva::files::write(&garden_path, garden.to_json().as_bytes())?;
+        println!("wrote {}", garden_path.display());
+    }
+    if let Some(png) = &args.png {
+        write_picture(&scene, png, View::Iso, SCENE_PICTURE)?;
+    }
+    println!(
+        "wrote {}: {} plants, {} triangles",
+        args.output.display(),
+        scene.nodes.len(),
+        scene.triangle_count()
+    );
+    Ok(())
+}

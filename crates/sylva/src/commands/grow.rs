@@ -1,0 +1,51 @@
+//! `sylva grow`: one genome into a 3D asset (and a picture).
+
+use std::path::PathBuf;
+
+use sylva::assets::{asset_format, check_png, export, write_picture};
+use sylva::{Grown, load_genome};
+use sylva_mesh::render::View;
+
+/// Arguments of `sylva grow`.
+#[derive(clap::Args)]
+pub struct GrowArgs {
+    /// Genome JSON.
+    genome: PathBuf,
+    /// Output asset.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also render a picture.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Seed for the model's random choices [default: the genome's own seed for
+    /// PlantMaker genomes, 0 otherwise].
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Leave the roots out.
+    #[arg(long)]
+    hide_roots: bool,
+}
+
+/// `sylva grow`.
+pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
+    asset_format(&args.output)?;
+    if let Some(png) = &args.png {
+        check_png(png)?;
+    }
+    let genome = load_genome(&args.genome)?;
+    let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+    let grown = Grown::new(genome, seed, !args.hide_roots)?;
+    export(&grown.scene(), &args.output)?;
+    if let Some(png) = &args.png {
+        write_picture(&grown.scene(), png, View::Iso, (800, 800))?;
+    }
+    println!(
+        "wrote {}: {} segments, {} organs, {} vertices, {} triangles",
+        args.output.display(),
+        grown.plant.segments().len(),
+        grown.plant.organs().len(),
+        grown.mesh.vertex_count(),
+        grown.mesh.triangle_count()
+    );
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! The commands behind each subcommand: each reads the files it is given, calls the library,
+//! writes its results and reports what it wrote.
+
+pub mod breed;
+pub mod evolve;
+pub mod garden;
+pub mod grow;
+pub mod render;
+pub mod simulate;
+
+use std::path::Path;
+
+/// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
+pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
+
+/// Writes `bytes` to `name` inside `dir`, atomically.
+pub fn write_in(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), sylva::Error> {
+    sylva::files::write(&dir.join(name), bytes)
+}
+
+/// The worker pool for `--threads` (0: one per core).
+pub fn pool(threads: u32) -> Result<sylva_core::par::Pool, sylva::Error> {
+    Ok(sylva_core::par::Pool::with_threads(threads as usize)?)
+}
+
+/// Parses `WIDTHxDEPTH` in metres, each from 0.1 to 100,000.
+pub fn parse_area(text: &str) -> Result<(f64, f64), String> {
+    let bad = || {
+        format!("expected WIDTHxDEPTH in metres, each from 0.1 to 100000, like 30x20; got {text:?}")
+    };
+    let (w, d) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: f64 = w.trim().parse().map_err(|_| bad())?;
+    let d: f64 = d.trim().parse().map_err(|_| bad())?;
+    if [w, d]
+        .iter()
+        .all(|v| v.is_finite() && (0.1..=100_000.0).contains(v))
+    {
+        Ok((w, d))
+    } else {
+        Err(bad())
+    }
+}
+
+/// Parses `WIDTHxHEIGHT`, each 16 to 8192 pixels.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let bad =
+        || format!("expected WIDTHxHEIGHT with each from 16 to 8192, like 800x600; got {text:?}");
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if (16..=8192).contains(&w) && (16..=8192).contains(&h) {
+        Ok((w, h))
+    } else {
+        Err(bad())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_areas() {
+        assert_eq!(parse_size("800x600"), Ok((800, 600)));
+        assert_eq!(parse_size("64X64"), Ok((64, 64)));
+        for bad in ["", "800", "x600", "0x10", "800x99999", "-5x10", "axb"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_area("30x20"), Ok((30.0, 20.0)));
+        for bad in ["", "0x10", "1e9x1", "nanx1", "5"] {
+            assert!(parse_area(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,87 @@
+//! `sylva simulate`: one of Bornhofen and Lattaud's experiments, its measured outcome as a
+//! report, per-step records, and the grown plants as a scene and a picture.
+
+use std::path::{Path, PathBuf};
+
+use sylva::assets::{Origin, Placed, SceneAssets, export, write_picture};
+use sylva::files::read_text;
+use sylva::genome::load_genome_of;
+use sylva::report::simulation_report;
+use sylva::{Genome, InputError};
+use sylva_lsystem::LSystemModel;
+use sylva_lsystem::experiments::Simulation;
+use sylva_lsystem::garden::records_csv;
+use sylva_mesh::render::View;
+use sylva_model::Model;
+
+use super::{SCENE_PICTURE, write_in};
+
+/// Arguments of `sylva simulate`.
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    /// Experiment config (`[herbs-under-tree]`, `[lateral-light]` or `[empty-rules]`).
+    config: PathBuf,
+    /// Output directory [default: runs/<config name>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads; 0 means one per core. Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
+    threads: u32,
+}
+
+/// `sylva simulate`.
+pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    let path = &args.config;
+    let text = read_text(path)?;
+    let simulation: Simulation =
+        toml::from_str(&text).map_err(|e| InputError::toml(path, &text, &e))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let genomes = simulation
+        .genome_files()
+        .iter()
+        .map(|file| load_genome_of::<LSystemModel>(&base.join(file), "experiments grow"))
+        .collect::<Result<Vec<_>, _>>()?;
+    let pool = super::pool(args.threads)?;
+    let outcome = simulation
+        .run(&genomes, &pool)
+        .map_err(|e| InputError::file(path, e))?;
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = path
+            .file_stem()
+            .map_or("simulation".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("runs").join(stem)
+    });
+    sylva::files::create_dir(&out)?;
+    let report = simulation_report(&outcome);
+    write_in(&out, "report.txt", report.as_bytes())?;
+    write_in(
+        &out,
+        "records.csv",
+        records_csv(outcome.records()).as_bytes(),
+    )?;
+    let hint = LSystemModel.mesh_hint();
+    let placed: Vec<Placed> = outcome
+        .plants()
+        .iter()
+        .map(|p| {
+            // Each plant grew in a shared world; its genome and seed regrow it alone.
+            let mut extras = Origin::of(&Genome::new(LSystemModel, p.genome.clone()), 0).extras();
+            extras["biomass_g"] = p.biomass.into();
+            Placed {
+                translation: p.position,
+                extras: Some(extras),
+                ..Placed::new(p.label.clone(), &p.plant, hint)
+            }
+        })
+        .collect();
+    let assets = SceneAssets::mesh(&placed)?;
+    let scene = assets.scene();
+    export(&scene, &out.join("scene.glb"))?;
+    write_picture(&scene, &out.join("scene.png"), View::Iso, SCENE_PICTURE)?;
+    print!("{report}");
+    println!(
+        "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",
+        out.display()
+    );
+    Ok(())
+}
