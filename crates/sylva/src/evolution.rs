@@ -376,9 +376,7 @@ fn setup<M: Evolve>(
 ) -> Result<sylva_model::Setup<M>, InputError> {
     model
         .setup(settings, start, seed, population)
-        .map_err(|e| {
-            InputError::new(source, format!("[{}.{}]: {}", M::NAME, e.field, e.message))
-        })
+        .map_err(|e| InputError::new(source, format!("[{}.{}]: {}", M::NAME, e.field, e.message)))
 }
 
 impl Clone for Config {
@@ -652,6 +650,15 @@ impl<M: Evolve + Default> SavedRun<M> {
             config: serde_json::from_value(config).map_err(bad)?,
             checkpoint: serde_json::from_value(checkpoint).map_err(bad)?,
         })
+    }
+}
+
+impl std::fmt::Debug for Evolution {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Evolution")
+            .field("model", &self.title())
+            .field("generation", &self.generation())
+            .finish()
     }
 }
 

@@ -9,6 +9,9 @@ use std::process::{Command, Output};
 
 use sylva_core::hash::stable_hash;
 
+mod common;
+use common::validate;
+
 fn sylva(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sylva"))
         .args(args)
@@ -30,28 +33,6 @@ fn ok(output: &Output) {
         output.status.code(),
         String::from_utf8_lossy(&output.stdout),
         String::from_utf8_lossy(&output.stderr)
-    );
-}
-
-/// Runs the Khronos glTF validator; every GLB must have zero errors and zero warnings.
-fn validate(glbs: &[PathBuf]) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let script = root.join("tools/gltf-validator/validate.mjs");
-    assert!(
-        root.join("tools/gltf-validator/node_modules/gltf-validator")
-            .exists(),
-        "the validator is not installed: run `npm ci --prefix tools/gltf-validator`"
-    );
-    let out = Command::new("node")
-        .arg(&script)
-        .args(glbs)
-        .output()
-        .expect("node runs (install Node.js)");
-    assert!(
-        out.status.success(),
-        "validator: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
     );
 }
 

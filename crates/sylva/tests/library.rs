@@ -1,0 +1,378 @@
+//! The library layer as the studio and Python use it: configs of every model, runs that step,
+//! browse, checkpoint and resume, breeding by hand with each model's own operators, and a
+//! fifth model added through the trait alone.
+#![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
+
+use std::path::{Path, PathBuf};
+
+use sylva::assets::export;
+use sylva::{Config, Evolution, Genome, Grown, InputError, ModelEntry, Registry, load_genome};
+use sylva_core::par::Pool;
+
+mod common;
+
+fn example(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(path)
+}
+
+fn config(text: &str) -> Result<Config, InputError> {
+    Config::parse(Path::new("c.toml"), text)
+}
+
+#[test]
+fn every_example_config_reads_and_the_default_is_written_out() {
+    for name in [
+        "bintree/default.toml",
+        "bintree/paper.toml",
+        "automata/sphere.toml",
+        "automata/box-above.toml",
+        "plantmaker/evolve.toml",
+        "lsystem/evolve.toml",
+    ] {
+        let c = Config::load(&example(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // What a run records reads back as the same config.
+        assert_eq!(
+            config(&c.to_toml()).unwrap().to_toml(),
+            c.to_toml(),
+            "{name}"
+        );
+    }
+    let default = Config::load(&example("bintree/default.toml")).unwrap();
+    assert_eq!(default.to_toml(), Config::default().to_toml());
+    assert_eq!(config("").unwrap().to_toml(), Config::default().to_toml());
+    let paper = Config::load(&example("bintree/paper.toml")).unwrap();
+    let paper = paper.get::<sylva_bintree::BinTreeModel>().unwrap();
+    assert_eq!(paper.settings.weights.pipe_model, 0.0);
+    assert!(!paper.settings.cull_clones);
+}
+
+#[test]
+fn config_errors_point_at_the_value() {
+    let cases = [
+        ("[run]\npopulation = -5\n", "c.toml:2:14", "population"),
+        ("[run]\npopulation = 0\n", "c.toml:2:14", "1 to 1000000"),
+        ("[bintree.weights]\nheight = nan\n", "c.toml:2:10", "weight"),
+        ("[bintree.weights]\nheight = inf\n", "c.toml:2:10", "weight"),
+        ("[bintree]\nmin_radius = 1e9\n", "c.toml:2:14", "min_radius"),
+        (
+            "[run]\npopulaton = 5\n",
+            "c.toml:2:1",
+            "unknown field `populaton`",
+        ),
+        ("model = \"oak\"\n", "c.toml:1:9", "unknown model `oak`"),
+        ("[output]\nview = \"back\"\n", "c.toml:2:8", "front"),
+        ("[run\n", "c.toml:1:", ""),
+        ("[run]\nseed = 18446744073709551616\n", "c.toml:2:8", ""),
+        // A section of another model is refused where it stands, not quietly ignored.
+        (
+            "[automata]\nautomata = 3\n",
+            "c.toml:1:2",
+            "this config evolves `bintree`",
+        ),
+        (
+            "model = \"lsystem\"\n[lsystem]\nrandom_rounds = 5000\n",
+            "c.toml:3:17",
+            "random_rounds",
+        ),
+    ];
+    for (text, location, mention) in cases {
+        let e = config(text).unwrap_err();
+        assert!(
+            e.location.starts_with(location),
+            "{text:?}: {} (expected {location})",
+            e.location
+        );
+        assert!(e.message.contains(mention), "{text:?}: {}", e.message);
+        assert!(e.line > 0 && e.snippet.is_some(), "{text:?}: {e:?}");
+    }
+}
+
+/// A small run of `model` with `extra` settings.
+fn small(model: &str, extra: &str) -> Config {
+    config(&format!(
+        "model = \"{model}\"\n[run]\ngenerations = 4\npopulation = 8\nseed = 5\n{extra}"
+    ))
+    .unwrap()
+}
+
+#[test]
+fn runs_of_every_model_step_browse_and_resume_exactly() {
+    let growth = "[lsystem.grow]\nsteps = 20\n[lsystem.grow.world]\nsize = [16, 16, 16]\n\
+                  soil_layers = 4\n";
+    for (model, extra) in [
+        ("bintree", ""),
+        ("automata", "[automata.growth]\niterations = 30\n"),
+        ("plantmaker", ""),
+        ("lsystem", growth),
+    ] {
+        let c = small(model, extra);
+        let mut straight = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
+        straight.step_batch(4, |_| {});
+        assert_eq!(straight.generation(), 4);
+        assert_eq!(straight.stats().len(), 5);
+        assert_eq!(straight.population().len(), 8);
+        assert_eq!(straight.best().genome.model(), model);
+
+        // Stopped after two generations, saved, and resumed on two threads.
+        let mut first = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
+        first.step_batch(2, |_| {});
+        let saved = first.checkpoint().unwrap();
+        let mut resumed = Evolution::resume(
+            &c,
+            Path::new("cp.json"),
+            &saved,
+            Pool::with_threads(2).unwrap(),
+        )
+        .unwrap();
+        resumed.step_batch(2, |_| {});
+        let rows = |e: &Evolution| -> Vec<(u32, f64, f64, Vec<f64>)> {
+            e.stats()
+                .iter()
+                .map(|s| (s.generation, s.best, s.mean, s.best_terms.clone()))
+                .collect()
+        };
+        assert_eq!(rows(&resumed), rows(&straight), "{model}");
+        assert_eq!(resumed.best(), straight.best(), "{model}");
+
+        // A checkpoint of another config is refused.
+        let other = small(model, &format!("{extra}\n[output]\nsheet_size = 3\n"));
+        let refused = Evolution::resume(&other, Path::new("cp.json"), &saved, Pool::Serial);
+        assert!(refused.is_err_and(|e| e.is_input()), "{model}");
+    }
+}
+
+#[test]
+fn a_member_s_family_is_browsed_through_kept_generations() {
+    let c = small("bintree", "");
+    let mut run = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
+    run.keep_history(10);
+    run.step_batch(4, |_| {});
+    assert!(run.generation_members(1).is_some());
+    let best = run.best();
+    let family = run.family(best.id);
+    assert_eq!(family[0].id, best.id);
+    for m in &family[1..] {
+        assert!(
+            family
+                .iter()
+                .any(|child| child.origin.parents.contains(&m.id))
+        );
+    }
+    if !best.origin.parents.is_empty() {
+        assert!(family.len() > 1, "the parents are kept");
+    }
+}
+
+#[test]
+fn start_genomes_must_be_of_the_run_s_model() {
+    let c = small("plantmaker", "");
+    let herb = load_genome(&example("lsystem/herb.json")).unwrap();
+    let e = Evolution::start(&c, vec![herb], Pool::Serial).unwrap_err();
+    assert!(
+        e.is_input() && e.to_string().contains("`plantmaker`"),
+        "{e}"
+    );
+    let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
+    let run = Evolution::start(&c, vec![tulip.clone()], Pool::Serial).unwrap();
+    assert_eq!(run.population()[0].genome, tulip);
+}
+
+#[test]
+fn every_model_breeds_by_hand_with_its_own_operators() {
+    for name in [
+        "bintree/oak.json",
+        "automata/helix.json",
+        "plantmaker/fern.json",
+        "lsystem/herb.json",
+    ] {
+        let a = load_genome(&example(name)).unwrap();
+        let model = a.model();
+        let entry = Registry::standard().get(model).unwrap();
+        let b = entry.random(None, 3).unwrap();
+        assert_eq!(b.model(), model);
+        // Mutation and crossover are the model's, deterministic in the seed.
+        let m = a.mutate(None, 9).unwrap();
+        assert_eq!(m, a.mutate(None, 9).unwrap(), "{name}");
+        let (child, parents) = Genome::cross(&[(&a, 1.0), (&b, 2.0)], None, 4).unwrap();
+        assert_eq!(child.model(), model);
+        assert!(
+            !parents.is_empty() && parents.iter().all(|&p| p < 2),
+            "{name}"
+        );
+        let (again, _) = Genome::cross(&[(&a, 1.0), (&b, 2.0)], None, 4).unwrap();
+        assert_eq!(child, again, "{name}");
+        // What breeding makes is a genome file of the model that reads back the same.
+        let text = child.to_json();
+        assert_eq!(Registry::standard().parse_genome(&text).unwrap(), child);
+    }
+    let oak = load_genome(&example("bintree/oak.json")).unwrap();
+    let fern = load_genome(&example("plantmaker/fern.json")).unwrap();
+    let e = Genome::cross(&[(&oak, 1.0), (&fern, 1.0)], None, 1).unwrap_err();
+    assert!(
+        e.is_input() && e.to_string().contains("cannot be crossed"),
+        "{e}"
+    );
+    let e = Genome::cross(&[(&oak, 1.0)], None, 1).unwrap_err();
+    assert!(e.to_string().contains("two or more parents"), "{e}");
+    let e = Genome::cross(&[(&oak, 1.0), (&oak, f64::NAN)], None, 1).unwrap_err();
+    assert!(e.to_string().contains("dominance"), "{e}");
+    let settings = serde_json::json!({ "mutation_rat": 0.5 });
+    let e = oak.mutate(Some(&settings), 1).unwrap_err();
+    assert!(e.to_string().contains("mutation_rat"), "{e}");
+    let settings = serde_json::json!({ "mutation_rate": 1.5 });
+    let e = oak.mutate(Some(&settings), 1).unwrap_err();
+    assert!(e.to_string().contains("mutation_rate"), "{e}");
+    // PlantMaker crosses every parent by dominance, at the settings' level.
+    let bush = load_genome(&example("plantmaker/flowering-bush.json")).unwrap();
+    let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
+    let high = serde_json::json!({ "crossover": "high" });
+    let (_, parents) =
+        Genome::cross(&[(&fern, 1.0), (&bush, 1.0), (&tulip, 1.0)], Some(&high), 2).unwrap();
+    assert!(parents.len() >= 2, "{parents:?}");
+}
+
+/// A toy fifth model, added through the trait alone: one cylinder of a given height.
+mod cylinder {
+    use rand::{Rng, RngExt};
+    use serde::{Deserialize, Serialize};
+    use sylva_core::Plant;
+    use sylva_core::glam::Vec3;
+    use sylva_model::{
+        Bred, DevelopError, FormatV1, Model, Parent, VariationError, model_tag, plant_meta,
+        two_most_dominant,
+    };
+
+    model_tag!(
+        /// `"model": "cylinder"`.
+        CylinderTag,
+        "cylinder"
+    );
+
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct CylinderGenome {
+        pub model: CylinderTag,
+        pub format: FormatV1,
+        #[serde(deserialize_with = "height")]
+        pub height: f32,
+        #[serde(deserialize_with = "radius")]
+        pub radius: f32,
+    }
+
+    sylva_core::ranged!(height: f32, "height", 0.01, 100.0, " m");
+    sylva_core::ranged!(radius: f32, "radius", 0.001, 10.0, " m");
+
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Cylinder;
+
+    impl Model for Cylinder {
+        type Genome = CylinderGenome;
+        type Settings = ();
+        const NAME: &'static str = "cylinder";
+        const TITLE: &'static str = "Cylinders";
+
+        fn develop(&self, g: &CylinderGenome, seed: u64) -> Result<Plant, DevelopError> {
+            let mut plant = Plant::new(plant_meta::<Self>(g, seed));
+            let top = Vec3::Y * g.height;
+            plant.add_segment(
+                Vec3::ZERO,
+                top,
+                (g.radius, g.radius),
+                None,
+                false,
+                Plant::BARK,
+            )?;
+            Ok(plant)
+        }
+
+        fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> CylinderGenome {
+            CylinderGenome {
+                model: CylinderTag,
+                format: FormatV1,
+                height: rng.random_range(0.5..5.0),
+                radius: rng.random_range(0.05..0.5),
+            }
+        }
+
+        fn mutate<R: Rng + ?Sized>(
+            &self,
+            g: &CylinderGenome,
+            _: &(),
+            rng: &mut R,
+        ) -> CylinderGenome {
+            CylinderGenome {
+                height: (g.height * rng.random_range(0.8..1.25)).clamp(0.01, 100.0),
+                ..g.clone()
+            }
+        }
+
+        fn cross<R: Rng + ?Sized>(
+            &self,
+            parents: &[Parent<'_, CylinderGenome>],
+            _: &(),
+            _: &mut R,
+        ) -> Result<Bred<CylinderGenome>, VariationError> {
+            let (a, b) = two_most_dominant(parents)?;
+            let genome = CylinderGenome {
+                height: parents[a].genome.height,
+                ..parents[b].genome.clone()
+            };
+            Ok(Bred {
+                genome,
+                parents: vec![a, b],
+            })
+        }
+    }
+}
+
+#[test]
+fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
+    use sylva_model::Model;
+    let registry = Registry::standard()
+        .models()
+        .iter()
+        .fold(Registry::new(), |r, m| r.with(*m))
+        .with(ModelEntry::model::<cylinder::Cylinder>());
+    let text = r#"{"model": "cylinder", "format": 1, "height": 2.5, "radius": 0.2}"#;
+    let genome = registry.parse_genome(text).unwrap();
+    assert_eq!(genome.model(), "cylinder");
+    assert_eq!(genome.get::<cylinder::Cylinder>().unwrap().height, 2.5);
+    // Its files are checked like any model's: ranges, unknown fields, positions.
+    let e = registry
+        .parse_genome(r#"{"model": "cylinder", "format": 1, "height": -1, "radius": 0.2}"#)
+        .unwrap_err();
+    assert!(e.message.contains("`height` must be"), "{}", e.message);
+    assert!(
+        Registry::standard().parse_genome(text).is_err(),
+        "not in the standard list"
+    );
+    // Grown, meshed and exported as any plant, carrying its origin.
+    let grown = Grown::new(genome.clone(), 0, true).unwrap();
+    assert_eq!(grown.plant.segments().len(), 1);
+    assert!(grown.mesh.triangle_count() > 0);
+    let dir = std::env::temp_dir().join(format!("sylva-cylinder-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let glb = dir.join("cylinder.glb");
+    export(&grown.scene(), &glb).unwrap();
+    common::validate(std::slice::from_ref(&glb));
+    let imported = sylva_mesh::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
+    assert_eq!(imported.scene().nodes.len(), 1);
+    let bytes = std::fs::read(&glb).unwrap();
+    assert!(String::from_utf8_lossy(&bytes).contains(r#""model":"cylinder""#));
+    // Bred by hand like the four.
+    let child = genome.mutate(None, 1).unwrap();
+    assert_eq!(child.model(), cylinder::Cylinder::NAME);
+    let random = registry.get("cylinder").unwrap().random(None, 2).unwrap();
+    let (bred, _) = Genome::cross(&[(&genome, 2.0), (&random, 1.0)], None, 3).unwrap();
+    assert_eq!(bred.get::<cylinder::Cylinder>().unwrap().height, 2.5);
+    // It does not evolve: the registry says so when a config names it.
+    assert!(!registry.get("cylinder").unwrap().evolves());
+    let e = registry
+        .parse_config(Path::new("c.toml"), "model = \"cylinder\"\n")
+        .err()
+        .unwrap();
+    assert!(e.message.contains("does not evolve"), "{}", e.message);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
