@@ -43,7 +43,7 @@ use crate::fitness::Fitness;
 use crate::individual::{Individual, IndividualId, Origin};
 use crate::problem::Problem;
 use crate::rng;
-use crate::strategy::{Breeding, Strategy};
+use crate::strategy::{Breeding, Strategy, fittest};
 use crate::variation::{Crossover, Mutate};
 
 /// How far the three rates may add up away from 1.
@@ -226,19 +226,6 @@ fn tournament<G, R: rand::Rng + ?Sized>(
     best
 }
 
-/// Slots of the `k` fittest members, fittest first.
-fn elites<G>(population: &[Individual<G>], k: usize) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..population.len()).collect();
-    order.sort_by(|&a, &b| {
-        population[b]
-            .total()
-            .total_cmp(&population[a].total())
-            .then(a.cmp(&b))
-    });
-    order.truncate(k);
-    order
-}
-
 impl<P, X, M> Strategy<P> for Generational<X, M>
 where
     P: Problem,
@@ -255,7 +242,7 @@ where
             return 0;
         }
         let s = &self.settings;
-        let elite = elites(population, s.elitism.min(population.len()));
+        let elite = fittest(population, s.elitism.min(population.len()));
         let (seed, generation) = (ctx.seed, ctx.generation);
         let old = &*population;
         let copy = |parent: usize, operator: Operator| {
@@ -365,6 +352,6 @@ mod tests {
             .count();
         // P(winner in the top 3 of 10 with 7 draws) = 1 - 0.7^7 ≈ 0.92.
         assert!(wins > 880, "{wins}");
-        assert_eq!(elites(&pop, 3), vec![9, 8, 7]);
+        assert_eq!(fittest(&pop, 3), vec![9, 8, 7]);
     }
 }

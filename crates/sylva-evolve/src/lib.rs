@@ -63,7 +63,7 @@ pub use generational::{Generational, GenerationalError, GenerationalSettings};
 pub use individual::{Individual, IndividualId, Origin};
 pub use problem::Problem;
 pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};
-pub use strategy::{Breeding, MeanReplacement, Strategy};
+pub use strategy::{Breeding, MeanReplacement, Strategy, fittest};
 pub use sylva_core::par::Pool;
 pub use sylva_core::rng;
 pub use variation::{Crossover, Mutate};

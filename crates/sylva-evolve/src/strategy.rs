@@ -89,6 +89,19 @@ pub fn mean_total<G>(population: &[Individual<G>]) -> f64 {
     }
 }
 
+/// Slots of the `k` fittest members, fittest first (ties go to the lower slot).
+pub fn fittest<G>(population: &[Individual<G>], k: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..population.len()).collect();
+    order.sort_by(|&a, &b| {
+        population[b]
+            .total()
+            .total_cmp(&population[a].total())
+            .then(a.cmp(&b))
+    });
+    order.truncate(k);
+    order
+}
+
 /// Indices of the best and second-best members (ties go to the lower index). `None` for an
 /// empty population; both are the same index for a population of one.
 pub fn two_best<G>(population: &[Individual<G>]) -> Option<(usize, usize)> {

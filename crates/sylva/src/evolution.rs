@@ -528,6 +528,7 @@ trait AnyRun: Send {
     fn stats(&self) -> &[GenerationStats];
     fn term_names(&self) -> &[String];
     fn population(&self) -> Vec<Member>;
+    fn fittest(&self, count: usize) -> Vec<Member>;
     fn best(&self) -> Member;
     fn member(&self, id: IndividualId) -> Option<Member>;
     fn generation_members(&self, generation: u32) -> Option<Vec<Member>>;
@@ -586,6 +587,14 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
             .population()
             .iter()
             .map(|i| self.member(i))
+            .collect()
+    }
+
+    fn fittest(&self, count: usize) -> Vec<Member> {
+        let population = self.run.population();
+        sylva_evolve::fittest(population, count)
+            .into_iter()
+            .map(|i| self.member(&population[i]))
             .collect()
     }
 
@@ -734,6 +743,12 @@ impl Evolution {
     /// The current population, in slot order.
     pub fn population(&self) -> Vec<Member> {
         self.inner.population()
+    }
+
+    /// The `count` fittest members of the current population, fittest first (ties go to the
+    /// lower slot).
+    pub fn fittest(&self, count: usize) -> Vec<Member> {
+        self.inner.fittest(count)
     }
 
     /// The best member of the current population (ties go to the lowest slot).

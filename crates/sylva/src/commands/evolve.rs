@@ -6,7 +6,6 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{export, guide_mesh};
-use sylva::evolution::Member;
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, Grown, InputError};
 use sylva_mesh::SceneNode;
@@ -177,16 +176,7 @@ fn population_sheet(
     path: &Path,
     pool: &sylva_core::par::Pool,
 ) -> anyhow::Result<()> {
-    let population = evolution.population();
-    let mut order: Vec<usize> = (0..population.len()).collect();
-    order.sort_by(|&a, &b| {
-        population[b]
-            .total()
-            .total_cmp(&population[a].total())
-            .then(a.cmp(&b))
-    });
-    order.truncate(count);
-    let chosen: Vec<&Member> = order.iter().map(|&i| &population[i]).collect();
+    let chosen = evolution.fittest(count);
     let grown = chosen
         .iter()
         .map(|m| Grown::new(m.genome.clone(), m.genome.default_seed(), true))
@@ -204,7 +194,7 @@ fn population_sheet(
             "Generation {}: best {} of {}",
             evolution.generation(),
             cells.len(),
-            population.len()
+            evolution.config().run().population
         )),
         ..SheetOptions::default()
     };
