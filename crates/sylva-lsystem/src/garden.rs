@@ -60,7 +60,7 @@ impl Default for GrowSettings {
 #[derive(Debug, thiserror::Error)]
 pub enum GardenError {
     /// The world's settings are out of range.
-    #[error("world: {0}")]
+    #[error("world")]
     Environment(#[from] EnvironmentError),
     /// A genome's physiology is out of range.
     #[error("plant {plant}: {error}")]
@@ -71,7 +71,7 @@ pub enum GardenError {
         error: PhysiologyError,
     },
     /// Interpretation produced an invalid part (a NaN slipped through).
-    #[error("invalid plant part: {0}")]
+    #[error("invalid plant part")]
     Plant(#[from] PlantError),
     /// More steps than [`MAX_STEPS`].
     #[error("{0} steps asked for; at most {MAX_STEPS}")]

@@ -228,7 +228,7 @@ pub fn two_most_dominant<G>(parents: &[Parent<'_, G>]) -> Result<(usize, usize),
 #[derive(Debug, thiserror::Error)]
 pub enum DevelopError {
     /// The plant refused a part (a NaN, negative or far value slipped through).
-    #[error("invalid plant part: {0}")]
+    #[error("invalid plant part")]
     Plant(#[from] PlantError),
     /// The genome asks for a larger plant than the model allows.
     #[error("the plant would have more than {limit} parts (segments and organs)")]

@@ -127,7 +127,7 @@ pub enum GardenError {
     #[error("the garden has no plants")]
     Empty,
     /// A plant could not be grown.
-    #[error("plant {index} of genome {group} could not be grown: {source}")]
+    #[error("plant {index} of genome {group} could not be grown")]
     Develop {
         /// Its genome.
         group: usize,

@@ -202,7 +202,7 @@ pub fn export(scene: &Scene<'_>, path: &Path) -> Result<(), Error> {
 
 /// Checks an output path's extension before any work is done.
 pub fn asset_format(path: &Path) -> Result<Format, InputError> {
-    Format::from_path(path).map_err(|e| InputError::file(path, e))
+    Format::from_path(path).map_err(|e| InputError::file_error(path, &e))
 }
 
 /// Checks that a picture path ends in `.png`.

@@ -3,7 +3,9 @@
 //! [`InputError`] is anything wrong with what a user gave: a file (a genome, a config, a
 //! checkpoint), a value of a field or a flag. It names where (the file with its line and
 //! column, or the flag) and what was expected, and keeps the offending text so a front end
-//! can show it. Every other failure is an [`Error`] variant that says what Sylva was doing.
+//! can show it. Every other failure is an [`Error`] variant that says what Sylva was doing,
+//! with the reason as its [`source`](std::error::Error::source): print the chain (as
+//! `anyhow`'s `{:#}` does) to see both.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -40,6 +42,11 @@ impl InputError {
             message: message.to_string(),
             snippet: None,
         }
+    }
+
+    /// An error about a whole file, from a library error and its causes.
+    pub fn file_error(path: &Path, e: &dyn std::error::Error) -> Self {
+        InputError::file(path, chain(e))
     }
 
     /// An error about a whole file.
@@ -104,7 +111,7 @@ pub enum Error {
     #[error(transparent)]
     Input(#[from] InputError),
     /// A file or folder could not be read, written or made.
-    #[error("{action} {}: {source}", path.display())]
+    #[error("{action} {}", path.display())]
     Io {
         /// `"reading"`, `"writing"` or `"creating"`.
         action: &'static str,
@@ -115,7 +122,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A genome could not grow.
-    #[error("growing the {model} genome: {source}")]
+    #[error("growing the {model} genome")]
     Develop {
         /// The model.
         model: &'static str,
@@ -124,19 +131,19 @@ pub enum Error {
         source: DevelopError,
     },
     /// A plant could not be meshed (too many triangles, bad options).
-    #[error("meshing: {0}")]
+    #[error("meshing")]
     Mesh(#[from] sylva_mesh::mesher::MeshError),
     /// A scene could not be written.
     #[error(transparent)]
     Export(#[from] sylva_mesh::export::ExportError),
     /// A picture could not be drawn or written.
-    #[error("drawing a picture: {0}")]
+    #[error("drawing a picture")]
     Render(#[from] sylva_mesh::render::RenderError),
     /// A plot could not be drawn.
     #[error(transparent)]
     Plot(#[from] crate::report::PlotError),
     /// The worker threads could not start.
-    #[error("starting the worker threads: {0}")]
+    #[error("starting the worker threads")]
     Threads(#[from] sylva_core::par::ThreadPoolBuildError),
 }
 
@@ -146,6 +153,18 @@ impl Error {
     pub fn is_input(&self) -> bool {
         matches!(self, Error::Input(_))
     }
+}
+
+/// An error and its causes, joined by ": " (as `anyhow`'s `{:#}` prints them).
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        text.push_str(": ");
+        text.push_str(&c.to_string());
+        cause = c.source();
+    }
+    text
 }
 
 /// Byte offset of a 1-based line and column (columns count characters); clamped to the text.
@@ -206,6 +225,17 @@ mod tests {
         assert_eq!(token_start("x", 0), 0);
         let e = InputError::at(Path::new("g.json"), text, 0, 0, "bad".into());
         assert_eq!(e.location, "g.json");
+    }
+
+    #[test]
+    fn chains_name_every_cause() {
+        let io = std::io::Error::other("disk full");
+        let e = Error::Io {
+            action: "writing",
+            path: "x.glb".into(),
+            source: io,
+        };
+        assert_eq!(chain(&e), "writing x.glb: disk full");
     }
 
     #[test]

@@ -62,7 +62,7 @@ pub enum ExportError {
         path: PathBuf,
     },
     /// Writing a file failed.
-    #[error("cannot write {path:?}: {source}")]
+    #[error("cannot write {path:?}")]
     Io {
         /// The file being written.
         path: PathBuf,
@@ -105,7 +105,7 @@ pub enum ExportError {
         uvs: usize,
     },
     /// A texture could not be encoded as PNG.
-    #[error("cannot encode texture {id} as PNG: {source}")]
+    #[error("cannot encode texture {id} as PNG")]
     Png {
         /// The texture id.
         id: u16,
@@ -154,7 +154,7 @@ pub enum ExportError {
         bytes: u64,
     },
     /// The glTF JSON could not be written.
-    #[error("cannot write the glTF JSON: {0}")]
+    #[error("cannot write the glTF JSON")]
     Json(#[from] serde_json::Error),
 }
 

@@ -50,7 +50,7 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
     let pool = super::pool(args.threads)?;
     let mut rng = sylva_core::rng::seeded(args.seed);
     let garden = breed_garden(&mother, &settings, &mut rng, &pool)
-        .map_err(|e| InputError::file(&args.mother, e))?;
+        .map_err(|e| InputError::file_error(&args.mother, &e))?;
     sylva::files::create_dir(&args.out)?;
     let shown: Vec<Plant> = garden
         .specimens

@@ -80,7 +80,9 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         }
         garden
     };
-    let grown = garden.grow().map_err(|e| InputError::file(first, e))?;
+    let grown = garden
+        .grow()
+        .map_err(|e| InputError::file_error(first, &e))?;
     let hint = PlantMakerModel.mesh_hint();
     let placed: Vec<Placed> = grown
         .placements

@@ -41,8 +41,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     if is_glb {
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
-        let imported =
-            sylva_mesh::import::read_glb(&bytes).map_err(|e| InputError::file(&args.file, e))?;
+        let imported = sylva_mesh::import::read_glb(&bytes)
+            .map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
         let genome = load_genome(&args.file)?;

@@ -44,7 +44,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let pool = super::pool(args.threads)?;
     let outcome = simulation
         .run(&genomes, &pool)
-        .map_err(|e| InputError::file(path, e))?;
+        .map_err(|e| InputError::file_error(path, &e))?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = path
             .file_stem()
