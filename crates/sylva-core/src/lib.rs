@@ -1,8 +1,10 @@
 //! Sylva's shared vocabulary.
 //!
-//! Every model grows a [`Plant`]; fitness terms, meshing and pictures read only a `Plant`.
+//! Every model grows a [`Plant`]; fitness terms, meshing and pictures read only a `Plant`,
+//! and a `Plant` keeps its own rules, so they can trust it.
 //!
 //! - [`turtle`]: the HLU [`Frame`] and [`Turtle`] of *The Algorithmic Beauty of Plants*.
+//! - [`environment`]: the voxel world of light and minerals that plants can grow in.
 //! - [`plant`]: [`Plant`], its [`Segment`]s, [`Organ`]s and [`Material`]s, with typed ids.
 //! - [`measures`]: tips, height, bounds, surface area, volume, and Susinno's
 //!   [`TreeMeasures`].
