@@ -401,36 +401,6 @@ struct Memory {
     newborn: Vec<Inst>,
 }
 
-/// Turns the pair `(a, b)`: `a` moves towards `b`.
-#[inline(always)]
-fn turn(a: &mut Vec3, b: &mut Vec3, sin: f32, cos: f32) {
-    let (x, y) = (*a, *b);
-    *a = x * cos + y * sin;
-    *b = y * cos - x * sin;
-}
-
-/// Makes the frame orthonormal again after rotations. Rotations keep the vectors within a
-/// few ulps of unit length, so one Newton step (`v × (3 - |v|²) / 2`) restores it without a
-/// square root; a frame that drifted further (never seen) is normalised exactly.
-#[inline]
-fn orthonormalise(f: &mut Frame) {
-    let h = f.heading;
-    let hh = h.length_squared();
-    let l = f.left - h * h.dot(f.left);
-    let ll = l.length_squared();
-    if (hh - 1.0).abs() < 1e-3 && (ll - 1.0).abs() < 1e-3 {
-        f.heading = h * (1.5 - 0.5 * hh);
-        let l = f.left - f.heading * f.heading.dot(f.left);
-        f.left = l * (1.5 - 0.5 * l.length_squared());
-    } else {
-        f.heading = h.normalize_or(Vec3::Y);
-        f.left = (f.left - f.heading * f.heading.dot(f.left))
-            .try_normalize()
-            .unwrap_or_else(|| f.heading.any_orthonormal_vector());
-    }
-    f.up = f.heading.cross(f.left);
-}
-
 /// A leaf's orientation. Horizontal leaves are also turned about the vertical by the golden
 /// angle times the leaf's index: leaves an automaton adds at one spot (`(Repeat 5
 /// (CreateAutomaton Leaf))` is common in evolved trees) fan out instead of lying on top of
@@ -633,15 +603,15 @@ impl Memory {
                 }
                 Op::Kill => break false,
                 Op::RotateH => {
-                    turn(&mut me.frame.left, &mut me.frame.up, s.x, s.y);
+                    me.frame.turn_h(s.x, s.y);
                     me.turns = me.turns.saturating_add(1);
                 }
                 Op::RotateL => {
-                    turn(&mut me.frame.heading, &mut me.frame.up, s.x, s.y);
+                    me.frame.turn_l(s.x, s.y);
                     me.turns = me.turns.saturating_add(1);
                 }
                 Op::RotateU => {
-                    turn(&mut me.frame.heading, &mut me.frame.left, s.x, s.y);
+                    me.frame.turn_u(s.x, s.y);
                     me.turns = me.turns.saturating_add(1);
                 }
                 Op::Assign => me.vars[usize::from(s.arg)] = s.x,
@@ -770,7 +740,7 @@ impl Memory {
             }
         }
         if me.turns >= RENORMALISE {
-            orthonormalise(&mut me.frame);
+            me.frame.renormalise();
             me.turns = 0;
         }
         // Pushes since the last move: the point they saved becomes a segment boundary.
@@ -932,7 +902,7 @@ impl Memory {
         let unit = cx.options.unit;
         let mut frame = me.frame;
         if cx.full && me.turns > 0 {
-            orthonormalise(&mut frame);
+            frame.renormalise();
         }
         let (orientation, size, material) = if kind == OrganKind::Leaf {
             rep.leaves += 1;

@@ -6,6 +6,10 @@
 //! [`Frame::rotate_h`] turns L towards U (roll). Every rotation re-orthonormalises, so a frame
 //! stays orthonormal to within `1e-5` after any number of rotations.
 //!
+//! Hot loops that turn many times by precomputed angles (the automata simulator) use
+//! [`Frame::turn_u`], [`Frame::turn_l`] and [`Frame::turn_h`], which take the angle's sine
+//! and cosine and leave the frame as it is, and call [`Frame::renormalise`] every few turns.
+//!
 //! Local coordinates: a frame maps a local vector `(x, y, z)` to `x·R + y·H + z·U` where
 //! `R = -L` is the turtle's right. The upright frame is the identity: H is world +Y, U is world
 //! +Z, R is world +X. Angles are radians.
@@ -30,11 +34,13 @@ impl Default for Frame {
     }
 }
 
-/// Turns the pair `(a, b)` by `angle` in their plane: `a` moves towards `b`.
-#[inline]
-fn turn_pair(a: Vec3, b: Vec3, angle: f32) -> (Vec3, Vec3) {
-    let (sin, cos) = angle.sin_cos();
-    (a * cos + b * sin, b * cos - a * sin)
+/// Turns the pair `(a, b)` in their plane by the angle of `sin` and `cos`: `a` moves
+/// towards `b`.
+#[inline(always)]
+fn turn_pair(a: &mut Vec3, b: &mut Vec3, sin: f32, cos: f32) {
+    let (x, y) = (*a, *b);
+    *a = x * cos + y * sin;
+    *b = y * cos - x * sin;
 }
 
 impl Frame {
@@ -59,20 +65,63 @@ impl Frame {
 
     /// Yaw: turns H towards L by `angle` about U ("+" in the book).
     pub fn rotate_u(&mut self, angle: f32) {
-        (self.heading, self.left) = turn_pair(self.heading, self.left, angle);
+        let (sin, cos) = angle.sin_cos();
+        self.turn_u(sin, cos);
         self.orthonormalise();
     }
 
     /// Pitch: turns H towards U by `angle` about L.
     pub fn rotate_l(&mut self, angle: f32) {
-        (self.heading, self.up) = turn_pair(self.heading, self.up, angle);
+        let (sin, cos) = angle.sin_cos();
+        self.turn_l(sin, cos);
         self.orthonormalise();
     }
 
     /// Roll: turns L towards U by `angle` about H.
     pub fn rotate_h(&mut self, angle: f32) {
-        (self.left, self.up) = turn_pair(self.left, self.up, angle);
+        let (sin, cos) = angle.sin_cos();
+        self.turn_h(sin, cos);
         self.orthonormalise();
+    }
+
+    /// Yaw by the angle of `sin` and `cos`, without re-orthonormalising.
+    #[inline(always)]
+    pub fn turn_u(&mut self, sin: f32, cos: f32) {
+        turn_pair(&mut self.heading, &mut self.left, sin, cos);
+    }
+
+    /// Pitch by the angle of `sin` and `cos`, without re-orthonormalising.
+    #[inline(always)]
+    pub fn turn_l(&mut self, sin: f32, cos: f32) {
+        turn_pair(&mut self.heading, &mut self.up, sin, cos);
+    }
+
+    /// Roll by the angle of `sin` and `cos`, without re-orthonormalising.
+    #[inline(always)]
+    pub fn turn_h(&mut self, sin: f32, cos: f32) {
+        turn_pair(&mut self.left, &mut self.up, sin, cos);
+    }
+
+    /// Makes the frame orthonormal again after turns. Turns keep the vectors within a few
+    /// ulps of unit length, so one Newton step (`v × (3 − |v|²) / 2`) restores them without
+    /// a square root; a frame that drifted further is normalised exactly.
+    #[inline]
+    pub fn renormalise(&mut self) {
+        let h = self.heading;
+        let hh = h.length_squared();
+        let l = self.left - h * h.dot(self.left);
+        let ll = l.length_squared();
+        if (hh - 1.0).abs() < 1e-3 && (ll - 1.0).abs() < 1e-3 {
+            self.heading = h * (1.5 - 0.5 * hh);
+            let l = self.left - self.heading * self.heading.dot(self.left);
+            self.left = l * (1.5 - 0.5 * l.length_squared());
+        } else {
+            self.heading = h.normalize_or(Vec3::Y);
+            self.left = (self.left - self.heading * self.heading.dot(self.left))
+                .try_normalize()
+                .unwrap_or_else(|| self.heading.any_orthonormal_vector());
+        }
+        self.up = self.heading.cross(self.left);
     }
 
     /// Rotates the frame by `angle` about an axis given in the frame's local coordinates
