@@ -3,11 +3,16 @@
 //!
 //! A strongly typed GP tree ([`GpTree`], section 4.2) is compiled by cellular encoding into
 //! flat automata ([`Program`], Figures 4 to 6); a [`Simulator`] runs them as the paper's
-//! pseudo-code says (section 2.2) and draws a [`Plant`](sylva_core::Plant). Trees print and
-//! parse as lilgp-style S-expressions ([`sexpr`]); [`gp`] holds ramped half-and-half
-//! initialisation and the typed subtree crossover and mutation; [`AutomataGenome`] is the
-//! genome file; [`problem`] is Poncin's GP run as an evolution problem; [`AutomataModel`]
-//! is the model as Sylva's [`Model`] and [`Evolve`].
+//! pseudo-code says (section 2.2) and draws a [`Plant`].
+//!
+//! - [`tree`]: the typed GP tree, its node types and checks.
+//! - [`sexpr`]: trees printed and parsed as lilgp-style S-expressions.
+//! - [`compile`]: cellular encoding into flat automata, and the semantics chosen.
+//! - [`sim`]: the bounded simulator.
+//! - [`gp`]: ramped half-and-half initialisation, typed subtree crossover and mutation.
+//! - [`genome`]: [`AutomataGenome`], the genome file (a program and how it grows).
+//! - [`problem`]: Poncin's GP run as an evolution problem (the `[automata]` settings).
+//! - [`AutomataModel`]: the model as Sylva's [`Model`] and [`Evolve`].
 //!
 //! ```
 //! use sylva_core::{Plant, PlantMeta};

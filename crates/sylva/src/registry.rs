@@ -105,6 +105,7 @@ fn parse_config<M: Evolve + Default>(path: &Path, text: &str) -> Result<Config, 
 }
 
 /// The models Sylva knows, in the order they are listed.
+#[derive(Clone)]
 pub struct Registry {
     models: Vec<ModelEntry>,
 }

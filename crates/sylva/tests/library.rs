@@ -330,10 +330,9 @@ mod cylinder {
 #[test]
 fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     use sylva_model::Model;
+    // The registry line: the standard four and the cylinder.
     let registry = Registry::standard()
-        .models()
-        .iter()
-        .fold(Registry::new(), |r, m| r.with(*m))
+        .clone()
         .with(ModelEntry::model::<cylinder::Cylinder>());
     let text = r#"{"model": "cylinder", "format": 1, "height": 2.5, "radius": 0.2}"#;
     let genome = registry.parse_genome(text).unwrap();
