@@ -216,13 +216,8 @@ pub fn check_png(path: &Path) -> Result<(), InputError> {
     }
 }
 
-/// Renders a scene and writes it as PNG.
-pub fn write_picture(
-    scene: &Scene<'_>,
-    path: &Path,
-    view: View,
-    size: (u32, u32),
-) -> Result<(), Error> {
+/// Renders a scene as a PNG picture (the bytes of the file).
+pub fn picture(scene: &Scene<'_>, view: View, size: (u32, u32)) -> Result<Vec<u8>, Error> {
     let options = RenderOptions {
         width: size.0,
         height: size.1,
@@ -230,5 +225,15 @@ pub fn write_picture(
         ..RenderOptions::default()
     };
     let image = render::render(scene, &options)?;
-    Ok(render::write_png(path, &image)?)
+    Ok(render::encode_png(&image)?)
+}
+
+/// Renders a scene and writes it as a PNG file.
+pub fn write_picture(
+    scene: &Scene<'_>,
+    path: &Path,
+    view: View,
+    size: (u32, u32),
+) -> Result<(), Error> {
+    crate::files::write(path, &picture(scene, view, size)?)
 }
