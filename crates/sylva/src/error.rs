@@ -64,8 +64,16 @@ impl InputError {
         if line == 0 {
             return InputError::file(path, message);
         }
-        let end = offset_of(text, line, column);
-        let start = token_start(text, end);
+        let mut end = offset_of(text, line, column);
+        let mut start = token_start(text, end);
+        // serde_json reports a bad value in an object's last field at the closing bracket
+        // after it (it looked ahead for more fields): point at the value instead. A missing
+        // field belongs to the whole object, so it stays at the bracket.
+        let closing = text[end..].starts_with(['}', ']']);
+        if start == end && closing && !message.starts_with("missing field") {
+            end = text[..end].trim_end().len();
+            start = token_start(text, end);
+        }
         Self::spanned(path, text, start..end, message)
     }
 
@@ -236,6 +244,15 @@ mod tests {
             source: io,
         };
         assert_eq!(chain(&e), "writing x.glb: disk full");
+    }
+
+    #[test]
+    fn a_bad_last_value_is_shown_where_it_stands() {
+        let text = "{\n  \"a\": 1,\n  \"b\": -3\n}\n";
+        let e = InputError::at(Path::new("g.json"), text, 4, 1, "bad b".into());
+        assert_eq!(e.location, "g.json:3:8");
+        let e = InputError::at(Path::new("g.json"), text, 4, 1, "missing field `c`".into());
+        assert_eq!(e.location, "g.json:4:1");
     }
 
     #[test]

@@ -9,19 +9,11 @@ use crate::error::{Error, InputError};
 /// Largest text file read: 64 MiB.
 pub const MAX_TEXT: u64 = 64 << 20;
 
-/// Reads a UTF-8 text file, refusing files over [`MAX_TEXT`] bytes.
+/// Reads a UTF-8 text file of at most [`MAX_TEXT`] bytes. A leading byte-order mark is
+/// dropped (editors show none, so columns stay the editor's).
 pub fn read_text(path: &Path) -> Result<String, InputError> {
-    let meta =
-        std::fs::metadata(path).map_err(|e| InputError::file(path, format!("cannot read: {e}")))?;
-    if meta.len() > MAX_TEXT {
-        return Err(InputError::file(
-            path,
-            format!("file is {} bytes; at most {MAX_TEXT} are read", meta.len()),
-        ));
-    }
-    let bytes =
-        std::fs::read(path).map_err(|e| InputError::file(path, format!("cannot read: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| {
+    let bytes = read_bytes(path, MAX_TEXT)?;
+    let mut text = String::from_utf8(bytes).map_err(|e| {
         InputError::file(
             path,
             format!(
@@ -29,20 +21,34 @@ pub fn read_text(path: &Path) -> Result<String, InputError> {
                 e.utf8_error().valid_up_to()
             ),
         )
-    })
+    })?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
-/// Reads a binary file (a GLB), refusing files over `limit` bytes.
+/// Reads a file of at most `limit` bytes. The limit is a hard cap on what is read, not a
+/// check of the size the file reports, so a device or a pipe (`/dev/zero`) is refused
+/// after `limit` bytes too.
 pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
-    let meta =
-        std::fs::metadata(path).map_err(|e| InputError::file(path, format!("cannot read: {e}")))?;
-    if meta.len() > limit {
+    use std::io::Read;
+    let cannot = |e: std::io::Error| InputError::file(path, format!("cannot read: {e}"));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    if file.metadata().map_err(cannot)?.is_dir() {
+        return Err(InputError::file(path, "is a folder, not a file"));
+    }
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limit {
         return Err(InputError::file(
             path,
-            format!("file is {} bytes; at most {limit} are read", meta.len()),
+            format!("file is over {limit} bytes; at most {limit} are read"),
         ));
     }
-    std::fs::read(path).map_err(|e| InputError::file(path, format!("cannot read: {e}")))
+    Ok(bytes)
 }
 
 /// Writes `bytes` to `path` through a temporary file and a rename.

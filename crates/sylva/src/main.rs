@@ -48,16 +48,20 @@ enum Command {
 
 fn main() -> ExitCode {
     diagnostic::install();
-    let result = match Cli::parse().command {
+    let command = Cli::parse().command;
+    // A panic would be a bug in Sylva: it is reported as one, in one line, with exit code 1.
+    std::panic::set_hook(Box::new(diagnostic::report_bug));
+    let result = std::panic::catch_unwind(|| match command {
         Command::Evolve(args) => commands::evolve::run(&args),
         Command::Grow(args) => commands::grow::run(&args),
         Command::Garden(args) => commands::garden::run(&args),
         Command::Simulate(args) => commands::simulate::run(&args),
         Command::Breed(args) => commands::breed::run(&args),
         Command::Render(args) => commands::render::run(&args),
-    };
+    });
     match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => diagnostic::report(&e),
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Err(e)) => diagnostic::report(&e),
+        Err(_) => ExitCode::FAILURE,
     }
 }
