@@ -1,8 +1,9 @@
-//! Reading the files people give and writing the files Sylva makes: text read whole with a
-//! size limit and a UTF-8 check, and every output written to a temporary name and renamed,
-//! so no half-written file is ever left behind.
+//! Reading the files people give and writing the files Sylva makes: input read with a hard
+//! size cap and a UTF-8 check; every output written to a temporary name and renamed, so no
+//! half-written file is ever left behind; and [`Outputs`], the files of one command, which
+//! appear together or not at all.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, InputError};
 
@@ -67,4 +68,127 @@ pub fn create_dir(path: &Path) -> Result<(), Error> {
         path: path.to_owned(),
         source,
     })
+}
+
+/// The files one command writes, which appear together or not at all. Each file is written
+/// to a temporary name beside its destination as it is added; [`Outputs::commit`] renames
+/// them all into place. Dropped without a commit (an error on the way), the temporary
+/// files go, and so do the folders it made.
+#[derive(Debug, Default)]
+pub struct Outputs {
+    /// `(temporary, destination)`, in the order added.
+    staged: Vec<(PathBuf, PathBuf)>,
+    /// Folders made for the outputs, outermost first.
+    made: Vec<PathBuf>,
+}
+
+impl Outputs {
+    /// No files yet.
+    pub fn new() -> Outputs {
+        Outputs::default()
+    }
+
+    /// Makes `dir` (and its missing parents) for the outputs; they are removed again if the
+    /// outputs are dropped, when empty.
+    pub fn create_dir(&mut self, dir: &Path) -> Result<(), Error> {
+        let missing: Vec<PathBuf> = dir
+            .ancestors()
+            .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        create_dir(dir)?;
+        self.made.extend(missing.into_iter().rev());
+        Ok(())
+    }
+
+    /// Adds a file: written now under a temporary name, renamed on commit.
+    pub fn add(&mut self, path: &Path, bytes: &[u8]) -> Result<(), Error> {
+        let name = path
+            .file_name()
+            .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+        let temp = path.with_file_name(format!(
+            ".{name}.{}-{}.tmp",
+            std::process::id(),
+            self.staged.len()
+        ));
+        // The destination is named in errors: the temporary name is ours, not the user's.
+        sylva_core::io::write_atomic(&temp, bytes).map_err(|source| Error::Io {
+            action: "writing",
+            path: path.to_owned(),
+            source,
+        })?;
+        self.staged.push((temp, path.to_owned()));
+        Ok(())
+    }
+
+    /// Adds every file of a scene's export to `path` (an OBJ's MTL and textures too).
+    pub fn add_scene(&mut self, path: &Path, scene: &sylva_mesh::Scene<'_>) -> Result<(), Error> {
+        for (file, bytes) in sylva_mesh::export::scene_files(path, scene)? {
+            self.add(&file, &bytes)?;
+        }
+        Ok(())
+    }
+
+    /// Renames every file into place, in the order added.
+    pub fn commit(mut self) -> Result<(), Error> {
+        for (temp, path) in std::mem::take(&mut self.staged) {
+            std::fs::rename(&temp, &path).map_err(|source| Error::Io {
+                action: "writing",
+                path,
+                source,
+            })?;
+        }
+        self.made.clear();
+        Ok(())
+    }
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        for (temp, _) in &self.staged {
+            let _ = std::fs::remove_file(temp);
+        }
+        for dir in self.made.iter().rev() {
+            // Only empty folders go: anything else in them is not ours.
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("sylva-files-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    #[test]
+    fn outputs_appear_together_on_commit() {
+        let dir = temp_dir("commit");
+        let mut out = Outputs::new();
+        out.create_dir(&dir.join("run")).unwrap();
+        out.add(&dir.join("run/a.txt"), b"a").unwrap();
+        out.add(&dir.join("run/b.txt"), b"b").unwrap();
+        assert!(!dir.join("run/a.txt").exists(), "nothing before the commit");
+        out.commit().unwrap();
+        assert_eq!(std::fs::read(dir.join("run/a.txt")).unwrap(), b"a");
+        assert_eq!(std::fs::read_dir(dir.join("run")).unwrap().count(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn dropped_outputs_leave_nothing() {
+        let dir = temp_dir("drop");
+        {
+            let mut out = Outputs::new();
+            out.create_dir(&dir.join("run/deep")).unwrap();
+            out.add(&dir.join("run/deep/a.txt"), b"a").unwrap();
+            // A second file that cannot be written: the command fails.
+            assert!(out.add(&dir.join("missing/b.txt"), b"b").is_err());
+        }
+        assert!(!dir.exists(), "folders made for the outputs go too");
+    }
 }

@@ -198,45 +198,57 @@ impl Format {
     }
 }
 
-/// Writes `scene` to `path` in the format its extension names, atomically. An OBJ also gets
-/// its MTL file next to it, named after the OBJ's stem made a single word (spaces become
-/// `_`, as in the OBJ's `mtllib` line); OBJ and VRML97 files also get the PNGs of the
-/// textures their materials use ([`texture_files`]). These are written first, so the model
-/// never refers to a missing file. The scene is checked first ([`check_scene`]), so no
-/// malformed file is written.
+/// Writes `scene` to `path` in the format its extension names, each file atomically (see
+/// [`scene_files`] for the files an OBJ or VRML97 export adds). The scene is checked first
+/// ([`check_scene`]), so no malformed file is written.
 pub fn write_scene(path: &Path, scene: &Scene) -> Result<(), ExportError> {
+    for (file, bytes) in scene_files(path, scene)? {
+        sylva_core::io::write_atomic(&file, &bytes).map_err(|source| ExportError::Io {
+            path: file.clone(),
+            source,
+        })?;
+    }
+    Ok(())
+}
+
+/// The files an export of `scene` to `path` consists of, in the order to write them: the
+/// textures and the MTL file first (so the model never refers to a missing file), the file
+/// at `path` last. An OBJ gets its MTL file next to it, named after the OBJ's stem made a
+/// single word (spaces become `_`, as in the OBJ's `mtllib` line); OBJ and VRML97 files also
+/// get the PNGs of the textures their materials use ([`texture_files`]). The scene is
+/// checked first ([`check_scene`]).
+pub fn scene_files(path: &Path, scene: &Scene) -> Result<Vec<(PathBuf, Vec<u8>)>, ExportError> {
     let format = Format::from_path(path)?;
     check_scene(scene)?;
-    let write = |path: &Path, bytes: &[u8]| {
-        sylva_core::io::write_atomic(path, bytes).map_err(|source| ExportError::Io {
-            path: path.to_owned(),
-            source,
-        })
-    };
     let stem = path
         .file_stem()
         .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned());
     let sibling = |name: &str| path.with_file_name(name);
-    let write_textures = || -> Result<(), ExportError> {
-        for (name, png) in texture_files(scene, &stem)? {
-            write(&sibling(&name), &png)?;
-        }
-        Ok(())
+    let textures = || -> Result<Vec<(PathBuf, Vec<u8>)>, ExportError> {
+        Ok(texture_files(scene, &stem)?
+            .into_iter()
+            .map(|(name, png)| (sibling(&name), png))
+            .collect())
     };
-    match format {
-        Format::Glb => write(path, &to_glb(scene)?),
+    Ok(match format {
+        Format::Glb => vec![(path.to_owned(), to_glb(scene)?)],
         Format::Vrml => {
-            write_textures()?;
-            write(path, to_vrml_with_textures(scene, &stem).as_bytes())
+            let mut files = textures()?;
+            files.push((
+                path.to_owned(),
+                to_vrml_with_textures(scene, &stem).into_bytes(),
+            ));
+            files
         }
         Format::Obj => {
             let mtl_name = format!("{}.mtl", stem.replace(char::is_whitespace, "_"));
             let (obj, mtl) = to_obj(scene, &mtl_name);
-            write_textures()?;
-            write(&sibling(&mtl_name), mtl.as_bytes())?;
-            write(path, obj.as_bytes())
+            let mut files = textures()?;
+            files.push((sibling(&mtl_name), mtl.into_bytes()));
+            files.push((path.to_owned(), obj.into_bytes()));
+            files
         }
-    }
+    })
 }
 
 /// The PNG files OBJ and VRML97 exports of `scene` refer to: one `(file name, PNG bytes)`

@@ -5,7 +5,8 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, export, write_picture};
+use sylva::assets::{Origin, Placed, SceneAssets, picture};
+use sylva::files::Outputs;
 use sylva::genome::load_genome_of;
 use sylva::{Genome, InputError};
 use sylva_core::glam::Vec3;
@@ -16,7 +17,7 @@ use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva_mesh::{Scene, SceneNode};
 use sylva_model::Model;
 
-use super::{SCENE_PICTURE, write_in};
+use super::SCENE_PICTURE;
 
 /// Arguments of `sylva breed`.
 #[derive(clap::Args)]
@@ -51,7 +52,8 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
     let mut rng = sylva_core::rng::seeded(args.seed);
     let garden = breed_garden(&mother, &settings, &mut rng, &pool)
         .map_err(|e| InputError::file_error(&args.mother, &e))?;
-    sylva::files::create_dir(&args.out)?;
+    let mut out = Outputs::new();
+    out.create_dir(&args.out)?;
     let shown: Vec<Plant> = garden
         .specimens
         .iter()
@@ -90,9 +92,8 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
         String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");
     for (specimen, name) in garden.specimens.iter().zip(&names) {
         let file = format!("{name}.json");
-        write_in(
-            &args.out,
-            &file,
+        out.add(
+            &args.out.join(&file),
             LSystemModel.write(&specimen.genome).as_bytes(),
         )?;
         let s = &specimen.stats;
@@ -108,7 +109,7 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
             s.bounds.symbols + s.bounds.modules
         );
     }
-    write_in(&args.out, "specimens.csv", table.as_bytes())?;
+    out.add(&args.out.join("specimens.csv"), table.as_bytes())?;
     for (i, specimen) in garden.specimens.iter().enumerate() {
         let b = specimen.stats.bounds;
         if b.any() {
@@ -122,12 +123,10 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
         }
     }
     let scene = assets.scene();
-    export(&scene, &args.out.join("garden.glb"))?;
-    write_picture(
-        &scene,
+    out.add_scene(&args.out.join("garden.glb"), &scene)?;
+    out.add(
         &args.out.join("garden.png"),
-        View::Iso,
-        SCENE_PICTURE,
+        &picture(&scene, View::Iso, SCENE_PICTURE)?,
     )?;
     let cells: Vec<SheetCell> = assets
         .meshes()
@@ -144,7 +143,9 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
         ..SheetOptions::default()
     };
     let sheet = render::contact_sheet(&cells, &options, &pool).map_err(sylva::Error::from)?;
-    render::write_png(&args.out.join("specimens.png"), &sheet).map_err(sylva::Error::from)?;
+    let sheet = render::encode_png(&sheet).map_err(sylva::Error::from)?;
+    out.add(&args.out.join("specimens.png"), &sheet)?;
+    out.commit()?;
     print!("{table}");
     println!(
         "wrote {}/{{garden.glb, garden.png, specimens.png, specimens.csv, mother.json, \

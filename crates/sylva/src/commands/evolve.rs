@@ -5,13 +5,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sylva::assets::{export, guide_mesh};
+use sylva::assets::{guide_mesh, picture};
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, Grown, InputError};
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::{self, SheetCell, SheetOptions};
 
-use super::write_in;
+use sylva::files::Outputs;
 
 const CHECKPOINT: &str = "checkpoint.json";
 
@@ -111,38 +111,36 @@ fn write_results(
     out: &Path,
     pool: &sylva_core::par::Pool,
 ) -> anyhow::Result<()> {
-    write_in(out, "config.toml", config.to_toml().as_bytes())?;
+    let mut files = Outputs::new();
+    files.add(&out.join("config.toml"), config.to_toml().as_bytes())?;
     let stats = evolution.stats();
-    write_in(
-        out,
-        "stats.csv",
+    files.add(
+        &out.join("stats.csv"),
         stats_csv(evolution.term_names(), stats).as_bytes(),
     )?;
     let title = format!("{}, seed {}", evolution.title(), config.run().seed);
-    write_in(out, "fitness.svg", fitness_svg(stats, &title)?.as_bytes())?;
+    files.add(
+        &out.join("fitness.svg"),
+        fitness_svg(stats, &title)?.as_bytes(),
+    )?;
     let best = evolution.best();
-    write_in(out, "best.json", best.genome.to_json().as_bytes())?;
+    files.add(&out.join("best.json"), best.genome.to_json().as_bytes())?;
     let seed = best.genome.default_seed();
     let grown = Grown::new(best.genome.clone(), seed, true)?;
-    export(&grown.scene(), &out.join("best.glb"))?;
+    files.add_scene(&out.join("best.glb"), &grown.scene())?;
     let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
     let mut scene = grown.scene();
     if let Some(mesh) = &guides {
         scene.nodes.push(SceneNode::new("guides", mesh));
     }
     let size = config.output().image_size;
-    sylva::assets::write_picture(
-        &scene,
+    files.add(
         &out.join("best.png"),
-        config.output().view,
-        (size, size),
+        &picture(&scene, config.output().view, (size, size))?,
     )?;
-    population_sheet(
-        evolution,
-        config.output().sheet_size as usize,
-        &out.join("population.png"),
-        pool,
-    )?;
+    let sheet = population_sheet(evolution, config.output().sheet_size as usize, pool)?;
+    files.add(&out.join("population.png"), &sheet)?;
+    files.commit()?;
 
     let last = stats
         .last()
@@ -169,13 +167,12 @@ fn write_results(
     Ok(())
 }
 
-/// A contact sheet of the best `count` members of the current population.
+/// A contact sheet (PNG) of the best `count` members of the current population.
 fn population_sheet(
     evolution: &Evolution,
     count: usize,
-    path: &Path,
     pool: &sylva_core::par::Pool,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<Vec<u8>> {
     let chosen = evolution.fittest(count);
     let grown = chosen
         .iter()
@@ -199,6 +196,5 @@ fn population_sheet(
         ..SheetOptions::default()
     };
     let image = render::contact_sheet(&cells, &options, pool).map_err(sylva::Error::from)?;
-    render::write_png(path, &image).map_err(sylva::Error::from)?;
-    Ok(())
+    Ok(render::encode_png(&image).map_err(sylva::Error::from)?)
 }

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, asset_format, check_png, export, write_picture};
-use sylva::files::read_text;
+use sylva::assets::{Origin, Placed, SceneAssets, asset_format, check_png, picture};
+use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
 use sylva::{Genome, InputError};
 use sylva_mesh::render::View;
@@ -105,14 +105,18 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         .collect();
     let assets = SceneAssets::mesh(&placed)?;
     let scene = assets.scene();
-    export(&scene, &args.output)?;
+    let mut out = Outputs::new();
+    out.add_scene(&args.output, &scene)?;
+    let garden_path = args.output.with_extension("garden.json");
     if !is_garden {
-        let garden_path = args.output.with_extension("garden.json");
-        sylva::files::write(&garden_path, garden.to_json().as_bytes())?;
-        println!("wrote {}", garden_path.display());
+        out.add(&garden_path, garden.to_json().as_bytes())?;
     }
     if let Some(png) = &args.png {
-        write_picture(&scene, png, View::Iso, SCENE_PICTURE)?;
+        out.add(png, &picture(&scene, View::Iso, SCENE_PICTURE)?)?;
+    }
+    out.commit()?;
+    if !is_garden {
+        println!("wrote {}", garden_path.display());
     }
     println!(
         "wrote {}: {} plants, {} triangles",

@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{asset_format, check_png, export, write_picture};
+use sylva::assets::{asset_format, check_png, picture};
+use sylva::files::Outputs;
 use sylva::{Grown, load_genome};
 use sylva_mesh::render::View;
 
@@ -35,10 +36,12 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let genome = load_genome(&args.genome)?;
     let seed = args.seed.unwrap_or_else(|| genome.default_seed());
     let grown = Grown::new(genome, seed, !args.hide_roots)?;
-    export(&grown.scene(), &args.output)?;
+    let mut out = Outputs::new();
+    out.add_scene(&args.output, &grown.scene())?;
     if let Some(png) = &args.png {
-        write_picture(&grown.scene(), png, View::Iso, (800, 800))?;
+        out.add(png, &picture(&grown.scene(), View::Iso, (800, 800))?)?;
     }
+    out.commit()?;
     println!(
         "wrote {}: {} segments, {} organs, {} vertices, {} triangles",
         args.output.display(),

@@ -8,15 +8,8 @@ pub mod grow;
 pub mod render;
 pub mod simulate;
 
-use std::path::Path;
-
 /// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
 pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
-
-/// Writes `bytes` to `name` inside `dir`, atomically.
-pub fn write_in(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), sylva::Error> {
-    sylva::files::write(&dir.join(name), bytes)
-}
 
 /// The worker pool for `--threads` (0: one per core).
 pub fn pool(threads: u32) -> Result<sylva_core::par::Pool, sylva::Error> {

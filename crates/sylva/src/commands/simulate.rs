@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use sylva::assets::{Origin, Placed, SceneAssets, export, write_picture};
-use sylva::files::read_text;
+use sylva::assets::{Origin, Placed, SceneAssets, picture};
+use sylva::files::{Outputs, read_text};
 use sylva::genome::load_genome_of;
 use sylva::report::simulation_report;
 use sylva::{Genome, InputError};
@@ -14,7 +14,7 @@ use sylva_lsystem::garden::records_csv;
 use sylva_mesh::render::View;
 use sylva_model::Model;
 
-use super::{SCENE_PICTURE, write_in};
+use super::SCENE_PICTURE;
 
 /// Arguments of `sylva simulate`.
 #[derive(clap::Args)]
@@ -51,12 +51,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             .map_or("simulation".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from("runs").join(stem)
     });
-    sylva::files::create_dir(&out)?;
+    let mut files = Outputs::new();
+    files.create_dir(&out)?;
     let report = simulation_report(&outcome);
-    write_in(&out, "report.txt", report.as_bytes())?;
-    write_in(
-        &out,
-        "records.csv",
+    files.add(&out.join("report.txt"), report.as_bytes())?;
+    files.add(
+        &out.join("records.csv"),
         records_csv(outcome.records()).as_bytes(),
     )?;
     let hint = LSystemModel.mesh_hint();
@@ -76,8 +76,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         .collect();
     let assets = SceneAssets::mesh(&placed)?;
     let scene = assets.scene();
-    export(&scene, &out.join("scene.glb"))?;
-    write_picture(&scene, &out.join("scene.png"), View::Iso, SCENE_PICTURE)?;
+    files.add_scene(&out.join("scene.glb"), &scene)?;
+    files.add(
+        &out.join("scene.png"),
+        &picture(&scene, View::Iso, SCENE_PICTURE)?,
+    )?;
+    files.commit()?;
     print!("{report}");
     println!(
         "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",

@@ -1,0 +1,181 @@
+//! Hostile and huge input through the command line: every refusal is clean (exit code 2, the
+//! file and what was expected, no panic), bounded, and leaves no output behind.
+#![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn sylva(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(args)
+        .output()
+        .expect("the sylva binary runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sylva-hostile-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn example(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(path)
+        .display()
+        .to_string()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Runs sylva and expects a clean refusal: `code`, no panic, and `mention` in what it says.
+fn refused(args: &[&str], code: i32, mention: &str) -> String {
+    let out = sylva(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(code), "{args:?}\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}\n{stderr}");
+    assert!(
+        stderr.contains(mention),
+        "{args:?}: expected {mention:?} in\n{stderr}"
+    );
+    stderr
+}
+
+/// Files left in `dir`.
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn errors_far_along_a_long_line_print_a_short_snippet() {
+    let dir = temp_dir("long-lines");
+    let oak = fs::read_to_string(example("bintree/oak.json")).unwrap();
+    let genome: serde_json::Value = serde_json::from_str(&oak).unwrap();
+    let one_line = serde_json::to_string(&genome).unwrap();
+    let padded = one_line
+        .replacen(",", &format!(",{}", " ".repeat(200_000)), 1)
+        .replace("\"min_radius\":0.02", "\"min_radius\":-5");
+    let path = dir.join("long.json");
+    fs::write(&path, padded).unwrap();
+    let stderr = refused(
+        &["grow", s(&path), "-o", s(&dir.join("x.glb"))],
+        2,
+        "min_radius",
+    );
+    assert!(stderr.len() < 3000, "{} bytes of error", stderr.len());
+    assert!(stderr.contains("long.json:1:2"), "{stderr}");
+    // The same in a config, with a huge number.
+    let config = dir.join("long.toml");
+    let text = format!("[bintree]\nmutation_rate = {}\n", "9".repeat(100_000));
+    fs::write(&config, text).unwrap();
+    let stderr = refused(&["evolve", s(&config)], 2, "long.toml:2:17");
+    assert!(stderr.len() < 3000, "{} bytes of error", stderr.len());
+    assert_eq!(files_in(&dir), ["long.json", "long.toml"]);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn devices_folders_and_byte_order_marks() {
+    let dir = temp_dir("files");
+    let glb = dir.join("x.glb");
+    if Path::new("/dev/zero").exists() {
+        refused(&["grow", "/dev/zero", "-o", s(&glb)], 2, "at most");
+    }
+    refused(&["grow", s(&dir), "-o", s(&glb)], 2, "folder");
+    // A byte-order mark, as some editors write, is read past.
+    let bom = dir.join("bom.json");
+    let text = format!(
+        "\u{feff}{}",
+        fs::read_to_string(example("bintree/oak.json")).unwrap()
+    );
+    fs::write(&bom, text).unwrap();
+    assert!(sylva(&["grow", s(&bom), "-o", s(&glb)]).status.success());
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_bad_last_value_is_pointed_at_not_the_closing_bracket() {
+    let dir = temp_dir("last-value");
+    let oak = fs::read_to_string(example("bintree/oak.json")).unwrap();
+    let line = oak
+        .lines()
+        .position(|l| l.contains("\"min_radius\""))
+        .unwrap()
+        + 1;
+    let path = dir.join("g.json");
+    fs::write(
+        &path,
+        oak.replace("\"min_radius\": 0.02", "\"min_radius\": -3"),
+    )
+    .unwrap();
+    refused(
+        &["grow", s(&path), "-o", s(&dir.join("x.glb"))],
+        2,
+        &format!("g.json:{line}:17"),
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_failing_command_leaves_no_output_behind() {
+    let dir = temp_dir("outputs");
+    // The picture cannot be written: the asset is not left either.
+    let out = sylva(&[
+        "grow",
+        &example("bintree/oak.json"),
+        "-o",
+        s(&dir.join("tree.glb")),
+        "--png",
+        s(&dir.join("missing/tree.png")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("missing/tree.png"));
+    assert!(files_in(&dir).is_empty(), "{:?}", files_in(&dir));
+    // An OBJ's MTL and textures go with it.
+    let out = sylva(&[
+        "grow",
+        &example("plantmaker/fern.json"),
+        "-o",
+        s(&dir.join("fern.obj")),
+        "--png",
+        s(&dir.join("missing/fern.png")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(files_in(&dir).is_empty(), "{:?}", files_in(&dir));
+    // Bad input makes no run or experiment folder.
+    let config = dir.join("c.toml");
+    fs::write(&config, "[run]\npopulation = 0\n").unwrap();
+    refused(
+        &["evolve", s(&config), "--out", s(&dir.join("run"))],
+        2,
+        "population",
+    );
+    let experiment = dir.join("e.toml");
+    fs::write(&experiment, "[lateral-light]\ntree = \"nowhere.json\"\n").unwrap();
+    refused(
+        &["simulate", s(&experiment), "--out", s(&dir.join("sim"))],
+        2,
+        "nowhere.json",
+    );
+    refused(
+        &[
+            "breed",
+            &example("bintree/oak.json"),
+            "--out",
+            s(&dir.join("b")),
+        ],
+        2,
+        "`lsystem` genomes",
+    );
+    assert_eq!(files_in(&dir), ["c.toml", "e.toml"]);
+    fs::remove_dir_all(&dir).unwrap();
+}
