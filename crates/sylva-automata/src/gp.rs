@@ -274,8 +274,10 @@ impl GpConfig {
                     pick_family(&terminals, rng)
                 } else if full && depth + 1 < max_depth {
                     pick_family(&branching, rng)
-                } else if full || rng.random_bool(self.grow_function_rate.clamp(0.0, 1.0)) {
-                    if rng.random_bool(self.branching_rate.clamp(0.0, 1.0)) {
+                } else if full
+                    || rng.random_bool(sylva_core::rng::probability(self.grow_function_rate))
+                {
+                    if rng.random_bool(sylva_core::rng::probability(self.branching_rate)) {
                         pick_family(&branching, rng)
                     } else {
                         pick_family(&actions, rng)
@@ -343,7 +345,7 @@ impl GpConfig {
             (0, 0) => return None,
             (0, _) => false,
             (_, 0) => true,
-            _ => rng.random_bool(self.function_point_rate.clamp(0.0, 1.0)),
+            _ => rng.random_bool(sylva_core::rng::probability(self.function_point_rate)),
         };
         let pool = if want_function {
             &found.functions

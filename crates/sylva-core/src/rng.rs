@@ -28,6 +28,14 @@ fn key(seed: u64) -> [u8; 32] {
     key
 }
 
+/// `p` made a legal probability: clamped to 0..=1, and NaN read as 0. For probabilities that
+/// come from settings built in code, which no reader has range-checked (`random_bool`
+/// panics on anything else).
+#[inline]
+pub fn probability(p: f64) -> f64 {
+    if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) }
+}
+
 /// A generator for one seed, on stream 0. Use it for work that is not split among
 /// individuals (for example a model's own randomness from a genome's seed).
 pub fn seeded(seed: u64) -> ChaCha8Rng {

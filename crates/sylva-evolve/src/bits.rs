@@ -234,7 +234,7 @@ pub struct BitFlip {
 
 impl<const W: usize> Mutate<BitString<W>> for BitFlip {
     fn mutate<R: Rng + ?Sized>(&self, genome: &mut BitString<W>, rng: &mut R) {
-        let rate = self.rate.clamp(0.0, 1.0);
+        let rate = crate::rng::probability(self.rate);
         for i in 0..genome.len() {
             if rng.random_bool(rate) {
                 genome.flip(i);

@@ -52,9 +52,9 @@ const RATE_SUM_TOLERANCE: f64 = 1e-6;
 /// Why generational settings are refused.
 #[derive(Debug, Error, PartialEq)]
 pub enum GenerationalError {
-    /// A tournament of no one.
-    #[error("`tournament` must be at least 1, got 0")]
-    EmptyTournament,
+    /// A tournament of no one, or of more than [`MAX_TOURNAMENT`].
+    #[error("`tournament` must be 1 to {MAX_TOURNAMENT}, got {0}")]
+    Tournament(usize),
     /// A rate that is NaN, infinite or outside 0..=1.
     #[error("`{name}` rate must be a number from 0 to 1, got {value}")]
     BadRate {
@@ -84,20 +84,36 @@ pub enum GenerationalError {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GenerationalSettings {
-    /// Members drawn per tournament (with replacement). Default 7.
+    /// Members drawn per tournament (with replacement), 1 to 1000. Default 7.
+    #[serde(deserialize_with = "tournament_size")]
     pub tournament: usize,
-    /// Share of offspring made by crossover. Default 0.88.
+    /// Share of offspring made by crossover, 0 to 1. Default 0.88.
+    #[serde(deserialize_with = "crossover")]
     pub crossover: f64,
-    /// Share of offspring copied unchanged. Default 0.10.
+    /// Share of offspring copied unchanged, 0 to 1. Default 0.10.
+    #[serde(deserialize_with = "reproduction")]
     pub reproduction: f64,
-    /// Share of offspring made by mutating a copy. Default 0.02.
+    /// Share of offspring made by mutating a copy, 0 to 1. Default 0.02.
+    #[serde(deserialize_with = "mutation")]
     pub mutation: f64,
-    /// Best members carried over unchanged (at most the population). Default 1.
+    /// Best members carried over unchanged, 0 to 1,000,000 (at most the population).
+    /// Default 1.
+    #[serde(deserialize_with = "elitism")]
     pub elitism: usize,
     /// Re-evaluate copies (elites, reproductions) rather than reuse their fitness.
     /// Default `true` (see the module docs).
     pub reevaluate: bool,
 }
+
+/// Largest tournament: beyond, selection costs more and changes nothing (a tournament of
+/// 1000 picks the best of any population to within 0.1%).
+pub const MAX_TOURNAMENT: usize = 1000;
+
+sylva_core::ranged!(tournament_size: usize, "tournament", 1, MAX_TOURNAMENT);
+sylva_core::ranged!(crossover: f64, "crossover", 0.0, 1.0);
+sylva_core::ranged!(reproduction: f64, "reproduction", 0.0, 1.0);
+sylva_core::ranged!(mutation: f64, "mutation", 0.0, 1.0);
+sylva_core::ranged!(elitism: usize, "elitism", 0, 1_000_000);
 
 impl Default for GenerationalSettings {
     fn default() -> Self {
@@ -115,8 +131,8 @@ impl Default for GenerationalSettings {
 impl GenerationalSettings {
     /// Checks the tournament size and that the rates are in 0..=1 and add up to 1.
     pub fn validate(&self) -> Result<(), GenerationalError> {
-        if self.tournament == 0 {
-            return Err(GenerationalError::EmptyTournament);
+        if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {
+            return Err(GenerationalError::Tournament(self.tournament));
         }
         for (name, value) in [
             ("crossover", self.crossover),

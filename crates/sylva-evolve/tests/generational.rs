@@ -122,7 +122,14 @@ fn rates_and_tournament_are_validated() {
             tournament: 0,
             ..base.clone()
         }),
-        Err(GenerationalError::EmptyTournament)
+        Err(GenerationalError::Tournament(0))
+    ));
+    assert!(matches!(
+        bad(GenerationalSettings {
+            tournament: 1_000_000_000_000_000,
+            ..base.clone()
+        }),
+        Err(GenerationalError::Tournament(_))
     ));
     for value in [-0.1, 1.5, f64::NAN, f64::INFINITY] {
         assert!(matches!(

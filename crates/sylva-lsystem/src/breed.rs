@@ -31,13 +31,18 @@ pub struct BreedSettings {
     /// World and growing time. Default [`GrowSettings::default`] (64³ voxels of 0.125 m,
     /// 150 steps).
     pub grow: GrowSettings,
-    /// Distance between neighbouring seeds, metres. Default 2.5.
+    /// Distance between neighbouring seeds, 0.01 to 1000 metres. Default 2.5.
+    #[serde(deserialize_with = "spacing")]
     pub spacing: f32,
     /// Children sown with the mother, 0 to 8. Default 8.
+    #[serde(deserialize_with = "children")]
     pub children: usize,
     /// Mutation probabilities. Default [`MutationRates::default`].
     pub rates: MutationRates,
 }
+
+sylva_core::ranged!(spacing: f32, "spacing", 0.01, 1000.0, " m");
+sylva_core::ranged!(children: usize, "children", 0, MAX_SPECIMENS - 1);
 
 impl Default for BreedSettings {
     fn default() -> Self {

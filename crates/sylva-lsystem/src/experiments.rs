@@ -25,7 +25,7 @@ use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant};
 
 use crate::breed::{BiomorphRun, BreedSettings, evolve_biomorphs, largest_biomass};
-use crate::garden::{Garden, GardenError, Sowing, StepRecord};
+use crate::garden::{Garden, GardenError, MAX_STEPS, Sowing, StepRecord};
 use crate::genome::LSystemGenome;
 
 /// Why a simulation could not run.
@@ -148,22 +148,32 @@ pub struct HerbsUnderTree {
     /// The world; its light is made vertical. Default [`EnvironmentSettings::default`].
     #[serde(default)]
     pub world: EnvironmentSettings,
-    /// Steps the tree grows alone before the herbs are sown. Default 120.
-    #[serde(default = "default_head_start")]
+    /// Steps the tree grows alone before the herbs are sown, 0 to half of
+    /// [`MAX_STEPS`]. Default 120.
+    #[serde(default = "default_head_start", deserialize_with = "head_start")]
     pub head_start: u32,
-    /// Steps everything then grows together. Default 60.
-    #[serde(default = "default_herb_steps")]
+    /// Steps everything then grows together, 0 to half of [`MAX_STEPS`]. Default 60.
+    #[serde(default = "default_herb_steps", deserialize_with = "half_steps")]
     pub steps: u32,
-    /// Radius of the ring of herbs under the crown, metres. Default 0.8.
-    #[serde(default = "default_inner")]
+    /// Radius of the ring of herbs under the crown, 0 to 1000 metres. Default 0.8.
+    #[serde(default = "default_inner", deserialize_with = "inner_radius")]
     pub inner_radius: f32,
-    /// Radius of the ring of herbs in the open, metres. Default 3.2.
-    #[serde(default = "default_outer")]
+    /// Radius of the ring of herbs in the open, 0 to 1000 metres. Default 3.2.
+    #[serde(default = "default_outer", deserialize_with = "outer_radius")]
     pub outer_radius: f32,
     /// Herbs in each ring, 1 to 64. Default 6.
-    #[serde(default = "default_per_ring")]
+    #[serde(default = "default_per_ring", deserialize_with = "herbs_per_ring")]
     pub herbs_per_ring: u32,
 }
+
+sylva_core::ranged!(head_start: u32, "head_start", 0, MAX_STEPS / 2);
+sylva_core::ranged!(half_steps: u32, "steps", 0, MAX_STEPS / 2);
+sylva_core::ranged!(inner_radius: f32, "inner_radius", 0.0, 1000.0, " m");
+sylva_core::ranged!(outer_radius: f32, "outer_radius", 0.0, 1000.0, " m");
+sylva_core::ranged!(herbs_per_ring: u32, "herbs_per_ring", 1, 64);
+sylva_core::ranged!(steps: u32, "steps", 0, MAX_STEPS);
+sylva_core::ranged!(spacing: f32, "spacing", 0.0, 1000.0, " m");
+sylva_core::ranged!(generations: u32, "generations", 1, 10_000);
 
 fn default_head_start() -> u32 {
     120
@@ -306,12 +316,12 @@ pub struct LateralLight {
     /// light from +X at 30 degrees above the horizon.
     #[serde(default = "default_lateral_world")]
     pub world: EnvironmentSettings,
-    /// Steps to grow. Default 150.
-    #[serde(default = "default_lateral_steps")]
+    /// Steps to grow, 0 to [`MAX_STEPS`]. Default 150.
+    #[serde(default = "default_lateral_steps", deserialize_with = "steps")]
     pub steps: u32,
-    /// Distance between the two trees, metres; they stand side by side across the light.
-    /// Default 3.
-    #[serde(default = "default_lateral_spacing")]
+    /// Distance between the two trees, 0 to 1000 metres; they stand side by side across the
+    /// light. Default 3.
+    #[serde(default = "default_lateral_spacing", deserialize_with = "spacing")]
     pub spacing: f32,
 }
 
@@ -422,7 +432,7 @@ pub struct EmptyRules {
     #[serde(default)]
     pub breed: BreedSettings,
     /// Generations, 1 to 10000. Default 30.
-    #[serde(default = "default_generations")]
+    #[serde(default = "default_generations", deserialize_with = "generations")]
     pub generations: u32,
     /// Seed of the mutations. Default 1.
     #[serde(default = "default_seed")]

@@ -44,8 +44,11 @@ pub struct GrowSettings {
     pub world: EnvironmentSettings,
     /// Steps to grow, 0 to [`MAX_STEPS`]. Default 150: long enough for the example tree
     /// (`examples/lsystem/tree.json`) to form its crown.
+    #[serde(deserialize_with = "steps")]
     pub steps: u32,
 }
+
+sylva_core::ranged!(steps: u32, "steps", 0, MAX_STEPS);
 
 impl Default for GrowSettings {
     fn default() -> Self {

@@ -434,14 +434,10 @@ pub struct LSystemMutation {
 
 impl Mutate<LSystemGenome> for LSystemMutation {
     fn mutate<R: Rng + ?Sized>(&self, genome: &mut LSystemGenome, rng: &mut R) {
-        mutate_rules(
-            &mut genome.shoot.rules,
-            &self.rates,
-            Compartment::Shoot,
-            rng,
-        );
-        mutate_rules(&mut genome.root.rules, &self.rates, Compartment::Root, rng);
-        if rng.random_bool(self.rates.mutate_parameter) {
+        let rates = self.rates.legal();
+        mutate_rules(&mut genome.shoot.rules, &rates, Compartment::Shoot, rng);
+        mutate_rules(&mut genome.root.rules, &rates, Compartment::Root, rng);
+        if rng.random_bool(rates.mutate_parameter) {
             let scale = if self.parameter_scale > 0.0 {
                 self.parameter_scale
             } else {

@@ -121,10 +121,20 @@ impl Evolve for LSystemModel {
         _seed: u64,
         _population: usize,
     ) -> Result<Setup<Self>, ConfigError> {
+        // Every genome grows in this world: one that cannot be built would fail them all.
+        settings
+            .grow
+            .world
+            .validate()
+            .map_err(|e| ConfigError::new("grow.world", e))?;
         let start = start
             .into_iter()
             .next()
             .unwrap_or_else(LSystemGenome::empty);
+        start
+            .physiology
+            .validate()
+            .map_err(|e| ConfigError::new("start", e))?;
         let (problem, strategy) = settings
             .run(start)
             .map_err(|e| ConfigError::new("breeding", e))?;

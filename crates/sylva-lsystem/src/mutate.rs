@@ -25,24 +25,43 @@ use crate::grammar::{Axis, Compartment, MAX_RULES, Module, Rule, RuleSet, Symbol
 #[serde(deny_unknown_fields, default)]
 pub struct MutationRates {
     /// Delete a character, per rule. Default 0.1.
+    #[serde(deserialize_with = "delete_char")]
     pub delete_char: f64,
     /// Insert a character, per rule. Default 0.1.
+    #[serde(deserialize_with = "insert_char")]
     pub insert_char: f64,
     /// Permute two adjacent characters, per rule. Default 0.1.
+    #[serde(deserialize_with = "permute_char")]
     pub permute_char: f64,
     /// Duplicate a character, per rule. Default 0.1.
+    #[serde(deserialize_with = "duplicate_char")]
     pub duplicate_char: f64,
     /// Replace a character, per rule. Default 0.1.
+    #[serde(deserialize_with = "mutate_char")]
     pub mutate_char: f64,
     /// Delete a rule, per rule set. Default 0.05.
+    #[serde(deserialize_with = "delete_rule")]
     pub delete_rule: f64,
     /// Append an empty rule, per rule set. Default 0.1.
+    #[serde(deserialize_with = "insert_rule")]
     pub insert_rule: f64,
     /// Append a copy of a rule, per rule set. Default 0.05.
+    #[serde(deserialize_with = "duplicate_rule")]
     pub duplicate_rule: f64,
     /// Nudge the shapes and angles, per genome. Default 0.3.
+    #[serde(deserialize_with = "mutate_parameter")]
     pub mutate_parameter: f64,
 }
+
+sylva_core::ranged!(delete_char: f64, "delete_char", 0.0, 1.0);
+sylva_core::ranged!(insert_char: f64, "insert_char", 0.0, 1.0);
+sylva_core::ranged!(permute_char: f64, "permute_char", 0.0, 1.0);
+sylva_core::ranged!(duplicate_char: f64, "duplicate_char", 0.0, 1.0);
+sylva_core::ranged!(mutate_char: f64, "mutate_char", 0.0, 1.0);
+sylva_core::ranged!(delete_rule: f64, "delete_rule", 0.0, 1.0);
+sylva_core::ranged!(insert_rule: f64, "insert_rule", 0.0, 1.0);
+sylva_core::ranged!(duplicate_rule: f64, "duplicate_rule", 0.0, 1.0);
+sylva_core::ranged!(mutate_parameter: f64, "mutate_parameter", 0.0, 1.0);
 
 impl Default for MutationRates {
     fn default() -> Self {
@@ -56,6 +75,24 @@ impl Default for MutationRates {
             insert_rule: 0.1,
             duplicate_rule: 0.05,
             mutate_parameter: 0.3,
+        }
+    }
+}
+
+impl MutationRates {
+    /// Every rate made a legal probability (rates built in code are not range-checked).
+    pub fn legal(&self) -> MutationRates {
+        let p = sylva_core::rng::probability;
+        MutationRates {
+            delete_char: p(self.delete_char),
+            insert_char: p(self.insert_char),
+            permute_char: p(self.permute_char),
+            duplicate_char: p(self.duplicate_char),
+            mutate_char: p(self.mutate_char),
+            delete_rule: p(self.delete_rule),
+            insert_rule: p(self.insert_rule),
+            duplicate_rule: p(self.duplicate_rule),
+            mutate_parameter: p(self.mutate_parameter),
         }
     }
 }
@@ -200,6 +237,7 @@ pub fn mutate_rules<R: Rng + ?Sized>(
     compartment: Compartment,
     rng: &mut R,
 ) {
+    let rates = &rates.legal();
     let count = set.rules.len();
     for rule in &mut set.rules {
         mutate_rule(rule, rates, compartment, count, rng);

@@ -338,7 +338,9 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
         };
         let run = Run::with_genomes(setup.problem, setup.strategy, pool, settings, setup.first)
             .map_err(|e| InputError::new("[run]", e))?;
-        Ok(Evolution::typed(self.clone(), run))
+        let evolution = Evolution::typed(self.clone(), run);
+        evolution.check_finite(source)?;
+        Ok(evolution)
     }
 
     fn resume(
@@ -360,7 +362,9 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
         let setup = setup(&self.model, &self.settings, Vec::new(), 0, 0, source)?;
         let run = Run::resume(setup.problem, setup.strategy, pool, saved.checkpoint)
             .map_err(|e| InputError::file(path, e))?;
-        Ok(Evolution::typed(self.clone(), run))
+        let evolution = Evolution::typed(self.clone(), run);
+        evolution.check_finite(source)?;
+        Ok(evolution)
     }
 }
 
@@ -709,9 +713,12 @@ impl Evolution {
         self.inner.title()
     }
 
-    /// Breeds one generation and returns its statistics.
-    pub fn step(&mut self) -> &GenerationStats {
-        self.inner.step()
+    /// Breeds one generation and returns its statistics. A generation in which no member
+    /// has a finite fitness stops the run with an error: its settings cannot score.
+    pub fn step(&mut self) -> Result<&GenerationStats, Error> {
+        self.inner.step();
+        self.check_finite("the run")?;
+        Ok(self.stats().last().expect("a run has statistics"))
     }
 
     /// Breeds `generations` generations, calling `on_generation` after each.
@@ -719,9 +726,28 @@ impl Evolution {
         &mut self,
         generations: u32,
         mut on_generation: impl FnMut(&GenerationStats),
-    ) {
+    ) -> Result<(), Error> {
         for _ in 0..generations {
-            on_generation(self.inner.step());
+            on_generation(self.step()?);
+        }
+        Ok(())
+    }
+
+    /// An error if no member of the last generation has a finite fitness.
+    fn check_finite(&self, source: &str) -> Result<(), InputError> {
+        match self.stats().last() {
+            Some(s) if !s.best.is_finite() => Err(InputError::new(
+                source,
+                format!(
+                    "no member of generation {} has a finite fitness (the best is {}): these \
+                     settings cannot score a {} genome; check the model's settings and start \
+                     genomes",
+                    s.generation,
+                    s.best,
+                    self.title()
+                ),
+            )),
+            _ => Ok(()),
         }
     }
 

@@ -19,8 +19,15 @@ pub fn stats_csv(term_names: &[String], stats: &[GenerationStats]) -> String {
     out.push_str(",evals_per_s\n");
     for s in stats {
         let _ = write!(out, "{},{},{}", s.generation, s.best, s.mean);
-        for t in &s.best_terms {
-            let _ = write!(out, ",{t}");
+        // One cell per term named in the header, empty where the best had none (a genome
+        // that could not grow), so every row is as wide as the header.
+        for i in 0..term_names.len() {
+            match s.best_terms.get(i) {
+                Some(t) => {
+                    let _ = write!(out, ",{t}");
+                }
+                None => out.push(','),
+            }
         }
         let _ = writeln!(out, ",{:.0}", s.evals_per_second());
     }
@@ -185,6 +192,11 @@ mod tests {
             csv,
             "generation,best,mean,a,b,evals_per_s\n0,1.5,1,0.75,0.75,20\n1,2,1.25,1,1,20\n"
         );
+        // A best without terms still fills every column.
+        let mut short = row(0, 0.0, 0.0);
+        short.best_terms.clear();
+        let csv = stats_csv(&["a".into(), "b".into()], &[short]);
+        assert_eq!(csv.lines().nth(1), Some("0,0,0,,,20"));
     }
 
     #[test]

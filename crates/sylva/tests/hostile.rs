@@ -179,3 +179,90 @@ fn a_failing_command_leaves_no_output_behind() {
     assert_eq!(files_in(&dir), ["c.toml", "e.toml"]);
     fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn every_config_number_is_range_checked_where_it_stands() {
+    let dir = temp_dir("ranges");
+    let config = dir.join("c.toml");
+    for (text, location, mention) in [
+        (
+            "model = \"lsystem\"\n[lsystem.rates]\ndelete_char = 2\n",
+            "3:15",
+            "`delete_char` must be a number from 0 to 1",
+        ),
+        (
+            "model = \"lsystem\"\n[lsystem.rates]\nmutate_char = nan\n",
+            "3:15",
+            "mutate_char",
+        ),
+        (
+            "model = \"automata\"\n[automata.breeding]\ntournament = 1000000000000000\n",
+            "3:14",
+            "`tournament` must be a whole number from 1 to 1000",
+        ),
+        (
+            "model = \"plantmaker\"\n[plantmaker.breeding]\nelitism = -1\n",
+            "3:11",
+            "elitism",
+        ),
+        (
+            "model = \"lsystem\"\n[lsystem.grow]\nsteps = 4000000000\n",
+            "3:9",
+            "`steps` must be a whole number from 0 to 100000",
+        ),
+    ] {
+        fs::write(&config, text).unwrap();
+        let out = dir.join("run");
+        refused(
+            &["evolve", s(&config), "--out", s(&out)],
+            2,
+            &format!("c.toml:{location}"),
+        );
+        refused(&["evolve", s(&config), "--out", s(&out)], 2, mention);
+        assert!(!out.exists());
+    }
+    // A world that cannot be built is refused before any genome grows in it.
+    for (world, mention) in [
+        ("size = [1024, 1024, 1024]", "voxels"),
+        ("size = [16, 16, 16]\nsoil_layers = 16", "soil_layers"),
+    ] {
+        let text = format!("model = \"lsystem\"\n[lsystem.grow.world]\n{world}\n");
+        fs::write(&config, text).unwrap();
+        refused(&["evolve", s(&config)], 2, mention);
+        refused(&["evolve", s(&config)], 2, "[lsystem.grow.world]");
+    }
+    // Experiments: every number has its range too.
+    let tree = example("lsystem/tree.json");
+    let herb = example("lsystem/herb.json");
+    for (text, mention) in [
+        (
+            format!(
+                "[herbs-under-tree]\ntree = {tree:?}\nherb = {herb:?}\nhead_start = 4000000000\n"
+            ),
+            "head_start",
+        ),
+        (
+            format!("[herbs-under-tree]\ntree = {tree:?}\nherb = {herb:?}\nouter_radius = -1e30\n"),
+            "outer_radius",
+        ),
+        (
+            format!("[lateral-light]\ntree = {tree:?}\nspacing = inf\n"),
+            "spacing",
+        ),
+        (
+            "[empty-rules.breed]\nchildren = 1000000\n".to_owned(),
+            "`children` must be",
+        ),
+        (
+            "[empty-rules.breed.rates]\ninsert_rule = 1.5\n".to_owned(),
+            "insert_rule",
+        ),
+        ("[empty-rules]\ngenerations = 0\n".to_owned(), "generations"),
+    ] {
+        fs::write(&config, &text).unwrap();
+        let out = dir.join("sim");
+        refused(&["simulate", s(&config), "--out", s(&out)], 2, mention);
+        assert!(!out.exists());
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}

@@ -109,7 +109,7 @@ fn runs_of_every_model_step_browse_and_resume_exactly() {
     ] {
         let c = small(model, extra);
         let mut straight = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
-        straight.step_batch(4, |_| {});
+        straight.step_batch(4, |_| {}).unwrap();
         assert_eq!(straight.generation(), 4);
         assert_eq!(straight.stats().len(), 5);
         assert_eq!(straight.population().len(), 8);
@@ -117,7 +117,7 @@ fn runs_of_every_model_step_browse_and_resume_exactly() {
 
         // Stopped after two generations, saved, and resumed on two threads.
         let mut first = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
-        first.step_batch(2, |_| {});
+        first.step_batch(2, |_| {}).unwrap();
         let saved = first.checkpoint().unwrap();
         let mut resumed = Evolution::resume(
             &c,
@@ -126,7 +126,7 @@ fn runs_of_every_model_step_browse_and_resume_exactly() {
             Pool::with_threads(2).unwrap(),
         )
         .unwrap();
-        resumed.step_batch(2, |_| {});
+        resumed.step_batch(2, |_| {}).unwrap();
         let rows = |e: &Evolution| -> Vec<(u32, f64, f64, Vec<f64>)> {
             e.stats()
                 .iter()
@@ -148,7 +148,7 @@ fn a_member_s_family_is_browsed_through_kept_generations() {
     let c = small("bintree", "");
     let mut run = Evolution::start(&c, Vec::new(), Pool::Serial).unwrap();
     run.keep_history(10);
-    run.step_batch(4, |_| {});
+    run.step_batch(4, |_| {}).unwrap();
     assert!(run.generation_members(1).is_some());
     let best = run.best();
     let family = run.family(best.id);
@@ -374,4 +374,102 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
         .unwrap();
     assert!(e.message.contains("does not evolve"), "{}", e.message);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A model whose every genome scores NaN: no run of it can go anywhere.
+mod void {
+    use rand::{Rng, RngExt};
+    use sylva_core::Plant;
+    use sylva_evolve::{Crossover, Fitness, Generational, Mutate, Problem};
+    use sylva_model::{
+        Bred, ConfigError, DevelopError, Evolve, Model, Parent, Setup, VariationError, plant_meta,
+    };
+
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Void;
+
+    #[derive(Clone, Debug)]
+    pub struct Unscorable;
+
+    #[derive(Clone, Copy, Debug)]
+    pub struct Keep;
+
+    impl Mutate<u32> for Keep {
+        fn mutate<R: Rng + ?Sized>(&self, _: &mut u32, _: &mut R) {}
+    }
+
+    impl Crossover<u32> for Keep {
+        fn crossover<R: Rng + ?Sized>(&self, a: &u32, _: &u32, _: &mut R) -> u32 {
+            *a
+        }
+    }
+
+    impl Problem for Unscorable {
+        type Genome = u32;
+        fn term_names(&self) -> Vec<String> {
+            vec!["x".into()]
+        }
+        fn evaluate(&self, _: &u32) -> Fitness {
+            Fitness::new(f64::NAN, &[f64::NAN])
+        }
+        fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> u32 {
+            rng.random()
+        }
+    }
+
+    impl Model for Void {
+        type Genome = u32;
+        type Settings = ();
+        const NAME: &'static str = "void";
+        const TITLE: &'static str = "Nothing";
+
+        fn develop(&self, g: &u32, seed: u64) -> Result<Plant, DevelopError> {
+            Ok(Plant::new(plant_meta::<Self>(g, seed)))
+        }
+        fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> u32 {
+            rng.random()
+        }
+        fn mutate<R: Rng + ?Sized>(&self, g: &u32, _: &(), _: &mut R) -> u32 {
+            *g
+        }
+        fn cross<R: Rng + ?Sized>(
+            &self,
+            parents: &[Parent<'_, u32>],
+            _: &(),
+            _: &mut R,
+        ) -> Result<Bred<u32>, VariationError> {
+            Ok(Bred {
+                genome: *parents[0].genome,
+                parents: vec![0],
+            })
+        }
+    }
+
+    impl Evolve for Void {
+        type Problem = Unscorable;
+        type Strategy = Generational<Keep, Keep>;
+        fn setup(&self, _: &(), _: Vec<u32>, _: u64, _: usize) -> Result<Setup<Self>, ConfigError> {
+            Ok(Setup {
+                problem: Unscorable,
+                strategy: Generational::new(Keep, Keep, Default::default())
+                    .map_err(|e| ConfigError::new("breeding", e))?,
+                first: Vec::new(),
+            })
+        }
+        fn genome_file(&self, _: &Unscorable, g: &u32) -> u32 {
+            *g
+        }
+    }
+}
+
+#[test]
+fn a_run_that_cannot_score_stops_with_an_error() {
+    let config = Config::new(sylva::EvolveConfig::<void::Void>::default());
+    let e = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap_err();
+    assert!(e.is_input(), "{e}");
+    assert!(
+        e.to_string()
+            .contains("no member of generation 0 has a finite fitness"),
+        "{e}"
+    );
 }

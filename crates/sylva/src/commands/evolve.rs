@@ -90,7 +90,7 @@ fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyho
     let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
     let mut last_save = Instant::now();
     while evolution.generation() < target {
-        let best = evolution.step().best;
+        let best = evolution.step()?.best;
         bar.set_message(format!("{best:.4}"));
         bar.set_position(u64::from(evolution.generation()));
         if last_save.elapsed() >= every {
