@@ -8,6 +8,7 @@
 //! - [`plant`]: [`Plant`], its [`Segment`]s, [`Organ`]s and [`Material`]s, with typed ids.
 //! - [`measures`]: tips, height, bounds, surface area, volume, and Susinno's
 //!   [`TreeMeasures`].
+//! - [`budget`]: the memory a job may use, checked before the work starts.
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
 //! - [`par`]: the one seam where work goes parallel ([`par::Pool`]).
@@ -32,6 +33,7 @@
 //! # Ok::<(), sylva_core::PlantError>(())
 //! ```
 
+pub mod budget;
 pub mod environment;
 pub mod hash;
 pub mod io;

@@ -12,6 +12,8 @@
 //! a world-space copy of its mesh. Every offset and count is checked, so a truncated or
 //! hostile file is an error, never a panic.
 
+use std::collections::{HashMap, HashSet};
+
 use serde_json::Value;
 use sylva_core::glam::{Mat3, Mat4, Quat, Vec3};
 use sylva_core::{Material, MaterialKind};
@@ -40,6 +42,9 @@ pub enum ImportError {
         /// The limit.
         limit: usize,
     },
+    /// Reading it would not fit in the memory budget.
+    #[error(transparent)]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
 }
 
 /// Meshes read from a GLB, each already placed in world space.
@@ -64,8 +69,6 @@ impl ImportedScene {
 
 /// Most triangles read from one file.
 const MAX_TRIANGLES: usize = 100_000_000;
-/// Deepest node hierarchy followed (deeper nodes, or cycles, are an error).
-const MAX_DEPTH: usize = 64;
 
 fn invalid(what: impl Into<String>) -> ImportError {
     ImportError::Invalid(what.into())
@@ -125,107 +128,180 @@ impl Reader<'_> {
             .ok_or_else(|| invalid(format!("{list}[{i}] does not exist")))
     }
 
-    fn scene(&self) -> Result<ImportedScene, ImportError> {
-        let roots: Vec<Value> = match self
+    /// The default scene's nodes (every node nobody names as a child, without a scene),
+    /// after checking the hierarchy is what glTF allows: each node at most one parent, no
+    /// cycles, roots without parents, each listed once. A walk from the roots then visits
+    /// every node at most once, whatever the file.
+    fn roots(&self) -> Result<Vec<usize>, ImportError> {
+        let nodes = self.list("nodes");
+        let index = |v: &Value, what: &str| -> Result<usize, ImportError> {
+            v.as_u64()
+                .filter(|&i| (i as usize) < nodes.len())
+                .map(|i| i as usize)
+                .ok_or_else(|| invalid(format!("{what} names node {v}, which does not exist")))
+        };
+        let mut parent: Vec<Option<usize>> = vec![None; nodes.len()];
+        for (i, node) in nodes.iter().enumerate() {
+            for child in node["children"].as_array().map_or(&[][..], Vec::as_slice) {
+                let c = index(child, &format!("node {i}"))?;
+                if parent[c].replace(i).is_some() || c == i {
+                    return Err(invalid(format!(
+                        "node {c} has more than one parent (glTF allows one, and no cycles)"
+                    )));
+                }
+            }
+        }
+        let roots: Vec<usize> = match self
             .list("scenes")
             .get(self.root["scene"].as_u64().unwrap_or(0) as usize)
         {
-            Some(scene) => scene["nodes"].as_array().cloned().unwrap_or_default(),
-            // No scene: every node that is nobody's child is a root.
-            None => {
-                let children: Vec<u64> = self
-                    .list("nodes")
-                    .iter()
-                    .flat_map(|n| n["children"].as_array().cloned().unwrap_or_default())
-                    .filter_map(|c| c.as_u64())
-                    .collect();
-                (0..self.list("nodes").len() as u64)
-                    .filter(|i| !children.contains(i))
-                    .map(Value::from)
-                    .collect()
-            }
+            Some(scene) => scene["nodes"]
+                .as_array()
+                .map_or(&[][..], Vec::as_slice)
+                .iter()
+                .map(|n| index(n, "the scene"))
+                .collect::<Result<_, _>>()?,
+            None => (0..nodes.len()).filter(|&i| parent[i].is_none()).collect(),
         };
+        let mut listed = vec![false; nodes.len()];
+        for &r in &roots {
+            if parent[r].is_some() || std::mem::replace(&mut listed[r], true) {
+                return Err(invalid(format!(
+                    "the scene lists node {r}, which is a child or listed twice"
+                )));
+            }
+        }
+        Ok(roots)
+    }
+
+    /// Every node the scene shows with its world transform, parents first.
+    fn placed_nodes(&self, roots: &[usize]) -> Result<Vec<(usize, Mat4)>, ImportError> {
+        let nodes = self.list("nodes");
+        let mut placed = Vec::new();
+        let mut stack: Vec<(usize, Mat4)> =
+            roots.iter().rev().map(|&r| (r, Mat4::IDENTITY)).collect();
+        while let Some((i, parent)) = stack.pop() {
+            let world = parent * local_transform(&nodes[i])?;
+            placed.push((i, world));
+            let children = nodes[i]["children"]
+                .as_array()
+                .map_or(&[][..], Vec::as_slice);
+            // Indices were checked by `roots`.
+            for child in children.iter().rev() {
+                stack.push((child.as_u64().unwrap_or(0) as usize, world));
+            }
+        }
+        Ok(placed)
+    }
+
+    fn scene(&self) -> Result<ImportedScene, ImportError> {
+        let roots = self.roots()?;
+        let placed = self.placed_nodes(&roots)?;
+        let nodes = self.list("nodes");
+        // Count the work before doing it: every node gets its own world-space copy of its
+        // mesh, whose primitives share their vertices when they share an accessor.
+        let (mut vertices, mut indices) = (0u64, 0u64);
+        let mut sizes: HashMap<u64, (u64, u64)> = HashMap::new();
+        for &(i, _) in &placed {
+            if let Some(mesh) = nodes[i].get("mesh") {
+                let key = mesh.as_u64().unwrap_or(u64::MAX);
+                let (v, n) = match sizes.get(&key) {
+                    Some(&size) => size,
+                    None => {
+                        let size = self.mesh_size(self.item("meshes", mesh)?)?;
+                        sizes.insert(key, size);
+                        size
+                    }
+                };
+                vertices = vertices.saturating_add(v);
+                indices = indices.saturating_add(n);
+            }
+        }
+        if indices / 3 > MAX_TRIANGLES as u64 {
+            return Err(ImportError::TooLarge {
+                limit: MAX_TRIANGLES,
+            });
+        }
+        sylva_core::budget::check(
+            crate::mesher::mesh_bytes(vertices, indices / 3),
+            format_args!(
+                "reading a GLB of {vertices} vertices and {} triangles",
+                indices / 3
+            ),
+            "read a smaller file",
+        )?;
         let mut out = ImportedScene::default();
-        let mut triangles = 0;
-        for r in &roots {
-            self.node(r, Mat4::IDENTITY, 0, &mut out, &mut triangles)?;
+        for (i, world) in placed {
+            let node = &nodes[i];
+            if let Some(mesh) = node.get("mesh") {
+                let name = node["name"].as_str().unwrap_or("node").to_owned();
+                let mesh = self.mesh(self.item("meshes", mesh)?, world)?;
+                out.meshes.push((name, mesh));
+            }
         }
         Ok(out)
     }
 
-    fn node(
-        &self,
-        index: &Value,
-        parent: Mat4,
-        depth: usize,
-        out: &mut ImportedScene,
-        triangles: &mut usize,
-    ) -> Result<(), ImportError> {
-        if depth > MAX_DEPTH {
-            return Err(invalid("node hierarchy is deeper than 64 (or has a cycle)"));
+    /// Vertices (one copy per distinct vertex-attribute accessors) and indices a mesh holds
+    /// once read.
+    fn mesh_size(&self, mesh: &Value) -> Result<(u64, u64), ImportError> {
+        let mut seen = HashSet::new();
+        let (mut vertices, mut indices) = (0u64, 0u64);
+        for prim in triangle_primitives(mesh) {
+            let a = &prim["attributes"];
+            let count = |v: &Value| -> Result<u64, ImportError> {
+                self.item("accessors", v)?["count"]
+                    .as_u64()
+                    .ok_or_else(|| invalid("accessor without count"))
+            };
+            let positions = count(&a["POSITION"])?;
+            if seen.insert(vertex_key(prim)) {
+                vertices = vertices.saturating_add(positions);
+            }
+            let n = match prim.get("indices") {
+                Some(i) => count(i)?,
+                None => positions,
+            };
+            indices = indices.saturating_add(n);
         }
-        let node = self.item("nodes", index)?;
-        let world = parent * local_transform(node)?;
-        if let Some(mesh) = node.get("mesh") {
-            let name = node["name"].as_str().unwrap_or("node").to_owned();
-            let mesh = self.mesh(self.item("meshes", mesh)?, world, triangles)?;
-            out.meshes.push((name, mesh));
-        }
-        for child in node["children"].as_array().map_or(&[][..], Vec::as_slice) {
-            self.node(child, world, depth + 1, out, triangles)?;
-        }
-        Ok(())
+        Ok((vertices, indices))
     }
 
-    fn mesh(&self, mesh: &Value, world: Mat4, triangles: &mut usize) -> Result<Mesh, ImportError> {
+    fn mesh(&self, mesh: &Value, world: Mat4) -> Result<Mesh, ImportError> {
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         let mut out = Mesh::default();
-        for prim in mesh["primitives"].as_array().map_or(&[][..], Vec::as_slice) {
-            if prim["mode"].as_u64().unwrap_or(4) != 4 {
-                continue;
-            }
+        // Vertices already copied, by the accessors they came from.
+        let mut shared: HashMap<VertexKey, u32> = HashMap::new();
+        for prim in triangle_primitives(mesh) {
             let positions = self.vec3s(self.item("accessors", &prim["attributes"]["POSITION"])?)?;
-            let base =
-                u32::try_from(out.positions.len()).map_err(|_| invalid("too many vertices"))?;
             let indices: Vec<u32> = match prim.get("indices") {
                 Some(i) => self.indices(self.item("accessors", i)?)?,
                 None => (0..positions.len() as u32).collect(),
             };
             let usable = indices.len() / 3 * 3;
-            *triangles += usable / 3;
-            if *triangles > MAX_TRIANGLES {
-                return Err(ImportError::TooLarge {
-                    limit: MAX_TRIANGLES,
-                });
-            }
             if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
                 return Err(invalid(format!(
                     "index {bad} is past the {} vertices of its primitive",
                     positions.len()
                 )));
             }
-            let normals = match prim["attributes"].get("NORMAL") {
-                Some(n) => self.vec3s(self.item("accessors", n)?)?,
-                None => flat_normals(&positions, &indices[..usable]),
-            };
-            if normals.len() != positions.len() {
-                return Err(invalid("NORMAL and POSITION counts differ"));
-            }
-            match prim["attributes"].get("TEXCOORD_0") {
-                Some(t) => {
-                    let uvs = self.vec2s(self.item("accessors", t)?)?;
-                    if uvs.len() != positions.len() {
-                        return Err(invalid("TEXCOORD_0 and POSITION counts differ"));
-                    }
-                    out.uvs.extend(uvs);
+            let base = match shared.get(&vertex_key(prim)) {
+                Some(&base) => base,
+                None => {
+                    let base = u32::try_from(out.positions.len())
+                        .map_err(|_| invalid("too many vertices"))?;
+                    self.vertices(
+                        prim,
+                        &positions,
+                        &indices[..usable],
+                        world,
+                        normal_matrix,
+                        &mut out,
+                    )?;
+                    shared.insert(vertex_key(prim), base);
+                    base
                 }
-                None => out.uvs.resize(out.uvs.len() + positions.len(), [0.0; 2]),
-            }
-            for (p, n) in positions.iter().zip(&normals) {
-                out.positions.push(world.transform_point3(*p).to_array());
-                out.normals
-                    .push((normal_matrix * *n).normalize_or(Vec3::Y).to_array());
-            }
+            };
             out.primitives.push(Primitive {
                 material: out.materials.len(),
                 indices: indices[..usable].iter().map(|i| i + base).collect(),
@@ -233,6 +309,41 @@ impl Reader<'_> {
             out.materials.push(self.material(prim.get("material"))?);
         }
         Ok(out)
+    }
+
+    /// Appends a primitive's vertices, placed in world space.
+    fn vertices(
+        &self,
+        prim: &Value,
+        positions: &[Vec3],
+        indices: &[u32],
+        world: Mat4,
+        normal_matrix: Mat3,
+        out: &mut Mesh,
+    ) -> Result<(), ImportError> {
+        let normals = match prim["attributes"].get("NORMAL") {
+            Some(n) => self.vec3s(self.item("accessors", n)?)?,
+            None => flat_normals(positions, indices),
+        };
+        if normals.len() != positions.len() {
+            return Err(invalid("NORMAL and POSITION counts differ"));
+        }
+        match prim["attributes"].get("TEXCOORD_0") {
+            Some(t) => {
+                let uvs = self.vec2s(self.item("accessors", t)?)?;
+                if uvs.len() != positions.len() {
+                    return Err(invalid("TEXCOORD_0 and POSITION counts differ"));
+                }
+                out.uvs.extend(uvs);
+            }
+            None => out.uvs.resize(out.uvs.len() + positions.len(), [0.0; 2]),
+        }
+        for (p, n) in positions.iter().zip(&normals) {
+            out.positions.push(world.transform_point3(*p).to_array());
+            out.normals
+                .push((normal_matrix * *n).normalize_or(Vec3::Y).to_array());
+        }
+        Ok(())
     }
 
     fn material(&self, index: Option<&Value>) -> Result<Material, ImportError> {
@@ -399,6 +510,27 @@ fn local_transform(node: &Value) -> Result<Mat4, ImportError> {
     Ok(Mat4::from_scale_rotation_translation(s, r, t))
 }
 
+/// The accessors a primitive's vertices come from: primitives with the same share them.
+type VertexKey = (Option<u64>, Option<u64>, Option<u64>);
+
+fn vertex_key(prim: &Value) -> VertexKey {
+    let a = &prim["attributes"];
+    (
+        a["POSITION"].as_u64(),
+        a.get("NORMAL").and_then(Value::as_u64),
+        a.get("TEXCOORD_0").and_then(Value::as_u64),
+    )
+}
+
+/// A mesh's triangle primitives (other modes are left out).
+fn triangle_primitives(mesh: &Value) -> impl Iterator<Item = &Value> {
+    mesh["primitives"]
+        .as_array()
+        .map_or(&[][..], Vec::as_slice)
+        .iter()
+        .filter(|p| p["mode"].as_u64().unwrap_or(4) == 4)
+}
+
 fn flat_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
@@ -498,5 +630,84 @@ mod tests {
             }
         }
         let _ = read_glb(&flipped); // must not panic
+    }
+
+    /// A GLB of `json` and a binary chunk.
+    fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+        let mut j = serde_json::to_vec(json).unwrap();
+        while j.len() % 4 != 0 {
+            j.push(b' ');
+        }
+        let mut b = bin.to_vec();
+        while b.len() % 4 != 0 {
+            b.push(0);
+        }
+        let total = 12 + 8 + j.len() + 8 + b.len();
+        let mut out = Vec::new();
+        for v in [0x4654_6C67u32, 2, total as u32, j.len() as u32, 0x4E4F_534A] {
+            out.extend(v.to_le_bytes());
+        }
+        out.extend(&j);
+        out.extend((b.len() as u32).to_le_bytes());
+        out.extend(0x004E_4942u32.to_le_bytes());
+        out.extend(&b);
+        out
+    }
+
+    /// One triangle's positions and a mesh whose `primitives` primitives all use them.
+    fn shared_mesh(primitives: usize, nodes: serde_json::Value) -> Vec<u8> {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        let prim = serde_json::json!({ "attributes": { "POSITION": 0 } });
+        let json = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{ "byteLength": bin.len() }],
+            "bufferViews": [{ "buffer": 0, "byteLength": bin.len() }],
+            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3" }],
+            "meshes": [{ "primitives": vec![prim; primitives] }],
+            "nodes": nodes,
+        });
+        glb(&json, &bin)
+    }
+
+    #[test]
+    fn what_gltf_forbids_is_refused_before_any_work() {
+        // Nodes that share children (a DAG): sixty levels would be 2^60 paths.
+        let dag: Vec<serde_json::Value> = (0..60)
+            .map(|i| serde_json::json!({ "mesh": 0, "children": [i + 1] }))
+            .chain((0..60).map(|i| serde_json::json!({ "children": [i + 1] })))
+            .chain([serde_json::json!({ "mesh": 0 })])
+            .collect();
+        let e = read_glb(&shared_mesh(1, serde_json::json!(dag))).unwrap_err();
+        assert!(e.to_string().contains("more than one parent"), "{e}");
+        // A cycle, and a node that is its own child.
+        let cycle = serde_json::json!([{ "children": [1] }, { "children": [0], "mesh": 0 }]);
+        let e = read_glb(&shared_mesh(1, cycle)).unwrap();
+        assert!(e.meshes.is_empty(), "a cycle has no root: nothing to show");
+        let selfish = serde_json::json!([{ "children": [0], "mesh": 0 }]);
+        assert!(read_glb(&shared_mesh(1, selfish)).is_err());
+        // A hierarchy deeper than any recursion could follow is read, once per node.
+        let deep: Vec<serde_json::Value> = (0..10_000)
+            .map(|i| serde_json::json!({ "children": [i + 1] }))
+            .chain([serde_json::json!({ "mesh": 0 })])
+            .collect();
+        assert_eq!(
+            read_glb(&shared_mesh(1, serde_json::json!(deep)))
+                .unwrap()
+                .meshes
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn primitives_that_share_an_accessor_share_their_vertices() {
+        let file = shared_mesh(5000, serde_json::json!([{ "mesh": 0 }]));
+        let scene = read_glb(&file).unwrap();
+        let mesh = &scene.meshes[0].1;
+        assert_eq!(mesh.positions.len(), 3, "one copy of the shared vertices");
+        assert_eq!(mesh.triangle_count(), 5000);
     }
 }

@@ -151,6 +151,9 @@ pub enum MeshError {
         /// What the plant needs.
         needed: u64,
     },
+    /// The mesh would not fit in the memory budget.
+    #[error(transparent)]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
 }
 
 /// What a call to [`Mesher::mesh_into`] produced.
@@ -160,6 +163,14 @@ pub struct MeshStats {
     pub vertices: usize,
     /// Triangles written.
     pub triangles: usize,
+}
+
+/// Bytes a mesh of `vertices` and `triangles` holds: a position, normal and texture
+/// coordinate per vertex, three indices per triangle.
+pub fn mesh_bytes(vertices: u64, triangles: u64) -> u64 {
+    vertices
+        .saturating_mul(32)
+        .saturating_add(triangles.saturating_mul(12))
 }
 
 /// Largest bend factor `1 / cos(half angle)` applied to a joint ring (a 120° bend).
@@ -355,6 +366,11 @@ impl Mesher {
     pub fn mesh_into(&mut self, plant: &Plant, out: &mut Mesh) -> Result<MeshStats, MeshError> {
         self.link(plant);
         let (vertices, triangles) = self.count(plant)?;
+        sylva_core::budget::check(
+            mesh_bytes(vertices as u64, triangles as u64),
+            format_args!("a mesh of {triangles} triangles"),
+            "lower `max_triangles`, or grow a smaller plant",
+        )?;
 
         out.positions.clear();
         out.normals.clear();

@@ -57,6 +57,30 @@ const ROUGHNESS: f64 = 0.9;
 /// large for a GLB's 32-bit lengths.
 pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
     check_scene(scene)?;
+    // The binary chunk is built, then copied into the file: about twice its size at once.
+    let mut seen = std::collections::HashSet::new();
+    let binary: u64 = scene
+        .nodes
+        .iter()
+        .filter(|n| seen.insert(n.mesh as *const Mesh))
+        .map(|n| {
+            let m = n.mesh;
+            (m.positions.len() as u64 * 32).saturating_add(
+                m.primitives
+                    .iter()
+                    .map(|p| p.indices.len() as u64 * 4)
+                    .sum(),
+            )
+        })
+        .sum();
+    sylva_core::budget::check(
+        binary.saturating_mul(2),
+        format_args!(
+            "writing a GLB of about {}",
+            sylva_core::budget::Bytes(binary)
+        ),
+        "export fewer or smaller plants",
+    )?;
     let mut w = Writer::default();
     let mut mesh_of: HashMap<*const Mesh, Option<usize>> = HashMap::new();
     let mut nodes = Vec::with_capacity(scene.nodes.len());

@@ -153,6 +153,9 @@ pub enum ExportError {
         /// The size it would have.
         bytes: u64,
     },
+    /// The file would not fit in the memory budget while it is made.
+    #[error(transparent)]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
     /// The glTF JSON could not be written.
     #[error("cannot write the glTF JSON")]
     Json(#[from] serde_json::Error),
