@@ -308,6 +308,7 @@ impl AutomataGenome {
 
     /// Grows the plant and says what the simulator did.
     pub fn develop_with_report(&self, seed: u64) -> Result<(Plant, GrowthReport), DevelopError> {
+        self.growth.limits.check_budget()?;
         let mut plant = Plant::new(sylva_model::plant_meta::<crate::AutomataModel>(self, seed));
         let program = Program::compile(&self.program, &self.growth.semantics());
         let report = Simulator::new().run(

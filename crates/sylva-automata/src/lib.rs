@@ -182,6 +182,11 @@ impl Evolve for AutomataModel {
         _seed: u64,
         _population: usize,
     ) -> Result<Setup<Self>, ConfigError> {
+        settings
+            .growth
+            .limits
+            .check_budget()
+            .map_err(|e| ConfigError::new("growth.limits", e))?;
         let problem = AutomataProblem::new(settings);
         let strategy =
             problem::strategy(&problem, settings).map_err(|e| ConfigError::new("breeding", e))?;
@@ -194,6 +199,10 @@ impl Evolve for AutomataModel {
 
     fn genome_file(&self, problem: &AutomataProblem, tree: &GpTree) -> AutomataGenome {
         AutomataGenome::with_growth(tree.clone(), problem.growth.clone())
+    }
+
+    fn genome_bytes(&self, settings: &AutomataSettings) -> u64 {
+        u64::from(settings.max_size) * tree::NODE_BYTES + 64
     }
 
     fn guides(&self, problem: &AutomataProblem) -> Option<Plant> {

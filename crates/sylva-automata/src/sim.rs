@@ -51,7 +51,7 @@
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
-use sylva_core::{Frame, Organ, OrganKind, Plant, SegmentId};
+use sylva_core::{Frame, Organ, OrganKind, Plant, Segment, SegmentId};
 
 use crate::compile::{Op, Program, State};
 use crate::tree::{VARIABLES, Var};
@@ -108,7 +108,8 @@ pub struct Limits {
     /// 1 to 1 000 000.
     #[serde(deserialize_with = "states_per_step")]
     pub states_per_step: u32,
-    /// States in the whole run; growth stops when reached. Default 2 000 000; 1 to 10^10.
+    /// States in the whole run; growth stops when reached. Default 2 000 000; 1 to 10^9
+    /// (about ten seconds of simulation).
     #[serde(deserialize_with = "total_states")]
     pub states: u64,
     /// Automata instances in the whole run, the root included. Default 2000; 1 to 1 000 000.
@@ -126,7 +127,32 @@ sylva_core::ranged!(states_per_step: u32, "limits.states_per_step", 1, 1_000_000
 sylva_core::ranged!(automata: u32, "limits.automata", 1, 1_000_000);
 sylva_core::ranged!(points: u32, "limits.points", 1, 100_000_000);
 sylva_core::ranged!(organs: u32, "limits.organs", 0, 10_000_000);
-sylva_core::ranged!(total_states: u64, "limits.states", 1, 10_000_000_000);
+sylva_core::ranged!(total_states: u64, "limits.states", 1, 1_000_000_000);
+
+impl Limits {
+    /// Bytes a growth may hold at these bounds: a segment per point, the organs, and the
+    /// automaton instances.
+    pub fn memory_bound(&self) -> u64 {
+        let segment = std::mem::size_of::<Segment>() as u64;
+        let organ = std::mem::size_of::<Organ>() as u64 + 4;
+        let instance = std::mem::size_of::<Inst>() as u64 + 64;
+        u64::from(self.points) * segment
+            + u64::from(self.organs) * organ
+            + u64::from(self.automata) * instance
+    }
+
+    /// Refuses bounds whose growth may not fit in the memory budget.
+    pub fn check_budget(&self) -> Result<(), sylva_core::budget::OverBudget> {
+        sylva_core::budget::check(
+            self.memory_bound(),
+            format_args!(
+                "growth to `limits` of {} points, {} organs and {} automata",
+                self.points, self.organs, self.automata
+            ),
+            "lower `limits.points`, `limits.organs` or `limits.automata`",
+        )
+    }
+}
 
 impl Default for Limits {
     fn default() -> Self {

@@ -400,6 +400,9 @@ pub fn legal_targets(automaton: usize, count: usize) -> String {
     }
 }
 
+/// Bytes a node takes in a [`GpTree`] (the node and the facts kept about it).
+pub const NODE_BYTES: u64 = (std::mem::size_of::<Node>() + std::mem::size_of::<NodeInfo>()) as u64;
+
 /// A valid GP tree: well typed, following the rules of construction. It keeps the
 /// [`NodeInfo`] of its nodes, found while checking them, for breeding (each tree is a parent
 /// about twice a generation, and crossover needs the facts of every node of both parents).

@@ -19,7 +19,10 @@ static MAX_MEMORY: AtomicU64 = AtomicU64::new(0);
 
 /// Work that would not fit in the memory budget.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{what} would need about {needed} of memory, more than the budget of {budget}; {advice}")]
+#[error(
+    "{what} would need about {needed} of memory, more than the budget of {budget} (set with \
+     `--max-memory`); {advice}"
+)]
 pub struct OverBudget {
     /// What was asked for, and of which field or flag it follows.
     pub what: String,

@@ -211,9 +211,20 @@ pub enum EnvironmentError {
         /// Voxels asked for.
         voxels: u64,
     },
+    /// The world would not fit in the memory budget.
+    #[error("the world does not fit in memory")]
+    OverBudget(#[from] crate::budget::OverBudget),
 }
 
 impl EnvironmentSettings {
+    /// Bytes the world's voxels hold: shade, light and light leaving each sky voxel, minerals
+    /// and their scratch in each soil voxel.
+    pub fn memory_bytes(&self) -> u64 {
+        let [x, y, z] = self.size.map(u64::from);
+        let soil = u64::from(self.soil_layers).min(y);
+        x * (y - soil) * z * 3 * 4 + x * soil * z * 2 * 8 + x * z * 8
+    }
+
     /// Checks every range, including those serde cannot see (a struct built in code).
     pub fn validate(&self) -> Result<(), EnvironmentError> {
         let check = |field, value: f64, lo: f64, hi: f64, expected| {
@@ -316,6 +327,11 @@ impl Environment {
     /// A world with full light and uniform minerals.
     pub fn new(settings: EnvironmentSettings) -> Result<Environment, EnvironmentError> {
         settings.validate()?;
+        crate::budget::check(
+            settings.memory_bytes(),
+            format_args!("a world of {:?} voxels (`size`)", settings.size),
+            "use fewer or larger voxels",
+        )?;
         let dims = settings.size.map(|s| s as usize);
         let soil = settings.soil_layers as usize;
         let size = settings.voxel_size as f32;

@@ -85,12 +85,16 @@ pub enum GardenError {
     /// A position is not finite.
     #[error("plant {0} is sown at a position that is not finite")]
     BadPosition(usize),
+    /// The plants at their bounds and the world would not fit in the memory budget.
+    #[error("the garden does not fit in memory")]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
 }
 
 impl From<GardenError> for sylva_model::DevelopError {
     fn from(e: GardenError) -> Self {
         match e {
             GardenError::Plant(e) => sylva_model::DevelopError::Plant(e),
+            GardenError::OverBudget(e) => sylva_model::DevelopError::OverBudget(e),
             other => sylva_model::DevelopError::Model(Box::new(other)),
         }
     }
@@ -180,6 +184,22 @@ impl Garden {
         if sowings.len() > MAX_PLANTS {
             return Err(GardenError::TooManyPlants(sowings.len()));
         }
+        // What the plants may grow to (their `max_symbols` and `max_modules`), before the
+        // world is made.
+        let plants: u64 = sowings
+            .iter()
+            .map(|s| GrowingPlant::memory_bound(&s.genome.physiology))
+            .sum();
+        sylva_core::budget::check(
+            plants.saturating_add(world.memory_bytes()),
+            format_args!(
+                "{} plants at their bounds (`max_symbols`, `max_modules`) in a world of {:?} \
+                 voxels",
+                sowings.len(),
+                world.size
+            ),
+            "lower the bounds, sow fewer plants or use a smaller world",
+        )?;
         let env = Environment::new(world)?;
         let mut plants = Vec::with_capacity(sowings.len());
         for (i, s) in sowings.into_iter().enumerate() {

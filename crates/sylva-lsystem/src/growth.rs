@@ -27,7 +27,7 @@ use sylva_core::{Plant, PlantError};
 use crate::genome::LSystemGenome;
 use crate::grammar::{Compartment, Module, RuleSet, Symbol};
 use crate::interpret::{Layout, ModuleMaterials, ModuleShape, interpret};
-use crate::physiology::{Flows, Pools, ROOT, SHOOT};
+use crate::physiology::{Flows, Physiology, Pools, ROOT, SHOOT};
 
 /// How far above (shoot) or below (root) the ground an apex at the foot is read, metres.
 const GROUND_OFFSET: f32 = 1e-3;
@@ -161,6 +161,17 @@ fn compartment(x: usize) -> Compartment {
 }
 
 impl GrowingPlant {
+    /// Bytes a plant of this physiology may come to hold at its bounds: both compartments'
+    /// strings (and their rewriting buffers) at `max_symbols`, and `max_modules` modules
+    /// drawn as segments and organs.
+    pub fn memory_bound(physiology: &Physiology) -> u64 {
+        let symbol = (2 * std::mem::size_of::<Symbol>() + 2 * 8) as u64;
+        let module = (std::mem::size_of::<sylva_core::Segment>()
+            + std::mem::size_of::<sylva_core::Organ>()
+            + 64) as u64;
+        2 * u64::from(physiology.max_symbols) * symbol + u64::from(physiology.max_modules) * module
+    }
+
     /// A seed of `genome` at `position` (on the ground), sown at step `sown_at`.
     pub fn new(genome: LSystemGenome, position: Vec3, sown_at: u32) -> Result<Self, PlantError> {
         let shapes = genome.modules.as_array();

@@ -43,7 +43,7 @@ pub enum ImportError {
         limit: usize,
     },
     /// Reading it would not fit in the memory budget.
-    #[error(transparent)]
+    #[error("the file's meshes do not fit in memory")]
     OverBudget(#[from] sylva_core::budget::OverBudget),
 }
 

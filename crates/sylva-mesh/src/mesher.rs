@@ -152,7 +152,7 @@ pub enum MeshError {
         needed: u64,
     },
     /// The mesh would not fit in the memory budget.
-    #[error(transparent)]
+    #[error("the mesh does not fit in memory")]
     OverBudget(#[from] sylva_core::budget::OverBudget),
 }
 
@@ -369,7 +369,7 @@ impl Mesher {
         sylva_core::budget::check(
             mesh_bytes(vertices as u64, triangles as u64),
             format_args!("a mesh of {triangles} triangles"),
-            "lower `max_triangles`, or grow a smaller plant",
+            "grow a smaller plant",
         )?;
 
         out.positions.clear();
@@ -412,6 +412,14 @@ impl Mesher {
             vertices,
             triangles,
         })
+    }
+
+    /// Bytes the mesh of `plant` will hold (counted exactly, without meshing); an error if
+    /// it is over [`MeshOptions::max_triangles`].
+    pub fn bytes_for(&mut self, plant: &Plant) -> Result<u64, MeshError> {
+        self.link(plant);
+        let (vertices, triangles) = self.count(plant)?;
+        Ok(mesh_bytes(vertices as u64, triangles as u64))
     }
 
     /// Meshes `plant` into a new mesh.

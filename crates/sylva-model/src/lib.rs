@@ -236,6 +236,9 @@ pub enum DevelopError {
         /// The limit, in segments plus organs.
         limit: usize,
     },
+    /// The plant may need more memory than the budget allows.
+    #[error("the plant does not fit in memory")]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
     /// A model's own reason (an L-system world that cannot be built, say).
     #[error(transparent)]
     Model(Box<dyn std::error::Error + Send + Sync>),
@@ -295,6 +298,12 @@ pub trait Evolve: Model {
     /// Guides drawn beside plants in pictures (a target surface, forbidden cells).
     fn guides(&self, _problem: &Self::Problem) -> Option<Plant> {
         None
+    }
+
+    /// Bytes an evolved genome may hold at the settings' bounds, for the memory estimate of
+    /// a population. The default, 4 KiB, suits small fixed-size genomes.
+    fn genome_bytes(&self, _settings: &Self::Settings) -> u64 {
+        4096
     }
 }
 

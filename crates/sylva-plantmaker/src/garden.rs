@@ -126,6 +126,12 @@ pub enum GardenError {
     /// The garden has no plants.
     #[error("the garden has no plants")]
     Empty,
+    /// More plants than [`MAX_PLANTS`].
+    #[error("the garden has {0} plants; at most {MAX_PLANTS}")]
+    TooManyPlants(usize),
+    /// The plants would not fit in the memory budget.
+    #[error("the garden does not fit in memory")]
+    OverBudget(#[from] sylva_core::budget::OverBudget),
     /// A plant could not be grown.
     #[error("plant {index} of genome {group} could not be grown")]
     Develop {
@@ -164,6 +170,14 @@ pub enum GardenError {
         /// Darts per plant.
         tries: u32,
     },
+}
+
+/// Most plants in a garden.
+pub const MAX_PLANTS: usize = 100_000;
+
+/// Bytes a grown plant holds.
+fn plant_bytes(plant: &Plant) -> u64 {
+    (std::mem::size_of_val(plant.segments()) + std::mem::size_of_val(plant.organs())) as u64
 }
 
 /// A plant that found no spot, by index in the radii given.
@@ -297,10 +311,17 @@ impl Garden {
         s
     }
 
-    /// Grows every plant and places them.
+    /// Grows every plant and places them. A garden file is held to the same limits as
+    /// gardens planted from genomes: at most [`MAX_PLANTS`] plants, and plants that fit the
+    /// memory budget (estimated from the first plant of each genome, before the others grow).
     pub fn grow(&self) -> Result<GrownGarden, GardenError> {
-        let mut plants = Vec::with_capacity(self.count());
-        let mut ids = Vec::with_capacity(self.count());
+        let count = self.count();
+        if count > MAX_PLANTS {
+            return Err(GardenError::TooManyPlants(count));
+        }
+        let mut plants = Vec::with_capacity(count);
+        let mut ids = Vec::with_capacity(count);
+        let mut estimate = 0u64;
         for (group, g) in self.plants.iter().enumerate() {
             for (index, &seed) in g.seeds.iter().enumerate() {
                 let plant = g
@@ -311,6 +332,15 @@ impl Garden {
                         index,
                         source,
                     })?;
+                if index == 0 {
+                    estimate = estimate
+                        .saturating_add(plant_bytes(&plant).saturating_mul(g.seeds.len() as u64));
+                    sylva_core::budget::check(
+                        estimate,
+                        format_args!("a garden of {count} plants (its genomes' counts)"),
+                        "plant fewer",
+                    )?;
+                }
                 plants.push(plant);
                 ids.push((group, index, seed));
             }

@@ -141,19 +141,24 @@ pub struct SceneAssets {
 }
 
 impl SceneAssets {
-    /// Meshes every plant (one mesher per set of options, its buffers reused).
+    /// Meshes every plant (one mesher per set of options, its buffers reused), after
+    /// checking that all the meshes together fit the memory budget.
     pub fn mesh(placed: &[Placed<'_>]) -> Result<SceneAssets, Error> {
         let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
+        let mut needed = 0u64;
+        for p in placed {
+            let mesher = mesher_for(&mut meshers, p.hint)?;
+            needed = needed.saturating_add(mesher.bytes_for(p.plant)?);
+        }
+        sylva_core::budget::check(
+            needed,
+            format_args!("a scene of {} plants", placed.len()),
+            "place fewer or smaller plants",
+        )
+        .map_err(sylva_mesh::mesher::MeshError::from)?;
         let mut meshes = Vec::with_capacity(placed.len());
         for p in placed {
-            let mesher = match meshers.iter().position(|(h, _)| *h == p.hint) {
-                Some(i) => &mut meshers[i].1,
-                None => {
-                    meshers.push((p.hint, Mesher::new(mesh_options(p.hint))?));
-                    &mut meshers.last_mut().expect("just pushed").1
-                }
-            };
-            meshes.push(mesher.mesh(p.plant)?);
+            meshes.push(mesher_for(&mut meshers, p.hint)?.mesh(p.plant)?);
         }
         let nodes = placed
             .iter()
@@ -183,6 +188,18 @@ impl SceneAssets {
             .collect();
         Scene { nodes }
     }
+}
+
+/// The mesher for plants of `hint`, made the first time it is asked for.
+fn mesher_for(meshers: &mut Vec<(MeshHint, Mesher)>, hint: MeshHint) -> Result<&mut Mesher, Error> {
+    let i = match meshers.iter().position(|(h, _)| *h == hint) {
+        Some(i) => i,
+        None => {
+            meshers.push((hint, Mesher::new(mesh_options(hint))?));
+            meshers.len() - 1
+        }
+    };
+    Ok(&mut meshers[i].1)
 }
 
 /// Meshes guide wires (a target surface, grid cells) thinly, for pictures.

@@ -161,6 +161,42 @@ impl Error {
     pub fn is_input(&self) -> bool {
         matches!(self, Error::Input(_))
     }
+
+    /// A refusal of legal input that asks for more than a limit or the memory budget allows
+    /// (a plant, mesh or file too large): the user's to change, like bad input.
+    pub fn is_limit(&self) -> bool {
+        use sylva_mesh::export::ExportError;
+        use sylva_mesh::mesher::MeshError;
+        let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(self);
+        while let Some(e) = cause {
+            let limit = e.is::<sylva_core::budget::OverBudget>()
+                || matches!(e.downcast_ref(), Some(DevelopError::TooLarge { .. }))
+                || matches!(
+                    e.downcast_ref(),
+                    Some(MeshError::TooManyTriangles { .. } | MeshError::TooManyVertices { .. })
+                )
+                || matches!(e.downcast_ref(), Some(ExportError::TooLarge { .. }))
+                || matches!(
+                    e.downcast_ref(),
+                    Some(sylva_plantmaker::GardenError::TooManyPlants(_))
+                );
+            if limit {
+                return true;
+            }
+            cause = e.source();
+        }
+        false
+    }
+
+    /// This error as bad input in `path` when it is a limit's refusal ([`Error::is_limit`]),
+    /// so it names the file; otherwise unchanged.
+    pub fn in_file(self, path: &Path) -> Error {
+        if self.is_limit() {
+            Error::Input(InputError::file_error(path, &self))
+        } else {
+            self
+        }
+    }
 }
 
 /// An error and its causes, joined by ": " (as `anyhow`'s `{:#}` prints them).

@@ -330,6 +330,14 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
             })?);
         }
         let (seed, population) = (self.run.seed, self.run.population as usize);
+        // A population and its offspring, each genome at the settings' bounds.
+        let genome = self.model.genome_bytes(&self.settings);
+        sylva_core::budget::check(
+            (population as u64).saturating_mul(genome).saturating_mul(2),
+            format_args!("a population of {population} (`population`)"),
+            "breed a smaller population, or smaller genomes",
+        )
+        .map_err(|e| InputError::new(source, e))?;
         let setup = setup(&self.model, &self.settings, typed, seed, population, source)?;
         let settings = RunSettings {
             seed,

@@ -20,6 +20,10 @@ use clap::{Parser, Subcommand};
                   then exports them as 3D assets (GLB, OBJ, VRML97) and pictures (PNG)."
 )]
 struct Cli {
+    /// Memory Sylva may use, like 4G or 512M [default: half of the machine's memory]. Work
+    /// that would need more is refused before it starts, with its estimate.
+    #[arg(long, global = true, value_parser = sylva_core::budget::parse_bytes)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -48,7 +52,11 @@ enum Command {
 
 fn main() -> ExitCode {
     diagnostic::install();
-    let command = Cli::parse().command;
+    let cli = Cli::parse();
+    if let Some(bytes) = cli.max_memory {
+        sylva_core::budget::set_max_memory(bytes);
+    }
+    let command = cli.command;
     // A panic would be a bug in Sylva: it is reported as one, in one line, with exit code 1.
     std::panic::set_hook(Box::new(diagnostic::report_bug));
     let result = std::panic::catch_unwind(|| match command {

@@ -266,3 +266,128 @@ fn every_config_number_is_range_checked_where_it_stands() {
     }
     fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn work_that_does_not_fit_is_refused_with_its_estimate() {
+    let dir = temp_dir("budget");
+    let glb = dir.join("x.glb");
+    // A small budget refuses even a small tree, naming the file, the estimate and the flag.
+    let stderr = refused(
+        &[
+            "grow",
+            &example("bintree/oak.json"),
+            "-o",
+            s(&glb),
+            "--max-memory",
+            "1M",
+        ],
+        2,
+        "oak.json",
+    );
+    assert!(
+        stderr.contains("would need about") && stderr.contains("--max-memory"),
+        "{stderr}"
+    );
+    // Automata limits at their documented maxima.
+    let automata = dir.join("a.json");
+    fs::write(
+        &automata,
+        r#"{"model": "automata", "format": 1, "program": "(Top (Wait))",
+            "limits": {"points": 100000000, "organs": 10000000, "automata": 1000000,
+                       "states": 1000000000, "states_per_step": 1000000}}"#,
+    )
+    .unwrap();
+    refused(
+        &["grow", s(&automata), "-o", s(&glb), "--max-memory", "1G"],
+        2,
+        "limits.points",
+    );
+    // A population of the largest automata trees.
+    let config = dir.join("c.toml");
+    fs::write(
+        &config,
+        "model = \"automata\"\n[run]\npopulation = 1000000\n[automata]\nmax_size = 5000\n",
+    )
+    .unwrap();
+    refused(
+        &["evolve", s(&config), "--out", s(&dir.join("run"))],
+        2,
+        "`population`",
+    );
+    // L-system plants at their bounds in an experiment.
+    let mut tree: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(example("lsystem/tree.json")).unwrap()).unwrap();
+    tree["physiology"]["max_symbols"] = 1_000_000.into();
+    tree["physiology"]["max_modules"] = 1_000_000.into();
+    let big = dir.join("big.json");
+    fs::write(&big, serde_json::to_string(&tree).unwrap()).unwrap();
+    fs::write(&config, format!("[lateral-light]\ntree = {:?}\n", s(&big))).unwrap();
+    refused(
+        &[
+            "simulate",
+            s(&config),
+            "--out",
+            s(&dir.join("sim")),
+            "--max-memory",
+            "256M",
+        ],
+        2,
+        "max_symbols",
+    );
+    // A garden file is held to the same limits as `--count`.
+    let mut garden: serde_json::Value = serde_json::json!({
+        "model": "plantmaker-garden", "format": 1, "area": [100000.0, 100000.0],
+        "placement_seed": 1, "plants": []
+    });
+    let fern: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(example("plantmaker/fern.json")).unwrap())
+            .unwrap();
+    let seeds: Vec<u64> = (0..200_000).collect();
+    garden["plants"] = serde_json::json!([{ "genome": fern, "seeds": seeds }]);
+    let file = dir.join("forest.garden.json");
+    fs::write(&file, serde_json::to_string(&garden).unwrap()).unwrap();
+    refused(&["garden", s(&file), "-o", s(&glb)], 2, "at most 100000");
+    assert!(!glb.exists());
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_glb_whose_nodes_share_children_is_refused_at_once() {
+    let dir = temp_dir("dag");
+    // Sixty levels of nodes that each name the next level twice over: 2^60 paths.
+    let nodes: Vec<serde_json::Value> = (0..60)
+        .map(|i| serde_json::json!({ "children": [2 * i + 1, 2 * i + 2] }))
+        .chain((0..61).map(|_| serde_json::json!({})))
+        .collect();
+    let mut nodes = nodes;
+    for i in 0..60 {
+        nodes[2 * i + 1] = serde_json::json!({ "children": [2 * i + 3] });
+        nodes[2 * i + 2] = serde_json::json!({ "children": [2 * i + 3] });
+    }
+    let json = serde_json::json!({ "asset": { "version": "2.0" }, "nodes": nodes });
+    let mut j = serde_json::to_vec(&json).unwrap();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let mut file = Vec::new();
+    for v in [
+        0x4654_6C67u32,
+        2,
+        (20 + j.len()) as u32,
+        j.len() as u32,
+        0x4E4F_534A,
+    ] {
+        file.extend(v.to_le_bytes());
+    }
+    file.extend(&j);
+    let path = dir.join("dag.glb");
+    fs::write(&path, file).unwrap();
+    let start = std::time::Instant::now();
+    refused(
+        &["render", s(&path), "-o", s(&dir.join("x.png"))],
+        2,
+        "more than one parent",
+    );
+    assert!(start.elapsed().as_secs() < 10);
+    fs::remove_dir_all(&dir).unwrap();
+}

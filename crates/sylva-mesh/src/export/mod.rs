@@ -154,7 +154,7 @@ pub enum ExportError {
         bytes: u64,
     },
     /// The file would not fit in the memory budget while it is made.
-    #[error(transparent)]
+    #[error("the file does not fit in memory while it is made")]
     OverBudget(#[from] sylva_core::budget::OverBudget),
     /// The glTF JSON could not be written.
     #[error("cannot write the glTF JSON")]

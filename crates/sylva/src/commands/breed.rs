@@ -17,7 +17,7 @@ use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva_mesh::{Scene, SceneNode};
 use sylva_model::Model;
 
-use super::SCENE_PICTURE;
+use super::{InFile, SCENE_PICTURE};
 
 /// Arguments of `sylva breed`.
 #[derive(clap::Args)]
@@ -86,7 +86,7 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
-    let assets = SceneAssets::mesh(&placed)?;
+    let assets = SceneAssets::mesh(&placed).in_file(&args.mother)?;
 
     let mut table =
         String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");

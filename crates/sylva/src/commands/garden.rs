@@ -12,7 +12,7 @@ use sylva_model::Model;
 use sylva_plantmaker::garden::GARDEN_MODEL;
 use sylva_plantmaker::{Garden, PlantMakerModel};
 
-use super::SCENE_PICTURE;
+use super::{InFile, SCENE_PICTURE};
 
 /// Arguments of `sylva garden`.
 #[derive(clap::Args)]
@@ -103,10 +103,10 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
-    let assets = SceneAssets::mesh(&placed)?;
+    let assets = SceneAssets::mesh(&placed).in_file(first)?;
     let scene = assets.scene();
     let mut out = Outputs::new();
-    out.add_scene(&args.output, &scene)?;
+    out.add_scene(&args.output, &scene).in_file(first)?;
     let garden_path = args.output.with_extension("garden.json");
     if !is_garden {
         out.add(&garden_path, garden.to_json().as_bytes())?;

@@ -7,6 +7,8 @@ use sylva::files::Outputs;
 use sylva::{Grown, load_genome};
 use sylva_mesh::render::View;
 
+use super::InFile;
+
 /// Arguments of `sylva grow`.
 #[derive(clap::Args)]
 pub struct GrowArgs {
@@ -35,9 +37,10 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     }
     let genome = load_genome(&args.genome)?;
     let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-    let grown = Grown::new(genome, seed, !args.hide_roots)?;
+    let grown = Grown::new(genome, seed, !args.hide_roots).in_file(&args.genome)?;
     let mut out = Outputs::new();
-    out.add_scene(&args.output, &grown.scene())?;
+    out.add_scene(&args.output, &grown.scene())
+        .in_file(&args.genome)?;
     if let Some(png) = &args.png {
         out.add(png, &picture(&grown.scene(), View::Iso, (800, 800))?)?;
     }

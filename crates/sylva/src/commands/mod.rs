@@ -8,6 +8,20 @@ pub mod grow;
 pub mod render;
 pub mod simulate;
 
+use std::path::Path;
+
+/// A result whose limit refusals name the input file they follow from.
+pub trait InFile<T> {
+    /// Limit and budget refusals become bad input in `path` ([`sylva::Error::in_file`]).
+    fn in_file(self, path: &Path) -> Result<T, sylva::Error>;
+}
+
+impl<T> InFile<T> for Result<T, sylva::Error> {
+    fn in_file(self, path: &Path) -> Result<T, sylva::Error> {
+        self.map_err(|e| e.in_file(path))
+    }
+}
+
 /// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
 pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
 

@@ -6,6 +6,8 @@ use sylva::assets::{check_png, write_picture};
 use sylva::{Grown, InputError, load_genome};
 use sylva_mesh::render::View;
 
+use super::InFile;
+
 /// Largest GLB read: 1 GiB.
 const MAX_GLB: u64 = 1 << 30;
 
@@ -47,7 +49,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     } else {
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-        let grown = Grown::new(genome, seed, !args.hide_roots)?;
+        let grown = Grown::new(genome, seed, !args.hide_roots).in_file(&args.file)?;
         write_picture(&grown.scene(), &args.output, args.view, args.size)?;
     }
     println!("wrote {}", args.output.display());

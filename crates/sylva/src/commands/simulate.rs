@@ -14,7 +14,7 @@ use sylva_lsystem::garden::records_csv;
 use sylva_mesh::render::View;
 use sylva_model::Model;
 
-use super::SCENE_PICTURE;
+use super::{InFile, SCENE_PICTURE};
 
 /// Arguments of `sylva simulate`.
 #[derive(clap::Args)]
@@ -74,7 +74,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
-    let assets = SceneAssets::mesh(&placed)?;
+    let assets = SceneAssets::mesh(&placed).in_file(path)?;
     let scene = assets.scene();
     files.add_scene(&out.join("scene.glb"), &scene)?;
     files.add(
