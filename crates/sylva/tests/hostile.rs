@@ -366,7 +366,7 @@ fn a_glb_whose_nodes_share_children_is_refused_at_once() {
     }
     let json = serde_json::json!({ "asset": { "version": "2.0" }, "nodes": nodes });
     let mut j = serde_json::to_vec(&json).unwrap();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut file = Vec::new();
