@@ -97,6 +97,12 @@ pub struct Checkpoint<G> {
 /// The checkpoint format this version writes and reads.
 pub const CHECKPOINT_FORMAT: u32 = 1;
 
+/// Most generations a run keeps for browsing.
+pub const MAX_HISTORY: usize = 10_000;
+
+/// The last generation a run may reach.
+pub const MAX_GENERATION: u32 = 1_000_000_000;
+
 /// An evolving population.
 pub struct Run<P: Problem, S> {
     problem: P,
@@ -194,6 +200,18 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
                 checkpoint.settings.population
             ));
         }
+        if checkpoint.settings.keep_history > MAX_HISTORY {
+            return bad(format!(
+                "it keeps {} generations; at most {MAX_HISTORY}",
+                checkpoint.settings.keep_history
+            ));
+        }
+        if checkpoint.generation > MAX_GENERATION {
+            return bad(format!(
+                "generation {} is past the last, {MAX_GENERATION}",
+                checkpoint.generation
+            ));
+        }
         if checkpoint.stats.len() != checkpoint.generation as usize + 1 {
             return bad(format!(
                 "{} statistics rows for generation {}",
@@ -232,7 +250,8 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
             self.history
                 .push_back((self.generation, self.population.clone()));
         }
-        self.generation += 1;
+        // A run stops growing its generation count at the last one (streams then repeat).
+        self.generation = (self.generation + 1).min(MAX_GENERATION);
         let mut ctx = Breeding::new(
             self.settings.seed,
             self.generation,
@@ -306,6 +325,7 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
     /// Keeps the last `generations` generations for browsing from now on (0 keeps none;
     /// the current one is always there). Results do not depend on it.
     pub fn set_keep_history(&mut self, generations: usize) {
+        let generations = generations.min(MAX_HISTORY);
         self.settings.keep_history = generations;
         while self.history.len() > generations {
             self.history.pop_front();
@@ -405,7 +425,8 @@ impl Browser {
     pub fn later<P: Problem, S: Strategy<P>>(&mut self, run: &Run<P, S>) -> bool {
         let moved = self.generation < run.generation();
         if moved {
-            self.generation += 1;
+            // A run stops growing its generation count at the last one (streams then repeat).
+            self.generation = (self.generation + 1).min(MAX_GENERATION);
         }
         moved
     }

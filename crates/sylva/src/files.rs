@@ -70,6 +70,26 @@ pub fn create_dir(path: &Path) -> Result<(), Error> {
     })
 }
 
+/// Removes the temporary files that a killed command left in `dir` while writing one of
+/// `names` (`.<name>.<anything>.tmp`); nothing else is touched.
+pub fn remove_leftovers(dir: &Path, names: &[&str]) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(file) = file.to_str() else { continue };
+        let ours = file.ends_with(".tmp")
+            && file.starts_with('.')
+            && names
+                .iter()
+                .any(|n| file.trim_start_matches('.').starts_with(&format!("{n}.")));
+        if ours {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
 /// The files one command writes, which appear together or not at all. Each file is written
 /// to a temporary name beside its destination as it is added; [`Outputs::commit`] renames
 /// them all into place. Dropped without a commit (an error on the way), the temporary
@@ -111,13 +131,20 @@ impl Outputs {
             std::process::id(),
             self.staged.len()
         ));
-        // The destination is named in errors: the temporary name is ours, not the user's.
-        sylva_core::io::write_atomic(&temp, bytes).map_err(|source| Error::Io {
+        // Written whole and synced before the commit renames it; the destination is named in
+        // errors (the temporary name is ours, not the user's).
+        let written = (|| {
+            use std::io::Write;
+            let mut file = std::fs::File::create(&temp)?;
+            file.write_all(bytes)?;
+            file.sync_all()
+        })();
+        self.staged.push((temp, path.to_owned()));
+        written.map_err(|source| Error::Io {
             action: "writing",
             path: path.to_owned(),
             source,
         })?;
-        self.staged.push((temp, path.to_owned()));
         Ok(())
     }
 

@@ -15,6 +15,18 @@ use sylva::files::Outputs;
 
 const CHECKPOINT: &str = "checkpoint.json";
 
+/// Every file a run writes in its folder.
+const FILES: [&str; 8] = [
+    CHECKPOINT,
+    "config.toml",
+    "stats.csv",
+    "fitness.svg",
+    "best.json",
+    "best.glb",
+    "best.png",
+    "population.png",
+];
+
 /// Arguments of `sylva evolve`; a flag left out keeps the config's value.
 #[derive(clap::Args)]
 pub struct EvolveArgs {
@@ -69,6 +81,8 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
         Evolution::start(&config, start, pool.clone())?
     };
     sylva::files::create_dir(&out)?;
+    // A run killed while writing left temporary files: they go.
+    sylva::files::remove_leftovers(&out, &FILES);
     breed(&mut evolution, &config, &checkpoint)?;
     write_results(&evolution, &config, &out, &pool)
 }
