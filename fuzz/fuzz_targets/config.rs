@@ -5,6 +5,8 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let _ = sylva::Config::parse(std::path::Path::new("c.toml"), text);
 });

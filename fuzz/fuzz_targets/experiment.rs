@@ -7,7 +7,9 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     match toml::from_str::<Simulation>(text) {
         Ok(s) => {
             let _ = s.genome_files();

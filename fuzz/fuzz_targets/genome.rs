@@ -8,8 +8,12 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(genome) = sylva::parse_genome(Path::new("g.json"), text) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(genome) = sylva::parse_genome(Path::new("g.json"), text) else {
+        return;
+    };
     let _ = genome.to_json();
     if genome.model() != "lsystem" {
         let _ = genome.develop(genome.default_seed());

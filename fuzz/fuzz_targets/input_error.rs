@@ -21,7 +21,9 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let (a, b) = (word(&data[0..8]), word(&data[8..16]));
-    let Ok(text) = std::str::from_utf8(&data[16..]) else { return };
+    let Ok(text) = std::str::from_utf8(&data[16..]) else {
+        return;
+    };
     let path = Path::new("f");
     let _ = InputError::at(path, text, a, b, String::new());
     let _ = InputError::spanned(path, text, a..b, String::new());

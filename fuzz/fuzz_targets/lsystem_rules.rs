@@ -8,7 +8,9 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let mut lines = text.lines();
     let axiom = lines.next().unwrap_or("");
     let rules: Vec<&str> = lines.collect();

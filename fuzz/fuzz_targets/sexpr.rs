@@ -7,8 +7,12 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(tree) = GpTree::parse(text) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(tree) = GpTree::parse(text) else {
+        return;
+    };
     let _ = tree.to_string();
     let program = Program::compile(&tree, &Semantics::default());
     let mut plant = sylva_core::Plant::default();

@@ -391,10 +391,18 @@ impl Reader<'_> {
             return Err(invalid("only the GLB's own buffer 0 is read"));
         }
         let stride = view["byteStride"].as_u64().map_or(element, |s| s as usize);
-        let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
-            + accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
-        let view_end = view["byteOffset"].as_u64().unwrap_or(0) as usize
-            + view["byteLength"].as_u64().unwrap_or(0) as usize;
+        // Offsets come from the file: add them checked, so that huge ones are refused.
+        let field = |item: &Value, key: &str| item[key].as_u64().unwrap_or(0);
+        let overflow = || ImportError::Truncated("buffer view or accessor offset overflows".into());
+        let view_start = field(view, "byteOffset");
+        let start = view_start
+            .checked_add(field(accessor, "byteOffset"))
+            .and_then(|s| usize::try_from(s).ok())
+            .ok_or_else(overflow)?;
+        let view_end = view_start
+            .checked_add(field(view, "byteLength"))
+            .and_then(|e| usize::try_from(e).ok())
+            .ok_or_else(overflow)?;
         let needed = if count == 0 {
             0
         } else {
@@ -561,6 +569,21 @@ mod tests {
                 indices: vec![0, 1, 2],
             }],
             materials: vec![Material::of_kind(MaterialKind::Leaf)],
+        }
+    }
+
+    /// The fuzzer's finds: offsets near `u64::MAX` once overflowed an addition (a panic in
+    /// builds with overflow checks, as this test's); now they are refused as truncated.
+    #[test]
+    fn huge_offsets_found_by_the_fuzzer_are_refused() {
+        let folder = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fuzz/regressions/glb");
+        for name in ["view-end-add-overflow", "accessor-start-add-overflow"] {
+            let bytes = std::fs::read(format!("{folder}/{name}")).unwrap();
+            let error = read_glb(&bytes).unwrap_err();
+            assert!(
+                matches!(error, ImportError::Truncated(_)),
+                "{name}: {error}"
+            );
         }
     }
 
