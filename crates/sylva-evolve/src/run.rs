@@ -356,6 +356,31 @@ impl<P: Problem, S: Strategy<P>> Run<P, S> {
             .find(|ind| ind.id == id)
     }
 
+    /// Puts `genomes` (migrants from another population, as island models exchange them) in
+    /// the places of the current population's worst members, one each, and evaluates them.
+    /// They get new ids and the operator `"immigrant"`; their evaluations count toward the
+    /// current generation's row. Ties among the worst go to the higher slot; genomes beyond
+    /// the population's size are ignored. Returns the slots filled, in the order given.
+    pub fn immigrate(&mut self, genomes: Vec<P::Genome>) -> Vec<usize> {
+        let mut worst = crate::strategy::fittest(&self.population, self.population.len());
+        worst.reverse();
+        worst.truncate(genomes.len());
+        for (&slot, genome) in worst.iter().zip(genomes) {
+            self.population[slot] = Individual {
+                id: IndividualId(self.next_id),
+                genome,
+                fitness: None,
+                origin: Origin::new(self.generation, "immigrant"),
+            };
+            self.next_id += 1;
+        }
+        let evaluations = evaluate_missing(&self.problem, &mut self.population, &self.evaluator);
+        if let Some(row) = self.stats.last_mut() {
+            row.evaluations += evaluations;
+        }
+        worst
+    }
+
     /// Everything needed to resume.
     pub fn checkpoint(&self) -> Checkpoint<P::Genome> {
         Checkpoint {

@@ -202,3 +202,41 @@ fn clones_stall_the_papers_step_unless_culled() {
         );
     }
 }
+
+#[test]
+fn immigrants_take_the_places_of_the_worst() {
+    let mut home = Run::new(Rugged, strategy(), Pool::Serial, settings(20)).unwrap();
+    let mut away = Run::new(Rugged, strategy(), Pool::Serial, settings(20)).unwrap();
+    away.run_batch(30, |_| {});
+    let migrants: Vec<Bits> = sylva_evolve::fittest(away.population(), 3)
+        .into_iter()
+        .map(|i| away.population()[i].genome)
+        .collect();
+    let worst_before: Vec<f64> = {
+        let mut totals: Vec<f64> = home.population().iter().map(|i| i.total()).collect();
+        totals.sort_by(f64::total_cmp);
+        totals
+    };
+    let next_id = home.checkpoint().next_id;
+    let evaluations = home.stats()[0].evaluations;
+    let slots = home.immigrate(migrants.clone());
+    assert_eq!(slots.len(), 3);
+    for (slot, genome) in slots.iter().zip(&migrants) {
+        let ind = &home.population()[*slot];
+        assert_eq!(&ind.genome, genome);
+        assert_eq!(ind.origin.operator, "immigrant");
+        assert!(ind.id.0 >= next_id);
+        assert!(ind.fitness.is_some());
+    }
+    // The three worst are gone: everything left of the natives beats the third worst.
+    let natives: Vec<f64> = (0..20)
+        .filter(|i| !slots.contains(i))
+        .map(|i| home.population()[i].total())
+        .collect();
+    assert!(natives.iter().all(|&t| t >= worst_before[2]));
+    assert_eq!(home.stats()[0].evaluations, evaluations + 3);
+    // Too many migrants: the population keeps its size.
+    let all: Vec<Bits> = vec![migrants[0]; 25];
+    assert_eq!(home.immigrate(all).len(), 20);
+    assert_eq!(home.population().len(), 20);
+}

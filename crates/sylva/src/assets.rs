@@ -17,7 +17,8 @@ use sylva_mesh::export::{self, Format};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::{Mesh, Scene, SceneNode};
-use sylva_model::MeshHint;
+use sylva_model::{MeshHint, Model};
+use sylva_plantmaker::{Garden, PlantMakerModel};
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
@@ -188,6 +189,36 @@ impl SceneAssets {
             .collect();
         Scene { nodes }
     }
+}
+
+/// Grows a PlantMaker garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...),
+/// each standing at its placement and carrying its genome and seed. Errors name `source`,
+/// the garden's file (or whatever a front end calls it).
+pub fn garden_assets(garden: &Garden, source: &Path) -> Result<SceneAssets, Error> {
+    let grown = garden
+        .grow()
+        .map_err(|e| InputError::file_error(source, &e))?;
+    let hint = PlantMakerModel.mesh_hint();
+    let placed: Vec<Placed> = grown
+        .placements
+        .iter()
+        .zip(&grown.plants)
+        .enumerate()
+        .map(|(i, (placement, plant))| {
+            let genome = &garden.plants[placement.group].genome;
+            let origin = Origin::of(
+                &Genome::new(PlantMakerModel, genome.clone()),
+                placement.seed,
+            );
+            Placed {
+                translation: placement.translation,
+                rotation: placement.rotation(),
+                extras: Some(origin.extras()),
+                ..Placed::new(format!("plant-{i}"), plant, hint)
+            }
+        })
+        .collect();
+    SceneAssets::mesh(&placed).map_err(|e| e.in_file(source))
 }
 
 /// The mesher for plants of `hint`, made the first time it is asked for.

@@ -547,6 +547,8 @@ trait AnyRun: Send {
     fn keep_history(&mut self, generations: usize);
     fn checkpoint(&self) -> Result<String, Error>;
     fn guides(&self) -> Option<Plant>;
+    fn emigrants(&self, count: usize) -> Vec<String>;
+    fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError>;
 }
 
 struct TypedRun<M: Evolve> {
@@ -639,6 +641,34 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
 
     fn guides(&self) -> Option<Plant> {
         self.config.model.guides(self.run.problem())
+    }
+
+    fn emigrants(&self, count: usize) -> Vec<String> {
+        let population = self.run.population();
+        sylva_evolve::fittest(population, count)
+            .into_iter()
+            .map(|i| serde_json::to_string(&population[i].genome).unwrap_or_default())
+            .collect()
+    }
+
+    fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError> {
+        let genomes = migrants
+            .iter()
+            .enumerate()
+            .map(|(i, text)| {
+                serde_json::from_str(text).map_err(|e| {
+                    InputError::new(
+                        format!("migrant {}", i + 1),
+                        format!("not an evolved `{}` genome of this run: {e}", M::NAME),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let slots = self.run.immigrate(genomes);
+        Ok(slots
+            .into_iter()
+            .map(|slot| self.run.population()[slot].id)
+            .collect())
     }
 }
 
@@ -833,5 +863,19 @@ impl Evolution {
     /// model's fitness has any.
     pub fn guides(&self) -> Option<Plant> {
         self.inner.guides()
+    }
+
+    /// The `count` fittest genomes of the current population, fittest first, as the engine
+    /// evolves them (JSON text): what an island sends to its neighbours.
+    pub fn emigrants(&self, count: usize) -> Vec<String> {
+        self.inner.emigrants(count)
+    }
+
+    /// Puts migrants from [`Evolution::emigrants`] of another run of the same config (its
+    /// seed may differ) in the places of the current population's worst members, and
+    /// evaluates them; returns their new ids. Nothing changes if any migrant is not a genome
+    /// of this run.
+    pub fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError> {
+        self.inner.immigrate(migrants)
     }
 }

@@ -3,12 +3,11 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, asset_format, check_png, picture};
+use sylva::assets::{asset_format, check_png, garden_assets, picture};
 use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
 use sylva::{Genome, InputError};
 use sylva_mesh::render::View;
-use sylva_model::Model;
 use sylva_plantmaker::garden::GARDEN_MODEL;
 use sylva_plantmaker::{Garden, PlantMakerModel};
 
@@ -80,30 +79,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         }
         garden
     };
-    let grown = garden
-        .grow()
-        .map_err(|e| InputError::file_error(first, &e))?;
-    let hint = PlantMakerModel.mesh_hint();
-    let placed: Vec<Placed> = grown
-        .placements
-        .iter()
-        .zip(&grown.plants)
-        .enumerate()
-        .map(|(i, (placement, plant))| {
-            let genome = &garden.plants[placement.group].genome;
-            let origin = Origin::of(
-                &Genome::new(PlantMakerModel, genome.clone()),
-                placement.seed,
-            );
-            Placed {
-                translation: placement.translation,
-                rotation: placement.rotation(),
-                extras: Some(origin.extras()),
-                ..Placed::new(format!("plant-{i}"), plant, hint)
-            }
-        })
-        .collect();
-    let assets = SceneAssets::mesh(&placed).in_file(first)?;
+    let assets = garden_assets(&garden, first)?;
     let scene = assets.scene();
     let mut out = Outputs::new();
     out.add_scene(&args.output, &scene).in_file(first)?;
