@@ -1,0 +1,58 @@
+"""Sylva: grow and evolve 3D plants from genomes.
+
+The heavy work runs in Rust (Sylva's library, the same one the ``sylva`` command line
+stands on); long calls release the GIL.
+
+>>> import sylva
+>>> g = sylva.Genome.load("examples/plantmaker/tulip.json")
+>>> plant = g.grow()
+>>> plant.mesh.positions.shape            # doctest: +SKIP
+(5230, 3)
+>>> plant.export("tulip.glb")
+
+Genomes of the four models (``bintree``, ``automata``, ``plantmaker``, ``lsystem``) are
+:class:`Genome`; a grown one is a :class:`Plant`; many plants make a :class:`Scene`
+(:func:`garden`, :func:`scene`). :class:`Config` and :class:`Evolution` run evolutions;
+:func:`islands` runs several populations at once, on Ray when it is installed and on a
+local process pool otherwise. Errors are :class:`SylvaError`, :class:`InputError` (bad
+input, with its file, line and column) and :class:`LimitError`.
+"""
+
+from __future__ import annotations
+
+from ._sylva import (
+    Config,
+    Evolution,
+    Genome,
+    Member,
+    Mesh,
+    Plant,
+    Scene,
+    __version__,
+    cross,
+    garden,
+    models,
+    scene,
+)
+from .errors import InputError, LimitError, SylvaError
+from .islands import IslandsResult, islands
+
+__all__ = [
+    "Config",
+    "Evolution",
+    "Genome",
+    "InputError",
+    "IslandsResult",
+    "LimitError",
+    "Member",
+    "Mesh",
+    "Plant",
+    "Scene",
+    "SylvaError",
+    "__version__",
+    "cross",
+    "garden",
+    "islands",
+    "models",
+    "scene",
+]

@@ -1,0 +1,236 @@
+"""Typed stubs of Sylva's native module (``sylva._sylva``); see the docstrings at run time."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = str | os.PathLike[str]
+
+class Genome:
+    """A genome of any of Sylva's models; ``genome["field"]`` reads and sets its fields."""
+
+    @staticmethod
+    def load(path: _Path) -> Genome:
+        """Reads a genome file of any model."""
+    @staticmethod
+    def from_dict(data: dict[str, Any]) -> Genome:
+        """A genome from a dict shaped like a genome file (with its ``model`` and ``format``)."""
+    @staticmethod
+    def from_json(text: str, source: str = "<json>") -> Genome:
+        """A genome from a genome file's JSON text; ``source`` names it in errors."""
+    @staticmethod
+    def random(model: str, seed: int, settings: dict[str, Any] | None = None) -> Genome:
+        """A random genome of ``model``, made by the model with ``settings``."""
+    @property
+    def model(self) -> str:
+        """The model's name: "bintree", "automata", "plantmaker" or "lsystem"."""
+    @property
+    def title(self) -> str:
+        """The model's title."""
+    @property
+    def default_seed(self) -> int:
+        """The seed the genome grows with when none is given."""
+    def to_dict(self) -> dict[str, Any]:
+        """The genome as a dict, exactly as its file holds it."""
+    def to_json(self) -> str:
+        """The genome file's text."""
+    def save(self, path: _Path) -> None:
+        """Writes the genome file (atomically)."""
+    def fields(self) -> list[str]:
+        """The names of the genome's fields (``model`` and ``format`` left out)."""
+    def __getitem__(self, field: str) -> Any:
+        """A field's value; dotted paths reach into nested fields and lists."""
+    def __setitem__(self, field: str, value: Any) -> None:
+        """Sets a field in place, checked as the genome file would be."""
+    def with_field(self, field: str, value: Any) -> Genome:
+        """A copy with ``field`` set to ``value``, checked as the genome file would be."""
+    def grow(self, seed: int | None = None, roots: bool = True) -> Plant:
+        """Grows and meshes the plant with ``seed`` (the genome's own when None)."""
+    def mutate(self, seed: int, settings: dict[str, Any] | None = None) -> Genome:
+        """A mutated copy, made by the model's own mutation."""
+    def __eq__(self, other: object) -> bool: ...
+
+class Mesh:
+    """A triangle mesh as read-only numpy arrays that view the plant's memory (no copy);
+    ``.copy()`` one to edit it."""
+
+    positions: npt.NDArray[np.float32]
+    """(n, 3) vertex positions, metres."""
+    normals: npt.NDArray[np.float32]
+    """(n, 3) unit vertex normals."""
+    uvs: npt.NDArray[np.float32]
+    """(n, 2) texture coordinates."""
+    indices: npt.NDArray[np.uint32]
+    """(t, 3) vertex indices of each triangle."""
+    triangle_materials: npt.NDArray[np.uint32]
+    """(t,) index into ``materials`` of each triangle."""
+    materials: list[dict[str, Any]]
+    """Each material: ``name``, ``kind`` (bark, leaf, flower, root), ``color``, ``texture``."""
+
+class Plant:
+    """A grown genome: measures, mesh, exports and pictures."""
+
+    @property
+    def genome(self) -> Genome: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def segments(self) -> int: ...
+    @property
+    def organs(self) -> int: ...
+    @property
+    def tips(self) -> int: ...
+    @property
+    def height(self) -> float: ...
+    @property
+    def bounds(self) -> tuple[list[float], list[float]]: ...
+    @property
+    def surface_area(self) -> float: ...
+    @property
+    def volume(self) -> float: ...
+    @property
+    def total_length(self) -> float: ...
+    def measures(self) -> dict[str, float]:
+        """The measures of Susinno's paper, as a dict."""
+    @property
+    def mesh(self) -> Mesh: ...
+    def export(self, path: _Path) -> None:
+        """Writes GLB, OBJ or VRML97 by the extension; all or nothing."""
+    def glb(self) -> bytes:
+        """The plant as GLB bytes."""
+    def render(
+        self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (800, 800)
+    ) -> bytes:
+        """PNG bytes of a picture, also written to ``path`` when given."""
+
+class Scene:
+    """Many plants in one scene."""
+
+    @property
+    def plants(self) -> int: ...
+    @property
+    def triangles(self) -> int: ...
+    @property
+    def garden(self) -> str | None:
+        """The garden file's text that grows this scene again, for gardens."""
+    def meshes(self) -> list[Mesh]: ...
+    def export(self, path: _Path) -> None: ...
+    def glb(self) -> bytes: ...
+    def render(
+        self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (1200, 800)
+    ) -> bytes: ...
+
+class Config:
+    """An evolution config of any model that evolves."""
+
+    @staticmethod
+    def load(path: _Path) -> Config: ...
+    @staticmethod
+    def from_toml(text: str, source: str = "<toml>", base: _Path | None = None) -> Config: ...
+    @staticmethod
+    def from_dict(data: dict[str, Any], base: _Path | None = None) -> Config: ...
+    @staticmethod
+    def default() -> Config: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def base(self) -> str:
+        """The folder its ``start`` genome files are found in."""
+    @property
+    def generations(self) -> int: ...
+    @property
+    def population(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def threads(self) -> int: ...
+    def with_run(self, **fields: Any) -> Config:
+        """A copy with ``[run]`` fields changed, each checked against its range."""
+    def to_toml(self) -> str: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+class Member:
+    """A member of a run's population."""
+
+    id: int
+    genome: Genome
+    fitness: float | None
+    terms: dict[str, float]
+    generation: int
+    operator: str
+    parents: list[int]
+
+class Evolution:
+    """An evolution run of any model."""
+
+    def __init__(
+        self, config: Config, start: Sequence[Genome] | None = None, threads: int | None = None
+    ) -> None: ...
+    @staticmethod
+    def resume(
+        config: Config,
+        path: _Path | None = None,
+        text: str | None = None,
+        threads: int | None = None,
+    ) -> Evolution: ...
+    @property
+    def config(self) -> Config: ...
+    @property
+    def generation(self) -> int: ...
+    @property
+    def term_names(self) -> list[str]: ...
+    def step(self) -> dict[str, Any]:
+        """Breeds one generation; returns its statistics row."""
+    def run(
+        self,
+        generations: int | None = None,
+        on_generation: Callable[[dict[str, Any]], Any] | None = None,
+    ) -> None: ...
+    @property
+    def stats(self) -> list[dict[str, Any]]: ...
+    def population(self) -> list[Member]: ...
+    def best(self) -> Member: ...
+    def fittest(self, count: int) -> list[Member]: ...
+    def member(self, id: int) -> Member | None: ...
+    def family(self, id: int) -> list[Member]: ...
+    def generation_members(self, generation: int) -> list[Member] | None: ...
+    def keep_history(self, generations: int) -> None: ...
+    def checkpoint(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+    def emigrants(self, count: int) -> list[bytes]: ...
+    def immigrate(self, migrants: Sequence[bytes]) -> list[int]: ...
+
+def cross(
+    parents: Sequence[Genome],
+    seed: int,
+    dominance: Sequence[float] | None = None,
+    settings: dict[str, Any] | None = None,
+) -> tuple[Genome, list[int]]:
+    """A child of two or more parents of one model, by the model's own crossover."""
+
+def models() -> dict[str, str]:
+    """The models Sylva knows: name to title."""
+
+def garden(
+    genomes: Sequence[Genome] = ...,
+    count: int = 20,
+    area: tuple[float, float] = (20.0, 20.0),
+    seed: int = 1,
+    path: _Path | None = None,
+) -> Scene:
+    """Grows a PlantMaker garden, from genomes or a garden file."""
+
+def scene(
+    plants: Sequence[Plant],
+    positions: Sequence[tuple[float, float]],
+    turns: Sequence[float] | None = None,
+) -> Scene:
+    """Puts grown plants in one scene."""

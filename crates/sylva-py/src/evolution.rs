@@ -1,0 +1,514 @@
+//! `Config` and `Evolution`: evolution runs of any model, stepped from Python, and the
+//! migrants islands exchange.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use sylva::{Evolution as Run, Member as RunMember};
+use sylva_evolve::{GenerationStats, IndividualId};
+
+use crate::errors::{IntoPy, bad_value, input_error};
+use crate::genome::Genome;
+use crate::json::{from_py, to_py};
+
+/// An evolution config of any model that evolves: read from a TOML file (`Config.load`),
+/// TOML text (`Config.from_toml`) or a dict shaped like the file (`Config.from_dict`).
+/// Every number is range-checked as it is read; a bad one raises `InputError` naming it.
+#[pyclass(module = "sylva", name = "Config")]
+#[derive(Clone)]
+pub struct Config {
+    pub inner: sylva::Config,
+    /// The folder its `start` genome files are found in.
+    pub base: PathBuf,
+}
+
+/// Where a config given as a dict is named in errors.
+const DICT: &str = "<config dict>";
+
+impl Config {
+    fn parse(text: &str, source: &Path, base: PathBuf) -> PyResult<Config> {
+        let inner = sylva::Config::parse(source, text).py()?;
+        Ok(Config { inner, base })
+    }
+
+    /// The config with its run section changed through TOML, so the same range checks apply.
+    fn with_run_field(&self, field: &str, value: toml::Value) -> PyResult<Config> {
+        let mut table: toml::Table =
+            toml::from_str(&self.inner.to_toml()).map_err(|e| bad_value(field, e))?;
+        if let Some(toml::Value::Table(run)) = table.get_mut("run") {
+            run.insert(field.to_owned(), value);
+        }
+        let text = toml::to_string(&table).map_err(|e| bad_value(field, e))?;
+        let inner = sylva::Config::parse(Path::new(DICT), &text)
+            .map_err(|e| field_error(e, &text))
+            .map_err(|e| input_error(&e))?;
+        Ok(Config {
+            inner,
+            base: self.base.clone(),
+        })
+    }
+}
+
+/// A config error in TOML made from a dict, named by its field (`run.population`) rather
+/// than a line of text the user never saw.
+fn field_error(e: sylva::InputError, text: &str) -> sylva::InputError {
+    if e.line == 0 {
+        return e;
+    }
+    let mut table = String::new();
+    let mut key = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            table = name.trim().to_owned();
+        }
+        if i + 1 == e.line {
+            key = line.split('=').next().unwrap_or_default().trim().to_owned();
+            break;
+        }
+    }
+    let field = match (table.is_empty(), key.starts_with('[')) {
+        (_, true) => table,
+        (true, false) => key,
+        (false, false) => format!("{table}.{key}"),
+    };
+    sylva::InputError::new(format!("{DICT} `{field}`"), e.message)
+}
+
+#[pymethods]
+impl Config {
+    /// Reads a config file; genome files it names are found next to it.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Config> {
+        let inner = sylva::Config::load(&path).py()?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(Config { inner, base })
+    }
+
+    /// A config from TOML text; `source` names it in errors, and genome files it names are
+    /// found in `base` (the current folder by default).
+    #[staticmethod]
+    #[pyo3(signature = (text, source = "<toml>", base = None))]
+    fn from_toml(text: &str, source: &str, base: Option<PathBuf>) -> PyResult<Config> {
+        Config::parse(text, Path::new(source), base.unwrap_or_default())
+    }
+
+    /// A config from a dict shaped like the file: `{"model": "automata", "run":
+    /// {"population": 500}, "automata": {...}}`. Errors name the field.
+    #[staticmethod]
+    #[pyo3(signature = (data, base = None))]
+    fn from_dict(data: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<Config> {
+        let value = from_py(data, "config dict")?;
+        let text =
+            toml::to_string(&value).map_err(|e| bad_value(DICT, format!("not a config: {e}")))?;
+        let inner = sylva::Config::parse(Path::new(DICT), &text)
+            .map_err(|e| input_error(&field_error(e, &text)))?;
+        Ok(Config {
+            inner,
+            base: base.unwrap_or_default(),
+        })
+    }
+
+    /// The default config (binary trees, every setting at its default).
+    #[staticmethod]
+    fn default() -> Config {
+        Config {
+            inner: sylva::Config::default(),
+            base: PathBuf::new(),
+        }
+    }
+
+    /// The model evolved.
+    #[getter]
+    fn model(&self) -> &'static str {
+        self.inner.model()
+    }
+
+    /// The folder its `start` genome files are found in.
+    #[getter]
+    fn base(&self) -> PathBuf {
+        self.base.clone()
+    }
+
+    /// The config as TOML.
+    fn to_toml(&self) -> String {
+        self.inner.to_toml()
+    }
+
+    /// The config as a dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let table: toml::Table =
+            toml::from_str(&self.inner.to_toml()).map_err(|e| bad_value("config", e))?;
+        let value = serde_json::to_value(table).map_err(|e| bad_value("config", e))?;
+        to_py(py, &value)
+    }
+
+    /// Generations bred after the first (0 to 1,000,000).
+    #[getter]
+    fn generations(&self) -> u32 {
+        self.inner.run().generations
+    }
+
+    /// Individuals per generation (1 to 1,000,000).
+    #[getter]
+    fn population(&self) -> u32 {
+        self.inner.run().population
+    }
+
+    /// Seed of every random choice.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.inner.run().seed
+    }
+
+    /// Worker threads (0: one per core); results do not depend on it.
+    #[getter]
+    fn threads(&self) -> u32 {
+        self.inner.run().threads
+    }
+
+    /// A copy with `[run]` fields changed (generations, population, seed, threads,
+    /// checkpoint_seconds), each checked against its range.
+    #[pyo3(signature = (**fields))]
+    fn with_run(&self, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+        let mut config = self.clone();
+        if let Some(fields) = fields {
+            for (k, v) in fields.iter() {
+                let key: String = k.extract()?;
+                let value = from_py(&v, &key)?;
+                let value = toml::Value::try_from(value).map_err(|e| bad_value(&key, e))?;
+                config = config.with_run_field(&key, value)?;
+            }
+        }
+        Ok(config)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<sylva.Config {}>", self.inner.model())
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let from_toml = py.get_type::<Config>().getattr("from_toml")?;
+        let base = self.base.clone();
+        Ok((from_toml, (self.inner.to_toml(), "<toml>", base))
+            .into_pyobject(py)?
+            .into_any())
+    }
+}
+
+/// A member of a run's population: its id, genome, fitness and origin.
+#[pyclass(module = "sylva", name = "Member", frozen, get_all)]
+pub struct Member {
+    /// Its run-wide id.
+    id: u64,
+    /// Its genome.
+    genome: Genome,
+    /// Its total fitness (None before evaluation).
+    fitness: Option<f64>,
+    /// Its fitness terms, by name.
+    terms: Py<PyAny>,
+    /// The generation it was born in.
+    generation: u32,
+    /// The operator that made it ("random", "crossover+mutation", "immigrant", ...).
+    operator: String,
+    /// Its parents' ids.
+    parents: Vec<u64>,
+}
+
+impl Member {
+    fn of(py: Python<'_>, m: RunMember, names: &[String]) -> PyResult<Member> {
+        let terms = PyDict::new(py);
+        if let Some(f) = &m.fitness {
+            for (name, value) in names.iter().zip(f.terms()) {
+                terms.set_item(name, value)?;
+            }
+        }
+        Ok(Member {
+            id: m.id.0,
+            fitness: m.fitness.map(|f| f.total()),
+            genome: Genome { inner: m.genome },
+            terms: terms.into_any().unbind(),
+            generation: m.origin.generation,
+            operator: m.origin.operator.into_owned(),
+            parents: m.origin.parents.iter().map(|p| p.0).collect(),
+        })
+    }
+}
+
+#[pymethods]
+impl Member {
+    fn __repr__(&self) -> String {
+        format!(
+            "<sylva.Member {} fitness {}>",
+            self.id,
+            self.fitness.map_or("-".to_owned(), |f| format!("{f:.4}"))
+        )
+    }
+}
+
+/// An evolution run of any model. `Evolution(config)` makes and scores generation 0
+/// (with the config's `start` genomes, or `start` given here); `step` breeds one
+/// generation, `run` a batch; `stats`, `population`, `best`, `fittest` and `family` read
+/// it; `checkpoint`/`save` and `Evolution.resume` stop and go on exactly. Long calls
+/// release the GIL.
+#[pyclass(module = "sylva", name = "Evolution")]
+pub struct Evolution {
+    run: Mutex<Run>,
+}
+
+impl Evolution {
+    fn with<T>(&self, f: impl FnOnce(&mut Run) -> T) -> T {
+        // A panic inside a step would poison the lock; the run's state is still whole.
+        let mut run = self.run.lock().unwrap_or_else(|e| e.into_inner());
+        f(&mut run)
+    }
+
+    fn pool(config: &sylva::Config, threads: Option<u32>) -> PyResult<sylva_core::par::Pool> {
+        let threads = threads.unwrap_or(config.run().threads);
+        if threads > 1024 {
+            return Err(bad_value(
+                "threads",
+                format!("{threads}; expected 0 to 1024"),
+            ));
+        }
+        sylva_core::par::Pool::with_threads(threads as usize)
+            .map_err(sylva::Error::from)
+            .py()
+    }
+}
+
+/// A statistics row as a dict: generation, best, mean, best_id, evaluations, seconds, and
+/// each term of the best by name.
+fn row<'py>(
+    py: Python<'py>,
+    s: &GenerationStats,
+    names: &[String],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("generation", s.generation)?;
+    d.set_item("best", s.best)?;
+    d.set_item("mean", s.mean)?;
+    d.set_item("best_id", s.best_id.0)?;
+    d.set_item("evaluations", s.evaluations)?;
+    d.set_item("seconds", s.seconds)?;
+    for (name, value) in names.iter().zip(&s.best_terms) {
+        d.set_item(name, value)?;
+    }
+    Ok(d)
+}
+
+#[pymethods]
+impl Evolution {
+    /// Starts a run: generation 0 made and scored. `start` genomes are its first members
+    /// (the config's `start` files when left out); `threads` overrides the config's.
+    #[new]
+    #[pyo3(signature = (config, start = None, threads = None))]
+    fn new(
+        py: Python<'_>,
+        config: &Config,
+        start: Option<Vec<Genome>>,
+        threads: Option<u32>,
+    ) -> PyResult<Evolution> {
+        let start = match start {
+            Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
+            None => config.inner.load_start(&config.base).py()?,
+        };
+        let pool = Evolution::pool(&config.inner, threads)?;
+        let inner = &config.inner;
+        let run = py.detach(|| Run::start(inner, start, pool)).py()?;
+        Ok(Evolution {
+            run: Mutex::new(run),
+        })
+    }
+
+    /// Resumes a run from a checkpoint file (`path`) or its text (`text`), written by the
+    /// same config (only generations, threads and the checkpoint interval may change).
+    #[staticmethod]
+    #[pyo3(signature = (config, path = None, text = None, threads = None))]
+    fn resume(
+        py: Python<'_>,
+        config: &Config,
+        path: Option<PathBuf>,
+        text: Option<String>,
+        threads: Option<u32>,
+    ) -> PyResult<Evolution> {
+        let (path, text) = match (path, text) {
+            (Some(path), None) => {
+                let text = sylva::files::read_text(&path).py()?;
+                (path, text)
+            }
+            (None, Some(text)) => (PathBuf::from("<checkpoint>"), text),
+            _ => return Err(bad_value("resume", "give either `path` or `text`")),
+        };
+        let pool = Evolution::pool(&config.inner, threads)?;
+        let inner = &config.inner;
+        let run = py.detach(|| Run::resume(inner, &path, &text, pool)).py()?;
+        Ok(Evolution {
+            run: Mutex::new(run),
+        })
+    }
+
+    /// The effective config.
+    #[getter]
+    fn config(&self) -> Config {
+        Config {
+            inner: self.with(|r| r.config()),
+            base: PathBuf::new(),
+        }
+    }
+
+    /// The last completed generation.
+    #[getter]
+    fn generation(&self) -> u32 {
+        self.with(|r| r.generation())
+    }
+
+    /// Names of the fitness terms.
+    #[getter]
+    fn term_names(&self) -> Vec<String> {
+        self.with(|r| r.term_names().to_vec())
+    }
+
+    /// Breeds one generation; returns its statistics row. Releases the GIL.
+    fn step<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (stats, names) = py.detach(|| {
+            self.with(|r| {
+                let stats = r.step().cloned();
+                (stats, r.term_names().to_vec())
+            })
+        });
+        row(py, &stats.py()?, &names)
+    }
+
+    /// Breeds `generations` generations (up to the config's last when left out), calling
+    /// `on_generation(row)` after each when given. Releases the GIL between calls.
+    #[pyo3(signature = (generations = None, on_generation = None))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        generations: Option<u32>,
+        on_generation: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let todo = generations.unwrap_or_else(|| {
+            self.with(|r| r.config().run().generations.saturating_sub(r.generation()))
+        });
+        for _ in 0..todo {
+            let row = self.step(py)?;
+            if let Some(callback) = &on_generation {
+                callback.call1((row,))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Statistics of every generation so far: one dict per generation (see `step`).
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let (stats, names) = self.with(|r| (r.stats().to_vec(), r.term_names().to_vec()));
+        stats.iter().map(|s| row(py, s, &names)).collect()
+    }
+
+    /// The current population, in slot order.
+    fn population(&self, py: Python<'_>) -> PyResult<Vec<Member>> {
+        let (members, names) = self.with(|r| (r.population(), r.term_names().to_vec()));
+        members
+            .into_iter()
+            .map(|m| Member::of(py, m, &names))
+            .collect()
+    }
+
+    /// The best member of the current population.
+    fn best(&self, py: Python<'_>) -> PyResult<Member> {
+        let (best, names) = self.with(|r| (r.best(), r.term_names().to_vec()));
+        Member::of(py, best, &names)
+    }
+
+    /// The `count` fittest members, fittest first.
+    fn fittest(&self, py: Python<'_>, count: usize) -> PyResult<Vec<Member>> {
+        let (members, names) = self.with(|r| (r.fittest(count), r.term_names().to_vec()));
+        members
+            .into_iter()
+            .map(|m| Member::of(py, m, &names))
+            .collect()
+    }
+
+    /// A member by id, from the current population or a kept generation (None if gone).
+    fn member(&self, py: Python<'_>, id: u64) -> PyResult<Option<Member>> {
+        let (member, names) = self.with(|r| (r.member(IndividualId(id)), r.term_names().to_vec()));
+        member.map(|m| Member::of(py, m, &names)).transpose()
+    }
+
+    /// A member's family as far as kept generations reach: the member, its parents, theirs,
+    /// each once, nearest first. Call `keep_history` before stepping to keep generations.
+    fn family(&self, py: Python<'_>, id: u64) -> PyResult<Vec<Member>> {
+        let (members, names) = self.with(|r| (r.family(IndividualId(id)), r.term_names().to_vec()));
+        members
+            .into_iter()
+            .map(|m| Member::of(py, m, &names))
+            .collect()
+    }
+
+    /// The population of `generation`, if it is the current one or still kept.
+    fn generation_members(&self, py: Python<'_>, generation: u32) -> PyResult<Option<Vec<Member>>> {
+        let (members, names) =
+            self.with(|r| (r.generation_members(generation), r.term_names().to_vec()));
+        members
+            .map(|ms| ms.into_iter().map(|m| Member::of(py, m, &names)).collect())
+            .transpose()
+    }
+
+    /// Keeps the last `generations` generations for browsing (0 keeps only the current).
+    fn keep_history(&self, generations: usize) {
+        self.with(|r| r.keep_history(generations));
+    }
+
+    /// The checkpoint's text (JSON): everything needed to resume exactly.
+    fn checkpoint(&self, py: Python<'_>) -> PyResult<String> {
+        py.detach(|| self.with(|r| r.checkpoint())).py()
+    }
+
+    /// Writes the checkpoint file (atomically).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| {
+            let text = self.with(|r| r.checkpoint())?;
+            sylva::files::write(&path, text.as_bytes())
+        })
+        .py()
+    }
+
+    /// The `count` fittest genomes as the engine evolves them (bytes each): what an island
+    /// sends its neighbours.
+    fn emigrants<'py>(&self, py: Python<'py>, count: usize) -> Vec<Bound<'py, PyBytes>> {
+        self.with(|r| r.emigrants(count))
+            .iter()
+            .map(|m| PyBytes::new(py, m.as_bytes()))
+            .collect()
+    }
+
+    /// Puts migrants (from `emigrants` of a run of the same config) in the places of the
+    /// worst members and scores them; returns their new ids. Releases the GIL.
+    fn immigrate(&self, py: Python<'_>, migrants: Vec<Vec<u8>>) -> PyResult<Vec<u64>> {
+        let texts = migrants
+            .into_iter()
+            .enumerate()
+            .map(|(i, m)| {
+                String::from_utf8(m)
+                    .map_err(|_| bad_value(format!("migrant {}", i + 1), "not UTF-8 text"))
+            })
+            .collect::<PyResult<Vec<String>>>()?;
+        let ids = py.detach(|| self.with(|r| r.immigrate(&texts))).py()?;
+        Ok(ids.into_iter().map(|id| id.0).collect())
+    }
+
+    fn __repr__(&self) -> String {
+        self.with(|r| {
+            format!(
+                "<sylva.Evolution {} generation {}>",
+                r.title(),
+                r.generation()
+            )
+        })
+    }
+}

@@ -1,0 +1,272 @@
+//! `Genome`: a genome of any model, its fields, growth and breeding by hand.
+
+use std::path::{Path, PathBuf};
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use sylva::Registry;
+
+use crate::errors::{IntoPy, bad_value};
+use crate::json::{from_py, pointer, to_py};
+use crate::plant::Plant;
+
+/// A genome of any of Sylva's models. Load it from a file (`Genome.load`), a dict
+/// (`Genome.from_dict`) or JSON text (`Genome.from_json`); read and set its fields with
+/// `genome["field"]` (dotted paths reach into nested fields: `genome["rotation1.angle"]`);
+/// grow it with `grow`; breed it with `mutate` and `sylva.cross`.
+#[pyclass(module = "sylva", name = "Genome", from_py_object)]
+#[derive(Clone)]
+pub struct Genome {
+    pub inner: sylva::Genome,
+}
+
+impl Genome {
+    fn parse(text: &str, source: &str) -> PyResult<Genome> {
+        let inner = sylva::parse_genome(Path::new(source), text).py()?;
+        Ok(Genome { inner })
+    }
+
+    /// The genome file's JSON.
+    fn value(&self) -> serde_json::Value {
+        // A genome's own text always parses back.
+        serde_json::from_str(&self.inner.to_json()).unwrap_or_default()
+    }
+}
+
+#[pymethods]
+impl Genome {
+    /// Reads a genome file of any model.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Genome> {
+        let inner = sylva::load_genome(&path).py()?;
+        Ok(Genome { inner })
+    }
+
+    /// A genome from a dict shaped like a genome file (with its `model` and `format`).
+    #[staticmethod]
+    fn from_dict(data: &Bound<'_, PyAny>) -> PyResult<Genome> {
+        let value = from_py(data, "genome dict")?;
+        let text = serde_json::to_string_pretty(&value).unwrap_or_default();
+        Genome::parse(&text, "<genome dict>")
+    }
+
+    /// A genome from a genome file's JSON text; `source` names it in errors.
+    #[staticmethod]
+    #[pyo3(signature = (text, source = "<json>"))]
+    fn from_json(text: &str, source: &str) -> PyResult<Genome> {
+        Genome::parse(text, source)
+    }
+
+    /// A random genome of `model` ("bintree", "automata", "plantmaker" or "lsystem"),
+    /// made by the model with `settings` (a dict of its settings, or its defaults).
+    #[staticmethod]
+    #[pyo3(signature = (model, seed, settings = None))]
+    fn random(model: &str, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
+        let registry = Registry::standard();
+        let entry = registry.get(model).ok_or_else(|| {
+            let names: Vec<&str> = registry.models().iter().map(|m| m.name()).collect();
+            bad_value(
+                "model",
+                format!(
+                    "unknown model `{model}`; expected one of: {}",
+                    names.join(", ")
+                ),
+            )
+        })?;
+        let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
+        let inner = entry.random(settings.as_ref(), seed).py()?;
+        Ok(Genome { inner })
+    }
+
+    /// The model's name: "bintree", "automata", "plantmaker" or "lsystem".
+    #[getter]
+    fn model(&self) -> &'static str {
+        self.inner.model()
+    }
+
+    /// The model's title.
+    #[getter]
+    fn title(&self) -> &'static str {
+        self.inner.title()
+    }
+
+    /// The seed the genome grows with when none is given.
+    #[getter]
+    fn default_seed(&self) -> u64 {
+        self.inner.default_seed()
+    }
+
+    /// The genome as a dict, exactly as its file holds it.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.value())
+    }
+
+    /// The genome file's text: pretty JSON ending with a newline.
+    fn to_json(&self) -> String {
+        self.inner.to_json()
+    }
+
+    /// Writes the genome file (atomically: the file appears whole or not at all).
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        sylva::files::write(&path, self.inner.to_json().as_bytes()).py()
+    }
+
+    /// The names of the genome's fields (`model` and `format` left out).
+    fn fields(&self) -> Vec<String> {
+        match self.value() {
+            serde_json::Value::Object(map) => map
+                .keys()
+                .filter(|k| !matches!(k.as_str(), "model" | "format"))
+                .cloned()
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// A field's value; dotted paths reach into nested fields and lists.
+    fn __getitem__<'py>(&self, py: Python<'py>, field: &str) -> PyResult<Bound<'py, PyAny>> {
+        let value = self.value();
+        let found = value.pointer(&pointer(field)).ok_or_else(|| {
+            pyo3::exceptions::PyKeyError::new_err(format!(
+                "`{}` genomes have no field `{field}`; fields: {}",
+                self.inner.model(),
+                self.fields().join(", ")
+            ))
+        })?;
+        to_py(py, found)
+    }
+
+    /// A copy with `field` set to `value`, checked as the genome file would be: a value out
+    /// of its range raises `InputError` naming the field.
+    fn with_field(&self, field: &str, value: &Bound<'_, PyAny>) -> PyResult<Genome> {
+        let new = from_py(value, field)?;
+        let mut genome = self.value();
+        let slot = genome.pointer_mut(&pointer(field)).ok_or_else(|| {
+            bad_value(
+                field,
+                format!(
+                    "`{}` genomes have no field `{field}`; fields: {}",
+                    self.inner.model(),
+                    self.fields().join(", ")
+                ),
+            )
+        })?;
+        *slot = new;
+        let text = serde_json::to_string_pretty(&genome).unwrap_or_default();
+        let inner = Registry::standard()
+            .parse_genome(&text)
+            .map_err(|e| bad_value(field, e.message))?;
+        Ok(Genome { inner })
+    }
+
+    /// Grows the plant with `seed` (the genome's own seed when none is given) and meshes it;
+    /// `roots=False` leaves the roots out. Releases the GIL.
+    #[pyo3(signature = (seed = None, roots = true))]
+    fn grow(&self, py: Python<'_>, seed: Option<u64>, roots: bool) -> PyResult<Plant> {
+        let genome = self.inner.clone();
+        let seed = seed.unwrap_or_else(|| genome.default_seed());
+        let grown = py.detach(|| sylva::Grown::new(genome, seed, roots)).py()?;
+        Ok(Plant::new(grown))
+    }
+
+    /// A mutated copy, made by the model's own mutation with `settings` (a dict of the
+    /// model's settings, or its defaults), drawing from the stream of `seed`.
+    #[pyo3(signature = (seed, settings = None))]
+    fn mutate(&self, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
+        let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
+        let inner = self.inner.mutate(settings.as_ref(), seed).py()?;
+        Ok(Genome { inner })
+    }
+
+    /// Sets a field in place, checked as [`Genome::with_field`] checks it.
+    fn __setitem__(&mut self, field: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        *self = self.with_field(field, value)?;
+        Ok(())
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<Genome>()
+            .is_ok_and(|o| o.borrow().inner == self.inner)
+    }
+
+    fn __repr__(&self) -> String {
+        let hash = sylva_core::hash::stable_hash(self.inner.to_json().as_bytes());
+        format!("<sylva.Genome {} {hash:016x}>", self.inner.model())
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        // Pickled as its JSON text, so genomes cross process pools and Ray.
+        let from_json = py.get_type::<Genome>().getattr("from_json")?;
+        Ok((from_json, (self.inner.to_json(),))
+            .into_pyobject(py)?
+            .into_any())
+    }
+}
+
+/// A child of two or more parents of one model, made by the model's own crossover with
+/// `settings`, drawing from the stream of `seed`. `dominance` gives each parent's weight
+/// (all equal when left out). Returns the child and the positions of the parents that
+/// gave it genes.
+#[pyfunction]
+#[pyo3(signature = (parents, seed, dominance = None, settings = None))]
+pub fn cross(
+    parents: Vec<Genome>,
+    seed: u64,
+    dominance: Option<Vec<f64>>,
+    settings: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Genome, Vec<usize>)> {
+    let dominance = dominance.unwrap_or_else(|| vec![1.0; parents.len()]);
+    if dominance.len() != parents.len() {
+        return Err(bad_value(
+            "dominance",
+            format!(
+                "{} weights for {} parents; give one per parent",
+                dominance.len(),
+                parents.len()
+            ),
+        ));
+    }
+    if let Some(d) = dominance.iter().find(|d| !d.is_finite() || **d < 0.0) {
+        return Err(bad_value(
+            "dominance",
+            format!("{d} is not a weight; expected a finite number of 0 or more"),
+        ));
+    }
+    let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
+    let pairs: Vec<(&sylva::Genome, f64)> =
+        parents.iter().map(|g| &g.inner).zip(dominance).collect();
+    let (child, used) = sylva::Genome::cross(&pairs, settings.as_ref(), seed).py()?;
+    Ok((Genome { inner: child }, used))
+}
+
+/// Seconds per call of the library's grow-and-mesh (`sylva::Grown::new`) of `genome`,
+/// timed in Rust over `repeats` calls: the baseline `benches/overhead.py` compares
+/// `Genome.grow` with.
+#[pyfunction]
+pub fn _rust_grow_seconds(
+    py: Python<'_>,
+    genome: &Genome,
+    seed: u64,
+    repeats: u32,
+) -> PyResult<f64> {
+    let genome = genome.inner.clone();
+    py.detach(|| {
+        let start = std::time::Instant::now();
+        for _ in 0..repeats.max(1) {
+            std::hint::black_box(sylva::Grown::new(genome.clone(), seed, true)?);
+        }
+        Ok::<_, sylva::Error>(start.elapsed().as_secs_f64() / f64::from(repeats.max(1)))
+    })
+    .py()
+}
+
+/// The models Sylva knows: a dict of name to title.
+#[pyfunction]
+pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let dict = PyDict::new(py);
+    for m in Registry::standard().models() {
+        dict.set_item(m.name(), m.title())?;
+    }
+    Ok(dict)
+}

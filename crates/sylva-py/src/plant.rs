@@ -1,0 +1,513 @@
+//! `Plant` (a grown genome), `Mesh` (numpy arrays), `Scene` (many plants) and gardens.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use numpy::ndarray::{ArrayView, ArrayView1, ArrayView2, Dimension};
+use numpy::{PyArray, PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+use sylva::assets::{Origin, Placed, SceneAssets};
+use sylva::files::Outputs;
+use sylva_core::measures::TreeMeasures;
+use sylva_mesh::render::View;
+
+use crate::errors::{IntoPy, bad_value};
+use crate::genome::Genome;
+use crate::json::to_py;
+
+/// A grown genome: its plant's measures, its mesh, and the files it exports to.
+#[pyclass(module = "sylva", name = "Plant", frozen)]
+pub struct Plant {
+    grown: sylva::Grown,
+    /// The mesh's triangles gathered from its primitives, the first time they are asked for.
+    triangles: OnceLock<Triangles>,
+}
+
+impl Plant {
+    pub fn new(grown: sylva::Grown) -> Plant {
+        Plant {
+            grown,
+            triangles: OnceLock::new(),
+        }
+    }
+}
+
+#[pymethods]
+impl Plant {
+    /// The genome it grew from.
+    #[getter]
+    fn genome(&self) -> Genome {
+        Genome {
+            inner: self.grown.genome.clone(),
+        }
+    }
+
+    /// The seed it grew with.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.grown.seed
+    }
+
+    /// The model's name.
+    #[getter]
+    fn model(&self) -> &'static str {
+        self.grown.genome.model()
+    }
+
+    /// Segments of the skeleton (tapered cylinders).
+    #[getter]
+    fn segments(&self) -> usize {
+        self.grown.plant.segments().len()
+    }
+
+    /// Organs: leaves, flowers, fruits.
+    #[getter]
+    fn organs(&self) -> usize {
+        self.grown.plant.organs().len()
+    }
+
+    /// End points of the skeleton.
+    #[getter]
+    fn tips(&self) -> usize {
+        self.grown.plant.tips().count()
+    }
+
+    /// Highest point of the skeleton above the ground, metres.
+    #[getter]
+    fn height(&self) -> f32 {
+        self.grown.plant.height()
+    }
+
+    /// Bounds of everything visible: ((min x, y, z), (max x, y, z)), metres (zeros for an
+    /// empty plant).
+    #[getter]
+    fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+        let b = self.grown.plant.bounds();
+        if b.is_empty() {
+            ([0.0; 3], [0.0; 3])
+        } else {
+            (b.min.to_array(), b.max.to_array())
+        }
+    }
+
+    /// Lateral area of all segments, square metres.
+    #[getter]
+    fn surface_area(&self) -> f32 {
+        self.grown.plant.surface_area()
+    }
+
+    /// Volume of all segments, cubic metres.
+    #[getter]
+    fn volume(&self) -> f32 {
+        self.grown.plant.volume()
+    }
+
+    /// Length of the whole skeleton, metres.
+    #[getter]
+    fn total_length(&self) -> f32 {
+        self.grown.plant.total_length()
+    }
+
+    /// The six measures of Susinno's paper (height, surface area, volume, symmetry,
+    /// straightness, radius-to-length, pipe model, roundness), as a dict.
+    fn measures<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = TreeMeasures::of_plant(&self.grown.plant);
+        to_py(py, &serde_json::to_value(m).unwrap_or_default())
+    }
+
+    /// The mesh, as read-only numpy arrays that view the plant's own memory (no copy).
+    #[getter]
+    fn mesh(this: &Bound<'_, Self>) -> PyResult<Mesh> {
+        let plant = this.get();
+        let triangles = plant
+            .triangles
+            .get_or_init(|| Triangles::of(&plant.grown.mesh));
+        Mesh::view(this.as_any(), &plant.grown.mesh, triangles)
+    }
+
+    /// Writes the plant as GLB, OBJ (with its MTL and textures) or VRML97, by the file's
+    /// extension; every file appears whole or not at all. Releases the GIL.
+    fn export(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| write_scene(&self.grown.scene(), &path)).py()
+    }
+
+    /// The plant as GLB bytes.
+    fn glb<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = py.detach(|| glb_bytes(&self.grown.scene())).py()?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// Renders a picture of the plant: PNG bytes, also written to `path` when given.
+    /// `view` is "front", "side", "top" or "iso"; `size` is (width, height) in pixels.
+    #[pyo3(signature = (path = None, view = "iso", size = (800, 800)))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        path: Option<PathBuf>,
+        view: &str,
+        size: (u32, u32),
+    ) -> PyResult<Bound<'py, PyBytes>> {
+        render(py, &self.grown.scene(), path, view, size)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<sylva.Plant {} seed {}: {} segments, {} organs, {} triangles>",
+            self.grown.genome.model(),
+            self.grown.seed,
+            self.grown.plant.segments().len(),
+            self.grown.plant.organs().len(),
+            self.grown.mesh.triangle_count()
+        )
+    }
+}
+
+/// A triangle mesh as numpy arrays: `positions` and `normals` (n, 3) float32, `uvs` (n, 2)
+/// float32, `indices` (t, 3) uint32, `triangle_materials` (t,) uint32 (an index into
+/// `materials`), and `materials`, a list of dicts (name, kind, color, texture). The arrays
+/// are read-only views of the plant's (or scene's) memory, which they keep alive.
+#[pyclass(module = "sylva", name = "Mesh", frozen, get_all)]
+pub struct Mesh {
+    positions: Py<PyArray2<f32>>,
+    normals: Py<PyArray2<f32>>,
+    uvs: Py<PyArray2<f32>>,
+    indices: Py<PyArray2<u32>>,
+    triangle_materials: Py<PyArray1<u32>>,
+    materials: Py<PyAny>,
+}
+
+/// A mesh's triangles in one list, as numpy wants them: the mesher keeps one list per
+/// material.
+struct Triangles {
+    corners: Vec<[u32; 3]>,
+    materials: Vec<u32>,
+}
+
+impl Triangles {
+    fn of(mesh: &sylva_mesh::Mesh) -> Triangles {
+        let count = mesh.triangle_count();
+        let mut corners = Vec::with_capacity(count);
+        let mut materials = Vec::with_capacity(count);
+        for p in &mesh.primitives {
+            let (triangles, _) = p.indices.as_chunks::<3>();
+            corners.extend_from_slice(triangles);
+            materials.extend(std::iter::repeat_n(p.material as u32, triangles.len()));
+        }
+        Triangles { corners, materials }
+    }
+}
+
+/// A read-only numpy array viewing `data`, which lives inside `owner`: the array holds
+/// `owner` as its base, so the memory outlives it. numpy refuses to make such an array
+/// writeable again (it does not own its data), so the exporters read what the mesher made.
+///
+/// The one `unsafe` in Sylva: `owner` must be a frozen pyclass whose `data` never changes or
+/// moves while it lives. Every caller passes a field of `Plant` or `Scene`, both frozen and
+/// never mutated after they are made.
+#[allow(unsafe_code)]
+fn view<'py, T: numpy::Element, D: Dimension>(
+    owner: &Bound<'py, PyAny>,
+    data: &ArrayView<'_, T, D>,
+) -> PyResult<Py<PyArray<T, D>>> {
+    // SAFETY: as above: `data` belongs to the frozen `owner`, the array's base.
+    let array = unsafe { PyArray::borrow_from_array(data, owner.clone()) };
+    array.try_readwrite()?.make_nonwriteable();
+    Ok(array.unbind())
+}
+
+/// `rows` of `N` values each, inside `owner`, as an (n, N) read-only array (no copy).
+fn rows<T: numpy::Element, const N: usize>(
+    owner: &Bound<'_, PyAny>,
+    rows: &[[T; N]],
+) -> PyResult<Py<PyArray2<T>>> {
+    let data = ArrayView2::from_shape((rows.len(), N), rows.as_flattened())
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    view(owner, &data)
+}
+
+impl Mesh {
+    /// The arrays of `mesh` and its `triangles`, both held by the frozen `owner`.
+    fn view(
+        owner: &Bound<'_, PyAny>,
+        mesh: &sylva_mesh::Mesh,
+        triangles: &Triangles,
+    ) -> PyResult<Mesh> {
+        let py = owner.py();
+        let uvs = if mesh.uvs.len() == mesh.positions.len() {
+            rows(owner, &mesh.uvs)?
+        } else {
+            PyArray2::zeros(py, [mesh.positions.len(), 2], false).unbind()
+        };
+        let list = PyList::empty(py);
+        for m in &mesh.materials {
+            let d = PyDict::new(py);
+            d.set_item("name", &m.name)?;
+            d.set_item("kind", m.kind.name())?;
+            d.set_item("color", m.color)?;
+            d.set_item("texture", m.texture)?;
+            list.append(d)?;
+        }
+        Ok(Mesh {
+            positions: rows(owner, &mesh.positions)?,
+            normals: rows(owner, &mesh.normals)?,
+            uvs,
+            indices: rows(owner, &triangles.corners)?,
+            triangle_materials: view(owner, &ArrayView1::from(&triangles.materials[..]))?,
+            materials: list.into_any().unbind(),
+        })
+    }
+}
+
+#[pymethods]
+impl Mesh {
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "<sylva.Mesh {} vertices, {} triangles>",
+            self.positions.bind(py).shape()[0],
+            self.indices.bind(py).shape()[0]
+        )
+    }
+}
+
+/// Many plants in one scene (a garden): export it, picture it, read its meshes.
+#[pyclass(module = "sylva", name = "Scene", frozen)]
+pub struct Scene {
+    assets: SceneAssets,
+    garden: Option<String>,
+    /// Each mesh's triangles, gathered the first time they are asked for.
+    triangles: OnceLock<Vec<Triangles>>,
+}
+
+impl Scene {
+    fn new(assets: SceneAssets, garden: Option<String>) -> Scene {
+        Scene {
+            assets,
+            garden,
+            triangles: OnceLock::new(),
+        }
+    }
+}
+
+#[pymethods]
+impl Scene {
+    /// Plants in the scene.
+    #[getter]
+    fn plants(&self) -> usize {
+        self.assets.meshes().len()
+    }
+
+    /// Triangles of all plants.
+    #[getter]
+    fn triangles(&self) -> usize {
+        self.assets.scene().triangle_count()
+    }
+
+    /// The garden file's text (JSON) that grows this scene again, for gardens.
+    #[getter]
+    fn garden(&self) -> Option<&str> {
+        self.garden.as_deref()
+    }
+
+    /// Each plant's mesh, in its own coordinates (read-only views, as `Plant.mesh`).
+    fn meshes(this: &Bound<'_, Self>) -> PyResult<Vec<Mesh>> {
+        let scene = this.get();
+        let meshes = scene.assets.meshes();
+        let triangles = scene
+            .triangles
+            .get_or_init(|| meshes.iter().map(Triangles::of).collect());
+        meshes
+            .iter()
+            .zip(triangles)
+            .map(|(m, t)| Mesh::view(this.as_any(), m, t))
+            .collect()
+    }
+
+    /// Writes the scene as GLB, OBJ or VRML97, by the file's extension (one node per plant,
+    /// each carrying its genome and seed); every file appears whole or not at all.
+    fn export(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| write_scene(&self.assets.scene(), &path)).py()
+    }
+
+    /// The scene as GLB bytes.
+    fn glb<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = py.detach(|| glb_bytes(&self.assets.scene())).py()?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// Renders a picture of the scene: PNG bytes, also written to `path` when given.
+    #[pyo3(signature = (path = None, view = "iso", size = (1200, 800)))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        path: Option<PathBuf>,
+        view: &str,
+        size: (u32, u32),
+    ) -> PyResult<Bound<'py, PyBytes>> {
+        render(py, &self.assets.scene(), path, view, size)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<sylva.Scene {} plants>", self.plants())
+    }
+}
+
+fn write_scene(scene: &sylva_mesh::Scene<'_>, path: &Path) -> Result<(), sylva::Error> {
+    sylva::assets::asset_format(path)?;
+    let mut out = Outputs::new();
+    out.add_scene(path, scene)?;
+    out.commit()
+}
+
+fn glb_bytes(scene: &sylva_mesh::Scene<'_>) -> Result<Vec<u8>, sylva::Error> {
+    sylva_mesh::export::check_scene(scene)?;
+    Ok(sylva_mesh::export::to_glb(scene)?)
+}
+
+fn render<'py>(
+    py: Python<'py>,
+    scene: &sylva_mesh::Scene<'_>,
+    path: Option<PathBuf>,
+    view: &str,
+    size: (u32, u32),
+) -> PyResult<Bound<'py, PyBytes>> {
+    let view: View = view.parse().map_err(|e| bad_value("view", e))?;
+    if let Some(path) = &path {
+        sylva::assets::check_png(path).py()?;
+    }
+    let png = py
+        .detach(|| -> Result<Vec<u8>, sylva::Error> {
+            let png = sylva::assets::picture(scene, view, size)?;
+            if let Some(path) = &path {
+                sylva::files::write(path, &png)?;
+            }
+            Ok(png)
+        })
+        .py()?;
+    Ok(PyBytes::new(py, &png))
+}
+
+/// Grows a PlantMaker garden: `count` plants of each genome, on a plot `area` = (width,
+/// depth) metres centred on the origin, their seeds, places and turns drawn from `seed`.
+/// Or give `path`, a garden file (`*.garden.json`), to grow the garden it describes.
+/// Releases the GIL.
+#[pyfunction]
+#[pyo3(signature = (genomes = Vec::new(), count = 20, area = (20.0, 20.0), seed = 1, path = None))]
+pub fn garden(
+    py: Python<'_>,
+    genomes: Vec<Genome>,
+    count: u32,
+    area: (f64, f64),
+    seed: u64,
+    path: Option<PathBuf>,
+) -> PyResult<Scene> {
+    use sylva_plantmaker::{Garden, PlantMakerModel};
+    let (garden, source) = match path {
+        Some(path) => {
+            if !genomes.is_empty() {
+                return Err(bad_value(
+                    "genomes",
+                    "a garden file is grown on its own; give either genomes or a garden file",
+                ));
+            }
+            let text = sylva::files::read_text(&path).py()?;
+            let garden = Garden::from_json(&text)
+                .map_err(|e| sylva::InputError::genome(&path, &text, e))
+                .py()?;
+            (garden, path)
+        }
+        None => {
+            if !(1..=100_000).contains(&count) {
+                return Err(bad_value(
+                    "count",
+                    format!("{count} plants per genome; expected 1 to 100000"),
+                ));
+            }
+            let valid = |v: f64| v.is_finite() && (0.1..=1e6).contains(&v);
+            if !valid(area.0) || !valid(area.1) {
+                return Err(bad_value(
+                    "area",
+                    format!(
+                        "{} x {} m; each side must be 0.1 to 1000000 m",
+                        area.0, area.1
+                    ),
+                ));
+            }
+            let mut typed = Vec::with_capacity(genomes.len());
+            for (i, g) in genomes.iter().enumerate() {
+                let genome = g.inner.get::<PlantMakerModel>().ok_or_else(|| {
+                    bad_value(
+                        format!("genomes[{i}]"),
+                        format!(
+                            "gardens grow `plantmaker` genomes; this is a `{}` genome",
+                            g.inner.model()
+                        ),
+                    )
+                })?;
+                typed.push(genome.clone());
+            }
+            let Some((first, rest)) = typed.split_first() else {
+                return Err(bad_value("genomes", "a garden needs at least one genome"));
+            };
+            let mut garden = Garden::new(first.clone(), count as usize, [area.0, area.1], seed);
+            for g in rest {
+                garden.add(g.clone(), count as usize);
+            }
+            (garden, PathBuf::from("<garden>"))
+        }
+    };
+    let assets = py
+        .detach(|| sylva::assets::garden_assets(&garden, &source))
+        .py()?;
+    Ok(Scene::new(assets, Some(garden.to_json())))
+}
+
+/// Puts grown plants in one scene: each at (x, z) on the ground, turned by `turns`
+/// (radians about the vertical axis, 0 when left out).
+#[pyfunction]
+#[pyo3(signature = (plants, positions, turns = None))]
+pub fn scene(
+    py: Python<'_>,
+    plants: Vec<Py<Plant>>,
+    positions: Vec<(f32, f32)>,
+    turns: Option<Vec<f32>>,
+) -> PyResult<Scene> {
+    if positions.len() != plants.len() {
+        return Err(bad_value(
+            "positions",
+            format!("{} positions for {} plants", positions.len(), plants.len()),
+        ));
+    }
+    let turns = turns.unwrap_or_else(|| vec![0.0; plants.len()]);
+    if turns.len() != plants.len() {
+        return Err(bad_value(
+            "turns",
+            format!("{} turns for {} plants", turns.len(), plants.len()),
+        ));
+    }
+    if positions
+        .iter()
+        .flat_map(|(x, z)| [x, z])
+        .chain(&turns)
+        .any(|v| !v.is_finite() || v.abs() > 1e6)
+    {
+        return Err(bad_value(
+            "positions",
+            "positions and turns must be finite numbers within ±1000000",
+        ));
+    }
+    let grown: Vec<&sylva::Grown> = plants.iter().map(|p| &p.get().grown).collect();
+    let placed: Vec<Placed> = grown
+        .iter()
+        .zip(positions.iter().zip(&turns))
+        .enumerate()
+        .map(|(i, (g, ((x, z), turn)))| Placed {
+            translation: sylva_core::glam::Vec3::new(*x, 0.0, *z),
+            rotation: sylva_core::glam::Quat::from_rotation_y(*turn),
+            extras: Some(Origin::of(&g.genome, g.seed).extras()),
+            ..Placed::new(format!("plant-{i}"), &g.plant, g.genome.mesh_hint())
+        })
+        .collect();
+    let assets = py.detach(|| SceneAssets::mesh(&placed)).py()?;
+    Ok(Scene::new(assets, None))
+}

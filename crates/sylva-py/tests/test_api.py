@@ -1,0 +1,290 @@
+"""The package's API on all four models: genomes, plants, meshes, exports, operators,
+evolution runs, gardens, and the errors bad input gets."""
+
+from __future__ import annotations
+
+import gc
+import json
+import math
+import pickle
+import struct
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import sylva
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+
+GENOMES = {
+    "bintree": EXAMPLES / "bintree" / "oak.json",
+    "automata": EXAMPLES / "automata" / "helix.json",
+    "plantmaker": EXAMPLES / "plantmaker" / "tulip.json",
+    "lsystem": EXAMPLES / "lsystem" / "herb.json",
+}
+
+CONFIGS = {
+    "bintree": EXAMPLES / "bintree" / "default.toml",
+    "automata": EXAMPLES / "automata" / "sphere.toml",
+    "plantmaker": EXAMPLES / "plantmaker" / "evolve.toml",
+    "lsystem": EXAMPLES / "lsystem" / "evolve.toml",
+}
+
+MODELS = sorted(GENOMES)
+
+
+def glb_json(data: bytes) -> dict:
+    """The JSON chunk of a GLB, after checking the header and chunk lengths."""
+    magic, version, length = struct.unpack_from("<4sII", data)
+    assert (magic, version, length) == (b"glTF", 2, len(data))
+    chunk, kind = struct.unpack_from("<I4s", data, 12)
+    assert kind == b"JSON"
+    return json.loads(data[20 : 20 + chunk])
+
+
+def test_models_are_the_four():
+    assert sorted(sylva.models()) == MODELS
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_genome_files_round_trip(model, tmp_path):
+    genome = sylva.Genome.load(GENOMES[model])
+    assert genome.model == model
+    assert sylva.Genome.from_dict(genome.to_dict()) == genome
+    assert sylva.Genome.from_json(genome.to_json()) == genome
+    assert pickle.loads(pickle.dumps(genome)) == genome
+    genome.save(tmp_path / "copy.json")
+    assert sylva.Genome.load(tmp_path / "copy.json") == genome
+    assert genome.fields() and all(genome[f] is not None for f in genome.fields())
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_plant_grows_meshes_and_exports(model, tmp_path):
+    genome = sylva.Genome.load(GENOMES[model])
+    plant = genome.grow(seed=3)
+    assert (plant.model, plant.seed) == (model, 3)
+    assert plant.segments > 0 and plant.height > 0 and plant.volume > 0
+    low, high = np.array(plant.bounds[0]), np.array(plant.bounds[1])
+    assert (high >= low).all() and (high > low).any()
+    measures = plant.measures()
+    assert measures["height"] == pytest.approx(plant.height)
+    assert all(math.isfinite(v) for v in measures.values())
+
+    mesh = plant.mesh
+    n, t = len(mesh.positions), len(mesh.indices)
+    assert mesh.positions.shape == (n, 3) and mesh.positions.dtype == np.float32
+    assert mesh.normals.shape == (n, 3) and mesh.uvs.shape == (n, 2)
+    assert mesh.indices.shape == (t, 3) and mesh.indices.dtype == np.uint32
+    assert mesh.triangle_materials.shape == (t,)
+    assert t > 0 and mesh.indices.max() < n
+    assert mesh.triangle_materials.max() < len(mesh.materials)
+    assert np.allclose(np.linalg.norm(mesh.normals, axis=1), 1.0, atol=1e-3)
+    assert (mesh.positions.min(axis=0) >= low - 1e-3).all()
+    assert (mesh.positions.max(axis=0) <= high + 1e-3).all()
+    assert {m["kind"] for m in mesh.materials} <= {"bark", "leaf", "flower", "root"}
+    for array in [mesh.positions, mesh.normals, mesh.uvs, mesh.indices, mesh.triangle_materials]:
+        assert not array.flags.writeable and not array.flags.owndata, "a read-only view"
+        with pytest.raises(ValueError):
+            array.flags.writeable = True
+        with pytest.raises(ValueError):
+            array[0] = 0
+
+    glb = plant.glb()
+    doc = glb_json(glb)
+    shared = {p["attributes"]["POSITION"] for m in doc["meshes"] for p in m["primitives"]}
+    assert sum(doc["accessors"][a]["count"] for a in shared) == n
+    assert glb == genome.grow(seed=3).glb(), "the same genome and seed give the same bytes"
+    extras = doc["nodes"][0]["extras"]
+    assert sylva.Genome.from_dict(extras["genome"]) == genome and extras["seed"] == 3
+
+    for name in ["plant.glb", "plant.obj", "plant.wrl"]:
+        plant.export(tmp_path / name)
+        assert (tmp_path / name).stat().st_size > 0
+    assert (tmp_path / "plant.glb").read_bytes() == glb
+    assert (tmp_path / "plant.mtl").exists()
+
+    png = plant.render(tmp_path / "plant.png", view="front", size=(64, 48))
+    assert png.startswith(b"\x89PNG") and (tmp_path / "plant.png").read_bytes() == png
+    assert struct.unpack(">II", png[16:24]) == (64, 48)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_operators_make_valid_genomes_of_the_model(model):
+    genome = sylva.Genome.load(GENOMES[model])
+    mutant = genome.mutate(seed=11)
+    assert mutant.model == model
+    assert mutant == genome.mutate(seed=11), "mutation is seeded"
+    assert any(genome.mutate(seed=s) != genome for s in range(5))
+    other = sylva.Genome.random(model, seed=2)
+    child, parents = sylva.cross([genome, other], seed=4)
+    assert child.model == model and set(parents) <= {0, 1}
+    assert child == sylva.cross([genome, other], seed=4)[0]
+    for g in [mutant, other, child]:
+        assert sylva.Genome.from_json(g.to_json()) == g
+        assert g.grow(seed=1).segments >= 0
+
+
+def test_mesh_arrays_outlive_their_plant():
+    plant = sylva.Genome.load(GENOMES["plantmaker"]).grow()
+    expected = plant.mesh.positions.copy()
+    positions = plant.mesh.positions
+    del plant
+    gc.collect()
+    assert (positions == expected).all()
+    scene = sylva.garden([sylva.Genome.load(GENOMES["plantmaker"])], count=2, area=(2, 2))
+    meshes = scene.meshes()
+    del scene
+    gc.collect()
+    assert all(len(m.indices) > 0 and m.indices.max() < len(m.positions) for m in meshes)
+
+
+def test_cross_keeps_models_apart():
+    with pytest.raises(sylva.InputError, match="plantmaker|bintree|model"):
+        sylva.cross([sylva.Genome.load(GENOMES["plantmaker"]),
+                     sylva.Genome.load(GENOMES["bintree"])], seed=1)
+
+
+def test_plantmaker_cross_takes_dominance_and_level():
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    fern = sylva.Genome.load(EXAMPLES / "plantmaker" / "fern.json")
+    children = {sylva.cross([tulip, fern], seed=s, dominance=[0.9, 0.1],
+                            settings={"crossover": "high"})[0].to_json() for s in range(6)}
+    assert len(children) > 1
+
+
+def test_fields_are_read_and_set_with_the_files_checks():
+    oak = sylva.Genome.load(GENOMES["bintree"])
+    deeper = oak.with_field("depth", oak["depth"] - 1)
+    assert deeper["depth"] == oak["depth"] - 1 and deeper != oak
+    assert deeper.grow().segments < oak.grow().segments
+    with pytest.raises(sylva.InputError) as bad:
+        oak["depth"] = 10**9
+    assert "depth" in str(bad.value)
+    with pytest.raises(sylva.InputError):
+        oak["length"] = math.nan
+    with pytest.raises(sylva.InputError):
+        oak["no_such_field"] = 1
+    with pytest.raises(KeyError):
+        oak["no_such_field"]
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    first = tulip["branches.0"]
+    assert isinstance(first, dict)
+
+
+def test_bad_genome_files_name_the_place(tmp_path):
+    path = tmp_path / "bad.json"
+    text = GENOMES["bintree"].read_text()
+    path.write_text(text.replace('"depth": ', '"depth": -', 1))
+    with pytest.raises(sylva.InputError) as bad:
+        sylva.Genome.load(path)
+    e = bad.value
+    assert isinstance(e, ValueError) and isinstance(e, sylva.SylvaError)
+    assert e.path == str(path) and e.line >= 1 and e.column >= 1
+    assert str(e).startswith(f"{path}:{e.line}:{e.column}")
+
+    path.write_text(text[: len(text) // 2])
+    with pytest.raises(sylva.InputError, match="bad.json"):
+        sylva.Genome.load(path)
+    with pytest.raises(sylva.InputError):
+        sylva.Genome.from_dict({"model": "bintree", "format": 1, "depth": 3, "extra": 1})
+    with pytest.raises(sylva.InputError, match="model"):
+        sylva.Genome.from_dict({"model": "fern", "format": 1})
+    with pytest.raises(ValueError):
+        sylva.Genome.from_dict({"model": "bintree", "depth": math.inf})
+    with pytest.raises(sylva.SylvaError):
+        sylva.Genome.load(tmp_path / "missing.json")
+
+
+def test_evolution_steps_checkpoints_and_resumes(tmp_path):
+    config = sylva.Config.from_dict(
+        {**sylva.Config.load(CONFIGS["bintree"]).to_dict()}, base=EXAMPLES / "bintree"
+    ).with_run(population=16, generations=4, seed=9)
+    run = sylva.Evolution(config, threads=1)
+    row = run.step()
+    assert run.generation == 1 and row["generation"] == 1
+    run.run(2)
+    assert [r["generation"] for r in run.stats] == [0, 1, 2, 3]
+    assert set(run.term_names) <= set(run.stats[-1])
+    best = run.best()
+    assert best.fitness == max(m.fitness for m in run.population())
+    assert best.genome.model == "bintree" and len(run.population()) == 16
+    assert run.fittest(3)[0].id == best.id
+    assert run.family(best.id)[0].id == best.id
+    run.save(tmp_path / "run.json")
+    resumed = sylva.Evolution.resume(config, path=tmp_path / "run.json", threads=2)
+    assert resumed.step() == {**run.step(), "seconds": resumed.stats[-1]["seconds"]}
+    assert resumed.best().genome == run.best().genome
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_every_model_evolves(model):
+    config = sylva.Config.load(CONFIGS[model]).with_run(population=8, generations=2, seed=3)
+    run = sylva.Evolution(config, threads=2)
+    rows = []
+    run.run(on_generation=rows.append)
+    assert run.generation == 2 and len(rows) == 2
+    assert run.best().genome.model == model
+
+
+def test_bad_configs_name_the_field():
+    with pytest.raises(sylva.InputError, match="population") as bad:
+        sylva.Config.default().with_run(population=0)
+    assert "population" in bad.value.location
+    with pytest.raises(sylva.InputError) as bad:
+        sylva.Config.from_toml("[run]\npopulation = 10\nbogus = 1\n", source="c.toml")
+    assert bad.value.path == "c.toml" and bad.value.line == 3
+    with pytest.raises(sylva.InputError):
+        sylva.Config.from_dict({"run": {"population": math.nan}})
+
+
+def test_long_calls_release_the_gil():
+    config = sylva.Config.load(CONFIGS["automata"]).with_run(population=1000, generations=40)
+    run = sylva.Evolution(config, threads=1)
+    run.step()
+    ticks = 0
+    done = threading.Event()
+
+    def count():
+        nonlocal ticks
+        while not done.is_set():
+            ticks += 1
+            time.sleep(0.001)
+
+    ticker = threading.Thread(target=count)
+    ticker.start()
+    started = time.perf_counter()
+    run.run(30)
+    elapsed = time.perf_counter() - started
+    done.set()
+    ticker.join()
+    assert elapsed > 0.1, "the run must last long enough to tell"
+    # Held, the GIL would let the ticker in only every 5 ms switch interval at best, and
+    # not at all inside one Rust call.
+    assert ticks > elapsed * 1000 / 4, (ticks, elapsed)
+
+
+def test_gardens_and_scenes():
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    fern = sylva.Genome.load(EXAMPLES / "plantmaker" / "fern.json")
+    garden = sylva.garden([tulip, fern], count=3, area=(4, 4), seed=2)
+    assert garden.plants == 6 and garden.triangles > 0
+    again = sylva.garden(path=None, genomes=[tulip, fern], count=3, area=(4, 4), seed=2)
+    assert again.glb() == garden.glb()
+    assert len(garden.meshes()) == 6
+    with pytest.raises(sylva.InputError, match="count"):
+        sylva.garden([tulip], count=0)
+    with pytest.raises(sylva.InputError, match="area"):
+        sylva.garden([tulip], area=(math.nan, 1))
+    with pytest.raises(sylva.InputError, match="plantmaker"):
+        sylva.garden([sylva.Genome.load(GENOMES["bintree"])])
+
+    plants = [tulip.grow(seed=s) for s in range(3)]
+    scene = sylva.scene(plants, [(0, 0), (1, 0), (0, 1)], turns=[0, 1, 2])
+    assert scene.plants == 3 and len(glb_json(scene.glb())["nodes"]) >= 3
+    with pytest.raises(sylva.InputError, match="positions"):
+        sylva.scene(plants, [(0, 0)])
+    with pytest.raises(sylva.InputError):
+        sylva.scene(plants, [(0, 0), (1, math.inf), (0, 1)])
