@@ -17,6 +17,10 @@
 //! - The first child continues the parent's axis, the second starts a branch (meshing joins
 //!   the first into one tube).
 //!
+//! [`Geometry::Paper`] switches the first two off for the paper as written: every cylinder
+//! runs from the lower to the upper radius, and the genetic algorithm's [`PAPER_LAYOUT`]
+//! fixes the length ratio at 1 and lets the rotations take any axis and angle.
+//!
 //! [`BinTree::measures`] computes the paper's six tree measures analytically (no plant is
 //! built, which keeps evolution fast); [`TreeMeasures::of_plant`] computes them from any grown
 //! plant, and tests check that the two agree.
@@ -81,6 +85,35 @@ impl Rotation {
     }
 }
 
+/// How the recursion sizes its cylinders, and which bit layout the genetic algorithm uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Geometry {
+    /// Sylva's: the taper carries on from level to level, and evolution explores length
+    /// ratios of 0.55 to 0.9 and rotation axes within ±30° of the branch's normal plane
+    /// ([`LAYOUT`]).
+    #[default]
+    Sylva,
+    /// The paper's pseudo-code as written: every cylinder runs from the lower to the upper
+    /// radius (no smaller than the minimum), and evolution keeps the length ratio at 1 and
+    /// explores any axis and any angle from 0 to 180° ([`PAPER_LAYOUT`]).
+    Paper,
+}
+
+impl Geometry {
+    fn is_sylva(&self) -> bool {
+        *self == Geometry::Sylva
+    }
+
+    /// The genetic algorithm's bit layout.
+    pub fn layout(self) -> &'static [Field; 11] {
+        match self {
+            Geometry::Sylva => &LAYOUT,
+            Geometry::Paper => &PAPER_LAYOUT,
+        }
+    }
+}
+
 /// A binary-tree genome: the paper's parameter vector plus Sylva's length ratio and the
 /// minimum radius. Lengths are metres, angles degrees.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -112,6 +145,9 @@ pub struct BinTree {
     /// No cylinder is thinner than this, metres.
     #[serde(deserialize_with = "min_radius")]
     pub min_radius: f64,
+    /// Sylva's geometry (left out of files) or the paper's.
+    #[serde(default, skip_serializing_if = "Geometry::is_sylva")]
+    pub geometry: Geometry,
 }
 
 ranged!(lower_radius: f64, "lower_radius", 0.001, 5.0, " m");
@@ -198,16 +234,40 @@ pub const LAYOUT: [Field; 11] = [
     field("rotation2.axis elevation", 5, -30.0, 30.0),
 ];
 
-/// Bits the layout uses.
-pub const BITS: usize = {
+/// The bit layout of [`Geometry::Paper`]: [`LAYOUT`]'s fields and widths, but the paper's
+/// reach. The length ratio is fixed at 1 (its one bit decodes to 1 either way, so the two
+/// layouts share a shape); angles run from 0 to 180° and axes point anywhere (elevation
+/// ±90°), which together give every rotation there is.
+pub const PAPER_LAYOUT: [Field; 11] = [
+    field("depth", 3, 3.0, 10.0),
+    field("lower_radius", 7, 0.05, 0.6),
+    field("upper_radius", 7, 0.02, 0.6),
+    field("length", 7, 0.3, 3.0),
+    field("length_ratio", 1, 1.0, 1.0),
+    field("rotation1.angle", 7, 0.0, 180.0),
+    field("rotation1.axis azimuth", 6, 0.0, 354.375),
+    field("rotation1.axis elevation", 5, -90.0, 90.0),
+    field("rotation2.angle", 7, 0.0, 180.0),
+    field("rotation2.axis azimuth", 6, 0.0, 354.375),
+    field("rotation2.axis elevation", 5, -90.0, 90.0),
+];
+
+/// Bits a layout uses.
+const fn bits_of(layout: &[Field]) -> usize {
     let mut n = 0;
     let mut i = 0;
-    while i < LAYOUT.len() {
-        n += LAYOUT[i].code.bits as usize;
+    while i < layout.len() {
+        n += layout[i].code.bits as usize;
         i += 1;
     }
     n
-};
+}
+
+/// Bits [`LAYOUT`] uses.
+pub const BITS: usize = bits_of(&LAYOUT);
+
+/// Bits [`PAPER_LAYOUT`] uses.
+pub const PAPER_BITS: usize = bits_of(&PAPER_LAYOUT);
 
 /// The unit axis with this azimuth and elevation (degrees).
 fn axis_from_angles(azimuth: f64, elevation: f64) -> [f64; 3] {
@@ -228,9 +288,15 @@ fn angles_of_axis(axis: [f64; 3]) -> (f64, f64) {
 impl BinTree {
     /// Decodes a GA bit string (see [`LAYOUT`]); `min_radius` comes from the run.
     pub fn decode(bits: &Bits, min_radius: f64) -> BinTree {
+        BinTree::decode_as(bits, min_radius, Geometry::Sylva)
+    }
+
+    /// Decodes a GA bit string laid out for `geometry`, into a genome of that geometry.
+    pub fn decode_as(bits: &Bits, min_radius: f64, geometry: Geometry) -> BinTree {
+        let layout = geometry.layout();
         let mut values = [0.0; LAYOUT.len()];
         let mut offset = 0;
-        for (v, f) in values.iter_mut().zip(&LAYOUT) {
+        for (v, f) in values.iter_mut().zip(layout) {
             let width = usize::from(f.code.bits);
             *v = f.code.decode(bits.read(offset, width));
             offset += width;
@@ -253,6 +319,7 @@ impl BinTree {
                 axis: axis_from_angles(az2, el2),
             },
             min_radius,
+            geometry,
         }
     }
 
@@ -271,9 +338,10 @@ impl BinTree {
             angles_of_axis(self.rotation2.axis).0,
             angles_of_axis(self.rotation2.axis).1,
         ];
-        let mut bits = Bits::zeros(BITS).expect("the layout fits in two words");
+        let layout = self.geometry.layout();
+        let mut bits = Bits::zeros(bits_of(layout)).expect("the layout fits in two words");
         let mut offset = 0;
-        for (v, f) in values.iter().zip(&LAYOUT) {
+        for (v, f) in values.iter().zip(layout) {
             let width = usize::from(f.code.bits);
             bits.write(offset, width, f.code.encode(*v));
             offset += width;
@@ -293,7 +361,19 @@ impl BinTree {
 
     /// Radius at the foot of level `k`.
     fn radius_at(&self, k: u32) -> f64 {
-        (self.lower_radius * self.taper().powi(k as i32)).max(self.min_radius)
+        match self.geometry {
+            Geometry::Sylva => self.lower_radius * self.taper().powi(k as i32),
+            Geometry::Paper => self.lower_radius,
+        }
+        .max(self.min_radius)
+    }
+
+    /// Radius at the top of level `k`.
+    fn top_radius_at(&self, k: u32) -> f64 {
+        match self.geometry {
+            Geometry::Sylva => self.radius_at(k + 1),
+            Geometry::Paper => self.upper_radius.max(self.min_radius),
+        }
     }
 
     /// Length of level `k`.
@@ -307,7 +387,7 @@ impl BinTree {
         let (mut area, mut volume, mut radii, mut lengths) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..depth {
             let n = f64::from(1u32 << k);
-            let (r0, r1, len) = (self.radius_at(k), self.radius_at(k + 1), self.length_at(k));
+            let (r0, r1, len) = (self.radius_at(k), self.top_radius_at(k), self.length_at(k));
             area += n * PI * (r0 + r1) * ((r0 - r1).powi(2) + len * len).sqrt();
             volume += n * PI * len * (r0 * r0 + r0 * r1 + r1 * r1) / 3.0;
             radii += n * 0.5 * (r0 + r1);
@@ -342,6 +422,36 @@ impl BinTree {
             straightness,
             radius_to_length: radii / lengths,
         }
+    }
+
+    /// The paper's straightness, "inversely proportional to the average rotation angle":
+    /// `1 / θ̄`, the mean of the two rotation angles in radians (each folded into 0..180°),
+    /// with `θ̄` no less than 1° so that a pole scores 57.3 rather than infinity.
+    pub fn paper_straightness(&self) -> f64 {
+        1.0 / self.mean_rotation().max(1f64.to_radians())
+    }
+
+    /// The paper's height, "calculated with the sine of the two rotation angles": the trunk,
+    /// then every further level rising by its length times the sine of its elevation,
+    /// `90° − θ̄`, with `θ̄` the mean of the two rotation angles (at least 0). The paper's
+    /// code is not given; this reading uses only the lengths, the depth and the two angles,
+    /// and rewards "long cylinder length in conjunction with small rotation angle" as the
+    /// paper says it does.
+    pub fn paper_height(&self) -> f64 {
+        let depth = self.depth.clamp(1, MAX_DEPTH);
+        let rise = (0.5 * PI - self.mean_rotation()).sin();
+        let levels: f64 = (1..depth).map(|k| self.length_at(k) * rise).sum();
+        (self.length + levels).max(0.0)
+    }
+
+    /// Mean of the two rotation angles, each folded into 0..π (a turn by `a` about an axis is
+    /// a turn by `360° − a` about the opposite one), radians.
+    fn mean_rotation(&self) -> f64 {
+        let fold = |a: f64| {
+            let a = a.abs().rem_euclid(360.0);
+            a.min(360.0 - a).to_radians()
+        };
+        0.5 * (fold(self.rotation1.angle) + fold(self.rotation2.angle))
     }
 
     /// The largest `p · w` over the skeleton's points (the foot and every cylinder's top),
@@ -414,7 +524,7 @@ impl BinTree {
             vec![(Vec3::ZERO, Frame::UPRIGHT, 0, None, false)];
         while let Some((foot, frame, k, parent, lateral)) = stack.pop() {
             let top = foot + frame.heading * self.length_at(k) as f32;
-            let radii = (self.radius_at(k) as f32, self.radius_at(k + 1) as f32);
+            let radii = (self.radius_at(k) as f32, self.top_radius_at(k) as f32);
             let id = plant.add_segment(foot, top, radii, parent, lateral, Plant::BARK)?;
             if k + 1 < depth {
                 // Pushed in reverse so the first child is grown first.
@@ -449,6 +559,7 @@ impl Default for BinTree {
                 axis: [0.0, 0.3, -1.0],
             },
             min_radius: 0.01,
+            geometry: Geometry::Sylva,
         }
     }
 }
@@ -495,7 +606,86 @@ mod tests {
     #[test]
     fn layout_fits() {
         assert_eq!(BITS, 65);
+        assert_eq!(PAPER_BITS, 61);
         const { assert!(BITS <= Bits::CAPACITY) };
+    }
+
+    #[test]
+    fn paper_geometry_draws_every_cylinder_alike() {
+        let t = BinTree {
+            geometry: Geometry::Paper,
+            depth: 5,
+            lower_radius: 0.2,
+            upper_radius: 0.16,
+            ..BinTree::default()
+        };
+        let p = t.develop(0).unwrap();
+        assert!(p.segments().iter().all(|s| {
+            (s.start_radius - 0.2).abs() < 1e-6 && (s.end_radius - 0.16).abs() < 1e-6
+        }));
+        // Sylva's geometry tapers the same genome from level to level instead.
+        let sylva = BinTree {
+            geometry: Geometry::Sylva,
+            ..t
+        };
+        let thinnest = sylva
+            .develop(0)
+            .unwrap()
+            .segments()
+            .last()
+            .unwrap()
+            .end_radius;
+        assert!((thinnest - 0.2 * 0.8f32.powi(5)).abs() < 1e-6, "{thinnest}");
+    }
+
+    #[test]
+    fn paper_layout_reaches_the_papers_values() {
+        let mut bits = Bits::zeros(PAPER_BITS).unwrap();
+        let t = BinTree::decode_as(&bits, 0.02, Geometry::Paper);
+        assert_eq!((t.length_ratio, t.rotation1.angle), (1.0, 0.0));
+        for i in 0..PAPER_BITS {
+            bits.set(i, true);
+        }
+        let t = BinTree::decode_as(&bits, 0.02, Geometry::Paper);
+        assert_eq!((t.length_ratio, t.rotation1.angle), (1.0, 180.0));
+        assert!(
+            (t.rotation1.axis[1] - 1.0).abs() < 1e-12,
+            "an axis along the branch"
+        );
+        assert_eq!(BinTree::decode_as(&t.encode(), 0.02, Geometry::Paper), t);
+    }
+
+    #[test]
+    fn paper_forms_of_straightness_and_height() {
+        let turn = |angle| Rotation {
+            angle,
+            axis: [1.0, 0.0, 0.0],
+        };
+        let t = BinTree {
+            depth: 3,
+            length: 2.0,
+            length_ratio: 1.0,
+            rotation1: turn(30.0),
+            rotation2: turn(-90.0),
+            ..BinTree::default()
+        };
+        // Mean angle 60°: straightness 1 / (π/3); each of two levels rises 2·sin 30° = 1.
+        assert!((t.paper_straightness() - 3.0 / PI).abs() < 1e-12);
+        assert!((t.paper_height() - 4.0).abs() < 1e-12);
+        let pole = BinTree {
+            rotation1: turn(0.0),
+            rotation2: turn(360.0),
+            ..t
+        };
+        assert!((pole.paper_straightness() - 180.0 / PI).abs() < 1e-9);
+        assert!((pole.paper_height() - 6.0).abs() < 1e-12);
+        let drooping = BinTree {
+            depth: 8,
+            rotation1: turn(180.0),
+            rotation2: turn(180.0),
+            ..t
+        };
+        assert_eq!(drooping.paper_height(), 0.0);
     }
 
     #[test]

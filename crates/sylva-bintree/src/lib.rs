@@ -22,8 +22,14 @@
 pub mod genome;
 pub mod problem;
 
-pub use genome::{BITS, BinTree, Bits, Field, LAYOUT, MAX_DEPTH, MODEL, Rotation};
-pub use problem::{BinTreeProblem, BinTreeSettings, BinTreeStrategy, BitCrossover, CrossoverKind};
+pub use genome::{
+    BITS, BinTree, Bits, Field, Geometry, LAYOUT, MAX_DEPTH, MODEL, PAPER_BITS, PAPER_LAYOUT,
+    Rotation,
+};
+pub use problem::{
+    BinTreeProblem, BinTreeSettings, BinTreeStrategy, BitCrossover, CrossoverKind, Height,
+    Straightness,
+};
 
 use rand::Rng;
 use sylva_core::Plant;
@@ -49,7 +55,8 @@ impl Model for BinTreeModel {
     }
 
     fn random<R: Rng + ?Sized>(&self, v: &BinTreeSettings, rng: &mut R) -> BinTree {
-        BinTreeProblem::new(v.min_radius).decode(&BinTreeProblem::random_bits(rng))
+        let problem = BinTreeProblem::from_settings(v);
+        problem.decode(&problem.random_bits(rng))
     }
 
     /// Flips the bits of the genome's encoding (values round to the layout's steps).
@@ -59,11 +66,12 @@ impl Model for BinTreeModel {
             rate: v.mutation_rate,
         }
         .mutate(&mut bits, rng);
-        BinTree::decode(&bits, g.min_radius)
+        BinTree::decode_as(&bits, g.min_radius, g.geometry)
     }
 
     /// Crosses the encodings of the two most dominant parents (values round to the
-    /// layout's steps); the child keeps the first's minimum radius.
+    /// layout's steps); the child keeps the first's minimum radius and geometry (the second
+    /// is encoded in the first's layout).
     fn cross<R: Rng + ?Sized>(
         &self,
         parents: &[Parent<'_, BinTree>],
@@ -72,9 +80,13 @@ impl Model for BinTreeModel {
     ) -> Result<Bred<BinTree>, VariationError> {
         let (a, b) = two_most_dominant(parents)?;
         let (ga, gb) = (parents[a].genome, parents[b].genome);
+        let gb = BinTree {
+            geometry: ga.geometry,
+            ..*gb
+        };
         let bits = BitCrossover(v.crossover).crossover(&ga.encode(), &gb.encode(), rng);
         Ok(Bred {
-            genome: BinTree::decode(&bits, ga.min_radius),
+            genome: BinTree::decode_as(&bits, ga.min_radius, ga.geometry),
             parents: vec![a, b],
         })
     }

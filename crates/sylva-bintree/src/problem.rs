@@ -9,6 +9,9 @@
 //! mutation_rate = 0.02       # probability of flipping each bit of a child
 //! crossover = "one_point"    # or "uniform"
 //! cull_clones = true         # replace copies of a genome (false: the paper's step)
+//! geometry = "sylva"         # or "paper": the pseudo-code's cylinders and the paper's reach
+//! straightness = "bend"      # or "paper": 1 / mean rotation angle
+//! height = "skeleton"        # or "paper": from the sines of the rotation angles
 //!
 //! [bintree.weights]          # Susinno's fitness weights
 //! surface_to_volume = 0.02
@@ -21,11 +24,12 @@
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
+use sylva_core::TreeMeasures;
 use sylva_evolve::bits::{BitFlip, OnePoint, Uniform};
 use sylva_evolve::{Crossover, Fitness, MeanReplacement, Problem};
 use sylva_fitness::{SusinnoWeights, tree::TERM_NAMES};
 
-use crate::genome::{BITS, BinTree, Bits};
+use crate::genome::{BinTree, Bits, Geometry};
 
 /// How binary trees are crossed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -36,6 +40,30 @@ pub enum CrossoverKind {
     OnePoint,
     /// Each bit from either parent.
     Uniform,
+}
+
+/// Which straightness a run scores.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Straightness {
+    /// Sylva's: `1 − mean bend / 180°` over every child cylinder, 0 to 1, the same measure
+    /// read off any plant.
+    #[default]
+    Bend,
+    /// The paper's: inversely proportional to the mean rotation angle
+    /// ([`BinTree::paper_straightness`]).
+    Paper,
+}
+
+/// Which height a run scores.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Height {
+    /// Sylva's: the skeleton's highest point, the same measure read off any plant.
+    #[default]
+    Skeleton,
+    /// The paper's: from the sines of the rotation angles ([`BinTree::paper_height`]).
+    Paper,
 }
 
 /// The binary tree's settings, the `[bintree]` section of an evolution config: the minimum
@@ -56,6 +84,20 @@ pub struct BinTreeSettings {
     pub cull_clones: bool,
     /// Fitness weights.
     pub weights: SusinnoWeights,
+    /// Sylva's geometry and search ranges (default) or the paper's.
+    #[serde(skip_serializing_if = "is_default")]
+    pub geometry: Geometry,
+    /// Sylva's straightness (default) or the paper's.
+    #[serde(skip_serializing_if = "is_default")]
+    pub straightness: Straightness,
+    /// Sylva's height (default) or the paper's.
+    #[serde(skip_serializing_if = "is_default")]
+    pub height: Height,
+}
+
+/// Settings at their defaults stay out of written configs, which keep their bytes.
+fn is_default<T: Default + PartialEq>(value: &T) -> bool {
+    *value == T::default()
 }
 
 impl Default for BinTreeSettings {
@@ -66,6 +108,9 @@ impl Default for BinTreeSettings {
             crossover: CrossoverKind::OnePoint,
             cull_clones: true,
             weights: SusinnoWeights::default(),
+            geometry: Geometry::Sylva,
+            straightness: Straightness::Bend,
+            height: Height::Skeleton,
         }
     }
 }
@@ -80,15 +125,21 @@ pub struct BinTreeProblem {
     pub min_radius: f64,
     /// Fitness weights.
     pub weights: SusinnoWeights,
+    /// The genomes' geometry and bit layout.
+    pub geometry: Geometry,
+    /// The straightness scored.
+    pub straightness: Straightness,
+    /// The height scored.
+    pub height: Height,
 }
 
 impl BinTreeProblem {
-    /// A problem with the default weights and the given minimum radius.
+    /// A problem with the default settings and the given minimum radius.
     pub fn new(min_radius: f64) -> Self {
-        BinTreeProblem {
+        BinTreeProblem::from_settings(&BinTreeSettings {
             min_radius,
-            weights: SusinnoWeights::default(),
-        }
+            ..BinTreeSettings::default()
+        })
     }
 
     /// The problem the settings describe.
@@ -96,17 +147,37 @@ impl BinTreeProblem {
         BinTreeProblem {
             min_radius: settings.min_radius,
             weights: settings.weights,
+            geometry: settings.geometry,
+            straightness: settings.straightness,
+            height: settings.height,
         }
     }
 
     /// The genome a bit string stands for.
     pub fn decode(&self, bits: &Bits) -> BinTree {
-        BinTree::decode(bits, self.min_radius)
+        BinTree::decode_as(bits, self.min_radius, self.geometry)
     }
 
-    /// A random bit string of the layout's length.
-    pub fn random_bits<R: Rng + ?Sized>(rng: &mut R) -> Bits {
-        Bits::random(BITS, rng).expect("the layout fits its bit string")
+    /// A random bit string of the geometry's layout.
+    pub fn random_bits<R: Rng + ?Sized>(&self, rng: &mut R) -> Bits {
+        let width = self
+            .geometry
+            .layout()
+            .iter()
+            .map(|f| usize::from(f.code.bits));
+        Bits::random(width.sum(), rng).expect("the layout fits its bit string")
+    }
+
+    /// The measures the fitness weighs, in the forms the run asks for.
+    pub fn measures(&self, tree: &BinTree) -> TreeMeasures {
+        let mut m = tree.measures();
+        if self.straightness == Straightness::Paper {
+            m.straightness = tree.paper_straightness();
+        }
+        if self.height == Height::Paper {
+            m.height = tree.paper_height();
+        }
+        m
     }
 }
 
@@ -118,12 +189,12 @@ impl Problem for BinTreeProblem {
     }
 
     fn evaluate(&self, bits: &Bits) -> Fitness {
-        let score = self.weights.score(&self.decode(bits).measures());
+        let score = self.weights.score(&self.measures(&self.decode(bits)));
         Fitness::new(score.total, &score.terms)
     }
 
     fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> Bits {
-        Self::random_bits(rng)
+        self.random_bits(rng)
     }
 }
 

@@ -256,13 +256,16 @@ fn crown_roundness(plant: &Plant) -> f64 {
 /// `(1 - cos φ) / 2` for the angle φ between the parts of `d1` and `d2` across `h`, and how
 /// equal their bends are, `min(δ1, δ2) / max(δ1, δ2)` for their angles δ to `h`. 1 for a
 /// perfect mirror image, 0 for two children leaning the same way; two children that do not
-/// bend at all count as mirror images.
+/// bend at all (within 1e-6 radians, a single-precision plant's noise) count as mirror images.
 pub fn fork_symmetry(h: DVec3, d1: DVec3, d2: DVec3) -> f64 {
-    let bend = |d: DVec3| d.dot(h).clamp(-1.0, 1.0).acos();
-    let (b1, b2) = (bend(d1), bend(d2));
-    if b1.max(b2) < 1e-9 {
+    // Unbent is judged by the sine, which is exact near 0 where `acos` is not: a bend of
+    // 1e-16 reads as 1.5e-8 through `acos`.
+    let unbent = |d: DVec3| d.dot(h) > 0.0 && d.cross(h).length() < 1e-6;
+    if unbent(d1) && unbent(d2) {
         return 1.0;
     }
+    let bend = |d: DVec3| d.dot(h).clamp(-1.0, 1.0).acos();
+    let (b1, b2) = (bend(d1), bend(d2));
     let across = |d: DVec3| (d - d.dot(h) * h).normalize_or_zero();
     let opposite = 0.5 * (1.0 - across(d1).dot(across(d2)));
     opposite * b1.min(b2) / b1.max(b2)

@@ -26,6 +26,7 @@ fn every_example_config_reads_and_the_default_is_written_out() {
     for name in [
         "bintree/default.toml",
         "bintree/paper.toml",
+        "bintree/six-terms.toml",
         "automata/sphere.toml",
         "automata/box-above.toml",
         "plantmaker/evolve.toml",
@@ -46,6 +47,12 @@ fn every_example_config_reads_and_the_default_is_written_out() {
     let paper = paper.get::<sylva_bintree::BinTreeModel>().unwrap();
     assert_eq!(paper.settings.weights.pipe_model, 0.0);
     assert!(!paper.settings.cull_clones);
+    assert_eq!(paper.settings.geometry, sylva_bintree::Geometry::Paper);
+    assert_eq!(
+        paper.settings.straightness,
+        sylva_bintree::Straightness::Paper
+    );
+    assert_eq!(paper.settings.height, sylva_bintree::Height::Paper);
 }
 
 #[test]
