@@ -51,7 +51,7 @@ model_tag!(
 /// Deepest recursion a genome may ask for: `2^14 - 1` = 16383 cylinders.
 pub const MAX_DEPTH: u32 = 14;
 
-/// The bit string the genetic algorithm evolves (73 bits used).
+/// The bit string the genetic algorithm evolves ([`BITS`] or [`PAPER_BITS`] of its 128 used).
 pub type Bits = BitString<2>;
 
 /// A rotation: an angle about an axis in the parent's local frame.
@@ -77,6 +77,17 @@ impl Rotation {
     /// The rotation as a matrix in the parent's local frame.
     fn matrix(&self) -> DMat3 {
         DMat3::from_axis_angle(self.unit_axis(), self.angle.to_radians())
+    }
+
+    /// The same rotation with its angle in 0..=180° (a turn by `a` about an axis is a turn
+    /// by `360° − a` about the opposite one): the angle in radians and the unit axis.
+    fn folded(&self) -> (f64, DVec3) {
+        let a = self.angle.rem_euclid(360.0);
+        if a > 180.0 {
+            ((360.0 - a).to_radians(), -self.unit_axis())
+        } else {
+            (a.to_radians(), self.unit_axis())
+        }
     }
 
     /// Where it turns the parent's heading (local +y).
@@ -444,14 +455,23 @@ impl BinTree {
         (self.length + levels).max(0.0)
     }
 
-    /// Mean of the two rotation angles, each folded into 0..π (a turn by `a` about an axis is
-    /// a turn by `360° − a` about the opposite one), radians.
+    /// The paper's symmetry, which "promotes trees in which the two rotation angles and axes
+    /// are approximately equivalent, with partial credit for partial matches": the mean of
+    /// an angle match, `1 − |θ₁ − θ₂| / 180°`, and an axis match, `(1 + â₁·â₂) / 2`, each
+    /// 0 to 1, with both rotations folded to angles of 0..180°. 1 for a tree without forks.
+    pub fn paper_symmetry(&self) -> f64 {
+        if self.depth <= 1 {
+            return 1.0;
+        }
+        let ((a1, axis1), (a2, axis2)) = (self.rotation1.folded(), self.rotation2.folded());
+        let angles = 1.0 - (a1 - a2).abs() / PI;
+        let axes = 0.5 * (1.0 + axis1.dot(axis2));
+        0.5 * (angles + axes)
+    }
+
+    /// Mean of the two rotation angles, each folded into 0..π, radians.
     fn mean_rotation(&self) -> f64 {
-        let fold = |a: f64| {
-            let a = a.abs().rem_euclid(360.0);
-            a.min(360.0 - a).to_radians()
-        };
-        0.5 * (fold(self.rotation1.angle) + fold(self.rotation2.angle))
+        0.5 * (self.rotation1.folded().0 + self.rotation2.folded().0)
     }
 
     /// The largest `p · w` over the skeleton's points (the foot and every cylinder's top),
@@ -686,6 +706,35 @@ mod tests {
             ..t
         };
         assert_eq!(drooping.paper_height(), 0.0);
+    }
+
+    #[test]
+    fn paper_symmetry_credits_matching_angles_and_axes() {
+        let turn = |angle, axis| Rotation { angle, axis };
+        let tree = |r1, r2| BinTree {
+            depth: 4,
+            rotation1: r1,
+            rotation2: r2,
+            ..BinTree::default()
+        };
+        let x = [1.0, 0.0, 0.0];
+        assert_eq!(tree(turn(40.0, x), turn(40.0, x)).paper_symmetry(), 1.0);
+        // A turn by −40° about x is a turn by 40° about −x: the angles match, the axes not.
+        assert!((tree(turn(40.0, x), turn(-40.0, x)).paper_symmetry() - 0.5).abs() < 1e-12);
+        // 320° about x is that same turn written another way.
+        let same = tree(turn(-40.0, x), turn(320.0, x)).paper_symmetry();
+        assert!((same - 1.0).abs() < 1e-12);
+        // Half the angle range apart and perpendicular axes: half credit on each.
+        let partial = tree(turn(0.0, x), turn(90.0, [0.0, 0.0, 1.0])).paper_symmetry();
+        assert!((partial - 0.5).abs() < 1e-12);
+        assert_eq!(
+            BinTree {
+                depth: 1,
+                ..tree(turn(0.0, x), turn(180.0, x))
+            }
+            .paper_symmetry(),
+            1.0
+        );
     }
 
     #[test]

@@ -28,7 +28,7 @@ pub use genome::{
 };
 pub use problem::{
     BinTreeProblem, BinTreeSettings, BinTreeStrategy, BitCrossover, CrossoverKind, Height,
-    Straightness,
+    Straightness, Symmetry,
 };
 
 use rand::Rng;

@@ -10,16 +10,19 @@
 //! crossover = "one_point"    # or "uniform"
 //! cull_clones = true         # replace copies of a genome (false: the paper's step)
 //! geometry = "sylva"         # or "paper": the pseudo-code's cylinders and the paper's reach
+//! symmetry = "mirror"        # or "paper": the two rotations' angles and axes match
 //! straightness = "bend"      # or "paper": 1 / mean rotation angle
 //! height = "skeleton"        # or "paper": from the sines of the rotation angles
 //!
-//! [bintree.weights]          # Susinno's fitness weights
+//! [bintree.weights]          # Susinno's six weights and Sylva's two (the defaults)
 //! surface_to_volume = 0.02
-//! symmetry = 1.0
-//! radius_to_length = 2.0
-//! volume = 1.0
-//! height = 0.5
-//! straightness = 1.0
+//! symmetry = 4.0
+//! radius_to_length = 0.05
+//! volume = 0.1
+//! height = 1.5
+//! straightness = 2.0
+//! pipe_model = 3.0           # 0 for the paper's fitness
+//! roundness = 3.0            # 0 for the paper's fitness
 //! ```
 
 use rand::Rng;
@@ -55,6 +58,18 @@ pub enum Straightness {
     Paper,
 }
 
+/// Which symmetry a run scores.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Symmetry {
+    /// Sylva's: the two children mirror each other across the parent's axis, read off the
+    /// fork as off any plant's.
+    #[default]
+    Mirror,
+    /// The paper's: the two rotations' angles and axes match ([`BinTree::paper_symmetry`]).
+    Paper,
+}
+
 /// Which height a run scores.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -87,6 +102,9 @@ pub struct BinTreeSettings {
     /// Sylva's geometry and search ranges (default) or the paper's.
     #[serde(skip_serializing_if = "is_default")]
     pub geometry: Geometry,
+    /// Sylva's symmetry (default) or the paper's.
+    #[serde(skip_serializing_if = "is_default")]
+    pub symmetry: Symmetry,
     /// Sylva's straightness (default) or the paper's.
     #[serde(skip_serializing_if = "is_default")]
     pub straightness: Straightness,
@@ -109,6 +127,7 @@ impl Default for BinTreeSettings {
             cull_clones: true,
             weights: SusinnoWeights::default(),
             geometry: Geometry::Sylva,
+            symmetry: Symmetry::Mirror,
             straightness: Straightness::Bend,
             height: Height::Skeleton,
         }
@@ -127,6 +146,8 @@ pub struct BinTreeProblem {
     pub weights: SusinnoWeights,
     /// The genomes' geometry and bit layout.
     pub geometry: Geometry,
+    /// The symmetry scored.
+    pub symmetry: Symmetry,
     /// The straightness scored.
     pub straightness: Straightness,
     /// The height scored.
@@ -148,6 +169,7 @@ impl BinTreeProblem {
             min_radius: settings.min_radius,
             weights: settings.weights,
             geometry: settings.geometry,
+            symmetry: settings.symmetry,
             straightness: settings.straightness,
             height: settings.height,
         }
@@ -171,6 +193,9 @@ impl BinTreeProblem {
     /// The measures the fitness weighs, in the forms the run asks for.
     pub fn measures(&self, tree: &BinTree) -> TreeMeasures {
         let mut m = tree.measures();
+        if self.symmetry == Symmetry::Paper {
+            m.symmetry = tree.paper_symmetry();
+        }
         if self.straightness == Straightness::Paper {
             m.straightness = tree.paper_straightness();
         }

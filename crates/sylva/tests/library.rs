@@ -53,6 +53,7 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         sylva_bintree::Straightness::Paper
     );
     assert_eq!(paper.settings.height, sylva_bintree::Height::Paper);
+    assert_eq!(paper.settings.symmetry, sylva_bintree::Symmetry::Paper);
 }
 
 #[test]
