@@ -5,6 +5,9 @@
 //! flat automata ([`Program`], Figures 4 to 6); a [`Simulator`] runs them as the paper's
 //! pseudo-code says (section 2.2) and draws a [`Plant`].
 //!
+//! Where each element of the paper is in Sylva, and where Sylva chose otherwise and why:
+//! `docs/fidelity.md`.
+//!
 //! - [`tree`]: the typed GP tree, its node types and checks.
 //! - [`sexpr`]: trees printed and parsed as lilgp-style S-expressions.
 //! - [`compile`]: cellular encoding into flat automata, and the semantics chosen.

@@ -4,6 +4,10 @@
 //! depth; evolved by a bit-string genetic algorithm towards a weighted fitness of six tree
 //! measures.
 //!
+//! Where each element of the paper is in Sylva, and where Sylva chose otherwise and why:
+//! `docs/fidelity.md`; `geometry`, `symmetry`, `straightness` and `height` set to `"paper"`
+//! run the paper as written.
+//!
 //! - [`genome`]: [`BinTree`], how it grows, its analytic [`TreeMeasures`](sylva_core::TreeMeasures)
 //!   and the bit layout of the genetic algorithm ([`LAYOUT`]).
 //! - [`problem`]: the genetic algorithm as an evolution problem: the model's settings (the

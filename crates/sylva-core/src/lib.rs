@@ -8,6 +8,7 @@
 //! - [`plant`]: [`Plant`], its [`Segment`]s, [`Organ`]s and [`Material`]s, with typed ids.
 //! - [`measures`]: tips, height, bounds, surface area, volume, and Susinno's
 //!   [`TreeMeasures`].
+//! - [`hull`]: the volume of a cloud of points' convex hull (a crown's envelope).
 //! - [`budget`]: the memory a job may use, checked before the work starts.
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
@@ -36,6 +37,7 @@
 pub mod budget;
 pub mod environment;
 pub mod hash;
+pub mod hull;
 pub mod io;
 pub mod measures;
 pub mod par;

@@ -5,7 +5,9 @@
 //!   the ratio of shaded to unshaded biomass (the paper: shaded herbs "grow poorly").
 //! - [`LateralLight`] (Figure 9): two trees of one genome under lateral light, against the
 //!   same pair under vertical light. Outcome: crown asymmetry (the horizontal offset of the
-//!   leaves' centroid towards the light over the crown radius) and height and width.
+//!   leaves' centroid towards the light over the crown radius), height and width, and
+//!   bushiness (shoot tips per cubic metre of the crown's convex hull; the paper: the crown
+//!   is "replaced by rather bushy forms").
 //! - [`EmptyRules`] (section 4.1): biomorph breeding from empty rules, choosing the largest
 //!   biomass each generation, until plants have leaves and fine roots.
 //!
@@ -21,8 +23,9 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use sylva_core::environment::{EnvironmentSettings, LightSettings};
 use sylva_core::glam::{Vec2, Vec3};
+use sylva_core::hull::convex_hull_volume;
 use sylva_core::par::Pool;
-use sylva_core::{MaterialKind, Plant};
+use sylva_core::{MaterialKind, Plant, Segment};
 
 use crate::breed::{BiomorphRun, BreedSettings, evolve_biomorphs, largest_biomass};
 use crate::garden::{Garden, GardenError, MAX_STEPS, Sowing, StepRecord};
@@ -82,7 +85,8 @@ fn placed(garden: &Garden, labels: &[String]) -> Vec<PlacedPlant> {
         .collect()
 }
 
-/// Horizontal shape of a plant's leaves, measured from its foot.
+/// Shape of a plant's crown, measured from its foot: height, the spread and lean of its
+/// leaves, and how bushy it is (shoot tips per cubic metre of its convex hull).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct CrownShape {
     /// Highest point of the shoot, metres.
@@ -95,6 +99,16 @@ pub struct CrownShape {
     pub asymmetry: f32,
     /// Leaves.
     pub leaves: usize,
+    /// Shoot tips: ends of the woody skeleton, bark segments from which no bark segment
+    /// grows (leaves may).
+    pub tips: usize,
+    /// Woody axes of the shoot: the trunk and every bark segment that starts a branch.
+    pub branches: usize,
+    /// Crown volume: the convex hull of the shoot's skeleton (both ends of every bark and
+    /// leaf segment, the foot included), cubic metres.
+    pub volume: f32,
+    /// Bushiness: `tips / volume`, shoot tips per cubic metre of crown; 0 without volume.
+    pub bushiness: f32,
 }
 
 impl CrownShape {
@@ -103,13 +117,36 @@ impl CrownShape {
         let towards = towards.normalize_or_zero();
         let mut shape = CrownShape::default();
         let mut sum = Vec2::ZERO;
+        let kind = |s: &Segment| plant.materials().get(s.material.index()).map(|m| m.kind);
+        let bark = |s: &Segment| kind(s) == Some(MaterialKind::Bark);
+        let mut bears_wood = vec![false; plant.segments().len()];
+        let mut shoot = Vec::new();
+        for s in plant.segments() {
+            if bark(s) {
+                if let Some(p) = s.parent {
+                    bears_wood[p.index()] = true;
+                }
+                if s.lateral || s.parent.is_none() {
+                    shape.branches += 1;
+                }
+            }
+            if kind(s) != Some(MaterialKind::Root) {
+                shoot.extend([s.start.as_dvec3(), s.end.as_dvec3()]);
+            }
+        }
+        shape.tips = plant
+            .segments()
+            .iter()
+            .zip(&bears_wood)
+            .filter(|(s, wood)| bark(s) && !**wood)
+            .count();
+        shape.volume = convex_hull_volume(&shoot) as f32;
+        if shape.volume > 0.0 {
+            shape.bushiness = shape.tips as f32 / shape.volume;
+        }
         for s in plant.segments() {
             shape.height = shape.height.max(s.end.y).max(s.start.y);
-            let leaf = plant
-                .materials()
-                .get(s.material.index())
-                .is_some_and(|m| m.kind == MaterialKind::Leaf);
-            if !leaf {
+            if kind(s) != Some(MaterialKind::Leaf) {
                 continue;
             }
             let mid = (s.start + s.end) * 0.5;
@@ -380,6 +417,16 @@ impl LateralLightOutcome {
     pub fn vertical_asymmetry(&self) -> f32 {
         0.5 * (self.vertical[0].asymmetry + self.vertical[1].asymmetry)
     }
+
+    /// Mean bushiness of the two lateral-light trees.
+    pub fn lateral_bushiness(&self) -> f32 {
+        0.5 * (self.lateral[0].bushiness + self.lateral[1].bushiness)
+    }
+
+    /// Mean bushiness of the two vertical-light trees.
+    pub fn vertical_bushiness(&self) -> f32 {
+        0.5 * (self.vertical[0].bushiness + self.vertical[1].bushiness)
+    }
 }
 
 impl LateralLight {
@@ -603,5 +650,82 @@ impl SimulationOutcome {
             SimulationOutcome::LateralLight(o) => &o.records,
             SimulationOutcome::EmptyRules(o) => &o.run.last.records,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sylva_core::{Material, PlantMeta};
+
+    /// A trunk forking into two branches, one with a leaf, over a long root: the shoot's hull
+    /// is the tetrahedron of the foot, the fork and the two branch ends.
+    #[test]
+    fn crown_counts_tips_and_branches_over_the_shoots_hull() {
+        let mut p = Plant::new(PlantMeta::default());
+        let root = p
+            .add_material(Material::of_kind(MaterialKind::Root))
+            .unwrap();
+        let fork = Vec3::Y;
+        let trunk = p
+            .add_segment(Vec3::ZERO, fork, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        let a = p
+            .add_segment(
+                fork,
+                fork + Vec3::X,
+                (0.05, 0.05),
+                Some(trunk),
+                true,
+                Plant::BARK,
+            )
+            .unwrap();
+        p.add_segment(
+            fork,
+            fork + Vec3::Z,
+            (0.05, 0.05),
+            Some(trunk),
+            true,
+            Plant::BARK,
+        )
+        .unwrap();
+        // On the hull's face: it adds no volume, and branch `a` stays a tip.
+        let leaf_end = fork + Vec3::new(0.5, 0.0, 0.5);
+        p.add_segment(
+            fork + Vec3::X,
+            leaf_end,
+            (0.02, 0.02),
+            Some(a),
+            true,
+            Plant::LEAF,
+        )
+        .unwrap();
+        p.add_segment(Vec3::ZERO, Vec3::NEG_Y * 3.0, (0.1, 0.1), None, false, root)
+            .unwrap();
+        let crown = CrownShape::of(&p, Vec2::X);
+        assert_eq!((crown.tips, crown.branches, crown.leaves), (2, 3, 1));
+        assert!((crown.volume - 1.0 / 6.0).abs() < 1e-6, "{crown:?}");
+        assert!((crown.bushiness - 12.0).abs() < 1e-4, "{crown:?}");
+
+        // A branch growing from `a` makes it bear wood: still two tips, one more branch.
+        p.add_segment(
+            fork + Vec3::X,
+            fork + Vec3::X * 2.0,
+            (0.02, 0.02),
+            Some(a),
+            true,
+            Plant::BARK,
+        )
+        .unwrap();
+        let crown = CrownShape::of(&p, Vec2::X);
+        assert_eq!((crown.tips, crown.branches), (2, 4));
+        assert!((crown.volume - 2.0 / 6.0).abs() < 1e-6, "{crown:?}");
+    }
+
+    #[test]
+    fn a_plant_without_a_shoot_is_not_bushy() {
+        let crown = CrownShape::of(&Plant::new(PlantMeta::default()), Vec2::X);
+        assert_eq!((crown.tips, crown.branches, crown.volume), (0, 0, 0.0));
+        assert_eq!(crown.bushiness, 0.0);
     }
 }

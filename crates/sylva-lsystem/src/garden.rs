@@ -40,7 +40,7 @@ pub const MAX_PLANTS: usize = 4096;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GrowSettings {
-    /// The world. Default [`EnvironmentSettings::default`] (64³ voxels of 0.25 m).
+    /// The world. Default [`EnvironmentSettings::default`] (64³ voxels of 0.125 m).
     pub world: EnvironmentSettings,
     /// Steps to grow, 0 to [`MAX_STEPS`]. Default 150: long enough for the example tree
     /// (`examples/lsystem/tree.json`) to form its crown.

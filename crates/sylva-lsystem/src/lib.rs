@@ -1,6 +1,9 @@
 //! Bornhofen and Lattaud's virtual plants: L-system shoots and roots grown in a voxel world
 //! of light and minerals by a transport-resistance physiology, bred like biomorphs.
 //!
+//! Where each element of the paper is in Sylva, and where Sylva chose otherwise and why:
+//! `docs/fidelity.md`.
+//!
 //! - [`grammar`]: the alphabet of Table 1 and rules in the paper's notation.
 //! - [`mutate`]: the character and rule operators of section 3.3.
 //! - [`interpret`]: strings to sphylls (derivation is kept apart from interpretation).

@@ -88,10 +88,10 @@ pub struct Physiology {
     /// Default 0.02.
     #[serde(deserialize_with = "seed_biomass")]
     pub seed_biomass: f64,
-    /// Carbon reserve of the seed, 0 to 100 g. Default 0.6.
+    /// Carbon reserve of the seed, 0 to 100 g. Default 0.5.
     #[serde(deserialize_with = "seed_carbon")]
     pub seed_carbon: f64,
-    /// Mineral reserve of the seed, 0 to 100 g. Default 0.05.
+    /// Mineral reserve of the seed, 0 to 100 g. Default 0.04.
     #[serde(deserialize_with = "seed_minerals")]
     pub seed_minerals: f64,
     /// `f_C`: carbon in a gram of biomass, 0.01 to 1. Default 0.45.
@@ -101,7 +101,7 @@ pub struct Physiology {
     #[serde(deserialize_with = "mineral_content")]
     pub mineral_content: f64,
     /// `ε`: carbon fixed per unit of absorbed light (one unit is a square metre of
-    /// unshaded light for one step), 0 to 100 g. Default 2.
+    /// unshaded light for one step), 0 to 100 g. Default 1.
     #[serde(deserialize_with = "photosynthesis")]
     pub photosynthesis: f64,
     /// `u`: soil volume a square metre of fine-root surface draws on per step, 0 to 100 m.
@@ -131,10 +131,10 @@ pub struct Physiology {
     pub growth_loss: f64,
     /// `m`: carbon a gram of biomass costs to maintain each step, paid from its
     /// compartment's carbon pool before growth and shed as litter; 0 to 1 g/g.
-    /// Default 0.01.
+    /// Default 0.005.
     #[serde(deserialize_with = "maintenance")]
     pub maintenance: f64,
-    /// `δ`: biomass per cubic metre of module, 1 to 1e6 g/m³. Default 50.
+    /// `δ`: biomass per cubic metre of module, 1 to 1e6 g/m³. Default 200.
     #[serde(deserialize_with = "module_density")]
     pub module_density: f64,
     /// Least biomass any rewrite costs, so rules without modules are not free,

@@ -64,7 +64,8 @@ impl Default for LSystemSettings {
 }
 
 impl LSystemSettings {
-    /// The mutation operator (rules and characters; parameters stay).
+    /// The mutation operator: rules and characters, and with the `mutate_parameter` rate a
+    /// nudge of the shapes and angles at the default scale.
     pub fn mutation(&self) -> LSystemMutation {
         LSystemMutation {
             rates: self.rates,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use sylva_core::par::Pool;
 use sylva_lsystem::LSystemGenome;
-use sylva_lsystem::experiments::{Simulation, SimulationOutcome};
+use sylva_lsystem::experiments::{CrownShape, Simulation, SimulationOutcome};
 
 fn config(name: &str) -> (Simulation, PathBuf) {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/lsystem");
@@ -62,6 +62,43 @@ fn lateral_light_makes_one_sided_crowns() {
     }
     assert!(
         o.lateral_asymmetry() > 3.0 * o.vertical_asymmetry().abs(),
+        "{report}"
+    );
+    for s in o.lateral.iter().chain(&o.vertical) {
+        assert!(
+            s.tips > 0 && s.tips < s.branches && s.volume > 0.0,
+            "{report}"
+        );
+    }
+}
+
+/// Grown until both pairs stop at the 4000-module bound, the lateral-light crowns carry as
+/// many shoot tips as the vertical-light ones in a smaller hull: they are bushier.
+#[test]
+fn lateral_light_makes_bushier_crowns_of_equal_size() {
+    let (mut sim, dir) = config("lateral-light.toml");
+    if let Simulation::LateralLight(c) = &mut sim {
+        c.steps = 210;
+    }
+    let outcome = run(&sim, &dir);
+    let SimulationOutcome::LateralLight(o) = &outcome else {
+        panic!("{outcome:?}")
+    };
+    let report = format!("{o:?}");
+    let at_bound = o
+        .records
+        .iter()
+        .filter(|r| r.step == 210 && r.modules == 4000);
+    assert_eq!(at_bound.count(), 2, "{report}");
+    let tips = |s: &[CrownShape; 2]| 0.5 * (s[0].tips + s[1].tips) as f32;
+    let volume = |s: &[CrownShape; 2]| 0.5 * (s[0].volume + s[1].volume);
+    assert!(
+        (tips(&o.lateral) / tips(&o.vertical) - 1.0).abs() < 0.05,
+        "{report}"
+    );
+    assert!(volume(&o.lateral) < 0.9 * volume(&o.vertical), "{report}");
+    assert!(
+        o.lateral_bushiness() > 1.1 * o.vertical_bushiness(),
         "{report}"
     );
 }

@@ -1,5 +1,8 @@
 //! PlantMaker: Gal, Mahal and Sipper's *Evolutionary Plantographics* (Artificial Life, 2004).
 //!
+//! Where each element of the paper is in Sylva, and where Sylva chose otherwise and why:
+//! `docs/fidelity.md`.
+//!
 //! A [`PlantMaker`] genome holds n branch prototypes ([`Branch`], the paper's Table 1), m fans
 //! ([`Fan`], Table 2) and k inflorescences ([`Inflorescence`], Table 3), plus a seed. The first
 //! branch is the stem; a fan places copies of one branch prototype around a point; an

@@ -141,6 +141,27 @@ pub fn simulation_report(outcome: &SimulationOutcome) -> String {
                 o.lateral_asymmetry(),
                 o.vertical_asymmetry()
             );
+            for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
+                for (i, s) in shapes.iter().enumerate() {
+                    let _ = writeln!(
+                        out,
+                        "{name} light, tree {}: {} shoot tips, {} branches, {} leaves, \
+                         crown hull {:.2} m³, bushiness {:.1} tips/m³",
+                        i + 1,
+                        s.tips,
+                        s.branches,
+                        s.leaves,
+                        s.volume,
+                        s.bushiness
+                    );
+                }
+            }
+            let _ = writeln!(
+                out,
+                "mean bushiness (shoot tips per m³ of crown hull): lateral {:.1}, vertical {:.1}",
+                o.lateral_bushiness(),
+                o.vertical_bushiness()
+            );
         }
         SimulationOutcome::EmptyRules(o) => {
             for g in &o.run.generations {

@@ -270,6 +270,8 @@ fn a_breeding_round() {
 
 /// `scene.glb` changed once on purpose: its nodes carry each plant's genome and seed (with
 /// its biomass), so a plant of an experiment can be grown again.
+/// `report.txt` changed once on purpose: lines for each crown's bushiness (shoot tips per m³
+/// of its convex hull) were added after the unchanged asymmetry lines; `side.png` is new.
 #[test]
 fn an_experiment() {
     let dir = temp_dir("simulate");
@@ -282,10 +284,11 @@ fn an_experiment() {
     check(
         &dir,
         &[
-            ("report.txt", 0xf24f_4ecc_c899_b16b),
+            ("report.txt", 0x8755_3c32_5e90_8b96),
             ("records.csv", 0xb99e_2a2d_f61e_5f2e),
             ("scene.glb", 0x8493_205e_7532_486c),
             ("scene.png", 0x91c1_ec3a_02cf_40e7),
+            ("side.png", 0x3353_95bf_0e3d_bc8d),
         ],
     );
 }

@@ -8,10 +8,13 @@ use sylva::files::{Outputs, read_text};
 use sylva::genome::load_genome_of;
 use sylva::report::simulation_report;
 use sylva::{Genome, InputError};
+use sylva_core::glam::{Quat, Vec2, Vec3};
+use sylva_core::{MaterialKind, Plant};
 use sylva_lsystem::LSystemModel;
-use sylva_lsystem::experiments::Simulation;
+use sylva_lsystem::experiments::{LateralLightOutcome, Simulation, SimulationOutcome};
 use sylva_lsystem::garden::records_csv;
 use sylva_mesh::render::View;
+use sylva_model::MeshHint;
 use sylva_model::Model;
 
 use super::{InFile, SCENE_PICTURE};
@@ -81,11 +84,41 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         &out.join("scene.png"),
         &picture(&scene, View::Iso, SCENE_PICTURE)?,
     )?;
+    let mut written = "report.txt, records.csv, scene.glb, scene.png".to_owned();
+    if let SimulationOutcome::LateralLight(o) = &outcome {
+        files.add(&out.join("side.png"), &side_picture(o, hint, path)?)?;
+        written.push_str(", side.png");
+    }
     files.commit()?;
     print!("{report}");
-    println!(
-        "wrote {}/{{report.txt, records.csv, scene.glb, scene.png}}",
-        out.display()
-    );
+    println!("wrote {}/{{{written}}}", out.display());
     Ok(())
+}
+
+/// `side.png`: tree 1 under lateral light (left) beside tree 1 under vertical light
+/// (right), at one scale, roots left out, seen across the light: both are turned so that the
+/// lateral light comes from +X, the right of a front view, and set apart by their reach.
+fn side_picture(o: &LateralLightOutcome, hint: MeshHint, config: &Path) -> anyhow::Result<Vec<u8>> {
+    let t = o.towards_light;
+    let turn = Quat::from_rotation_y(t.y.atan2(t.x));
+    let lateral = o.plants[0].plant.without(MaterialKind::Root);
+    let vertical = o.control[0].plant.without(MaterialKind::Root);
+    let reach = |p: &Plant| {
+        p.segments()
+            .iter()
+            .map(|s| Vec2::new(s.end.x, s.end.z).length())
+            .fold(0.0, f32::max)
+    };
+    let gap = 0.25;
+    let placed = [
+        ("lateral light", &lateral, -(reach(&lateral) + gap)),
+        ("vertical light", &vertical, reach(&vertical) + gap),
+    ]
+    .map(|(name, plant, x)| Placed {
+        translation: Vec3::new(x, 0.0, 0.0),
+        rotation: turn,
+        ..Placed::new(name, plant, hint)
+    });
+    let assets = SceneAssets::mesh(&placed).in_file(config)?;
+    Ok(picture(&assets.scene(), View::Front, SCENE_PICTURE)?)
 }
