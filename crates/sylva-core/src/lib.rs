@@ -9,6 +9,7 @@
 //! - [`measures`]: tips, height, bounds, surface area, volume, and Susinno's
 //!   [`TreeMeasures`].
 //! - [`hull`]: the volume of a cloud of points' convex hull (a crown's envelope).
+//! - [`taper`]: the pipe model's radii for any grown plant.
 //! - [`budget`]: the memory a job may use, checked before the work starts.
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
@@ -44,6 +45,7 @@ pub mod par;
 pub mod plant;
 pub mod ranged;
 pub mod rng;
+pub mod taper;
 pub mod turtle;
 
 pub use glam;

@@ -316,6 +316,12 @@ impl Plant {
         }
     }
 
+    /// The skeleton to edit in place, for the crate's own transforms (such as
+    /// [`crate::taper`]) that keep every segment's checks true.
+    pub(crate) fn segments_mut(&mut self) -> &mut [Segment] {
+        &mut self.segments
+    }
+
     /// The skeleton, parents first.
     #[inline]
     pub fn segments(&self) -> &[Segment] {

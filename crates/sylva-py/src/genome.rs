@@ -160,12 +160,25 @@ impl Genome {
     }
 
     /// Grows the plant with `seed` (the genome's own seed when none is given) and meshes it;
-    /// `roots=False` leaves the roots out. Releases the GIL.
-    #[pyo3(signature = (seed = None, roots = true))]
-    fn grow(&self, py: Python<'_>, seed: Option<u64>, roots: bool) -> PyResult<Plant> {
+    /// `roots=False` leaves the roots out; `taper=E` thickens the branches by the pipe model,
+    /// radius ∝ (tips above)^(1/E), E from 2 to 3. Releases the GIL.
+    #[pyo3(signature = (seed = None, roots = true, taper = None))]
+    fn grow(
+        &self,
+        py: Python<'_>,
+        seed: Option<u64>,
+        roots: bool,
+        taper: Option<f64>,
+    ) -> PyResult<Plant> {
         let genome = self.inner.clone();
         let seed = seed.unwrap_or_else(|| genome.default_seed());
-        let grown = py.detach(|| sylva::Grown::new(genome, seed, roots)).py()?;
+        let taper = taper
+            .map(sylva_core::taper::PipeTaper::new)
+            .transpose()
+            .map_err(|e| bad_value("taper", e))?;
+        let grown = py
+            .detach(|| sylva::Grown::with_taper(genome, seed, roots, taper))
+            .py()?;
         Ok(Plant::new(grown))
     }
 

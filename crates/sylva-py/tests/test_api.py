@@ -141,6 +141,17 @@ def test_mesh_arrays_outlive_their_plant():
     assert all(len(m.indices) > 0 and m.indices.max() < len(m.positions) for m in meshes)
 
 
+def test_the_pipe_taper_thickens_the_trunk_and_keeps_the_twigs():
+    genome = sylva.Genome.load(EXAMPLES / "lsystem" / "tree.json")
+    plain, tapered = genome.grow(roots=False), genome.grow(roots=False, taper=2.5)
+    assert tapered.segments == plain.segments
+    assert tapered.volume > 1.5 * plain.volume, "the trunk carries every tip above it"
+    assert tapered.glb() == genome.grow(roots=False, taper=2.5).glb()
+    for bad in (1.5, 3.5, float("nan")):
+        with pytest.raises(sylva.InputError, match="taper"):
+            genome.grow(taper=bad)
+
+
 def test_cross_keeps_models_apart():
     with pytest.raises(sylva.InputError, match="plantmaker|bintree|model"):
         sylva.cross([sylva.Genome.load(GENOMES["plantmaker"]),

@@ -11,6 +11,7 @@ use std::path::Path;
 
 use serde_json::json;
 use sylva_core::glam::{Quat, Vec3};
+use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
 use sylva_evolve::IndividualId;
 use sylva_mesh::export::{self, Format};
@@ -77,15 +78,30 @@ pub struct Grown {
     pub plant: Plant,
     /// Its mesh.
     pub mesh: Mesh,
+    /// The pipe-model taper applied before meshing, if any.
+    pub taper: Option<PipeTaper>,
 }
 
 impl Grown {
     /// Grows and meshes a genome, leaving out the roots when `roots` is false (they stay
     /// out of the exported asset and the pictures).
     pub fn new(genome: Genome, seed: u64, roots: bool) -> Result<Grown, Error> {
+        Grown::with_taper(genome, seed, roots, None)
+    }
+
+    /// As [`Grown::new`], then, with a `taper`, the pipe model's radii before meshing.
+    pub fn with_taper(
+        genome: Genome,
+        seed: u64,
+        roots: bool,
+        taper: Option<PipeTaper>,
+    ) -> Result<Grown, Error> {
         let mut plant = genome.develop(seed)?;
         if !roots {
             plant = plant.without(MaterialKind::Root);
+        }
+        if let Some(taper) = taper {
+            taper.apply(&mut plant);
         }
         let mesh = Mesher::new(mesh_options(genome.mesh_hint()))?.mesh(&plant)?;
         Ok(Grown {
@@ -93,13 +109,19 @@ impl Grown {
             seed,
             plant,
             mesh,
+            taper,
         })
     }
 
-    /// A scene holding this plant at the origin, carrying its origin.
+    /// A scene holding this plant at the origin, carrying its origin (and its taper, so
+    /// that the asset can be grown again).
     pub fn scene(&self) -> Scene<'_> {
         let mut node = SceneNode::new(self.genome.model(), &self.mesh);
-        node.extras = Some(Origin::of(&self.genome, self.seed).extras());
+        let mut extras = Origin::of(&self.genome, self.seed).extras();
+        if let Some(taper) = self.taper {
+            extras["taper"] = json!({ "pipe_exponent": taper.exponent });
+        }
+        node.extras = Some(extras);
         Scene::single(node)
     }
 }

@@ -481,3 +481,59 @@ fn a_run_that_cannot_score_stops_with_an_error() {
         "{e}"
     );
 }
+
+#[test]
+fn the_pipe_taper_keeps_the_pipes_and_travels_with_the_asset() {
+    let e = 2.5;
+    let taper = sylva_core::taper::PipeTaper::new(e).unwrap();
+    for file in ["lsystem/tree.json", "automata/helix.json"] {
+        let genome = load_genome(&example(file)).unwrap();
+        let plain = Grown::new(genome.clone(), 0, false).unwrap();
+        let tapered = Grown::with_taper(genome, 0, false, Some(taper)).unwrap();
+        let s = tapered.plant.segments();
+        assert_eq!(
+            s.len(),
+            plain.plant.segments().len(),
+            "{file}: the same skeleton"
+        );
+        // At every fork the pipes add up: r^e of a segment is the sum over its children.
+        let mut children = vec![0f64; s.len()];
+        let mut twigs = Vec::new();
+        let materials = tapered.plant.materials();
+        let woody = |seg: &sylva_core::Segment| {
+            materials[seg.material.index()].kind == sylva_core::MaterialKind::Bark
+        };
+        for (i, seg) in s.iter().enumerate().rev().filter(|(_, seg)| woody(seg)) {
+            if let Some(p) = seg.parent {
+                children[p.index()] += f64::from(seg.start_radius).powf(e);
+            }
+            if children[i] == 0.0 {
+                twigs.push(seg.start_radius);
+            } else {
+                let own = f64::from(seg.start_radius).powf(e);
+                assert!(
+                    (own - children[i]).abs() <= 1e-4 * own,
+                    "{file}: segment {i}"
+                );
+            }
+        }
+        // Every twig has the same radius, and the trunk carries them all.
+        assert!(
+            twigs.iter().all(|&r| (r - twigs[0]).abs() <= 1e-6 * r),
+            "{file}"
+        );
+        let tips = twigs.len() as f64;
+        let trunk = f64::from(s[0].start_radius);
+        assert!((trunk - f64::from(twigs[0]) * tips.powf(1.0 / e)).abs() < 1e-4 * trunk);
+        let extras = tapered.scene().nodes[0].extras.clone().unwrap();
+        assert_eq!(extras["taper"]["pipe_exponent"], e, "{file}");
+        assert!(
+            plain.scene().nodes[0]
+                .extras
+                .clone()
+                .unwrap()
+                .get("taper")
+                .is_none()
+        );
+    }
+}

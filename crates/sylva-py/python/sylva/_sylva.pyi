@@ -50,8 +50,11 @@ class Genome:
         """Sets a field in place, checked as the genome file would be."""
     def with_field(self, field: str, value: Any) -> Genome:
         """A copy with ``field`` set to ``value``, checked as the genome file would be."""
-    def grow(self, seed: int | None = None, roots: bool = True) -> Plant:
-        """Grows and meshes the plant with ``seed`` (the genome's own when None)."""
+    def grow(
+        self, seed: int | None = None, roots: bool = True, taper: float | None = None
+    ) -> Plant:
+        """Grows and meshes the plant with ``seed`` (the genome's own when None); ``taper=E``
+        thickens the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3."""
     def mutate(self, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A mutated copy, made by the model's own mutation."""
     def __eq__(self, other: object) -> bool: ...

@@ -24,6 +24,10 @@ pub struct GrowArgs {
     /// PlantMaker genomes, 0 otherwise].
     #[arg(long)]
     seed: Option<u64>,
+    /// Thicken the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3
+    /// (off by default: each model's own radii).
+    #[arg(long, value_name = "E", value_parser = super::parse_taper)]
+    taper: Option<sylva_core::taper::PipeTaper>,
     /// Leave the roots out.
     #[arg(long)]
     hide_roots: bool,
@@ -37,7 +41,8 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     }
     let genome = load_genome(&args.genome)?;
     let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-    let grown = Grown::new(genome, seed, !args.hide_roots).in_file(&args.genome)?;
+    let grown =
+        Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.genome)?;
     let mut out = Outputs::new();
     out.add_scene(&args.output, &grown.scene())
         .in_file(&args.genome)?;

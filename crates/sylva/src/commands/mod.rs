@@ -62,6 +62,13 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// Parses the pipe-model exponent of `--taper`, 2 to 3.
+pub fn parse_taper(text: &str) -> Result<sylva_core::taper::PipeTaper, String> {
+    let bad = || format!("expected the pipe-model exponent, a number from 2 to 3; got {text:?}");
+    let e: f64 = text.trim().parse().map_err(|_| bad())?;
+    sylva_core::taper::PipeTaper::new(e).map_err(|_| bad())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -76,6 +83,10 @@ mod tests {
         assert_eq!(parse_area("30x20"), Ok((30.0, 20.0)));
         for bad in ["", "0x10", "1e9x1", "nanx1", "5"] {
             assert!(parse_area(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_taper("2.5").map(|t| t.exponent), Ok(2.5));
+        for bad in ["", "1.9", "3.01", "nan", "inf", "two"] {
+            assert!(parse_taper(bad).is_err(), "{bad}");
         }
     }
 }

@@ -29,6 +29,10 @@ pub struct RenderArgs {
     /// seed for PlantMaker genomes, 0 otherwise].
     #[arg(long)]
     seed: Option<u64>,
+    /// Thicken the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3
+    /// (off by default: each model's own radii).
+    #[arg(long, value_name = "E", value_parser = super::parse_taper)]
+    taper: Option<sylva_core::taper::PipeTaper>,
     /// Leave the roots out (genomes only).
     #[arg(long)]
     hide_roots: bool,
@@ -49,7 +53,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     } else {
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
-        let grown = Grown::new(genome, seed, !args.hide_roots).in_file(&args.file)?;
+        let grown =
+            Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
         write_picture(&grown.scene(), &args.output, args.view, args.size)?;
     }
     println!("wrote {}", args.output.display());
