@@ -83,6 +83,48 @@ fn f_num_counts_endpoints_in_total_and_per_level() {
 }
 
 #[test]
+fn f_num_per_branch_counts_each_branchs_sub_branches() {
+    // A trunk with two first-order branches: A carries three sub-branches, B one.
+    let mut p = Plant::new(PlantMeta::default());
+    let (y, bark) = (Vec3::Y, Plant::BARK);
+    let t0 = p
+        .add_segment(Vec3::ZERO, y, (0.1, 0.1), None, false, bark)
+        .unwrap();
+    p.add_segment(y, 2.0 * y, (0.1, 0.1), Some(t0), false, bark)
+        .unwrap();
+    let a = p
+        .add_segment(y, y + Vec3::X, (0.1, 0.1), Some(t0), true, bark)
+        .unwrap();
+    for z in [-1.0, 0.0, 1.0] {
+        let end = y + Vec3::new(2.0, 0.5, z);
+        p.add_segment(y + Vec3::X, end, (0.1, 0.1), Some(a), true, bark)
+            .unwrap();
+    }
+    let b = p
+        .add_segment(y, y - Vec3::X, (0.1, 0.1), Some(t0), true, bark)
+        .unwrap();
+    let b_end = y - Vec3::X;
+    p.add_segment(b_end, b_end + Vec3::Y, (0.1, 0.1), Some(b), true, bark)
+        .unwrap();
+    let mut scratch = PoncinScratch::new();
+    let ends = scratch.read(&p, UNIT, EndpointRule::Axes);
+    let subs: Vec<(u16, u32)> = ends.iter().map(|e| (e.level, e.sub_branches)).collect();
+    assert_eq!(
+        subs,
+        [(0, 0), (1, 3), (2, 0), (2, 0), (2, 0), (1, 1), (2, 0)]
+    );
+    let per_branch = |branches, each| NumTarget::PerBranch { branches, each }.deviation(ends);
+    // The per-level form sees 1, 2 and 4 endpoints and is content.
+    assert_eq!(NumTarget::PerLevel(vec![1, 2, 4]).deviation(ends), 0.0);
+    // Counts met: only the spread is left, B one short of two.
+    assert_eq!(per_branch(2, 2), 1.0);
+    // Counts not met: the per-level deviation plus the most the spread can cost.
+    assert_eq!(per_branch(2, 1), 2.0 + 2.0);
+    assert_eq!(per_branch(3, 1), 2.0 + 3.0);
+    assert_eq!(per_branch(2, 0), 4.0 + 0.0);
+}
+
+#[test]
 fn endpoints_are_the_plants_tips() {
     let p = two_branches();
     let mut scratch = PoncinScratch::new();
@@ -474,6 +516,20 @@ fn config_defaults_and_round_trip() {
     )
     .unwrap();
     assert_eq!(config.num_target, NumTarget::PerLevel(vec![1, 30]));
+    let branches: PoncinFitness =
+        toml::from_str("num_target = { branches = 8, each = 4 }").unwrap();
+    let target = NumTarget::PerBranch {
+        branches: 8,
+        each: 4,
+    };
+    assert_eq!(branches.num_target, target);
+    let written = toml::to_string(&branches).unwrap();
+    assert_eq!(
+        toml::from_str::<PoncinFitness>(&written)
+            .unwrap()
+            .num_target,
+        target
+    );
     assert_eq!(
         config.weights.pos, 5.0,
         "unnamed weights keep their defaults"
@@ -510,7 +566,19 @@ fn config_errors_are_clear() {
         "`num_target` entries must be whole numbers",
     );
     refused("num_target = []", "`num_target` must list 1 to 16 levels");
-    refused("num_target = 2.5", "a number of endpoints or a list");
+    refused(
+        "num_target = 2.5",
+        "a number of endpoints, a list of them per branch level, or a table",
+    );
+    refused(
+        "num_target = { branches = 8 }",
+        "needs both `branches` and `each`",
+    );
+    refused(
+        "num_target = { branches = 8, each = 4, deep = 2 }",
+        "unknown field `deep` in `num_target`",
+    );
+    refused("num_target = { branches = 8, each = -4 }", "whole numbers");
     refused("[thick]\nreferences = []", "`references` must hold 1 to 16");
     refused(
         "[thick]\nreferences = [0.5, 2]",

@@ -640,6 +640,9 @@ fn the_automata_examples_beat_the_trap_and_avoid_the_box() {
     let last = &box_above[box_above.len() - 1];
     assert_eq!(box_above.len(), 101);
     assert!(last[leaves] > 0.0 && last[forbidden] == 0.0, "{last:?}");
+    // Two levels: 8 branches with 4 sub-branches on each by generation 50.
+    let two_levels = automata_example_stats("two-levels.toml", &dir);
+    assert_eq!(two_levels[50][f_num], 0.0, "{:?}", two_levels[50]);
     fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -29,6 +29,7 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "bintree/six-terms.toml",
         "automata/sphere.toml",
         "automata/box-above.toml",
+        "automata/two-levels.toml",
         "plantmaker/evolve.toml",
         "lsystem/evolve.toml",
     ] {

@@ -39,6 +39,9 @@ pub struct Endpoint {
     pub level: u16,
     /// Radius at the end of its segment, metres.
     pub radius: f64,
+    /// For the end of a first-order branch: the endpoints of level 2 on that branch (its
+    /// sub-branches' ends); 0 otherwise.
+    pub sub_branches: u32,
 }
 
 /// Buffers one evaluation needs; keep one per thread and pass it to every
@@ -54,6 +57,10 @@ pub struct PoncinScratch {
     last: Vec<u32>,
     /// Per segment: path length from the foot to its end (the taper measure).
     along: Vec<f64>,
+    /// Per segment: the first segment of the first-order branch it grows on (`u32::MAX` on
+    /// the trunk), and, per first-order branch, its level-2 endpoints.
+    branch: Vec<u32>,
+    subs: Vec<u32>,
     pub(crate) endpoints: Vec<Endpoint>,
     /// Endpoint positions as f32 columns (x, y, z), for the exact pair loop.
     pub(crate) columns: [Vec<f32>; 3],
@@ -94,6 +101,26 @@ impl PoncinScratch {
                 self.has_child[i] = self.last[axis as usize] != i as u32;
             }
         }
+        // Each segment's first-order branch, and each branch's level-2 endpoints.
+        self.branch.clear();
+        self.subs.clear();
+        self.subs.resize(segments.len(), 0);
+        for (i, s) in segments.iter().enumerate() {
+            let inherited = match s.parent.map(|p| p.index()) {
+                Some(p) if p < i => self.branch[p],
+                _ => u32::MAX,
+            };
+            let branch = if s.order == 1 {
+                self.axis[i]
+            } else {
+                inherited
+            };
+            self.branch
+                .push(if s.order == 0 { u32::MAX } else { branch });
+            if s.order == 2 && !self.has_child[i] && branch != u32::MAX {
+                self.subs[branch as usize] += 1;
+            }
+        }
         self.endpoints.clear();
         for column in &mut self.columns {
             column.clear();
@@ -101,6 +128,11 @@ impl PoncinScratch {
         let inv_unit = 1.0 / unit;
         let ends = segments.iter().zip(&self.has_child).zip(&self.axis);
         for ((s, _), &axis) in ends.filter(|((_, has_child), _)| !**has_child) {
+            let sub_branches = if s.order == 1 {
+                self.subs[axis as usize]
+            } else {
+                0
+            };
             let position = s.end.as_dvec3() * inv_unit;
             for (column, x) in self.columns.iter_mut().zip(position.to_array()) {
                 column.push(x as f32);
@@ -111,6 +143,7 @@ impl PoncinScratch {
                 direction: (s.end - base).as_dvec3().normalize_or_zero(),
                 level: s.order,
                 radius: f64::from(s.end_radius),
+                sub_branches,
             });
         }
         &self.endpoints

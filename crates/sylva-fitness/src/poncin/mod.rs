@@ -76,7 +76,8 @@ pub mod shape;
 use std::fmt;
 
 use glam::DVec3;
-use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde::ser::SerializeMap;
 use serde::{Deserialize, Serialize, Serializer};
 use sylva_core::{OrganKind, Plant, ranged};
 
@@ -194,12 +195,32 @@ impl Default for PoncinWeights {
 /// sum over the listed levels of `|target_k − N_k|`, and endpoints of deeper levels count
 /// against a target of 0: the list's length is the paper's "level of branch recursion". The
 /// sum keeps the scale of the single-number form, so the same weight serves both.
+///
+/// Per-level counts can be met by a tree whose sub-branches all crowd onto one or two
+/// branches. Sylva's third form, a table (`num_target = { branches = 8, each = 4 }`), asks
+/// for `branches` first-order branches with at least `each` sub-branches on every one, in
+/// two stages. Until the per-level counts are met, F_num is the per-level form's
+/// `|branches − N₁| + |branches · each − N₂|` plus every endpoint deeper than level 2, plus
+/// `branches · each`; once they are, it is the branches' shortfall, the sum of
+/// `max(0, each − n_b)` over the first-order branches (`n_b` the sub-branch ends of `b`),
+/// which is at most `branches · each`. So every tree that meets the counts beats every
+/// tree that does not, the road out of the two-endpoint trap stays the per-level form's
+/// (a branch may sprout many sub-branches first), and the spread is sorted out last. It
+/// reads the ends of first-order branches, so it is meant for `endpoints = "axes"` (one per
+/// automaton instance), where every branch has one.
 #[derive(Clone, Debug, PartialEq)]
 pub enum NumTarget {
     /// Target number of endpoints of any level. The paper's 30.
     Total(u32),
     /// Target number of endpoints of each level, from the trunk's (1 to 16 levels).
     PerLevel(Vec<u32>),
+    /// Target first-order branches, and sub-branches on each of them.
+    PerBranch {
+        /// First-order branches.
+        branches: u32,
+        /// Sub-branches on each first-order branch.
+        each: u32,
+    },
 }
 
 impl Default for NumTarget {
@@ -231,6 +252,31 @@ impl NumTarget {
                     .count();
                 listed + deeper as f64
             }
+            NumTarget::PerBranch { branches, each } => {
+                let (mut first, mut second, mut deeper, mut short) = (0usize, 0usize, 0usize, 0u32);
+                for e in endpoints {
+                    match e.level {
+                        0 => {}
+                        1 => {
+                            first += 1;
+                            short += each.saturating_sub(e.sub_branches);
+                        }
+                        2 => second += 1,
+                        _ => deeper += 1,
+                    }
+                }
+                let levels = off(*branches, first) + off(branches.saturating_mul(*each), second);
+                let levels = levels + deeper as f64;
+                // The spread counts once the counts are met: stages, as the paper brings
+                // terms in "after the plant is stable".
+                // Every tree that meets them is better than every tree that does not.
+                let most_short = f64::from(*branches) * f64::from(*each);
+                if levels == 0.0 {
+                    f64::from(short)
+                } else {
+                    levels + most_short
+                }
+            }
         }
     }
 }
@@ -240,6 +286,12 @@ impl Serialize for NumTarget {
         match self {
             NumTarget::Total(t) => s.serialize_u32(*t),
             NumTarget::PerLevel(v) => v.serialize(s),
+            NumTarget::PerBranch { branches, each } => {
+                let mut map = s.serialize_map(Some(2))?;
+                map.serialize_entry("branches", branches)?;
+                map.serialize_entry("each", each)?;
+                map.end()
+            }
         }
     }
 }
@@ -259,7 +311,10 @@ impl<'de> Deserialize<'de> for NumTarget {
         impl<'de> Visitor<'de> for V {
             type Value = NumTarget;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a number of endpoints or a list of them per branch level")
+                f.write_str(
+                    "a number of endpoints, a list of them per branch level, or a table \
+                     { branches = N, each = M }",
+                )
             }
             fn visit_i64<E: de::Error>(self, v: i64) -> Result<NumTarget, E> {
                 check(v).map(NumTarget::Total)
@@ -279,6 +334,28 @@ impl<'de> Deserialize<'de> for NumTarget {
                     )));
                 }
                 Ok(NumTarget::PerLevel(levels))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<NumTarget, A::Error> {
+                let (mut branches, mut each) = (None, None);
+                while let Some(key) = map.next_key::<String>()? {
+                    let slot = match key.as_str() {
+                        "branches" => &mut branches,
+                        "each" => &mut each,
+                        other => {
+                            return Err(de::Error::custom(format!(
+                                "unknown field `{other}` in `num_target`, expected `branches` \
+                                 or `each`"
+                            )));
+                        }
+                    };
+                    *slot = Some(check(map.next_value::<i64>()?)?);
+                }
+                match (branches, each) {
+                    (Some(branches), Some(each)) => Ok(NumTarget::PerBranch { branches, each }),
+                    _ => Err(de::Error::custom(
+                        "`num_target` as a table needs both `branches` and `each`",
+                    )),
+                }
             }
         }
         d.deserialize_any(V)
