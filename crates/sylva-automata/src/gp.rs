@@ -27,6 +27,7 @@
 use std::cell::RefCell;
 
 use rand::{Rng, RngExt};
+use serde::{Deserialize, Serialize};
 use sylva_evolve::{Crossover, Mutate};
 
 use crate::tree::{
@@ -45,11 +46,27 @@ const VARIABLE_OPS: &[Node] = &[Node::Assign, Node::Add, Node::Multiply];
 /// Tries before crossover gives up and copies the first parent.
 const ATTEMPTS: usize = 8;
 
+/// Which automata an automaton may create in bred trees.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Creation {
+    /// Any later automaton (Table 1).
+    #[default]
+    Later,
+    /// Only the next one: branches create sub-branches, never the trunk (section 3).
+    Next,
+}
+
 /// Settings of the GP operators. Every field says its default.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GpConfig {
     /// Automata per tree (children of `Top`). Default 2 (the paper: "usually 2 or 3").
     pub automata: u8,
+    /// Which automata an automaton's `CreateAutomaton` makes in the trees bred: any later
+    /// one (Table 1's rule, the default) or only the next (section 3's "the trunk automaton
+    /// can only create branch automata, the branch automata can only create sub-branch
+    /// automata"). Either way the trees read back under Table 1's rule.
+    pub creation: Creation,
     /// Smallest body depth of initial trees (ramped). Default 4 (with the largest, 8, initial
     /// trees of 2 automata average about 90 nodes: the paper's "around 100").
     pub min_init_depth: u32,
@@ -82,6 +99,7 @@ impl Default for GpConfig {
     fn default() -> Self {
         GpConfig {
             automata: 2,
+            creation: Creation::Later,
             min_init_depth: 4,
             max_init_depth: 8,
             max_depth: 17,
@@ -255,7 +273,7 @@ impl GpConfig {
             Type::Var => {
                 Node::Var(Var::new(rng.random_range(0..VARIABLES as u8)).unwrap_or(Var::LENGTH))
             }
-            Type::Automaton => Node::Target(random_target(automaton, count, rng)),
+            Type::Automaton => Node::Target(random_target(automaton, count, self.creation, rng)),
             Type::Root | Type::TreeNode => {
                 let w = &self.weights;
                 let branching = [
@@ -377,8 +395,15 @@ fn fallback(count: usize) -> GpTree {
 }
 
 /// A legal target of automaton `automaton` (1-based) of `count`.
-fn random_target<R: Rng + ?Sized>(automaton: usize, count: usize, rng: &mut R) -> Target {
-    if automaton < count {
+fn random_target<R: Rng + ?Sized>(
+    automaton: usize,
+    count: usize,
+    creation: Creation,
+    rng: &mut R,
+) -> Target {
+    if automaton < count && creation == Creation::Next {
+        Target::Automaton(automaton as u8 + 1)
+    } else if automaton < count {
         Target::Automaton(rng.random_range(automaton + 1..=count) as u8)
     } else if rng.random_bool(0.75) {
         Target::Leaf
@@ -388,18 +413,24 @@ fn random_target<R: Rng + ?Sized>(automaton: usize, count: usize, rng: &mut R) -
 }
 
 /// Moves a target from automaton `from` of `from_count` into automaton `to` of `to_count`
-/// (1-based), keeping its level relative to the automaton that creates it.
+/// (1-based), keeping its level relative to the automaton that creates it (always the next
+/// level under [`Creation::Next`]).
 pub fn repair_target(
     target: Target,
     from: usize,
     from_count: usize,
     to: usize,
     to_count: usize,
+    creation: Creation,
 ) -> Target {
-    if target.legal_in(to, to_count) && from == to && from_count == to_count {
+    let next_only = creation == Creation::Next;
+    let legal = target.legal_in(to, to_count)
+        && !(next_only && matches!(target, Target::Automaton(n) if usize::from(n) != to + 1));
+    if legal && from == to && from_count == to_count {
         return target;
     }
     let offset = match target {
+        Target::Automaton(_) if next_only => 1,
         Target::Automaton(n) => usize::from(n).saturating_sub(from).max(1),
         Target::Leaf | Target::Flower => 1,
     };
@@ -458,9 +489,14 @@ impl SubtreeCrossover {
             nodes.extend_from_slice(&a.nodes()[..pa]);
             let (from, to) = (usize::from(ib[pb].automaton) + 1, usize::from(ka) + 1);
             nodes.extend(b.nodes()[pb..end_b].iter().map(|&n| match n {
-                Node::Target(t) => {
-                    Node::Target(repair_target(t, from, b.automata(), to, a.automata()))
-                }
+                Node::Target(t) => Node::Target(repair_target(
+                    t,
+                    from,
+                    b.automata(),
+                    to,
+                    a.automata(),
+                    c.creation,
+                )),
                 other => other,
             }));
             nodes.extend_from_slice(&a.nodes()[end_a..]);
@@ -527,13 +563,96 @@ mod tests {
     #[test]
     fn repair_keeps_relative_levels() {
         use Target::*;
-        assert_eq!(repair_target(Automaton(2), 1, 3, 2, 3), Automaton(3));
-        assert_eq!(repair_target(Automaton(3), 2, 3, 1, 3), Automaton(2));
-        assert_eq!(repair_target(Automaton(3), 1, 3, 2, 3), Automaton(3));
-        assert_eq!(repair_target(Automaton(2), 1, 3, 3, 3), Leaf);
-        assert_eq!(repair_target(Leaf, 3, 3, 1, 3), Automaton(2));
-        assert_eq!(repair_target(Flower, 2, 2, 2, 2), Flower);
-        assert_eq!(repair_target(Flower, 3, 3, 1, 2), Automaton(2));
+        assert_eq!(
+            repair_target(Automaton(2), 1, 3, 2, 3, Creation::Later),
+            Automaton(3)
+        );
+        assert_eq!(
+            repair_target(Automaton(3), 2, 3, 1, 3, Creation::Later),
+            Automaton(2)
+        );
+        assert_eq!(
+            repair_target(Automaton(3), 1, 3, 2, 3, Creation::Later),
+            Automaton(3)
+        );
+        assert_eq!(
+            repair_target(Automaton(2), 1, 3, 3, 3, Creation::Later),
+            Leaf
+        );
+        assert_eq!(
+            repair_target(Leaf, 3, 3, 1, 3, Creation::Later),
+            Automaton(2)
+        );
+        assert_eq!(repair_target(Flower, 2, 2, 2, 2, Creation::Later), Flower);
+        assert_eq!(
+            repair_target(Flower, 3, 3, 1, 2, Creation::Later),
+            Automaton(2)
+        );
+        // Only the next level under section 3's rule.
+        assert_eq!(
+            repair_target(Automaton(3), 1, 3, 1, 3, Creation::Next),
+            Automaton(2)
+        );
+        assert_eq!(
+            repair_target(Automaton(2), 1, 3, 1, 3, Creation::Next),
+            Automaton(2)
+        );
+        assert_eq!(
+            repair_target(Automaton(3), 1, 4, 2, 4, Creation::Next),
+            Automaton(3)
+        );
+        assert_eq!(
+            repair_target(Automaton(3), 2, 3, 3, 3, Creation::Next),
+            Leaf
+        );
+    }
+
+    #[test]
+    fn next_only_trees_create_only_the_next_automaton() {
+        let c = GpConfig {
+            automata: 3,
+            creation: Creation::Next,
+            ..GpConfig::default()
+        };
+        let next_only = |t: &GpTree| {
+            t.nodes()
+                .iter()
+                .zip(t.node_info())
+                .all(|(n, info)| match n {
+                    Node::Target(Target::Automaton(k)) => {
+                        usize::from(*k) == usize::from(info.automaton) + 2
+                    }
+                    _ => true,
+                })
+        };
+        let (cross, mutate) = (
+            SubtreeCrossover { config: c },
+            SubtreeMutation { config: c },
+        );
+        let mut r = rng::seeded(5);
+        let mut pool: Vec<GpTree> = (0..40).map(|i| c.ramped(i, &mut r)).collect();
+        // Parents bred under Table 1's rule may create any later automaton; their children
+        // under section 3's are repaired to the next.
+        let loose = GpConfig {
+            creation: Creation::Later,
+            ..c
+        };
+        pool.extend((0..40).map(|i| loose.ramped(i, &mut r)));
+        assert!(pool[..40].iter().all(next_only));
+        assert!(
+            !pool[40..].iter().all(next_only),
+            "the loose rule skips levels"
+        );
+        for i in 0..400 {
+            let (a, b) = (&pool[i % 80], &pool[(i * 7 + 3) % 80]);
+            let mut child = cross.crossover(a, b, &mut r);
+            mutate.mutate(&mut child, &mut r);
+            // What comes from the second parent is repaired, and mutation grows by the
+            // rule: a child of a next-only first parent is next-only, whatever the second.
+            if next_only(a) {
+                assert!(next_only(&child), "child {i}");
+            }
+        }
     }
 
     #[test]

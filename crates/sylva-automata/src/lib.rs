@@ -108,7 +108,7 @@ pub mod tree;
 
 pub use compile::{AtEnd, ElseEnd, Program, Semantics};
 pub use genome::{AutomataGenome, AutomataTag, Growth, MODEL};
-pub use gp::{GpConfig, SubtreeCrossover, SubtreeMutation, Weights};
+pub use gp::{Creation, GpConfig, SubtreeCrossover, SubtreeMutation, Weights};
 pub use problem::{AutomataProblem, AutomataSettings, AutomataStrategy};
 pub use sexpr::ParseError;
 pub use sim::{

@@ -5,6 +5,7 @@
 //! ```toml
 //! [automata]
 //! automata = 2            # automata per individual (children of Top), 1 to 8
+//! creation = "later"      # or "next": each automaton creates only the next (section 3)
 //! init_min_depth = 4      # ramped half-and-half depths of initial bodies, 1 to 16
 //! init_max_depth = 8
 //! max_depth = 17          # deepest tree breeding may make, 2 to 64
@@ -27,7 +28,7 @@ use sylva_fitness::poncin::{PoncinContext, TERM_NAMES};
 use sylva_fitness::{PoncinFitness, PoncinScore, PoncinScratch};
 
 use crate::genome::Growth;
-use crate::gp::{GpConfig, SubtreeCrossover, SubtreeMutation};
+use crate::gp::{Creation, GpConfig, SubtreeCrossover, SubtreeMutation};
 use crate::sim::{Detail, GrowOptions, Simulator};
 use crate::{GpTree, Program, Semantics};
 
@@ -38,6 +39,11 @@ pub struct AutomataSettings {
     /// Automata per individual (children of `Top`), 1 to 8. Default 2.
     #[serde(deserialize_with = "automata_count")]
     pub automata: u32,
+    /// Which automata an automaton creates in bred trees: `"later"` (any later one,
+    /// Table 1; the default) or `"next"` (only the next: the trunk creates branches, the
+    /// branches sub-branches, section 3).
+    #[serde(skip_serializing_if = "is_later")]
+    pub creation: Creation,
     /// Smallest depth of initial bodies (ramped half-and-half), 1 to 16. Default 4.
     #[serde(deserialize_with = "init_depth")]
     pub init_min_depth: u32,
@@ -58,10 +64,16 @@ pub struct AutomataSettings {
     pub fitness: PoncinFitness,
 }
 
+/// Section 3's rule stays out of written configs unless chosen, so they keep their bytes.
+fn is_later(creation: &Creation) -> bool {
+    *creation == Creation::Later
+}
+
 impl Default for AutomataSettings {
     fn default() -> Self {
         AutomataSettings {
             automata: 2,
+            creation: Creation::Later,
             init_min_depth: 4,
             init_max_depth: 8,
             max_depth: 17,
@@ -83,6 +95,7 @@ impl AutomataSettings {
     pub fn gp(&self) -> GpConfig {
         GpConfig {
             automata: self.automata as u8,
+            creation: self.creation,
             min_init_depth: self.init_min_depth.min(self.init_max_depth),
             max_init_depth: self.init_max_depth.max(self.init_min_depth),
             max_depth: self.max_depth,

@@ -85,6 +85,11 @@ fn config_errors_point_at_the_value() {
             "c.toml:3:17",
             "random_rounds",
         ),
+        (
+            "model = \"automata\"\n[automata]\ncreation = \"any\"\n",
+            "c.toml:3:12",
+            "expected `later` or `next`",
+        ),
     ];
     for (text, location, mention) in cases {
         let e = config(text).unwrap_err();
