@@ -562,49 +562,30 @@ mod tests {
 
     #[test]
     fn repair_keeps_relative_levels() {
+        use Creation::{Later, Next};
         use Target::*;
-        assert_eq!(
-            repair_target(Automaton(2), 1, 3, 2, 3, Creation::Later),
-            Automaton(3)
-        );
-        assert_eq!(
-            repair_target(Automaton(3), 2, 3, 1, 3, Creation::Later),
-            Automaton(2)
-        );
-        assert_eq!(
-            repair_target(Automaton(3), 1, 3, 2, 3, Creation::Later),
-            Automaton(3)
-        );
-        assert_eq!(
-            repair_target(Automaton(2), 1, 3, 3, 3, Creation::Later),
-            Leaf
-        );
-        assert_eq!(
-            repair_target(Leaf, 3, 3, 1, 3, Creation::Later),
-            Automaton(2)
-        );
-        assert_eq!(repair_target(Flower, 2, 2, 2, 2, Creation::Later), Flower);
-        assert_eq!(
-            repair_target(Flower, 3, 3, 1, 2, Creation::Later),
-            Automaton(2)
-        );
-        // Only the next level under section 3's rule.
-        assert_eq!(
-            repair_target(Automaton(3), 1, 3, 1, 3, Creation::Next),
-            Automaton(2)
-        );
-        assert_eq!(
-            repair_target(Automaton(2), 1, 3, 1, 3, Creation::Next),
-            Automaton(2)
-        );
-        assert_eq!(
-            repair_target(Automaton(3), 1, 4, 2, 4, Creation::Next),
-            Automaton(3)
-        );
-        assert_eq!(
-            repair_target(Automaton(3), 2, 3, 3, 3, Creation::Next),
-            Leaf
-        );
+        // (target, from, from count, to, to count, rule) and the repaired target.
+        let cases = [
+            ((Automaton(2), 1, 3, 2, 3, Later), Automaton(3)),
+            ((Automaton(3), 2, 3, 1, 3, Later), Automaton(2)),
+            ((Automaton(3), 1, 3, 2, 3, Later), Automaton(3)),
+            ((Automaton(2), 1, 3, 3, 3, Later), Leaf),
+            ((Leaf, 3, 3, 1, 3, Later), Automaton(2)),
+            ((Flower, 2, 2, 2, 2, Later), Flower),
+            ((Flower, 3, 3, 1, 2, Later), Automaton(2)),
+            // Only the next level under section 3's rule.
+            ((Automaton(3), 1, 3, 1, 3, Next), Automaton(2)),
+            ((Automaton(2), 1, 3, 1, 3, Next), Automaton(2)),
+            ((Automaton(3), 1, 4, 2, 4, Next), Automaton(3)),
+            ((Automaton(3), 2, 3, 3, 3, Next), Leaf),
+        ];
+        for ((t, from, from_count, to, to_count, rule), repaired) in cases {
+            let got = repair_target(t, from, from_count, to, to_count, rule);
+            assert_eq!(
+                got, repaired,
+                "{t} from {from}/{from_count} to {to}/{to_count}"
+            );
+        }
     }
 
     #[test]
