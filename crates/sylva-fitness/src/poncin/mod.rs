@@ -253,28 +253,27 @@ impl NumTarget {
                 listed + deeper as f64
             }
             NumTarget::PerBranch { branches, each } => {
-                let (mut first, mut second, mut deeper, mut short) = (0usize, 0usize, 0usize, 0u32);
+                let (branches, each) = (f64::from(*branches), f64::from(*each));
+                let (mut first, mut second, mut deeper, mut short) = (0.0, 0.0, 0.0, 0.0);
                 for e in endpoints {
                     match e.level {
                         0 => {}
                         1 => {
-                            first += 1;
-                            short += each.saturating_sub(e.sub_branches);
+                            first += 1.0;
+                            short += (each - f64::from(e.sub_branches)).max(0.0);
                         }
-                        2 => second += 1,
-                        _ => deeper += 1,
+                        2 => second += 1.0,
+                        _ => deeper += 1.0,
                     }
                 }
-                let levels = off(*branches, first) + off(branches.saturating_mul(*each), second);
-                let levels = levels + deeper as f64;
-                // The spread counts once the counts are met: stages, as the paper brings
-                // terms in "after the plant is stable".
-                // Every tree that meets them is better than every tree that does not.
-                let most_short = f64::from(*branches) * f64::from(*each);
-                if levels == 0.0 {
-                    f64::from(short)
+                let counts = (branches - first).abs() + (branches * each - second).abs() + deeper;
+                // Two stages: the spread counts once the counts are met, and every tree that
+                // meets them beats every tree that does not (the shortfall is at most
+                // `branches · each`).
+                if counts == 0.0 {
+                    short
                 } else {
-                    levels + most_short
+                    counts + branches * each
                 }
             }
         }
