@@ -23,6 +23,7 @@
 //! image_size = 800           # pixels, square, for best.png
 //! view = "iso"               # front, side, top or iso
 //! sheet_size = 48            # individuals on the contact sheet
+//! taper = 2.5                # optional: the pipe model's radii for best.* and the sheet (2 to 3)
 //! ```
 //!
 //! [`Config`] is a config of any model (it knows which from the `model` field, through the
@@ -39,6 +40,7 @@ use serde::ser::SerializeStruct;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::Plant;
 use sylva_core::par::Pool;
+use sylva_core::taper::PipeTaper;
 use sylva_evolve::{
     Checkpoint, Fitness, GenerationStats, IndividualId, Origin, Problem, Run, RunSettings,
 };
@@ -100,6 +102,18 @@ pub struct OutputConfig {
     /// Individuals shown on the contact sheet (the best ones), 1 to 400. Default 48.
     #[serde(deserialize_with = "sheet_size")]
     pub sheet_size: u32,
+    /// The pipe-model exponent `E`, 2 to 3, for the best plant and the sheet: radius ∝
+    /// (tips above)^(1/E), as `sylva grow --taper E`. Default none: each model's own radii
+    /// (evolution scores the plants as grown, without it).
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "taper")]
+    pub taper: Option<f64>,
+}
+
+impl OutputConfig {
+    /// The taper the outputs are grown with, if any.
+    pub fn pipe_taper(&self) -> Option<PipeTaper> {
+        self.taper.and_then(|e| PipeTaper::new(e).ok())
+    }
 }
 
 impl Default for OutputConfig {
@@ -108,7 +122,19 @@ impl Default for OutputConfig {
             image_size: 800,
             view: View::Iso,
             sheet_size: 48,
+            taper: None,
         }
+    }
+}
+
+/// Reads `taper`, checked to lie in 2..=3.
+fn taper<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let exponent = f64::deserialize(d)?;
+    match PipeTaper::new(exponent) {
+        Ok(_) => Ok(Some(exponent)),
+        Err(_) => Err(serde::de::Error::custom(format!(
+            "`taper` must be a number from 2 to 3 (the pipe-model exponent), got {exponent}"
+        ))),
     }
 }
 

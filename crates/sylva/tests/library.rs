@@ -41,6 +41,12 @@ fn every_example_config_reads_and_the_default_is_written_out() {
             "{name}"
         );
     }
+    let tapered = config("[output]\ntaper = 2.5\n").unwrap();
+    assert!(tapered.to_toml().contains("taper = 2.5"));
+    assert!(
+        !Config::default().to_toml().contains("taper"),
+        "left out when not asked for"
+    );
     let default = Config::load(&example("bintree/default.toml")).unwrap();
     assert_eq!(default.to_toml(), Config::default().to_toml());
     assert_eq!(config("").unwrap().to_toml(), Config::default().to_toml());
@@ -84,6 +90,11 @@ fn config_errors_point_at_the_value() {
             "model = \"lsystem\"\n[lsystem]\nrandom_rounds = 5000\n",
             "c.toml:3:17",
             "random_rounds",
+        ),
+        (
+            "[output]\ntaper = 5\n",
+            "c.toml:2:9",
+            "`taper` must be a number from 2 to 3",
         ),
         (
             "model = \"automata\"\n[automata]\ncreation = \"any\"\n",

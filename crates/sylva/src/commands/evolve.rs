@@ -8,6 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, Grown, InputError};
+use sylva_core::taper::PipeTaper;
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::{self, SheetCell, SheetOptions};
 
@@ -140,7 +141,8 @@ fn write_results(
     let best = evolution.best();
     files.add(&out.join("best.json"), best.genome.to_json().as_bytes())?;
     let seed = best.genome.default_seed();
-    let grown = Grown::new(best.genome.clone(), seed, true)?;
+    let taper = config.output().pipe_taper();
+    let grown = Grown::with_taper(best.genome.clone(), seed, true, taper)?;
     files.add_scene(&out.join("best.glb"), &grown.scene())?;
     let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
     let mut scene = grown.scene();
@@ -152,7 +154,7 @@ fn write_results(
         &out.join("best.png"),
         &picture(&scene, config.output().view, (size, size))?,
     )?;
-    let sheet = population_sheet(evolution, config.output().sheet_size as usize, pool)?;
+    let sheet = population_sheet(evolution, config.output().sheet_size as usize, taper, pool)?;
     files.add(&out.join("population.png"), &sheet)?;
     files.commit()?;
 
@@ -185,12 +187,13 @@ fn write_results(
 fn population_sheet(
     evolution: &Evolution,
     count: usize,
+    taper: Option<PipeTaper>,
     pool: &sylva_core::par::Pool,
 ) -> anyhow::Result<Vec<u8>> {
     let chosen = evolution.fittest(count);
     let grown = chosen
         .iter()
-        .map(|m| Grown::new(m.genome.clone(), m.genome.default_seed(), true))
+        .map(|m| Grown::with_taper(m.genome.clone(), m.genome.default_seed(), true, taper))
         .collect::<Result<Vec<_>, _>>()?;
     let cells: Vec<SheetCell> = chosen
         .iter()
