@@ -7,6 +7,7 @@ pub mod garden;
 pub mod grow;
 pub mod render;
 pub mod simulate;
+pub mod studio;
 
 use std::path::Path;
 

@@ -9,6 +9,7 @@ use std::process::{Command, Output};
 
 use sylva_core::hash::stable_hash;
 
+#[path = "../../sylva/tests/common/mod.rs"]
 mod common;
 use common::validate;
 

@@ -48,6 +48,10 @@ enum Command {
     Breed(commands::breed::BreedArgs),
     /// Render a genome (.json) or a GLB (.glb) to a PNG picture.
     Render(commands::render::RenderArgs),
+    /// Start the studio: a web page where you breed plants by eye (PlantMaker's grid, the
+    /// biomorph garden, the binary-tree family, the GP designer), every step kept in an
+    /// SQLite archive. Prints the address to open.
+    Studio(commands::studio::StudioArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => commands::simulate::run(&args),
         Command::Breed(args) => commands::breed::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Studio(args) => commands::studio::run(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

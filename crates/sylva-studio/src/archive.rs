@@ -1,0 +1,806 @@
+//! The archive: every session, plant, parentage, step and run, in SQLite.
+//!
+//! One connection behind a mutex (the studio's writes are small and human-paced; SQLite
+//! serialises writers anyway), in WAL mode with `synchronous = FULL`, so that a committed
+//! step survives a kill of the process at any moment. Every multi-row change is one
+//! transaction ([`Archive::transaction`]). The schema is built by ordered migrations, and
+//! `schema_version` records how far a file has come.
+
+use std::path::Path;
+use std::sync::Mutex;
+
+use rusqlite::{Connection, OptionalExtension, Transaction, params};
+use serde::Serialize;
+
+/// Ordered schema steps: step `i` takes a file from version `i` to `i + 1`.
+const MIGRATIONS: &[&str] = &[r#"
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY,
+    mode TEXT NOT NULL,
+    model TEXT NOT NULL,
+    title TEXT NOT NULL,
+    state TEXT NOT NULL,
+    created TEXT NOT NULL
+);
+CREATE TABLE plants (
+    id INTEGER PRIMARY KEY,
+    session INTEGER REFERENCES sessions(id),
+    model TEXT NOT NULL,
+    genome TEXT NOT NULL,
+    seed INTEGER NOT NULL,
+    operator TEXT NOT NULL,
+    settings TEXT NOT NULL,
+    created TEXT NOT NULL
+);
+CREATE INDEX plants_session ON plants(session);
+CREATE TABLE parents (
+    child INTEGER NOT NULL REFERENCES plants(id),
+    ord INTEGER NOT NULL,
+    parent INTEGER NOT NULL REFERENCES plants(id),
+    dominance REAL NOT NULL,
+    PRIMARY KEY (child, ord)
+);
+CREATE INDEX parents_parent ON parents(parent);
+CREATE TABLE meshes (
+    plant INTEGER PRIMARY KEY REFERENCES plants(id),
+    glb BLOB NOT NULL
+);
+CREATE TABLE scenes (
+    id INTEGER PRIMARY KEY,
+    glb BLOB NOT NULL
+);
+CREATE TABLE steps (
+    id INTEGER PRIMARY KEY,
+    session INTEGER NOT NULL REFERENCES sessions(id),
+    seq INTEGER NOT NULL,
+    action TEXT NOT NULL,
+    before TEXT NOT NULL,
+    after TEXT NOT NULL,
+    undone INTEGER NOT NULL DEFAULT 0,
+    created TEXT NOT NULL,
+    UNIQUE (session, seq)
+);
+CREATE TABLE runs (
+    id INTEGER PRIMARY KEY,
+    session INTEGER NOT NULL REFERENCES sessions(id),
+    config TEXT NOT NULL,
+    checkpoint TEXT,
+    status TEXT NOT NULL,
+    generation INTEGER NOT NULL,
+    generations INTEGER NOT NULL,
+    terms TEXT NOT NULL DEFAULT '[]',
+    error TEXT
+);
+CREATE TABLE run_generations (
+    run INTEGER NOT NULL REFERENCES runs(id),
+    generation INTEGER NOT NULL,
+    best REAL NOT NULL,
+    mean REAL NOT NULL,
+    best_terms TEXT NOT NULL,
+    plant INTEGER REFERENCES plants(id),
+    PRIMARY KEY (run, generation)
+);
+CREATE TABLE run_checkpoints (
+    run INTEGER NOT NULL REFERENCES runs(id),
+    generation INTEGER NOT NULL,
+    checkpoint TEXT NOT NULL,
+    PRIMARY KEY (run, generation)
+);
+"#];
+
+/// Why the archive failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ArchiveError {
+    /// SQLite refused.
+    #[error("archive: {0}")]
+    Sqlite(#[from] rusqlite::Error),
+    /// The file was written by a newer studio.
+    #[error("archive: schema version {found} is newer than this studio's {known}")]
+    TooNew {
+        /// The file's version.
+        found: usize,
+        /// The newest this studio knows.
+        known: usize,
+    },
+}
+
+/// The archive.
+pub struct Archive {
+    connection: Mutex<Connection>,
+}
+
+/// A plant as stored.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlantRow {
+    /// Its id.
+    pub id: i64,
+    /// The session it was made in, if any.
+    pub session: Option<i64>,
+    /// Its model.
+    pub model: String,
+    /// Its genome file's text.
+    #[serde(skip)]
+    pub genome: String,
+    /// The seed it grows with.
+    pub seed: u64,
+    /// How it was made: random, example, upload, cross, mutate, edit, regrow, garden,
+    /// family, design.
+    pub operator: String,
+    /// The settings of the operator.
+    pub settings: serde_json::Value,
+    /// When (UTC, RFC 3339).
+    pub created: String,
+}
+
+/// A parent of a plant.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct ParentRow {
+    /// The parent.
+    pub plant: i64,
+    /// Its dominance.
+    pub dominance: f64,
+}
+
+/// A new plant.
+pub struct NewPlant<'a> {
+    /// The session it is made in.
+    pub session: Option<i64>,
+    /// Its model.
+    pub model: &'a str,
+    /// Its genome file's text.
+    pub genome: &'a str,
+    /// Its seed.
+    pub seed: u64,
+    /// How it was made.
+    pub operator: &'a str,
+    /// The operator's settings.
+    pub settings: &'a serde_json::Value,
+    /// Its parents.
+    pub parents: &'a [ParentRow],
+}
+
+/// A session as stored.
+#[derive(Clone, Debug, Serialize)]
+pub struct SessionRow {
+    /// Its id.
+    pub id: i64,
+    /// breed, garden, family or design.
+    pub mode: String,
+    /// The model its plants are of.
+    pub model: String,
+    /// A title.
+    pub title: String,
+    /// The current view.
+    pub state: serde_json::Value,
+    /// When (UTC).
+    pub created: String,
+}
+
+/// A step of a session's history.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepRow {
+    /// Its number in the session, from 1.
+    pub seq: i64,
+    /// What the person did.
+    pub action: serde_json::Value,
+    /// Whether it is undone.
+    pub undone: bool,
+    /// The view before it.
+    #[serde(skip)]
+    pub before: serde_json::Value,
+    /// The view after it.
+    #[serde(skip)]
+    pub after: serde_json::Value,
+}
+
+/// A run as stored.
+#[derive(Clone, Debug)]
+pub struct RunRow {
+    /// Its id.
+    pub id: i64,
+    /// Its session.
+    pub session: i64,
+    /// The effective config (TOML).
+    pub config: String,
+    /// The last checkpoint (JSON), once written.
+    pub checkpoint: Option<String>,
+    /// running, stopped, done or failed.
+    pub status: String,
+    /// The last completed generation.
+    pub generation: u32,
+    /// The generations it is asked to run.
+    pub generations: u32,
+    /// Why it failed.
+    pub error: Option<String>,
+}
+
+/// One generation of a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct GenerationRow {
+    /// The generation.
+    pub generation: u32,
+    /// Best total fitness.
+    pub best: f64,
+    /// Mean total fitness.
+    pub mean: f64,
+    /// The best's terms.
+    pub best_terms: Vec<f64>,
+    /// The best, archived.
+    pub plant: Option<i64>,
+}
+
+/// The time now, RFC 3339 in UTC, to the second.
+fn now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    let (y, m, d) = civil_from_days(days as i64);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+/// Days since 1970-01-01 to a civil date (Howard Hinnant's algorithm).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    (yoe + era * 400 + i64::from(m <= 2), m, d)
+}
+
+fn json(text: String) -> serde_json::Value {
+    serde_json::from_str(&text).unwrap_or(serde_json::Value::Null)
+}
+
+impl Archive {
+    /// Opens (or creates) the archive at `path` and brings its schema up to date.
+    pub fn open(path: &Path) -> Result<Archive, ArchiveError> {
+        let mut connection = Connection::open(path)?;
+        connection.pragma_update(None, "journal_mode", "WAL")?;
+        connection.pragma_update(None, "synchronous", "FULL")?;
+        connection.pragma_update(None, "foreign_keys", "ON")?;
+        connection.busy_timeout(std::time::Duration::from_secs(5))?;
+        migrate(&mut connection)?;
+        Ok(Archive {
+            connection: Mutex::new(connection),
+        })
+    }
+
+    /// Runs `f` in one transaction, committed if it returns `Ok`.
+    pub fn transaction<T, E: From<ArchiveError>>(
+        &self,
+        f: impl FnOnce(&Transaction<'_>) -> Result<T, E>,
+    ) -> Result<T, E> {
+        // A poisoned lock means a panic mid-transaction, which SQLite rolled back.
+        let mut connection = self
+            .connection
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        let tx = connection.transaction().map_err(ArchiveError::from)?;
+        let value = f(&tx)?;
+        tx.commit().map_err(ArchiveError::from)?;
+        Ok(value)
+    }
+
+    /// Runs a read.
+    pub fn read<T>(
+        &self,
+        f: impl FnOnce(&Connection) -> rusqlite::Result<T>,
+    ) -> Result<T, ArchiveError> {
+        let connection = self
+            .connection
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        Ok(f(&connection)?)
+    }
+}
+
+fn migrate(connection: &mut Connection) -> Result<(), ArchiveError> {
+    let tx = connection.transaction()?;
+    tx.execute_batch("CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL)")?;
+    let version: Option<i64> = tx
+        .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
+        .optional()?;
+    let version = version.map(|v| usize::try_from(v).unwrap_or(usize::MAX));
+    let version = match version {
+        Some(v) => v,
+        None => {
+            tx.execute("INSERT INTO schema_version (version) VALUES (0)", [])?;
+            0
+        }
+    };
+    if version > MIGRATIONS.len() {
+        return Err(ArchiveError::TooNew {
+            found: version,
+            known: MIGRATIONS.len(),
+        });
+    }
+    for step in &MIGRATIONS[version..] {
+        tx.execute_batch(step)?;
+    }
+    tx.execute(
+        "UPDATE schema_version SET version = ?1",
+        [MIGRATIONS.len() as i64],
+    )?;
+    tx.commit()?;
+    Ok(())
+}
+
+// What a transaction can do. Free functions over `Connection` (a `Transaction` derefs to
+// one), so handlers compose them in one transaction.
+
+/// Inserts a plant and its parents; returns its id.
+pub fn insert_plant(c: &Connection, p: &NewPlant<'_>) -> rusqlite::Result<i64> {
+    c.execute(
+        "INSERT INTO plants (session, model, genome, seed, operator, settings, created)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        params![
+            p.session,
+            p.model,
+            p.genome,
+            p.seed as i64,
+            p.operator,
+            p.settings.to_string(),
+            now()
+        ],
+    )?;
+    let id = c.last_insert_rowid();
+    for (ord, parent) in p.parents.iter().enumerate() {
+        c.execute(
+            "INSERT INTO parents (child, ord, parent, dominance) VALUES (?1, ?2, ?3, ?4)",
+            params![id, ord as i64, parent.plant, parent.dominance],
+        )?;
+    }
+    Ok(id)
+}
+
+/// Stores a plant's mesh (for plants that cannot be grown alone again: garden specimens).
+pub fn insert_mesh(c: &Connection, plant: i64, glb: &[u8]) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO meshes (plant, glb) VALUES (?1, ?2)",
+        params![plant, glb],
+    )?;
+    Ok(())
+}
+
+/// Stores a scene of many plants (a garden); returns its id.
+pub fn insert_scene(c: &Connection, glb: &[u8]) -> rusqlite::Result<i64> {
+    c.execute("INSERT INTO scenes (glb) VALUES (?1)", params![glb])?;
+    Ok(c.last_insert_rowid())
+}
+
+/// A stored scene.
+pub fn scene(c: &Connection, id: i64) -> rusqlite::Result<Option<Vec<u8>>> {
+    c.query_row("SELECT glb FROM scenes WHERE id = ?1", [id], |r| r.get(0))
+        .optional()
+}
+
+/// A stored mesh.
+pub fn mesh(c: &Connection, plant: i64) -> rusqlite::Result<Option<Vec<u8>>> {
+    c.query_row("SELECT glb FROM meshes WHERE plant = ?1", [plant], |r| {
+        r.get(0)
+    })
+    .optional()
+}
+
+fn plant_row(r: &rusqlite::Row<'_>) -> rusqlite::Result<PlantRow> {
+    Ok(PlantRow {
+        id: r.get(0)?,
+        session: r.get(1)?,
+        model: r.get(2)?,
+        genome: r.get(3)?,
+        seed: r.get::<_, i64>(4)? as u64,
+        operator: r.get(5)?,
+        settings: json(r.get(6)?),
+        created: r.get(7)?,
+    })
+}
+
+const PLANT_COLUMNS: &str = "id, session, model, genome, seed, operator, settings, created";
+
+/// A plant by id.
+pub fn plant(c: &Connection, id: i64) -> rusqlite::Result<Option<PlantRow>> {
+    c.query_row(
+        &format!("SELECT {PLANT_COLUMNS} FROM plants WHERE id = ?1"),
+        [id],
+        plant_row,
+    )
+    .optional()
+}
+
+/// A page of plants, newest first, of one session or all; and how many there are.
+pub fn plants(
+    c: &Connection,
+    session: Option<i64>,
+    offset: u32,
+    limit: u32,
+) -> rusqlite::Result<(u64, Vec<PlantRow>)> {
+    let (filter, args): (&str, Vec<i64>) = match session {
+        Some(s) => ("WHERE session = ?1", vec![s]),
+        None => ("", vec![]),
+    };
+    let total: i64 = c.query_row(
+        &format!("SELECT COUNT(*) FROM plants {filter}"),
+        rusqlite::params_from_iter(&args),
+        |r| r.get(0),
+    )?;
+    let mut stmt = c.prepare(&format!(
+        "SELECT {PLANT_COLUMNS} FROM plants {filter} ORDER BY id DESC LIMIT {limit} OFFSET {offset}"
+    ))?;
+    let rows = stmt
+        .query_map(rusqlite::params_from_iter(&args), plant_row)?
+        .collect::<rusqlite::Result<Vec<_>>>()?;
+    Ok((total as u64, rows))
+}
+
+/// A plant's parents, in order.
+pub fn parents(c: &Connection, child: i64) -> rusqlite::Result<Vec<ParentRow>> {
+    let mut stmt =
+        c.prepare_cached("SELECT parent, dominance FROM parents WHERE child = ?1 ORDER BY ord")?;
+    stmt.query_map([child], |r| {
+        Ok(ParentRow {
+            plant: r.get(0)?,
+            dominance: r.get(1)?,
+        })
+    })?
+    .collect()
+}
+
+/// Inserts a session; returns its id.
+pub fn insert_session(
+    c: &Connection,
+    mode: &str,
+    model: &str,
+    title: &str,
+    state: &serde_json::Value,
+) -> rusqlite::Result<i64> {
+    c.execute(
+        "INSERT INTO sessions (mode, model, title, state, created) VALUES (?1, ?2, ?3, ?4, ?5)",
+        params![mode, model, title, state.to_string(), now()],
+    )?;
+    Ok(c.last_insert_rowid())
+}
+
+/// Replaces a session's view.
+pub fn set_state(c: &Connection, session: i64, state: &serde_json::Value) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE sessions SET state = ?2 WHERE id = ?1",
+        params![session, state.to_string()],
+    )?;
+    Ok(())
+}
+
+fn session_row(r: &rusqlite::Row<'_>) -> rusqlite::Result<SessionRow> {
+    Ok(SessionRow {
+        id: r.get(0)?,
+        mode: r.get(1)?,
+        model: r.get(2)?,
+        title: r.get(3)?,
+        state: json(r.get(4)?),
+        created: r.get(5)?,
+    })
+}
+
+/// A session by id.
+pub fn session(c: &Connection, id: i64) -> rusqlite::Result<Option<SessionRow>> {
+    c.query_row(
+        "SELECT id, mode, model, title, state, created FROM sessions WHERE id = ?1",
+        [id],
+        session_row,
+    )
+    .optional()
+}
+
+/// Every session, newest first, with its number of live steps.
+pub fn sessions(c: &Connection) -> rusqlite::Result<Vec<(SessionRow, i64)>> {
+    let mut stmt = c.prepare(
+        "SELECT id, mode, model, title, state, created,
+                (SELECT COUNT(*) FROM steps WHERE steps.session = sessions.id AND undone = 0)
+         FROM sessions ORDER BY id DESC",
+    )?;
+    stmt.query_map([], |r| Ok((session_row(r)?, r.get(6)?)))?
+        .collect()
+}
+
+/// A session's history, in order.
+pub fn steps(c: &Connection, session: i64) -> rusqlite::Result<Vec<StepRow>> {
+    let mut stmt = c.prepare_cached(
+        "SELECT seq, action, undone, before, after FROM steps WHERE session = ?1 ORDER BY seq",
+    )?;
+    stmt.query_map([session], |r| {
+        Ok(StepRow {
+            seq: r.get(0)?,
+            action: json(r.get(1)?),
+            undone: r.get(2)?,
+            before: json(r.get(3)?),
+            after: json(r.get(4)?),
+        })
+    })?
+    .collect()
+}
+
+/// Records a step (dropping the undone steps it replaces) and sets the session's view to
+/// `after`. Returns the step's number.
+pub fn record_step(
+    c: &Connection,
+    session: i64,
+    action: &serde_json::Value,
+    before: &serde_json::Value,
+    after: &serde_json::Value,
+) -> rusqlite::Result<i64> {
+    c.execute(
+        "DELETE FROM steps WHERE session = ?1 AND undone = 1",
+        [session],
+    )?;
+    let seq: i64 = c.query_row(
+        "SELECT COALESCE(MAX(seq), 0) + 1 FROM steps WHERE session = ?1",
+        [session],
+        |r| r.get(0),
+    )?;
+    c.execute(
+        "INSERT INTO steps (session, seq, action, before, after, created)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
+        params![
+            session,
+            seq,
+            action.to_string(),
+            before.to_string(),
+            after.to_string(),
+            now()
+        ],
+    )?;
+    set_state(c, session, after)?;
+    Ok(seq)
+}
+
+/// The number the next step of a session will have.
+pub fn next_seq(c: &Connection, session: i64) -> rusqlite::Result<i64> {
+    c.query_row(
+        "SELECT COALESCE(MAX(seq), 0) + 1 FROM steps WHERE session = ?1 AND undone = 0",
+        [session],
+        |r| r.get(0),
+    )
+}
+
+/// Marks a step undone or done again.
+pub fn set_undone(c: &Connection, session: i64, seq: i64, undone: bool) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE steps SET undone = ?3 WHERE session = ?1 AND seq = ?2",
+        params![session, seq, undone],
+    )?;
+    Ok(())
+}
+
+/// Inserts a run; returns its id.
+pub fn insert_run(
+    c: &Connection,
+    session: i64,
+    config: &str,
+    generations: u32,
+) -> rusqlite::Result<i64> {
+    c.execute(
+        "INSERT INTO runs (session, config, status, generation, generations)
+         VALUES (?1, ?2, 'running', 0, ?3)",
+        params![session, config, generations],
+    )?;
+    Ok(c.last_insert_rowid())
+}
+
+fn run_row(r: &rusqlite::Row<'_>) -> rusqlite::Result<RunRow> {
+    Ok(RunRow {
+        id: r.get(0)?,
+        session: r.get(1)?,
+        config: r.get(2)?,
+        checkpoint: r.get(3)?,
+        status: r.get(4)?,
+        generation: r.get(5)?,
+        generations: r.get(6)?,
+        error: r.get(7)?,
+    })
+}
+
+const RUN_COLUMNS: &str = "id, session, config, checkpoint, status, generation, generations, error";
+
+/// A run by id.
+pub fn run(c: &Connection, id: i64) -> rusqlite::Result<Option<RunRow>> {
+    c.query_row(
+        &format!("SELECT {RUN_COLUMNS} FROM runs WHERE id = ?1"),
+        [id],
+        run_row,
+    )
+    .optional()
+}
+
+/// Runs with a status.
+pub fn runs_with_status(c: &Connection, status: &str) -> rusqlite::Result<Vec<RunRow>> {
+    let mut stmt = c.prepare(&format!(
+        "SELECT {RUN_COLUMNS} FROM runs WHERE status = ?1 ORDER BY id"
+    ))?;
+    stmt.query_map([status], run_row)?.collect()
+}
+
+/// Saves a run's progress: its checkpoint, generation and status.
+pub fn save_run(
+    c: &Connection,
+    id: i64,
+    checkpoint: Option<&str>,
+    generation: u32,
+    status: &str,
+    error: Option<&str>,
+) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE runs SET checkpoint = COALESCE(?2, checkpoint), generation = ?3, status = ?4,
+         error = ?5 WHERE id = ?1",
+        params![id, checkpoint, generation, status, error],
+    )?;
+    Ok(())
+}
+
+/// Records the names of a run's fitness terms.
+pub fn set_run_terms(c: &Connection, id: i64, terms: &[String]) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE runs SET terms = ?2 WHERE id = ?1",
+        params![id, serde_json::to_string(terms).unwrap_or_default()],
+    )?;
+    Ok(())
+}
+
+/// The names of a run's fitness terms.
+pub fn run_terms(c: &Connection, id: i64) -> rusqlite::Result<Vec<String>> {
+    let text: String = c.query_row("SELECT terms FROM runs WHERE id = ?1", [id], |r| r.get(0))?;
+    Ok(serde_json::from_str(&text).unwrap_or_default())
+}
+
+/// Sets a run's status.
+pub fn set_run_status(c: &Connection, id: i64, status: &str) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE runs SET status = ?2 WHERE id = ?1",
+        params![id, status],
+    )?;
+    Ok(())
+}
+
+/// Sets how many generations a run is asked to run.
+pub fn set_run_generations(c: &Connection, id: i64, generations: u32) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE runs SET generations = ?2 WHERE id = ?1",
+        params![id, generations],
+    )?;
+    Ok(())
+}
+
+/// Records one generation of a run.
+pub fn insert_generation(c: &Connection, run: i64, row: &GenerationRow) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO run_generations (run, generation, best, mean, best_terms, plant)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
+        params![
+            run,
+            row.generation,
+            finite_or_zero(row.best),
+            finite_or_zero(row.mean),
+            serde_json::to_string(&row.best_terms).unwrap_or_default(),
+            row.plant
+        ],
+    )?;
+    Ok(())
+}
+
+fn finite_or_zero(v: f64) -> f64 {
+    if v.is_finite() { v } else { 0.0 }
+}
+
+/// A run's generations up to `last`, in order.
+pub fn generations(c: &Connection, run: i64, last: u32) -> rusqlite::Result<Vec<GenerationRow>> {
+    let mut stmt = c.prepare_cached(
+        "SELECT generation, best, mean, best_terms, plant FROM run_generations
+         WHERE run = ?1 AND generation <= ?2 ORDER BY generation",
+    )?;
+    stmt.query_map(params![run, last], |r| {
+        Ok(GenerationRow {
+            generation: r.get(0)?,
+            best: r.get(1)?,
+            mean: r.get(2)?,
+            best_terms: serde_json::from_str(&r.get::<_, String>(3)?).unwrap_or_default(),
+            plant: r.get(4)?,
+        })
+    })?
+    .collect()
+}
+
+/// Keeps a run's checkpoint at a generation (for undo).
+pub fn insert_checkpoint(
+    c: &Connection,
+    run: i64,
+    generation: u32,
+    checkpoint: &str,
+) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO run_checkpoints (run, generation, checkpoint) VALUES (?1, ?2, ?3)",
+        params![run, generation, checkpoint],
+    )?;
+    Ok(())
+}
+
+/// A run's checkpoint kept at a generation.
+pub fn checkpoint_at(
+    c: &Connection,
+    run: i64,
+    generation: u32,
+) -> rusqlite::Result<Option<String>> {
+    c.query_row(
+        "SELECT checkpoint FROM run_checkpoints WHERE run = ?1 AND generation = ?2",
+        params![run, generation],
+        |r| r.get(0),
+    )
+    .optional()
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn dates_are_civil() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(20_417), (2025, 11, 25));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+    }
+
+    #[test]
+    fn migrations_run_once_and_newer_files_are_refused() {
+        let dir = std::env::temp_dir().join(format!("sylva-archive-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.db");
+        let _ = std::fs::remove_file(&path);
+        drop(Archive::open(&path).unwrap());
+        let archive = Archive::open(&path).unwrap();
+        let v: i64 = archive
+            .read(|c| c.query_row("SELECT version FROM schema_version", [], |r| r.get(0)))
+            .unwrap();
+        assert_eq!(v, MIGRATIONS.len() as i64);
+        archive
+            .read(|c| c.execute("UPDATE schema_version SET version = 99", []))
+            .unwrap();
+        drop(archive);
+        assert!(matches!(
+            Archive::open(&path),
+            Err(ArchiveError::TooNew { found: 99, .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_step_after_an_undo_drops_the_undone_steps() {
+        let dir = std::env::temp_dir().join(format!("sylva-archive-s-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let archive = Archive::open(&dir.join("s.db")).unwrap();
+        let v = |n: i64| serde_json::json!({ "n": n });
+        archive
+            .transaction(|c| -> Result<(), ArchiveError> {
+                let s = insert_session(c, "breed", "plantmaker", "t", &v(0))?;
+                record_step(c, s, &v(1), &v(0), &v(1))?;
+                record_step(c, s, &v(2), &v(1), &v(2))?;
+                set_undone(c, s, 2, true)?;
+                assert_eq!(next_seq(c, s)?, 2);
+                record_step(c, s, &v(3), &v(1), &v(3))?;
+                let steps = steps(c, s)?;
+                assert_eq!(steps.len(), 2);
+                assert_eq!(steps[1].action, v(3));
+                assert_eq!(session(c, s)?.unwrap().state, v(3));
+                Ok(())
+            })
+            .unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

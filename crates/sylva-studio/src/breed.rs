@@ -1,0 +1,777 @@
+//! Breed mode, PlantMaker's main window: nine plants in a grid, most dominant first; cross
+//! two or more (with a level and a dominance per parent) or mutate one (with a Depth); the
+//! offspring take the places of the least dominant plants. Works for any model: the level
+//! and Depth are PlantMaker's settings, other models breed with their own defaults.
+//!
+//! A plant's dominance is the step at which it last took part (born, or chosen as a
+//! parent), so a step's parents and offspring lead the grid and the plants left alone
+//! longest are replaced (`docs/studio.md`).
+
+use axum::Json;
+use axum::extract::{Path, State};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sylva::{Genome, Registry};
+
+use crate::Studio;
+use crate::archive::{self, NewPlant, ParentRow, PlantRow};
+use crate::error::{ApiError, input_message};
+use crate::http::Body;
+use crate::plants::{genome_of, grow_glb};
+use crate::sessions::{SessionView, example, session_of, step_seed, view};
+
+/// PlantMaker's name in files.
+const PLANTMAKER: &str = <sylva_plantmaker::PlantMakerModel as sylva_model::Model>::NAME;
+
+/// Plants in the grid.
+pub const GRID: usize = 9;
+
+/// Where a breed session's first plants come from (also what `add` takes).
+#[derive(Deserialize, Debug)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Plants {
+    /// N random genomes of the session's model, 1 to 9.
+    Random(u32),
+    /// Example genomes by name (`plantmaker/fern`).
+    Examples(Vec<String>),
+    /// Genome files' text (uploads).
+    Genomes(Vec<String>),
+    /// Plants already in the archive.
+    Plants(Vec<i64>),
+}
+
+/// `POST /api/sessions` in breed mode.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    /// The model, `plantmaker` by default.
+    model: Option<String>,
+    /// The first plants: 9 random by default.
+    start: Option<Plants>,
+    /// The session's seed, 1 by default.
+    seed: Option<u64>,
+}
+
+/// A cell of the grid.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// The plant.
+    pub plant: i64,
+    /// The step it last took part in.
+    pub dominance: i64,
+}
+
+/// A breed session's view.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct BreedState {
+    /// The grid, most dominant first.
+    pub grid: Vec<Cell>,
+    /// The session's seed.
+    pub seed: u64,
+}
+
+/// A plant about to be archived: grown, meshed and encoded already.
+pub struct Made {
+    /// Its genome.
+    pub genome: Genome,
+    /// Its seed.
+    pub seed: u64,
+    /// How it was made.
+    pub operator: &'static str,
+    /// The operator's settings.
+    pub settings: serde_json::Value,
+    /// Its parents.
+    pub parents: Vec<ParentRow>,
+    /// Its GLB, roots left out.
+    pub glb: Vec<u8>,
+}
+
+impl Made {
+    /// Grows `genome` with its default seed.
+    fn grow(
+        genome: Genome,
+        operator: &'static str,
+        settings: serde_json::Value,
+        parents: Vec<ParentRow>,
+    ) -> Result<Made, ApiError> {
+        let seed = genome.default_seed();
+        Made::grow_with(genome, seed, operator, settings, parents)
+    }
+
+    fn grow_with(
+        genome: Genome,
+        seed: u64,
+        operator: &'static str,
+        settings: serde_json::Value,
+        parents: Vec<ParentRow>,
+    ) -> Result<Made, ApiError> {
+        let glb = grow_glb(&genome, seed, false, &parents, operator)?;
+        Ok(Made {
+            genome,
+            seed,
+            operator,
+            settings,
+            parents,
+            glb,
+        })
+    }
+}
+
+/// Archives plants made in `session`; returns their ids and keeps their GLBs in memory.
+pub fn store(c: &rusqlite::Connection, session: i64, made: &[Made]) -> Result<Vec<i64>, ApiError> {
+    let mut ids = Vec::with_capacity(made.len());
+    for m in made {
+        let text = m.genome.to_json();
+        let id = archive::insert_plant(
+            c,
+            &NewPlant {
+                session: Some(session),
+                model: m.genome.model(),
+                genome: &text,
+                seed: m.seed,
+                operator: m.operator,
+                settings: &m.settings,
+                parents: &m.parents,
+            },
+        )?;
+        ids.push(id);
+    }
+    Ok(ids)
+}
+
+/// Keeps the GLBs of stored plants in memory (after the transaction committed).
+fn cache(studio: &Studio, ids: &[i64], made: Vec<Made>) {
+    for (id, m) in ids.iter().zip(made) {
+        studio.meshes.put((*id, false), std::sync::Arc::new(m.glb));
+    }
+}
+
+/// Reads plants of `model` from the archive.
+fn archived(
+    studio: &Studio,
+    ids: &[i64],
+    model: &str,
+    field: &str,
+) -> Result<Vec<PlantRow>, ApiError> {
+    let mut rows = Vec::with_capacity(ids.len());
+    for (i, &id) in ids.iter().enumerate() {
+        let row = studio
+            .archive
+            .read(|c| archive::plant(c, id))?
+            .ok_or_else(|| ApiError::bad(format!("{field}[{i}]"), format!("no plant {id}")))?;
+        if row.model != model {
+            return Err(ApiError::bad(
+                format!("{field}[{i}]"),
+                format!(
+                    "plant {id} is a {} plant; this session breeds {model}",
+                    row.model
+                ),
+            ));
+        }
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// New plants for `start`/`add`, grown (on the blocking pool); and archived plants reused.
+async fn make_plants(
+    studio: &Studio,
+    model: &'static str,
+    plants: Plants,
+    seed: u64,
+    seq: i64,
+    field: &str,
+) -> Result<(Vec<Made>, Vec<i64>), ApiError> {
+    let mut genomes: Vec<(Genome, &'static str, serde_json::Value)> = Vec::new();
+    let mut reused = Vec::new();
+    match plants {
+        Plants::Random(n) => {
+            if !(1..=GRID as u32).contains(&n) {
+                return Err(ApiError::bad(
+                    format!("{field}.random"),
+                    format!("expected 1 to 9, got {n}"),
+                ));
+            }
+            let entry = Registry::standard()
+                .get(model)
+                .ok_or_else(|| ApiError::internal(format!("no model {model}")))?;
+            for i in 0..n {
+                let s = step_seed(seed, seq, u64::from(i));
+                let genome = entry
+                    .random(None, s)
+                    .map_err(|e| ApiError::unprocessable(field, input_message(&e)))?;
+                genomes.push((genome, "random", json!({ "seed": s })));
+            }
+        }
+        Plants::Examples(names) => {
+            check_count(names.len(), &format!("{field}.examples"))?;
+            for (i, name) in names.into_iter().enumerate() {
+                let genome = example(&name).ok_or_else(|| {
+                    ApiError::bad(
+                        format!("{field}.examples[{i}]"),
+                        format!("no example {name:?}"),
+                    )
+                })?;
+                if genome.model() != model {
+                    return Err(ApiError::bad(
+                        format!("{field}.examples[{i}]"),
+                        format!(
+                            "{name} is a {} genome; this session breeds {model}",
+                            genome.model()
+                        ),
+                    ));
+                }
+                genomes.push((genome, "example", json!({ "example": name })));
+            }
+        }
+        Plants::Genomes(texts) => {
+            check_count(texts.len(), &format!("{field}.genomes"))?;
+            for (i, text) in texts.iter().enumerate() {
+                let f = format!("{field}.genomes[{i}]");
+                let genome = parse_genome(text, &f)?;
+                if genome.model() != model {
+                    return Err(ApiError::unprocessable(
+                        f,
+                        format!("a {} genome; this session breeds {model}", genome.model()),
+                    ));
+                }
+                genomes.push((genome, "upload", json!({})));
+            }
+        }
+        Plants::Plants(ids) => {
+            check_count(ids.len(), &format!("{field}.plants"))?;
+            archived(studio, &ids, model, &format!("{field}.plants"))?;
+            reused = ids;
+        }
+    }
+    let made = blocking_grow(studio, genomes, field).await?;
+    Ok((made, reused))
+}
+
+fn check_count(n: usize, field: &str) -> Result<(), ApiError> {
+    if (1..=GRID).contains(&n) {
+        Ok(())
+    } else {
+        Err(ApiError::bad(
+            field,
+            format!("expected 1 to 9 entries, got {n}"),
+        ))
+    }
+}
+
+/// Reads a genome file's text, naming `field` and the line and column of any error.
+pub fn parse_genome(text: &str, field: &str) -> Result<Genome, ApiError> {
+    Registry::standard().parse_genome(text).map_err(|e| {
+        ApiError::unprocessable(
+            field,
+            format!("line {}, column {}: {}", e.line, e.column, e.message),
+        )
+    })
+}
+
+/// Grows genomes side by side on the blocking pool.
+async fn blocking_grow(
+    studio: &Studio,
+    genomes: Vec<(Genome, &'static str, serde_json::Value)>,
+    field: &str,
+) -> Result<Vec<Made>, ApiError> {
+    let studio = studio.clone();
+    let field = field.to_owned();
+    tokio::task::spawn_blocking(move || {
+        let jobs = genomes.len();
+        studio
+            .pool
+            .map(jobs, |i| {
+                let (genome, operator, settings) = genomes[i].clone();
+                Made::grow(genome, operator, settings, Vec::new()).map_err(|mut e| {
+                    e.field = format!("{field}[{i}]");
+                    e
+                })
+            })
+            .into_iter()
+            .collect::<Result<Vec<Made>, ApiError>>()
+    })
+    .await?
+}
+
+/// The model named in a request, or PlantMaker.
+fn model_name(name: Option<&str>) -> Result<&'static str, ApiError> {
+    let name = name.unwrap_or(PLANTMAKER);
+    Registry::standard()
+        .get(name)
+        .map(|m| m.name())
+        .ok_or_else(|| {
+            let known: Vec<_> = Registry::standard()
+                .models()
+                .iter()
+                .map(|m| m.name())
+                .collect();
+            ApiError::bad("model", format!("expected one of {known:?}, got {name:?}"))
+        })
+}
+
+/// Puts `first` (in order) at the head of the grid with dominance `step`; the rest keep
+/// their order by dominance, and the least dominant fall off.
+fn promote(grid: &[Cell], first: &[i64], step: i64) -> Vec<Cell> {
+    let mut out: Vec<Cell> = Vec::with_capacity(GRID);
+    for &plant in first {
+        if !out.iter().any(|c| c.plant == plant) {
+            out.push(Cell {
+                plant,
+                dominance: step,
+            });
+        }
+    }
+    let mut rest: Vec<Cell> = grid
+        .iter()
+        .filter(|c| !first.contains(&c.plant))
+        .copied()
+        .collect();
+    rest.sort_by_key(|c| std::cmp::Reverse(c.dominance));
+    out.extend(rest);
+    out.truncate(GRID);
+    out
+}
+
+/// What a breed session starts from when not told: the model's examples, and random
+/// genomes up to a full grid when it has fewer than two. (Random PlantMaker genomes grow
+/// plants of up to a million triangles; the paper's users, too, began from chosen plants.)
+fn default_start(model: &str) -> Plants {
+    let examples: Vec<String> = crate::sessions::example_list()
+        .into_iter()
+        .filter(|(_, m)| *m == model)
+        .map(|(name, _)| name)
+        .take(GRID)
+        .collect();
+    if examples.len() >= 2 {
+        Plants::Examples(examples)
+    } else {
+        Plants::Random(GRID as u32)
+    }
+}
+
+/// Creates a breed session.
+pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+    let model = model_name(start.model.as_deref())?;
+    let seed = start.seed.unwrap_or(1);
+    let plants = match start.start {
+        Some(plants) => plants,
+        None => default_start(model),
+    };
+    let (made, reused) = make_plants(studio, model, plants, seed, 0, "start").await?;
+    let (id, ids) = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let title = format!("Breed {model}");
+        let id = archive::insert_session(c, "breed", model, &title, &json!({}))?;
+        let mut ids = store(c, id, &made)?;
+        ids.extend(reused);
+        let state = BreedState {
+            grid: promote(&[], &ids, 0),
+            seed,
+        };
+        archive::set_state(c, id, &json!(state))?;
+        Ok((id, ids))
+    })?;
+    cache(studio, &ids, made);
+    Ok(id)
+}
+
+/// A new breed session that starts from one archived plant.
+pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
+    create(
+        studio,
+        Start {
+            model: Some(row.model.clone()),
+            start: Some(Plants::Plants(vec![row.id])),
+            seed: Some(row.seed),
+        },
+    )
+    .await
+}
+
+/// The breed session and its state.
+fn breed_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, BreedState), ApiError> {
+    let row = session_of(studio, id, "breed")?;
+    let state: BreedState = serde_json::from_value(row.state.clone())
+        .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
+    Ok((row, state))
+}
+
+/// Records a step that made `made` (and promotes `lead` before them) in one transaction.
+fn record(
+    studio: &Studio,
+    id: i64,
+    state: &BreedState,
+    action: serde_json::Value,
+    lead: &[i64],
+    made: Vec<Made>,
+    replace: Option<i64>,
+) -> Result<SessionView, ApiError> {
+    let ids = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let seq = archive::next_seq(c, id)?;
+        let ids = store(c, id, &made)?;
+        let grid = match replace {
+            // An edit takes the edited plant's place.
+            Some(old) if state.grid.iter().any(|c| c.plant == old) => state
+                .grid
+                .iter()
+                .map(|cell| {
+                    if cell.plant == old {
+                        Cell {
+                            plant: ids[0],
+                            dominance: seq,
+                        }
+                    } else {
+                        *cell
+                    }
+                })
+                .collect(),
+            _ => {
+                let first: Vec<i64> = lead.iter().chain(&ids).copied().collect();
+                promote(&state.grid, &first, seq)
+            }
+        };
+        let after = BreedState {
+            grid,
+            seed: state.seed,
+        };
+        let mut action = action;
+        action["children"] = json!(ids);
+        archive::record_step(c, id, &action, &json!(state), &json!(after))?;
+        Ok(ids)
+    })?;
+    cache(studio, &ids, made);
+    view(studio, id)
+}
+
+/// A parent of a cross.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct CrossParent {
+    plant: i64,
+    #[serde(default = "one")]
+    dominance: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `POST /api/sessions/{id}/cross`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct CrossRequest {
+    parents: Vec<CrossParent>,
+    level: Option<String>,
+    children: Option<u32>,
+    seed: Option<u64>,
+}
+
+/// Checks a number of children, 1 to 9.
+fn children(n: Option<u32>, default: usize) -> Result<usize, ApiError> {
+    let n = n.map_or(default, |n| n as usize);
+    if (1..=GRID).contains(&n) {
+        Ok(n)
+    } else {
+        Err(ApiError::bad(
+            "children",
+            format!("expected 1 to 9, got {n}"),
+        ))
+    }
+}
+
+/// Breeds children on the blocking pool, each from its own stream; a child that cannot
+/// grow (too large a plant, say) is bred again from the next stream, up to four times.
+async fn breed_children(
+    studio: &Studio,
+    count: usize,
+    seed: u64,
+    seq: i64,
+    breed: impl Fn(u64) -> Result<(Genome, Vec<ParentRow>), ApiError> + Send + Sync + 'static,
+    operator: &'static str,
+    settings: serde_json::Value,
+) -> Result<Vec<Made>, ApiError> {
+    let studio = studio.clone();
+    tokio::task::spawn_blocking(move || {
+        studio
+            .pool
+            .map(count, |i| {
+                let mut last = None;
+                for attempt in 0..4u64 {
+                    let s = step_seed(seed, seq, i as u64 + 16 * attempt);
+                    let (genome, parents) = breed(s)?;
+                    let mut settings = settings.clone();
+                    settings["seed"] = json!(s);
+                    match Made::grow(genome, operator, settings, parents) {
+                        Ok(m) => return Ok(m),
+                        Err(e) => last = Some(e),
+                    }
+                }
+                Err(last.unwrap_or_else(|| ApiError::internal("no child")))
+            })
+            .into_iter()
+            .collect()
+    })
+    .await?
+}
+
+/// `POST /api/sessions/{id}/cross`.
+pub(crate) async fn cross(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<CrossRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (row, state) = breed_state(&studio, id)?;
+    if request.parents.len() < 2 || request.parents.len() > GRID {
+        return Err(ApiError::bad(
+            "parents",
+            format!(
+                "a cross takes 2 to 9 parents, got {}",
+                request.parents.len()
+            ),
+        ));
+    }
+    let ids: Vec<i64> = request.parents.iter().map(|p| p.plant).collect();
+    for (i, id) in ids.iter().enumerate() {
+        if ids[..i].contains(id) {
+            return Err(ApiError::bad(
+                format!("parents[{i}].plant"),
+                format!("plant {id} is given twice"),
+            ));
+        }
+    }
+    for (i, p) in request.parents.iter().enumerate() {
+        if !(p.dominance.is_finite() && (0.0..=1e6).contains(&p.dominance)) {
+            return Err(ApiError::bad(
+                format!("parents[{i}].dominance"),
+                format!("expected a number from 0 to 1000000, got {}", p.dominance),
+            ));
+        }
+    }
+    let rows = archived(&studio, &ids, &row.model, "parents")?;
+    let genomes = rows.iter().map(genome_of).collect::<Result<Vec<_>, _>>()?;
+    let level = request.level.as_deref().unwrap_or("medium");
+    if !matches!(level, "low" | "medium" | "high") {
+        return Err(ApiError::bad(
+            "level",
+            format!("expected low, medium or high, got {level:?}"),
+        ));
+    }
+    let count = children(request.children, GRID.saturating_sub(ids.len()).max(1))?;
+    let settings = (row.model == PLANTMAKER).then(|| json!({ "crossover": level }));
+    let weights: Vec<f64> = request.parents.iter().map(|p| p.dominance).collect();
+    let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
+    let seed = request.seed.unwrap_or(state.seed);
+    let parent_ids = ids.clone();
+    let made = breed_children(
+        &studio,
+        count,
+        seed,
+        seq,
+        move |s| {
+            let pairs: Vec<(&Genome, f64)> = genomes.iter().zip(weights.iter().copied()).collect();
+            let (child, used) = Genome::cross(&pairs, settings.as_ref(), s)
+                .map_err(|e| ApiError::library("parents", e))?;
+            let parents = used
+                .iter()
+                .map(|&i| ParentRow {
+                    plant: parent_ids[i],
+                    dominance: weights[i],
+                })
+                .collect();
+            Ok((child, parents))
+        },
+        "cross",
+        json!({ "level": level }),
+    )
+    .await?;
+    let action = json!({
+        "op": "cross",
+        "parents": request.parents.iter().map(|p| json!({"plant": p.plant, "dominance": p.dominance})).collect::<Vec<_>>(),
+        "level": level,
+        "seed": seed,
+    });
+    Ok(Json(record(&studio, id, &state, action, &ids, made, None)?))
+}
+
+/// `POST /api/sessions/{id}/mutate`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct MutateRequest {
+    plant: i64,
+    depth: Option<u32>,
+    children: Option<u32>,
+    seed: Option<u64>,
+}
+
+/// PlantMaker's mutation settings for a Depth of 1 to 10 (`docs/studio.md`).
+pub fn depth_settings(depth: u32) -> serde_json::Value {
+    let d = f64::from(depth);
+    json!({ "mutation_rate": 0.05 * d, "mutation_spread": 0.05 + 0.02 * d })
+}
+
+/// `POST /api/sessions/{id}/mutate`.
+pub(crate) async fn mutate(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<MutateRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (row, state) = breed_state(&studio, id)?;
+    let depth = request.depth.unwrap_or(2);
+    if !(1..=10).contains(&depth) {
+        return Err(ApiError::bad(
+            "depth",
+            format!("expected 1 to 10, got {depth}"),
+        ));
+    }
+    let count = children(request.children, GRID - 1)?;
+    let parent = archived(&studio, &[request.plant], &row.model, "plant")?.remove(0);
+    let genome = genome_of(&parent)?;
+    let settings = (row.model == PLANTMAKER).then(|| depth_settings(depth));
+    let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
+    let seed = request.seed.unwrap_or(state.seed);
+    let parent_id = parent.id;
+    let made = breed_children(
+        &studio,
+        count,
+        seed,
+        seq,
+        move |s| {
+            let child = genome
+                .mutate(settings.as_ref(), s)
+                .map_err(|e| ApiError::library("plant", e))?;
+            Ok((
+                child,
+                vec![ParentRow {
+                    plant: parent_id,
+                    dominance: 1.0,
+                }],
+            ))
+        },
+        "mutate",
+        json!({ "depth": depth }),
+    )
+    .await?;
+    let action = json!({ "op": "mutate", "plant": parent_id, "depth": depth, "seed": seed });
+    Ok(Json(record(
+        &studio,
+        id,
+        &state,
+        action,
+        &[parent_id],
+        made,
+        None,
+    )?))
+}
+
+/// `POST /api/sessions/{id}/add`.
+pub(crate) async fn add(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(plants): Body<Plants>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (row, state) = breed_state(&studio, id)?;
+    let model = model_name(Some(&row.model))?;
+    let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
+    let (made, reused) = make_plants(&studio, model, plants, state.seed, seq, "").await?;
+    let action = json!({ "op": "add", "plants": reused });
+    Ok(Json(record(
+        &studio, id, &state, action, &reused, made, None,
+    )?))
+}
+
+/// `POST /api/sessions/{id}/edit`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct EditRequest {
+    plant: i64,
+    genome: Option<serde_json::Value>,
+    seed: Option<u64>,
+}
+
+/// `POST /api/sessions/{id}/edit`: an edited genome or another seed.
+pub(crate) async fn edit(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<EditRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (row, state) = breed_state(&studio, id)?;
+    let old = archived(&studio, &[request.plant], &row.model, "plant")?.remove(0);
+    let original = genome_of(&old)?;
+    let genome = match &request.genome {
+        None => original.clone(),
+        Some(serde_json::Value::String(text)) => parse_genome(text, "genome")?,
+        Some(value) => parse_genome(&value.to_string(), "genome")?,
+    };
+    if genome.model() != row.model {
+        return Err(ApiError::unprocessable(
+            "genome",
+            format!(
+                "a {} genome; this session breeds {}",
+                genome.model(),
+                row.model
+            ),
+        ));
+    }
+    let same = genome == original;
+    let seed = request.seed.unwrap_or(if same {
+        old.seed
+    } else {
+        genome.default_seed()
+    });
+    if same && seed == old.seed {
+        return Err(ApiError::bad(
+            "genome",
+            "nothing changed: edit a field or give another seed",
+        ));
+    }
+    let operator = if same { "regrow" } else { "edit" };
+    let parents = vec![ParentRow {
+        plant: old.id,
+        dominance: 1.0,
+    }];
+    let made = tokio::task::spawn_blocking(move || {
+        Made::grow_with(genome, seed, operator, json!({ "seed": seed }), parents)
+    })
+    .await?
+    .map_err(|mut e| {
+        e.field = "genome".into();
+        e
+    })?;
+    let action = json!({ "op": operator, "plant": old.id, "seed": seed });
+    Ok(Json(record(
+        &studio,
+        id,
+        &state,
+        action,
+        &[],
+        vec![made],
+        Some(old.id),
+    )?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_least_dominant_fall_off() {
+        let grid: Vec<Cell> = (1..=9)
+            .map(|p| Cell {
+                plant: p,
+                dominance: p,
+            })
+            .collect();
+        let after = promote(&grid, &[3, 100, 101], 10);
+        let plants: Vec<i64> = after.iter().map(|c| c.plant).collect();
+        assert_eq!(plants, [3, 100, 101, 9, 8, 7, 6, 5, 4]);
+        assert!(after[..3].iter().all(|c| c.dominance == 10));
+    }
+}

@@ -1,0 +1,578 @@
+//! Design mode, the GP designer: a target surface, favoured and forbidden cells of the
+//! density grid and the weights become an evolution of automata trees that runs in the
+//! background, one thread per run, and shows each generation's best as it comes.
+//!
+//! A run checkpoints to the archive after every generation, in the transaction that records
+//! the generation, so a server killed at any moment resumes every running run from its last
+//! checkpoint when it starts again ([`resume_all`]), to the bytes of a run never stopped.
+
+use std::collections::HashMap;
+use std::convert::Infallible;
+use std::path::Path as FilePath;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sylva::{Config, Evolution};
+use sylva_automata::AutomataModel;
+use sylva_model::Model;
+use tokio::sync::broadcast;
+use tokio_stream::StreamExt;
+use tokio_stream::wrappers::BroadcastStream;
+
+use crate::Studio;
+use crate::archive::{self, GenerationRow, RunRow};
+use crate::error::{ApiError, config_error};
+use crate::family::{archive_member, generation_row};
+use crate::http::Body;
+use crate::sessions::{SessionView, session_of, view};
+
+const AUTOMATA: &str = AutomataModel::NAME;
+
+/// What a run tells the pages watching it.
+#[derive(Serialize, Clone, Debug)]
+pub struct RunEvent {
+    /// The run.
+    pub run: i64,
+    /// running, stopped, done or failed.
+    pub status: String,
+    /// The generation just made (or the last one).
+    pub generation: u32,
+    /// Its figures, for a generation event.
+    #[serde(flatten)]
+    pub row: Option<GenerationRow>,
+    /// Why the run failed.
+    pub error: Option<String>,
+}
+
+/// The runs going on, and the channels of the pages watching them.
+#[derive(Default)]
+pub struct Runs {
+    stops: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    channels: Mutex<HashMap<i64, broadcast::Sender<RunEvent>>>,
+}
+
+impl Runs {
+    /// The channel of a session's events.
+    fn channel(&self, session: i64) -> broadcast::Sender<RunEvent> {
+        self.channels
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .entry(session)
+            .or_insert_with(|| broadcast::channel(256).0)
+            .clone()
+    }
+
+    /// Asks every run to stop (at its next generation), leaving their status as it is, so
+    /// that they resume when the studio starts again.
+    pub fn stop_all(&self) {
+        for stop in self
+            .stops
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .values()
+        {
+            stop.store(true, Ordering::SeqCst);
+        }
+    }
+
+    fn is_running(&self, run: i64) -> bool {
+        self.stops
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .contains_key(&run)
+    }
+}
+
+/// A design: the target, the grid's cells, the weights and the run's size.
+#[derive(Deserialize, Serialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct Design {
+    /// `[automata.fitness.target]`: a shape and its fields, paper units.
+    target: Option<serde_json::Value>,
+    /// The density grid, if any.
+    grid: Option<GridDesign>,
+    /// `[automata.fitness.weights]`.
+    weights: Option<serde_json::Value>,
+    /// Branches wanted, 1 to 1000. Default 30.
+    num_target: Option<u32>,
+    /// Individuals, 10 to 20000. Default 1000.
+    population: Option<u32>,
+    /// Generations, 1 to 1000. Default 50.
+    generations: Option<u32>,
+    /// The run's seed. Default 1.
+    seed: Option<u64>,
+}
+
+/// A density grid with painted cells.
+#[derive(Deserialize, Serialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct GridDesign {
+    min: [f64; 3],
+    max: [f64; 3],
+    divisions: [u32; 3],
+    #[serde(default)]
+    cells: Vec<PaintedCell>,
+    target: Option<u32>,
+}
+
+/// A painted cell: weight 1 favoured, −1 forbidden.
+#[derive(Deserialize, Serialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct PaintedCell {
+    cell: [u32; 3],
+    weight: f64,
+}
+
+/// `POST /api/sessions` in design mode.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    design: Design,
+}
+
+/// A design session's view.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct DesignState {
+    /// The run.
+    pub run: i64,
+    /// The design it runs.
+    pub design: serde_json::Value,
+}
+
+fn range(value: u32, lo: u32, hi: u32, field: &str) -> Result<u32, ApiError> {
+    if (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(ApiError::bad(
+            format!("design.{field}"),
+            format!("expected {lo} to {hi}, got {value}"),
+        ))
+    }
+}
+
+/// The config a design stands for: Poncin's typical run (`examples/automata/sphere.toml`)
+/// with the design's target, grid, weights and size.
+fn config_of(design: &Design) -> Result<(Config, u32), ApiError> {
+    let population = range(design.population.unwrap_or(1000), 10, 20_000, "population")?;
+    let generations = range(design.generations.unwrap_or(50), 1, 1000, "generations")?;
+    let num_target = range(design.num_target.unwrap_or(30), 1, 1000, "num_target")?;
+    let mut fitness = json!({
+        "unit": 0.1,
+        "num_target": num_target,
+        "endpoints": "axes",
+        "weights": { "pos": 5.0, "num": 50.0, "dist": 200.0, "thick": 0.0, "angle": 0.0,
+                     "grid": if design.grid.is_some() { 10.0 } else { 0.0 } },
+        "target": { "shape": "sphere", "center": [0.0, 200.0, 0.0], "radius": 150.0 },
+    });
+    if let Some(target) = &design.target {
+        fitness["target"] = target.clone();
+    }
+    if let Some(serde_json::Value::Object(weights)) = &design.weights {
+        for (k, v) in weights {
+            fitness["weights"][k] = v.clone();
+        }
+    } else if design.weights.is_some() {
+        return Err(ApiError::bad(
+            "design.weights",
+            "expected an object of weights",
+        ));
+    }
+    if let Some(grid) = &design.grid {
+        let cells: Vec<serde_json::Value> = grid
+            .cells
+            .iter()
+            .map(|c| json!({ "at": c.cell, "weight": c.weight }))
+            .collect();
+        fitness["grid"] = json!({
+            "min": grid.min, "max": grid.max, "divisions": grid.divisions,
+            "weight": 0.0, "target": grid.target.unwrap_or(15), "cells": cells,
+        });
+    }
+    let doc = json!({
+        "model": AUTOMATA,
+        "run": { "generations": generations, "population": population,
+                 "seed": design.seed.unwrap_or(1) },
+        "automata": {
+            "automata": 2,
+            "breeding": { "mutation": 0.1, "reproduction": 0.02, "reevaluate": false },
+            "growth": { "iterations": 100, "root_length": 2.5, "leaf_length": 10.0 },
+            "fitness": fitness,
+        },
+    });
+    let value = toml::Value::try_from(&doc).map_err(|e| ApiError::bad("design", e))?;
+    let text = toml::to_string(&value).map_err(|e| ApiError::bad("design", e))?;
+    let config = Config::parse(FilePath::new("design"), &text).map_err(|e| {
+        let mut e = config_error("", &text, &e);
+        e.field = format!("design.{}", e.field.trim_start_matches("automata.fitness."));
+        e
+    })?;
+    Ok((config, generations))
+}
+
+/// Creates a design session and starts its run.
+pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+    let (config, generations) = config_of(&start.design)?;
+    let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let id = archive::insert_session(c, "design", AUTOMATA, "Design", &json!({}))?;
+        let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
+        let state = DesignState {
+            run,
+            design: json!(start.design),
+        };
+        archive::set_state(c, id, &json!(state))?;
+        Ok((id, run))
+    })?;
+    spawn(studio, run)?;
+    Ok(id)
+}
+
+/// `POST /api/sessions/{id}/design`: a new run of a new design in the session; the old
+/// one stops.
+pub(crate) async fn redesign(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(design): Body<Design>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let before = design_state(&studio, id)?;
+    let (config, generations) = config_of(&design)?;
+    stop_run(&studio, before.run)?;
+    let run = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
+        let after = DesignState {
+            run,
+            design: json!(design),
+        };
+        archive::set_state(c, id, &json!(after))?;
+        Ok(run)
+    })?;
+    spawn(&studio, run)?;
+    Ok(Json(view(&studio, id)?))
+}
+
+fn design_state(studio: &Studio, id: i64) -> Result<DesignState, ApiError> {
+    let row = session_of(studio, id, "design")?;
+    serde_json::from_value(row.state)
+        .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
+}
+
+fn run_row(studio: &Studio, run: i64) -> Result<RunRow, ApiError> {
+    studio
+        .archive
+        .read(|c| archive::run(c, run))?
+        .ok_or_else(|| ApiError::internal(format!("run {run} is missing")))
+}
+
+/// Starts (or resumes) a run's thread, unless it is going already.
+fn spawn(studio: &Studio, run: i64) -> Result<(), ApiError> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let mut stops = studio.runs.stops.lock().unwrap_or_else(|p| p.into_inner());
+        if stops.contains_key(&run) {
+            return Ok(());
+        }
+        stops.insert(run, stop.clone());
+    }
+    let worker = studio.clone();
+    let spawned = std::thread::Builder::new()
+        .name(format!("sylva-run-{run}"))
+        .spawn(move || {
+            let result = drive(&worker, run, &stop);
+            worker
+                .runs
+                .stops
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .remove(&run);
+            if let Err(e) = result {
+                let _ = worker.archive.transaction(|c| -> Result<(), ApiError> {
+                    let row = archive::run(c, run)?;
+                    let generation = row.map_or(0, |r| r.generation);
+                    archive::save_run(c, run, None, generation, "failed", Some(&e.error))?;
+                    Ok(())
+                });
+                if let Ok(row) = run_row(&worker, run) {
+                    let _ = worker.runs.channel(row.session).send(RunEvent {
+                        run,
+                        status: "failed".into(),
+                        generation: row.generation,
+                        row: None,
+                        error: Some(e.error),
+                    });
+                }
+            }
+        });
+    if let Err(e) = spawned {
+        studio
+            .runs
+            .stops
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .remove(&run);
+        return Err(ApiError::internal(format!("starting a run: {e}")));
+    }
+    Ok(())
+}
+
+/// Runs a run until it is done or asked to stop, saving every generation.
+fn drive(studio: &Studio, run: i64, stop: &AtomicBool) -> Result<(), ApiError> {
+    let row = run_row(studio, run)?;
+    let path = FilePath::new("design");
+    let config = Config::parse(path, &row.config).map_err(|e| ApiError::internal(e.message))?;
+    let channel = studio.runs.channel(row.session);
+    let mut evolution = match &row.checkpoint {
+        Some(text) => Evolution::resume(&config, path, text, studio.pool.clone())
+            .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?,
+        None => {
+            let evolution = Evolution::start(&config, Vec::new(), studio.pool.clone())
+                .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?;
+            studio.archive.transaction(|c| -> Result<_, ApiError> {
+                Ok(archive::set_run_terms(c, run, evolution.term_names())?)
+            })?;
+            save_generation(studio, &row, &evolution, stop, &channel)?;
+            evolution
+        }
+    };
+    loop {
+        let generations = run_row(studio, run)?.generations;
+        if stop.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        if evolution.generation() >= generations {
+            studio.archive.transaction(|c| {
+                archive::save_run(c, run, None, evolution.generation(), "done", None)
+                    .map_err(ApiError::from)
+            })?;
+            let _ = channel.send(RunEvent {
+                run,
+                status: "done".into(),
+                generation: evolution.generation(),
+                row: None,
+                error: None,
+            });
+            return Ok(());
+        }
+        evolution
+            .step()
+            .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?;
+        save_generation(studio, &row, &evolution, stop, &channel)?;
+    }
+}
+
+/// Archives a generation's best, its figures and the checkpoint, in one transaction; then
+/// tells the pages watching.
+fn save_generation(
+    studio: &Studio,
+    row: &RunRow,
+    evolution: &Evolution,
+    stop: &AtomicBool,
+    channel: &broadcast::Sender<RunEvent>,
+) -> Result<(), ApiError> {
+    let best = evolution.best();
+    let plant = archive_member(studio, row.session, row.id, evolution.generation(), &best)?;
+    let checkpoint = evolution
+        .checkpoint()
+        .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?;
+    let mut figures = generation_row(evolution);
+    figures.plant = Some(plant);
+    let status = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        archive::insert_generation(c, row.id, &figures)?;
+        // Read under the archive's lock: a stop acknowledged before this commit is kept.
+        let status = if stop.load(Ordering::SeqCst) {
+            archive::run(c, row.id)?.map_or_else(|| "stopped".to_owned(), |r| r.status)
+        } else {
+            "running".to_owned()
+        };
+        archive::save_run(
+            c,
+            row.id,
+            Some(&checkpoint),
+            evolution.generation(),
+            &status,
+            None,
+        )?;
+        Ok(status)
+    })?;
+    let _ = channel.send(RunEvent {
+        run: row.id,
+        status,
+        generation: evolution.generation(),
+        row: Some(figures),
+        error: None,
+    });
+    Ok(())
+}
+
+/// Stops a run: marked stopped now (so a restart does not resume it), and its thread ends
+/// after the generation it is making.
+fn stop_run(studio: &Studio, run: i64) -> Result<(), ApiError> {
+    if let Some(stop) = studio
+        .runs
+        .stops
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get(&run)
+    {
+        stop.store(true, Ordering::SeqCst);
+    }
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let row = archive::run(c, run)?.ok_or_else(|| ApiError::not_found(format!("run {run}")))?;
+        if row.status == "running" {
+            archive::set_run_status(c, run, "stopped")?;
+        }
+        Ok(())
+    })
+}
+
+/// `POST /api/sessions/{id}/stop`.
+pub(crate) async fn stop(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<SessionView>, ApiError> {
+    let state = design_state(&studio, id)?;
+    stop_run(&studio, state.run)?;
+    let row = run_row(&studio, state.run)?;
+    let _ = studio.runs.channel(id).send(RunEvent {
+        run: row.id,
+        status: row.status,
+        generation: row.generation,
+        row: None,
+        error: None,
+    });
+    Ok(Json(view(&studio, id)?))
+}
+
+/// `POST /api/sessions/{id}/resume`.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ResumeRequest {
+    /// Run to this many generations in all (more than asked at first, to go on), 1 to 1000.
+    generations: Option<u32>,
+}
+
+/// `POST /api/sessions/{id}/resume`: a stopped (or done) run goes on.
+pub(crate) async fn resume(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<ResumeRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let state = design_state(&studio, id)?;
+    let row = run_row(&studio, state.run)?;
+    let generations = match request.generations {
+        Some(g) => range(g, 1, 1000, "generations")?,
+        None => row.generations,
+    };
+    if row.status == "failed" {
+        return Err(ApiError::conflict(format!(
+            "the run failed ({}); start a new design",
+            row.error.unwrap_or_default()
+        )));
+    }
+    if studio.runs.is_running(row.id) && row.status == "running" {
+        return Err(ApiError::conflict("the run is running"));
+    }
+    if row.generation >= generations {
+        return Err(ApiError::conflict(format!(
+            "the run has made its {generations} generations; ask for more with `generations`"
+        )));
+    }
+    // A run still finishing its generation after a stop ends first.
+    for _ in 0..600 {
+        if !studio.runs.is_running(row.id) {
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+    }
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        archive::set_run_generations(c, row.id, generations)?;
+        archive::set_run_status(c, row.id, "running")?;
+        Ok(())
+    })?;
+    spawn(&studio, row.id)?;
+    Ok(Json(view(&studio, id)?))
+}
+
+#[derive(Serialize)]
+pub(crate) struct RunView {
+    run: i64,
+    status: String,
+    generation: u32,
+    generations: u32,
+    terms: Vec<String>,
+    rows: Vec<GenerationRow>,
+    error: Option<String>,
+}
+
+/// `GET /api/sessions/{id}/run`.
+pub(crate) async fn run(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<RunView>, ApiError> {
+    let state = design_state(&studio, id)?;
+    let (row, terms, rows) = studio.archive.read(|c| {
+        let row = archive::run(c, state.run)?;
+        let terms = archive::run_terms(c, state.run)?;
+        let rows = archive::generations(c, state.run, u32::MAX)?;
+        Ok((row, terms, rows))
+    })?;
+    let row = row.ok_or_else(|| ApiError::internal(format!("run {} is missing", state.run)))?;
+    Ok(Json(RunView {
+        run: row.id,
+        status: row.status,
+        generation: row.generation,
+        generations: row.generations,
+        terms,
+        rows,
+        error: row.error,
+    }))
+}
+
+/// `GET /api/sessions/{id}/events`: server-sent events, one per generation and one per
+/// change of status.
+pub(crate) async fn events(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Sse<impl tokio_stream::Stream<Item = Result<Event, Infallible>>>, ApiError> {
+    let state = design_state(&studio, id)?;
+    let receiver = studio.runs.channel(id).subscribe();
+    let row = run_row(&studio, state.run)?;
+    let first = RunEvent {
+        run: row.id,
+        status: row.status,
+        generation: row.generation,
+        row: None,
+        error: row.error,
+    };
+    let first = tokio_stream::once(first);
+    let rest = BroadcastStream::new(receiver).filter_map(|e| e.ok());
+    let stream = first.chain(rest).map(|e| {
+        let name = if e.row.is_some() {
+            "generation"
+        } else {
+            "status"
+        };
+        Ok(Event::default()
+            .event(name)
+            .data(serde_json::to_string(&e).unwrap_or_default()))
+    });
+    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
+}
+
+/// Resumes every run that was running when the studio stopped (or was killed).
+pub fn resume_all(studio: &Studio) {
+    let Ok(runs) = studio
+        .archive
+        .read(|c| archive::runs_with_status(c, "running"))
+    else {
+        return;
+    };
+    for run in runs {
+        let _ = spawn(studio, run.id);
+    }
+}

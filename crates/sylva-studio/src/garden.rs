@@ -1,0 +1,513 @@
+//! Garden mode, the biomorph loop of L-system plants: the mother (in one corner) and her
+//! mutated children grow together in one voxel world, shading each other; clicking a
+//! specimen makes it the next mother and grows her garden.
+//!
+//! A specimen's shape depends on its neighbours, so its mesh is stored when the garden
+//! grows (it cannot be grown alone again), and so is the whole garden's scene.
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sylva::Genome;
+use sylva::assets::{Placed, SceneAssets};
+use sylva_core::MaterialKind;
+use sylva_core::glam::Vec3;
+use sylva_lsystem::breed::{BreedSettings, breed_garden};
+use sylva_lsystem::{LSystemGenome, LSystemModel};
+use sylva_mesh::{Scene, SceneNode};
+use sylva_model::Model;
+
+use crate::Studio;
+use crate::archive::{self, NewPlant, ParentRow, PlantRow};
+use crate::error::ApiError;
+use crate::http::Body;
+use crate::plants::{extras, genome_of};
+use crate::sessions::{SessionView, example, session_of, step_seed, view};
+
+/// The garden's controls; each optional in a request (the session's otherwise).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GardenSettings {
+    /// Steps to grow, 0 to 1000. Default 100.
+    pub steps: u32,
+    /// The light's height above the horizon, 0 to 90 degrees. Default 90 (straight down).
+    pub elevation: f64,
+    /// The compass direction the light comes from, 0 to 360 degrees. Default 0.
+    pub azimuth: f64,
+    /// Children sown with the mother, 0 to 8. Default 8.
+    pub children: u32,
+}
+
+impl Default for GardenSettings {
+    fn default() -> Self {
+        GardenSettings {
+            steps: 100,
+            elevation: 90.0,
+            azimuth: 0.0,
+            children: 8,
+        }
+    }
+}
+
+/// Changes to the controls.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsChange {
+    steps: Option<u32>,
+    elevation: Option<f64>,
+    azimuth: Option<f64>,
+    children: Option<u32>,
+}
+
+impl GardenSettings {
+    fn with(self, change: &SettingsChange) -> Result<GardenSettings, ApiError> {
+        let s = GardenSettings {
+            steps: change.steps.unwrap_or(self.steps),
+            elevation: change.elevation.unwrap_or(self.elevation),
+            azimuth: change.azimuth.unwrap_or(self.azimuth),
+            children: change.children.unwrap_or(self.children),
+        };
+        let range = |ok: bool, field: &str, range: &str, got: String| {
+            if ok {
+                Ok(())
+            } else {
+                Err(ApiError::bad(
+                    format!("settings.{field}"),
+                    format!("expected {range}, got {got}"),
+                ))
+            }
+        };
+        range(s.steps <= 1000, "steps", "0 to 1000", s.steps.to_string())?;
+        range(
+            s.elevation.is_finite() && (0.0..=90.0).contains(&s.elevation),
+            "elevation",
+            "0 to 90 degrees",
+            s.elevation.to_string(),
+        )?;
+        range(
+            s.azimuth.is_finite() && (0.0..=360.0).contains(&s.azimuth),
+            "azimuth",
+            "0 to 360 degrees",
+            s.azimuth.to_string(),
+        )?;
+        range(
+            s.children <= 8,
+            "children",
+            "0 to 8",
+            s.children.to_string(),
+        )?;
+        Ok(s)
+    }
+
+    fn breed_settings(&self) -> BreedSettings {
+        let mut b = BreedSettings {
+            children: self.children as usize,
+            ..BreedSettings::default()
+        };
+        b.grow.steps = self.steps;
+        b.grow.world.light.elevation = self.elevation;
+        b.grow.world.light.azimuth = self.azimuth;
+        b
+    }
+}
+
+/// A specimen of the garden shown.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct SpecimenView {
+    /// The plant.
+    pub plant: i64,
+    /// True for the mother.
+    pub is_mother: bool,
+    /// Where it grew, metres.
+    pub x: f32,
+    /// Where it grew, metres.
+    pub z: f32,
+    /// Biomass at the end, grams.
+    pub biomass: f64,
+    /// Light absorbed over its life.
+    pub light: f64,
+    /// Leaves.
+    pub leaves: u32,
+    /// Fine roots.
+    pub fine_roots: u32,
+}
+
+/// A garden session's view.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct GardenState {
+    /// The mother.
+    pub mother: i64,
+    /// The garden grown from her, mother first.
+    pub specimens: Vec<SpecimenView>,
+    /// The controls.
+    pub settings: GardenSettings,
+    /// The session's seed.
+    pub seed: u64,
+    /// The stored scene of the whole garden.
+    pub scene: Option<i64>,
+}
+
+/// Where the first mother comes from.
+#[derive(Deserialize, Debug)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Mother {
+    /// An example genome (`lsystem/herb`).
+    Example(String),
+    /// A genome file's text.
+    Genome(String),
+    /// An archived L-system plant.
+    Plant(i64),
+    /// Empty rules, the paper's start.
+    Empty(bool),
+}
+
+/// `POST /api/sessions` in garden mode.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    start: Option<Mother>,
+    #[serde(default)]
+    settings: SettingsChange,
+    seed: Option<u64>,
+}
+
+const LSYSTEM: &str = LSystemModel::NAME;
+
+fn lsystem_genome(genome: &Genome, field: &str) -> Result<LSystemGenome, ApiError> {
+    genome.get::<LSystemModel>().cloned().ok_or_else(|| {
+        ApiError::unprocessable(
+            field,
+            format!("a {} genome; gardens grow L-system plants", genome.model()),
+        )
+    })
+}
+
+/// Creates a garden session and grows its first garden.
+pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+    let settings = GardenSettings::default().with(&start.settings)?;
+    let seed = start.seed.unwrap_or(1);
+    let (mother, operator, op_settings, existing) = match start
+        .start
+        .unwrap_or(Mother::Example("lsystem/herb".into()))
+    {
+        Mother::Example(name) => {
+            let genome = example(&name)
+                .ok_or_else(|| ApiError::bad("start.example", format!("no example {name:?}")))?;
+            (
+                lsystem_genome(&genome, "start.example")?,
+                "example",
+                json!({"example": name}),
+                None,
+            )
+        }
+        Mother::Genome(text) => {
+            let genome = crate::breed::parse_genome(&text, "start.genome")?;
+            (
+                lsystem_genome(&genome, "start.genome")?,
+                "upload",
+                json!({}),
+                None,
+            )
+        }
+        Mother::Plant(id) => {
+            let row = crate::plants::plant_row(studio, id)?;
+            let genome = genome_of(&row)?;
+            (
+                lsystem_genome(&genome, "start.plant")?,
+                "",
+                json!({}),
+                Some(id),
+            )
+        }
+        Mother::Empty(_) => (LSystemGenome::empty(), "empty", json!({}), None),
+    };
+    let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let id = archive::insert_session(c, "garden", LSYSTEM, "Garden", &json!({}))?;
+        let mother_id = match existing {
+            Some(m) => m,
+            None => archive::insert_plant(
+                c,
+                &NewPlant {
+                    session: Some(id),
+                    model: LSYSTEM,
+                    genome: &LSystemModel.write(&mother),
+                    seed: 0,
+                    operator,
+                    settings: &op_settings,
+                    parents: &[],
+                },
+            )?,
+        };
+        let state = GardenState {
+            mother: mother_id,
+            specimens: Vec::new(),
+            settings,
+            seed,
+            scene: None,
+        };
+        archive::set_state(c, id, &json!(state))?;
+        Ok(id)
+    })?;
+    let state = garden_state(studio, id)?.1;
+    let grown = grow_garden(studio, &state, &mother, 0).await?;
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let after = store_garden(c, id, &state, grown)?;
+        archive::set_state(c, id, &json!(after))?;
+        Ok(())
+    })?;
+    Ok(id)
+}
+
+/// A new garden session whose mother is an archived plant.
+pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
+    if row.model != LSYSTEM {
+        return Err(ApiError::bad(
+            "mode",
+            format!(
+                "gardens grow L-system plants; plant {} is {}",
+                row.id, row.model
+            ),
+        ));
+    }
+    create(
+        studio,
+        Start {
+            start: Some(Mother::Plant(row.id)),
+            settings: SettingsChange::default(),
+            seed: None,
+        },
+    )
+    .await
+}
+
+fn garden_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, GardenState), ApiError> {
+    let row = session_of(studio, id, "garden")?;
+    let state: GardenState = serde_json::from_value(row.state.clone())
+        .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
+    Ok((row, state))
+}
+
+/// A garden grown: each specimen's genome, figures and GLB, and the whole scene's GLB.
+struct Grown {
+    specimens: Vec<(LSystemGenome, bool, SpecimenView, Vec<u8>)>,
+    scene: Vec<u8>,
+}
+
+/// Grows the mother's garden on the blocking pool.
+async fn grow_garden(
+    studio: &Studio,
+    state: &GardenState,
+    mother: &LSystemGenome,
+    seq: i64,
+) -> Result<Grown, ApiError> {
+    let studio = studio.clone();
+    let settings = state.settings;
+    let seed = step_seed(state.seed, seq, 0);
+    let mother = mother.clone();
+    let mother_id = state.mother;
+    tokio::task::spawn_blocking(move || -> Result<Grown, ApiError> {
+        let mut rng = sylva_core::rng::seeded(seed);
+        let garden = breed_garden(&mother, &settings.breed_settings(), &mut rng, &studio.pool)
+            .map_err(|e| ApiError::unprocessable("settings", sylva::error::chain(&e)))?;
+        let shown: Vec<_> = garden
+            .specimens
+            .iter()
+            .map(|s| s.plant.without(MaterialKind::Root))
+            .collect();
+        let hint = LSystemModel.mesh_hint();
+        let genomes: Vec<Genome> = garden
+            .specimens
+            .iter()
+            .map(|s| Genome::new(LSystemModel, s.genome.clone()))
+            .collect();
+        let parents = [ParentRow {
+            plant: mother_id,
+            dominance: 1.0,
+        }];
+        let node_extras = |i: usize| {
+            let (operator, parents): (&str, &[ParentRow]) = if garden.specimens[i].is_mother {
+                ("mother", &[])
+            } else {
+                ("mutate", &parents)
+            };
+            extras(&genomes[i], seed, parents, operator)
+        };
+        let placed: Vec<Placed> = garden
+            .specimens
+            .iter()
+            .zip(&shown)
+            .enumerate()
+            .map(|(i, (s, plant))| Placed {
+                translation: Vec3::new(s.position.x, 0.0, s.position.y),
+                extras: Some(node_extras(i)),
+                ..Placed::new(format!("specimen-{i}"), plant, hint)
+            })
+            .collect();
+        let assets = SceneAssets::mesh(&placed).map_err(|e| ApiError::library("settings", e))?;
+        let scene = sylva_mesh::export::to_glb(&assets.scene())
+            .map_err(|e| ApiError::library("settings", e.into()))?;
+        let mut specimens = Vec::with_capacity(garden.specimens.len());
+        for (i, (s, mesh)) in garden.specimens.iter().zip(assets.meshes()).enumerate() {
+            let mut node = SceneNode::new(LSYSTEM, mesh);
+            node.extras = Some(node_extras(i));
+            let glb = sylva_mesh::export::to_glb(&Scene::single(node))
+                .map_err(|e| ApiError::library("settings", e.into()))?;
+            let view = SpecimenView {
+                plant: 0,
+                is_mother: s.is_mother,
+                x: s.position.x,
+                z: s.position.y,
+                biomass: s.stats.biomass,
+                light: s.stats.light,
+                leaves: s.stats.leaves(),
+                fine_roots: s.stats.fine_roots(),
+            };
+            specimens.push((s.genome.clone(), s.is_mother, view, glb));
+        }
+        Ok(Grown { specimens, scene })
+    })
+    .await?
+}
+
+/// Archives a grown garden: the children as plants with their meshes, the mother's mesh
+/// if she has none yet, the scene. Returns the view after.
+fn store_garden(
+    c: &rusqlite::Connection,
+    session: i64,
+    state: &GardenState,
+    grown: Grown,
+) -> Result<GardenState, ApiError> {
+    let mut specimens = Vec::with_capacity(grown.specimens.len());
+    let settings = json!(state.settings);
+    for (genome, is_mother, mut view, glb) in grown.specimens {
+        let id = if is_mother {
+            if archive::mesh(c, state.mother)?.is_none() {
+                archive::insert_mesh(c, state.mother, &glb)?;
+            }
+            state.mother
+        } else {
+            let id = archive::insert_plant(
+                c,
+                &NewPlant {
+                    session: Some(session),
+                    model: LSYSTEM,
+                    genome: &LSystemModel.write(&genome),
+                    seed: 0,
+                    operator: "mutate",
+                    settings: &settings,
+                    parents: &[ParentRow {
+                        plant: state.mother,
+                        dominance: 1.0,
+                    }],
+                },
+            )?;
+            archive::insert_mesh(c, id, &glb)?;
+            id
+        };
+        view.plant = id;
+        specimens.push(view);
+    }
+    let scene = archive::insert_scene(c, &grown.scene)?;
+    Ok(GardenState {
+        specimens,
+        scene: Some(scene),
+        ..state.clone()
+    })
+}
+
+/// `POST /api/sessions/{id}/grow`.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GrowRequest {
+    #[serde(default)]
+    settings: SettingsChange,
+}
+
+/// Grows a garden from `mother` with `settings` as one step.
+async fn step(
+    studio: &Studio,
+    id: i64,
+    mother: i64,
+    settings: &SettingsChange,
+    action: serde_json::Value,
+) -> Result<SessionView, ApiError> {
+    let (_, before) = garden_state(studio, id)?;
+    let row = crate::plants::plant_row(studio, mother)?;
+    let genome = lsystem_genome(&genome_of(&row)?, "plant")?;
+    let state = GardenState {
+        mother,
+        settings: before.settings.with(settings)?,
+        ..before.clone()
+    };
+    let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
+    let grown = grow_garden(studio, &state, &genome, seq).await?;
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let after = store_garden(c, id, &state, grown)?;
+        archive::record_step(c, id, &action, &json!(before), &json!(after))?;
+        Ok(())
+    })?;
+    view(studio, id)
+}
+
+/// `POST /api/sessions/{id}/grow`: the mother's garden grown again with new children.
+pub(crate) async fn grow(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<GrowRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (_, state) = garden_state(&studio, id)?;
+    let action = json!({ "op": "grow", "settings": state.settings.with(&request.settings)? });
+    Ok(Json(
+        step(&studio, id, state.mother, &request.settings, action).await?,
+    ))
+}
+
+/// `POST /api/sessions/{id}/pick`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct PickRequest {
+    plant: i64,
+}
+
+/// `POST /api/sessions/{id}/pick`: a specimen becomes the mother, and her garden grows.
+pub(crate) async fn pick(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<PickRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    let (_, state) = garden_state(&studio, id)?;
+    if !state.specimens.iter().any(|s| s.plant == request.plant) {
+        return Err(ApiError::bad(
+            "plant",
+            format!("plant {} is not in this garden", request.plant),
+        ));
+    }
+    let action = json!({ "op": "pick", "plant": request.plant });
+    let change = SettingsChange::default();
+    Ok(Json(
+        step(&studio, id, request.plant, &change, action).await?,
+    ))
+}
+
+/// `GET /api/sessions/{id}/garden.glb`.
+pub(crate) async fn scene(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let (_, state) = garden_state(&studio, id)?;
+    let scene = state
+        .scene
+        .ok_or_else(|| ApiError::not_found("a grown garden"))?;
+    let glb = studio
+        .archive
+        .read(|c| archive::scene(c, scene))?
+        .ok_or_else(|| ApiError::not_found(format!("scene {scene}")))?;
+    Ok(([(header::CONTENT_TYPE, "model/gltf-binary")], glb).into_response())
+}

@@ -1,0 +1,270 @@
+//! Sylva's studio: a web server and a single page where a person breeds plants by eye, in
+//! the four ways the papers did, with every plant and choice kept in an SQLite archive.
+//!
+//! - [`archive`]: the SQLite archive ([`Archive`]): sessions, plants, parentage, steps, runs.
+//! - [`sessions`]: sessions of every mode, their views, undo and redo.
+//! - [`breed`]: PlantMaker's main window (the 3×3 grid, cross and mutate), for any model.
+//! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
+//! - [`family`]: the deciduous-evolution viewer's binary-tree population.
+//! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
+//! - [`plants`]: plants as GLB, OBJ, PNG and genome files, and their lineage.
+//! - [`http`]: typed JSON bodies, the access token, the page's files.
+//!
+//! The server is a client of the library layer (the `sylva` crate), never of the command
+//! line. Heavy work (growing, meshing, evolving) runs on the blocking pool or a run's own
+//! thread, so the async threads stay free; every acknowledged step is committed to SQLite
+//! before the answer goes out. `docs/studio.md` documents every endpoint.
+//!
+//! ```no_run
+//! let options = sylva_studio::Options::default();
+//! sylva_studio::serve(options)?; // prints the address, serves until Ctrl+C
+//! # Ok::<(), sylva_studio::StartError>(())
+//! ```
+
+pub mod archive;
+pub mod breed;
+pub mod design;
+pub mod error;
+pub mod family;
+pub mod garden;
+pub mod http;
+pub mod plants;
+pub mod sessions;
+
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::ops::Deref;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+use axum::Router;
+use axum::routing::{get, post};
+use rand::RngExt;
+
+pub use archive::{Archive, ArchiveError};
+pub use error::ApiError;
+
+/// How to start the studio.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The address to bind: 127.0.0.1 by default. Any other needs the access token.
+    pub host: String,
+    /// The port; 0 picks a free one.
+    pub port: u16,
+    /// The archive file.
+    pub db: PathBuf,
+    /// Where three.js is installed (`web/node_modules/three` of the studio crate by
+    /// default).
+    pub three: PathBuf,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            host: "127.0.0.1".into(),
+            port: 8417,
+            db: PathBuf::from("sylva-studio.db"),
+            three: http::default_three(),
+        }
+    }
+}
+
+/// Why the studio could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum StartError {
+    /// The archive could not be opened.
+    #[error("opening the archive {path}")]
+    Archive {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: ArchiveError,
+    },
+    /// three.js is not installed.
+    #[error(
+        "three.js is not installed in {0}: run `npm ci --prefix crates/sylva-studio/web` (the page needs it)"
+    )]
+    NoThree(PathBuf),
+    /// The address could not be bound.
+    #[error("binding {address}")]
+    Bind {
+        /// host:port.
+        address: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The runtime or a worker could not start.
+    #[error("starting the server")]
+    Runtime(#[source] std::io::Error),
+}
+
+/// The studio's shared state: cheap to clone (one `Arc`).
+#[derive(Clone)]
+pub struct Studio(Arc<Inner>);
+
+/// What the studio holds.
+pub struct Inner {
+    /// The archive.
+    pub archive: Archive,
+    /// The access token, when bound beyond loopback.
+    pub token: Option<String>,
+    /// Where three.js is installed.
+    pub three: PathBuf,
+    /// Recently served meshes.
+    pub meshes: plants::MeshCache,
+    /// Threads for growing many plants at once.
+    pub pool: sylva_core::par::Pool,
+    /// One lock per session, so that two tabs' steps on one session queue up.
+    locks: Mutex<HashMap<i64, Arc<tokio::sync::Mutex<()>>>>,
+    /// Family runs in memory.
+    pub families: family::Families,
+    /// Design runs going on.
+    pub runs: design::Runs,
+}
+
+impl Deref for Studio {
+    type Target = Inner;
+    fn deref(&self) -> &Inner {
+        &self.0
+    }
+}
+
+impl Studio {
+    /// A studio on an archive, with an access token or none.
+    pub fn new(archive: Archive, token: Option<String>, three: PathBuf) -> Studio {
+        Studio(Arc::new(Inner {
+            archive,
+            token,
+            three,
+            meshes: plants::MeshCache::default(),
+            pool: sylva_core::par::Pool::with_threads(0).unwrap_or_default(),
+            locks: Mutex::default(),
+            families: family::Families::default(),
+            runs: design::Runs::default(),
+        }))
+    }
+
+    /// The lock of a session's steps.
+    pub fn session_lock(&self, session: i64) -> Arc<tokio::sync::Mutex<()>> {
+        let mut locks = self.locks.lock().unwrap_or_else(|p| p.into_inner());
+        locks.entry(session).or_default().clone()
+    }
+}
+
+/// The studio's routes.
+pub fn router(studio: Studio) -> Router {
+    let api = Router::new()
+        .route("/models", get(sessions::models))
+        .route("/examples", get(sessions::examples))
+        .route("/sessions", get(sessions::list).post(sessions::create))
+        .route("/sessions/{id}", get(sessions::get))
+        .route("/sessions/{id}/undo", post(sessions::undo))
+        .route("/sessions/{id}/redo", post(sessions::redo))
+        .route("/sessions/{id}/cross", post(breed::cross))
+        .route("/sessions/{id}/mutate", post(breed::mutate))
+        .route("/sessions/{id}/add", post(breed::add))
+        .route("/sessions/{id}/edit", post(breed::edit))
+        .route("/sessions/{id}/grow", post(garden::grow))
+        .route("/sessions/{id}/pick", post(garden::pick))
+        .route("/sessions/{id}/garden.glb", get(garden::scene))
+        .route("/sessions/{id}/generations", post(family::generations))
+        .route("/sessions/{id}/batch", post(family::batch))
+        .route("/sessions/{id}/stats", get(family::stats))
+        .route("/sessions/{id}/member", post(family::member))
+        .route("/sessions/{id}/design", post(design::redesign))
+        .route("/sessions/{id}/stop", post(design::stop))
+        .route("/sessions/{id}/resume", post(design::resume))
+        .route("/sessions/{id}/run", get(design::run))
+        .route("/sessions/{id}/events", get(design::events))
+        .route("/plants", get(plants::list))
+        .route("/plants/{id}", get(plants::get))
+        .route("/plants/{id}/plant.glb", get(plants::glb))
+        .route("/plants/{id}/plant.obj", get(plants::obj))
+        .route("/plants/{id}/plant.mtl", get(plants::mtl))
+        .route("/plants/{id}/plant.png", get(plants::png))
+        .route("/plants/{id}/genome.json", get(plants::genome))
+        .route("/plants/{id}/lineage", get(plants::lineage))
+        .route("/plants/{id}/branch", post(plants::branch))
+        .fallback(|| async { ApiError::not_found("no such endpoint") });
+    Router::new()
+        .nest("/api", api)
+        .route("/vendor/three/{*path}", get(http::vendor))
+        .route("/", get(http::page))
+        .route("/app/{*path}", get(http::page))
+        .layer(axum::middleware::from_fn_with_state(
+            studio.clone(),
+            http::require_token,
+        ))
+        .layer(axum::middleware::from_fn(http::json_errors))
+        .layer(axum::extract::DefaultBodyLimit::max(http::MAX_BODY))
+        .with_state(studio)
+}
+
+/// Whether `host` is a loopback address (no token needed).
+pub fn is_loopback(host: &str) -> bool {
+    host == "localhost"
+        || host
+            .trim_matches(['[', ']'])
+            .parse::<std::net::IpAddr>()
+            .is_ok_and(|ip| ip.is_loopback())
+}
+
+/// A fresh access token: 32 hex digits from the system's randomness.
+fn new_token() -> String {
+    let mut rng = rand::rng();
+    (0..16)
+        .map(|_| format!("{:02x}", rng.random::<u8>()))
+        .collect()
+}
+
+/// Opens the archive, resumes the runs that were running, binds, prints the address and
+/// serves until Ctrl+C.
+pub fn serve(options: Options) -> Result<(), StartError> {
+    if !options.three.join("build/three.module.js").is_file() {
+        return Err(StartError::NoThree(options.three));
+    }
+    let archive = Archive::open(&options.db).map_err(|source| StartError::Archive {
+        path: options.db.clone(),
+        source,
+    })?;
+    let token = (!is_loopback(&options.host)).then(new_token);
+    let studio = Studio::new(archive, token.clone(), options.three.clone());
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .map_err(StartError::Runtime)?;
+    runtime.block_on(async move {
+        let address = format!("{}:{}", options.host, options.port);
+        let listener = tokio::net::TcpListener::bind(&address)
+            .await
+            .map_err(|source| StartError::Bind {
+                address: address.clone(),
+                source,
+            })?;
+        let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
+        design::resume_all(&studio);
+        let shown = match bound {
+            SocketAddr::V6(a) => format!("[{}]:{}", a.ip(), a.port()),
+            SocketAddr::V4(a) => a.to_string(),
+        };
+        // Written, not printed: a closed stdout must not stop the server.
+        use std::io::Write;
+        let mut out = std::io::stdout();
+        let _ = match &token {
+            Some(t) => writeln!(out, "Sylva studio: http://{shown}/?token={t}"),
+            None => writeln!(out, "Sylva studio: http://{shown}/"),
+        };
+        let _ = writeln!(out, "archive: {}", options.db.display());
+        let _ = out.flush();
+        axum::serve(listener, router(studio.clone()))
+            .with_graceful_shutdown(async {
+                let _ = tokio::signal::ctrl_c().await;
+            })
+            .await
+            .map_err(StartError::Runtime)?;
+        studio.runs.stop_all();
+        Ok(())
+    })
+}

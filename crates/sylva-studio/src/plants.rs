@@ -1,0 +1,502 @@
+//! Plants: listed, shown with their genome, grown into GLB, OBJ and PNG, traced back
+//! through their lineage, and branched from.
+//!
+//! A plant's GLB is the source of its other forms: grown again from its genome and seed
+//! (growth is deterministic), or, for a garden specimen (whose shape depends on its
+//! neighbours), read from the mesh stored when the garden grew. Recent GLBs stay in memory.
+
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::sync::{Arc, Mutex};
+
+use axum::Json;
+use axum::extract::{Path, Query, State};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sylva::assets::Origin;
+use sylva::{Genome, Grown, Registry};
+use sylva_mesh::SceneNode;
+use sylva_mesh::render::View;
+
+use crate::Studio;
+use crate::archive::{self, ParentRow, PlantRow};
+use crate::error::ApiError;
+use crate::http::Body;
+use crate::sessions::SessionView;
+
+/// Recently served GLBs, by plant and whether roots are shown; the oldest go first.
+#[derive(Default)]
+pub struct MeshCache {
+    inner: Mutex<CachedMeshes>,
+}
+
+/// A plant and whether its roots are shown.
+type MeshKey = (i64, bool);
+
+/// The GLBs and the order they came in.
+type CachedMeshes = (HashMap<MeshKey, Arc<Vec<u8>>>, VecDeque<MeshKey>);
+
+/// GLBs kept in memory.
+const CACHED_MESHES: usize = 256;
+
+impl MeshCache {
+    /// A cached GLB.
+    pub fn get(&self, key: MeshKey) -> Option<Arc<Vec<u8>>> {
+        let inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+        inner.0.get(&key).cloned()
+    }
+
+    /// Keeps a GLB.
+    pub fn put(&self, key: MeshKey, glb: Arc<Vec<u8>>) {
+        let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+        let (map, order) = &mut *inner;
+        if map.insert(key, glb).is_none() {
+            order.push_back(key);
+        }
+        while order.len() > CACHED_MESHES {
+            if let Some(old) = order.pop_front() {
+                map.remove(&old);
+            }
+        }
+    }
+}
+
+/// A stored genome, read back.
+pub fn genome_of(row: &PlantRow) -> Result<Genome, ApiError> {
+    Registry::standard()
+        .parse_genome(&row.genome)
+        .map_err(|e| ApiError::internal(format!("plant {}'s stored genome: {}", row.id, e.message)))
+}
+
+/// A plant by id, or 404.
+pub fn plant_row(studio: &Studio, id: i64) -> Result<PlantRow, ApiError> {
+    studio
+        .archive
+        .read(|c| archive::plant(c, id))?
+        .ok_or_else(|| ApiError::not_found(format!("plant {id}")))
+}
+
+/// Grows a genome into a GLB whose node's extras carry its origin: genome, seed, parents
+/// (archive ids) and operator.
+pub fn grow_glb(
+    genome: &Genome,
+    seed: u64,
+    roots: bool,
+    parents: &[ParentRow],
+    operator: &str,
+) -> Result<Vec<u8>, ApiError> {
+    let grown =
+        Grown::new(genome.clone(), seed, roots).map_err(|e| ApiError::library("genome", e))?;
+    let mut node = SceneNode::new(genome.model(), &grown.mesh);
+    node.extras = Some(extras(genome, seed, parents, operator));
+    let scene = sylva_mesh::Scene::single(node);
+    sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
+}
+
+/// What an exported node's extras hold in the studio.
+pub fn extras(
+    genome: &Genome,
+    seed: u64,
+    parents: &[ParentRow],
+    operator: &str,
+) -> serde_json::Value {
+    let mut extras = Origin::of(genome, seed).extras();
+    extras["parents"] = json!(parents.iter().map(|p| p.plant).collect::<Vec<_>>());
+    extras["operator"] = json!(operator);
+    extras
+}
+
+/// A plant's GLB: from memory, the stored mesh, or grown again.
+pub fn plant_glb(studio: &Studio, id: i64, roots: bool) -> Result<Arc<Vec<u8>>, ApiError> {
+    if let Some(glb) = studio.meshes.get((id, roots)) {
+        return Ok(glb);
+    }
+    let (row, parents, stored) = studio.archive.read(|c| {
+        Ok((
+            archive::plant(c, id)?,
+            archive::parents(c, id)?,
+            archive::mesh(c, id)?,
+        ))
+    })?;
+    let row = row.ok_or_else(|| ApiError::not_found(format!("plant {id}")))?;
+    let glb = match stored {
+        Some(glb) => glb,
+        None => grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?,
+    };
+    let glb = Arc::new(glb);
+    studio.meshes.put((id, roots), glb.clone());
+    Ok(glb)
+}
+
+fn glb_response(glb: &[u8]) -> Response {
+    ([(header::CONTENT_TYPE, "model/gltf-binary")], glb.to_vec()).into_response()
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct GlbQuery {
+    #[serde(default)]
+    roots: bool,
+}
+
+/// `GET /api/plants/{id}/plant.glb`.
+pub(crate) async fn glb(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<GlbQuery>,
+) -> Result<Response, ApiError> {
+    let glb = tokio::task::spawn_blocking(move || plant_glb(&studio, id, q.roots)).await??;
+    Ok(glb_response(&glb))
+}
+
+fn imported(glb: &[u8]) -> Result<sylva_mesh::import::ImportedScene, ApiError> {
+    sylva_mesh::import::read_glb(glb)
+        .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))
+}
+
+/// `GET /api/plants/{id}/plant.obj`.
+pub(crate) async fn obj(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let (obj, _) = tokio::task::spawn_blocking(move || obj_files(&studio, id)).await??;
+    Ok(([(header::CONTENT_TYPE, "text/plain; charset=utf-8")], obj).into_response())
+}
+
+/// `GET /api/plants/{id}/plant.mtl`.
+pub(crate) async fn mtl(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let (_, mtl) = tokio::task::spawn_blocking(move || obj_files(&studio, id)).await??;
+    Ok(([(header::CONTENT_TYPE, "text/plain; charset=utf-8")], mtl).into_response())
+}
+
+fn obj_files(studio: &Studio, id: i64) -> Result<(String, String), ApiError> {
+    let glb = plant_glb(studio, id, false)?;
+    let scene = imported(&glb)?;
+    Ok(sylva_mesh::export::to_obj(&scene.scene(), "plant.mtl"))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PngQuery {
+    view: Option<String>,
+    size: Option<String>,
+}
+
+/// The largest picture edge.
+const MAX_PICTURE: u32 = 2048;
+
+/// `GET /api/plants/{id}/plant.png`.
+pub(crate) async fn png(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<PngQuery>,
+) -> Result<Response, ApiError> {
+    let view: View = match q.view.as_deref() {
+        None => View::Iso,
+        Some(v) => v.parse().map_err(|_| {
+            ApiError::bad(
+                "view",
+                format!("expected iso, front, side or top; got {v:?}"),
+            )
+        })?,
+    };
+    let size = match q.size.as_deref() {
+        None => (512, 512),
+        Some(s) => parse_size(s)?,
+    };
+    let png = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
+        let glb = plant_glb(&studio, id, false)?;
+        let scene = imported(&glb)?;
+        sylva::assets::picture(&scene.scene(), view, size).map_err(ApiError::internal)
+    })
+    .await??;
+    Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
+}
+
+/// `WxH`, each 16 to [`MAX_PICTURE`].
+fn parse_size(s: &str) -> Result<(u32, u32), ApiError> {
+    let bad = || {
+        ApiError::bad(
+            "size",
+            format!("expected WIDTHxHEIGHT, each from 16 to {MAX_PICTURE}; got {s:?}"),
+        )
+    };
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if (16..=MAX_PICTURE).contains(&w) && (16..=MAX_PICTURE).contains(&h) {
+        Ok((w, h))
+    } else {
+        Err(bad())
+    }
+}
+
+/// `GET /api/plants/{id}/genome.json`.
+pub(crate) async fn genome(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let row = plant_row(&studio, id)?;
+    Ok(([(header::CONTENT_TYPE, "application/json")], row.genome).into_response())
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ListQuery {
+    session: Option<i64>,
+    #[serde(default)]
+    offset: u32,
+    limit: Option<u32>,
+}
+
+#[derive(Serialize)]
+pub(crate) struct PlantSummary {
+    id: i64,
+    model: String,
+    operator: String,
+    seed: u64,
+    session: Option<i64>,
+    parents: Vec<i64>,
+}
+
+#[derive(Serialize)]
+pub(crate) struct PlantList {
+    total: u64,
+    plants: Vec<PlantSummary>,
+}
+
+/// `GET /api/plants`.
+pub(crate) async fn list(
+    State(studio): State<Studio>,
+    Query(q): Query<ListQuery>,
+) -> Result<Json<PlantList>, ApiError> {
+    let limit = q.limit.unwrap_or(100);
+    if !(1..=1000).contains(&limit) {
+        return Err(ApiError::bad(
+            "limit",
+            format!("expected 1 to 1000, got {limit}"),
+        ));
+    }
+    let (total, plants) = studio.archive.read(|c| {
+        let (total, rows) = archive::plants(c, q.session, q.offset, limit)?;
+        let mut plants = Vec::with_capacity(rows.len());
+        for r in rows {
+            let parents = archive::parents(c, r.id)?.iter().map(|p| p.plant).collect();
+            plants.push(PlantSummary {
+                id: r.id,
+                model: r.model,
+                operator: r.operator,
+                seed: r.seed,
+                session: r.session,
+                parents,
+            });
+        }
+        Ok((total, plants))
+    })?;
+    Ok(Json(PlantList { total, plants }))
+}
+
+#[derive(Serialize)]
+pub(crate) struct Field {
+    path: String,
+    value: serde_json::Value,
+}
+
+#[derive(Serialize)]
+pub(crate) struct PlantView {
+    id: i64,
+    model: String,
+    title: &'static str,
+    genome: serde_json::Value,
+    genome_text: String,
+    packed: Option<String>,
+    fields: Vec<Field>,
+    seed: u64,
+    operator: String,
+    settings: serde_json::Value,
+    parents: Vec<ParentRow>,
+    session: Option<i64>,
+    created: String,
+}
+
+/// The leaves of a JSON value with their paths (`branches[0].length`).
+fn fields(value: &serde_json::Value, path: &str, out: &mut Vec<Field>) {
+    match value {
+        serde_json::Value::Object(map) => {
+            for (k, v) in map {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                fields(v, &p, out);
+            }
+        }
+        serde_json::Value::Array(items) if items.iter().any(|v| v.is_object() || v.is_array()) => {
+            for (i, v) in items.iter().enumerate() {
+                fields(v, &format!("{path}[{i}]"), out);
+            }
+        }
+        leaf => out.push(Field {
+            path: path.to_owned(),
+            value: leaf.clone(),
+        }),
+    }
+}
+
+/// `GET /api/plants/{id}`.
+pub(crate) async fn get(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<PlantView>, ApiError> {
+    let (row, parents) = studio
+        .archive
+        .read(|c| Ok((archive::plant(c, id)?, archive::parents(c, id)?)))?;
+    let row = row.ok_or_else(|| ApiError::not_found(format!("plant {id}")))?;
+    let genome = genome_of(&row)?;
+    let value = genome.to_value();
+    let mut list = Vec::new();
+    fields(&value, "", &mut list);
+    let packed = genome
+        .get::<sylva_plantmaker::PlantMakerModel>()
+        .map(|g| g.to_packed());
+    Ok(Json(PlantView {
+        id: row.id,
+        title: genome.title(),
+        model: row.model,
+        genome: value,
+        genome_text: row.genome,
+        packed,
+        fields: list,
+        seed: row.seed,
+        operator: row.operator,
+        settings: row.settings,
+        parents,
+        session: row.session,
+        created: row.created,
+    }))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LineageQuery {
+    depth: Option<u32>,
+}
+
+#[derive(Serialize)]
+pub(crate) struct LineageNode {
+    id: i64,
+    model: String,
+    operator: String,
+    settings: serde_json::Value,
+    seed: u64,
+    depth: u32,
+}
+
+#[derive(Serialize)]
+pub(crate) struct LineageEdge {
+    child: i64,
+    parent: i64,
+    dominance: f64,
+}
+
+#[derive(Serialize)]
+pub(crate) struct Lineage {
+    nodes: Vec<LineageNode>,
+    edges: Vec<LineageEdge>,
+    /// True when the walk stopped at the node limit before reaching `depth`.
+    truncated: bool,
+}
+
+/// The most nodes a lineage answer holds.
+const MAX_LINEAGE: usize = 500;
+
+/// `GET /api/plants/{id}/lineage`.
+pub(crate) async fn lineage(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<LineageQuery>,
+) -> Result<Json<Lineage>, ApiError> {
+    let depth = q.depth.unwrap_or(8);
+    if !(1..=64).contains(&depth) {
+        return Err(ApiError::bad(
+            "depth",
+            format!("expected 1 to 64, got {depth}"),
+        ));
+    }
+    plant_row(&studio, id)?;
+    let lineage = studio.archive.read(|c| {
+        let mut nodes = Vec::new();
+        let mut edges = Vec::new();
+        let mut seen = HashSet::from([id]);
+        let mut queue = VecDeque::from([(id, 0u32)]);
+        let mut truncated = false;
+        while let Some((plant, d)) = queue.pop_front() {
+            let Some(row) = archive::plant(c, plant)? else {
+                continue;
+            };
+            nodes.push(LineageNode {
+                id: row.id,
+                model: row.model,
+                operator: row.operator,
+                settings: row.settings,
+                seed: row.seed,
+                depth: d,
+            });
+            if d == depth {
+                continue;
+            }
+            for p in archive::parents(c, plant)? {
+                edges.push(LineageEdge {
+                    child: plant,
+                    parent: p.plant,
+                    dominance: p.dominance,
+                });
+                if seen.insert(p.plant) {
+                    if seen.len() > MAX_LINEAGE {
+                        truncated = true;
+                        continue;
+                    }
+                    queue.push_back((p.plant, d + 1));
+                }
+            }
+        }
+        let kept: HashSet<i64> = nodes.iter().map(|n| n.id).collect();
+        edges.retain(|e| kept.contains(&e.parent));
+        Ok(Lineage {
+            nodes,
+            edges,
+            truncated,
+        })
+    })?;
+    Ok(Json(lineage))
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct BranchRequest {
+    mode: Option<String>,
+}
+
+/// `POST /api/plants/{id}/branch`: a new session that starts from this plant.
+pub(crate) async fn branch(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<BranchRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let row = plant_row(&studio, id)?;
+    let session = match request.mode.as_deref().unwrap_or("breed") {
+        "breed" => crate::breed::branch(&studio, &row).await?,
+        "garden" => crate::garden::branch(&studio, &row).await?,
+        other => {
+            return Err(ApiError::bad(
+                "mode",
+                format!("expected breed or garden, got {other:?}"),
+            ));
+        }
+    };
+    Ok(Json(crate::sessions::view(&studio, session)?))
+}

@@ -1,0 +1,258 @@
+//! Sessions: one line of breeding in one mode. A session's `state` is its view (the grid,
+//! the garden, the family's generation, the design's run); every step a person takes is
+//! recorded with the view before and after it, so undo and redo move between views while
+//! every plant made stays in the archive.
+
+use axum::Json;
+use axum::extract::{Path, State};
+use rust_embed::RustEmbed;
+use serde::{Deserialize, Serialize};
+use sylva::{Genome, Registry};
+
+use crate::Studio;
+use crate::archive::{self, StepRow};
+use crate::error::ApiError;
+use crate::http::Body;
+use crate::{breed, design, family, garden};
+
+/// A session as the page sees it.
+#[derive(Serialize)]
+pub struct SessionView {
+    /// Its id.
+    pub id: i64,
+    /// breed, garden, family or design.
+    pub mode: String,
+    /// The model of its plants.
+    pub model: String,
+    /// Its title.
+    pub title: String,
+    /// The mode's view.
+    pub state: serde_json::Value,
+    /// Whether there is a step to undo.
+    pub can_undo: bool,
+    /// Whether there is a step to redo.
+    pub can_redo: bool,
+    /// Every step, in order.
+    pub history: Vec<StepRow>,
+}
+
+/// A session's view, read from the archive.
+pub fn view(studio: &Studio, id: i64) -> Result<SessionView, ApiError> {
+    let (row, history) = studio
+        .archive
+        .read(|c| Ok((archive::session(c, id)?, archive::steps(c, id)?)))?;
+    let row = row.ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
+    Ok(SessionView {
+        id: row.id,
+        mode: row.mode,
+        model: row.model,
+        title: row.title,
+        state: row.state,
+        can_undo: history.iter().any(|s| !s.undone),
+        can_redo: history.iter().any(|s| s.undone),
+        history,
+    })
+}
+
+/// A session that must be of `mode`.
+pub fn session_of(studio: &Studio, id: i64, mode: &str) -> Result<archive::SessionRow, ApiError> {
+    let row = studio
+        .archive
+        .read(|c| archive::session(c, id))?
+        .ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
+    if row.mode != mode {
+        return Err(ApiError::conflict(format!(
+            "session {id} is a {} session, not {mode}",
+            row.mode
+        )));
+    }
+    Ok(row)
+}
+
+#[derive(Serialize)]
+pub(crate) struct ModelInfo {
+    name: &'static str,
+    title: &'static str,
+    evolves: bool,
+}
+
+/// `GET /api/models`.
+pub(crate) async fn models() -> Json<Vec<ModelInfo>> {
+    Json(
+        Registry::standard()
+            .models()
+            .iter()
+            .map(|m| ModelInfo {
+                name: m.name(),
+                title: m.title(),
+                evolves: m.evolves(),
+            })
+            .collect(),
+    )
+}
+
+/// The example genomes shipped with Sylva, built into the binary.
+#[derive(RustEmbed)]
+#[folder = "../../examples/"]
+#[include = "*/*.json"]
+struct ExampleFiles;
+
+/// An example genome by name (`plantmaker/fern`).
+pub fn example(name: &str) -> Option<Genome> {
+    let file = ExampleFiles::get(&format!("{name}.json"))?;
+    let text = std::str::from_utf8(&file.data).ok()?;
+    Registry::standard().parse_genome(text).ok()
+}
+
+/// Every example's name and model, sorted by name.
+pub fn example_list() -> Vec<(String, &'static str)> {
+    let mut list: Vec<(String, &'static str)> = ExampleFiles::iter()
+        .filter_map(|path| {
+            let name = path.strip_suffix(".json")?.to_owned();
+            let genome = example(&name)?;
+            Some((name, genome.model()))
+        })
+        .collect();
+    list.sort();
+    list
+}
+
+#[derive(Serialize)]
+pub(crate) struct ExampleInfo {
+    name: String,
+    model: &'static str,
+}
+
+/// `GET /api/examples`.
+pub(crate) async fn examples() -> Json<Vec<ExampleInfo>> {
+    Json(
+        example_list()
+            .into_iter()
+            .map(|(name, model)| ExampleInfo { name, model })
+            .collect(),
+    )
+}
+
+#[derive(Serialize)]
+pub(crate) struct SessionSummary {
+    id: i64,
+    mode: String,
+    model: String,
+    title: String,
+    created: String,
+    steps: i64,
+}
+
+/// `GET /api/sessions`.
+pub(crate) async fn list(
+    State(studio): State<Studio>,
+) -> Result<Json<Vec<SessionSummary>>, ApiError> {
+    let rows = studio.archive.read(archive::sessions)?;
+    Ok(Json(
+        rows.into_iter()
+            .map(|(s, steps)| SessionSummary {
+                id: s.id,
+                mode: s.mode,
+                model: s.model,
+                title: s.title,
+                created: s.created,
+                steps,
+            })
+            .collect(),
+    ))
+}
+
+/// What `POST /api/sessions` takes: the mode and how it starts.
+#[derive(Deserialize)]
+#[serde(tag = "mode", rename_all = "lowercase")]
+pub enum NewSession {
+    /// PlantMaker's main window.
+    Breed(breed::Start),
+    /// The biomorph garden.
+    Garden(garden::Start),
+    /// The binary-tree family.
+    Family(family::Start),
+    /// The GP designer.
+    Design(design::Start),
+}
+
+/// `POST /api/sessions`.
+pub(crate) async fn create(
+    State(studio): State<Studio>,
+    Body(request): Body<NewSession>,
+) -> Result<Json<SessionView>, ApiError> {
+    let id = match request {
+        NewSession::Breed(start) => breed::create(&studio, start).await?,
+        NewSession::Garden(start) => garden::create(&studio, start).await?,
+        NewSession::Family(start) => family::create(&studio, start).await?,
+        NewSession::Design(start) => design::create(&studio, start).await?,
+    };
+    Ok(Json(view(&studio, id)?))
+}
+
+/// `GET /api/sessions/{id}`.
+pub(crate) async fn get(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<SessionView>, ApiError> {
+    Ok(Json(view(&studio, id)?))
+}
+
+/// `POST /api/sessions/{id}/undo`.
+pub(crate) async fn undo(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<SessionView>, ApiError> {
+    move_in_history(&studio, id, true).await
+}
+
+/// `POST /api/sessions/{id}/redo`.
+pub(crate) async fn redo(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<SessionView>, ApiError> {
+    move_in_history(&studio, id, false).await
+}
+
+async fn move_in_history(
+    studio: &Studio,
+    id: i64,
+    back: bool,
+) -> Result<Json<SessionView>, ApiError> {
+    let lock = studio.session_lock(id);
+    let _guard = lock.lock().await;
+    studio.archive.transaction(|c| -> Result<(), ApiError> {
+        archive::session(c, id)?.ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
+        let steps = archive::steps(c, id)?;
+        let step = if back {
+            steps.iter().rev().find(|s| !s.undone)
+        } else {
+            steps.iter().find(|s| s.undone)
+        };
+        let step = step.ok_or_else(|| {
+            ApiError::conflict(if back {
+                "nothing to undo"
+            } else {
+                "nothing to redo"
+            })
+        })?;
+        archive::set_undone(c, id, step.seq, back)?;
+        let state = if back { &step.before } else { &step.after };
+        archive::set_state(c, id, state)?;
+        Ok(())
+    })?;
+    // A family's run in memory may be at another generation now; it reloads when needed.
+    studio.families.forget(id);
+    Ok(Json(view(studio, id)?))
+}
+
+/// Seeds a step's random choices: the session's seed, the step's number and a stream, mixed
+/// (SplitMix64), so that a session replays to the same plants.
+pub fn step_seed(session_seed: u64, seq: i64, stream: u64) -> u64 {
+    let mut z = session_seed
+        ^ (seq as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ stream.wrapping_mul(0xD1B5_4A32_D192_ED03);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
