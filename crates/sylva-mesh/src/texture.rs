@@ -46,6 +46,9 @@
 //! # Ok::<(), image::ImageError>(())
 //! ```
 
+use std::collections::HashMap;
+use std::sync::{Arc, LazyLock, Mutex};
+
 use image::GrayImage;
 
 /// Side of every texture, pixels (a power of two, so viewers can build mipmaps).
@@ -179,8 +182,53 @@ impl Texture {
     }
 }
 
-/// Generates texture `id` (see the module docs for the designs).
+/// Textures and PNGs made so far, by id: a texture is a pure function of its id, and making
+/// one (noise, then the best PNG compression) costs far more than meshing a small plant.
+/// At most [`KEPT_TEXTURES`] of each are kept; ids beyond are made again when asked.
+static MADE: LazyLock<Mutex<HashMap<u16, Arc<Texture>>>> = LazyLock::new(Mutex::default);
+static PNGS: LazyLock<Mutex<HashMap<u16, Arc<Vec<u8>>>>> = LazyLock::new(Mutex::default);
+
+/// Textures (and PNGs) kept in memory: the nine designs several times over (about 64 KiB
+/// each).
+const KEPT_TEXTURES: usize = 64;
+
+fn remember<T>(cache: &Mutex<HashMap<u16, Arc<T>>>, id: u16, value: Arc<T>) {
+    let mut cache = cache.lock().unwrap_or_else(|p| p.into_inner());
+    if cache.len() < KEPT_TEXTURES {
+        cache.insert(id, value);
+    }
+}
+
+fn recall<T>(cache: &Mutex<HashMap<u16, Arc<T>>>, id: u16) -> Option<Arc<T>> {
+    cache
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get(&id)
+        .cloned()
+}
+
+/// Texture `id` (see the module docs for the designs), made once per process.
 pub fn texture(id: u16) -> Texture {
+    if let Some(t) = recall(&MADE, id) {
+        return Texture::clone(&t);
+    }
+    let t = generate(id);
+    remember(&MADE, id, Arc::new(t.clone()));
+    t
+}
+
+/// Texture `id`'s PNG ([`Texture::png`]), encoded once per process.
+pub fn texture_png(id: u16) -> Result<Arc<Vec<u8>>, image::ImageError> {
+    if let Some(png) = recall(&PNGS, id) {
+        return Ok(png);
+    }
+    let png = Arc::new(texture(id).png()?);
+    remember(&PNGS, id, png.clone());
+    Ok(png)
+}
+
+/// Generates texture `id`.
+fn generate(id: u16) -> Texture {
     let seed = u32::from(id);
     let design: fn(f32, f32, u32) -> f32 = match id % TEXTURE_COUNT {
         0 => furrowed_bark,
@@ -509,6 +557,15 @@ fn spotted_petal(u: f32, v: f32, s: u32) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn textures_and_pngs_are_made_once_and_the_same() {
+        let first = super::texture_png(4).unwrap();
+        let again = super::texture_png(4).unwrap();
+        assert!(std::sync::Arc::ptr_eq(&first, &again));
+        assert_eq!(*first, super::generate(4).png().unwrap());
+        assert_eq!(super::texture(4), super::generate(4));
+    }
+
     use super::*;
 
     fn mean_abs_diff(a: &GrayImage, b: &GrayImage) -> f32 {

@@ -528,6 +528,38 @@ pub fn steps(c: &Connection, session: i64) -> rusqlite::Result<Vec<StepRow>> {
     .collect()
 }
 
+/// The last `count` steps of a session's history, in order, and whether any step is live
+/// (can be undone) or undone (can be redone).
+pub fn recent_steps(
+    c: &Connection,
+    session: i64,
+    count: u32,
+) -> rusqlite::Result<(Vec<StepRow>, bool, bool)> {
+    let mut stmt = c.prepare_cached(
+        "SELECT seq, action, undone FROM steps WHERE session = ?1 ORDER BY seq DESC LIMIT ?2",
+    )?;
+    let mut rows = stmt
+        .query_map(params![session, count], |r| {
+            Ok(StepRow {
+                seq: r.get(0)?,
+                action: json(r.get(1)?),
+                undone: r.get(2)?,
+                before: serde_json::Value::Null,
+                after: serde_json::Value::Null,
+            })
+        })?
+        .collect::<rusqlite::Result<Vec<_>>>()?;
+    rows.reverse();
+    let any = |undone: bool| -> rusqlite::Result<bool> {
+        c.query_row(
+            "SELECT EXISTS (SELECT 1 FROM steps WHERE session = ?1 AND undone = ?2)",
+            params![session, undone],
+            |r| r.get(0),
+        )
+    };
+    Ok((rows, any(false)?, any(true)?))
+}
+
 /// Records a step (dropping the undone steps it replaces) and sets the session's view to
 /// `after`. Returns the step's number.
 pub fn record_step(

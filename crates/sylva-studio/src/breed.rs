@@ -188,7 +188,7 @@ async fn make_plants(
         Plants::Random(n) => {
             if !(1..=GRID as u32).contains(&n) {
                 return Err(ApiError::bad(
-                    format!("{field}.random"),
+                    sub(field, "random"),
                     format!("expected 1 to 9, got {n}"),
                 ));
             }
@@ -204,17 +204,17 @@ async fn make_plants(
             }
         }
         Plants::Examples(names) => {
-            check_count(names.len(), &format!("{field}.examples"))?;
+            check_count(names.len(), &sub(field, "examples"))?;
             for (i, name) in names.into_iter().enumerate() {
                 let genome = example(&name).ok_or_else(|| {
                     ApiError::bad(
-                        format!("{field}.examples[{i}]"),
+                        sub(field, &format!("examples[{i}]")),
                         format!("no example {name:?}"),
                     )
                 })?;
                 if genome.model() != model {
                     return Err(ApiError::bad(
-                        format!("{field}.examples[{i}]"),
+                        sub(field, &format!("examples[{i}]")),
                         format!(
                             "{name} is a {} genome; this session breeds {model}",
                             genome.model()
@@ -225,9 +225,9 @@ async fn make_plants(
             }
         }
         Plants::Genomes(texts) => {
-            check_count(texts.len(), &format!("{field}.genomes"))?;
+            check_count(texts.len(), &sub(field, "genomes"))?;
             for (i, text) in texts.iter().enumerate() {
-                let f = format!("{field}.genomes[{i}]");
+                let f = sub(field, &format!("genomes[{i}]"));
                 let genome = parse_genome(text, &f)?;
                 if genome.model() != model {
                     return Err(ApiError::unprocessable(
@@ -239,13 +239,22 @@ async fn make_plants(
             }
         }
         Plants::Plants(ids) => {
-            check_count(ids.len(), &format!("{field}.plants"))?;
-            archived(studio, &ids, model, &format!("{field}.plants"))?;
+            check_count(ids.len(), &sub(field, "plants"))?;
+            archived(studio, &ids, model, &sub(field, "plants"))?;
             reused = ids;
         }
     }
     let made = blocking_grow(studio, genomes, field).await?;
     Ok((made, reused))
+}
+
+/// `name` under `field` (`start.random`), or `name` alone at the top of a request.
+fn sub(field: &str, name: &str) -> String {
+    if field.is_empty() {
+        name.to_owned()
+    } else {
+        format!("{field}.{name}")
+    }
 }
 
 fn check_count(n: usize, field: &str) -> Result<(), ApiError> {
@@ -691,7 +700,40 @@ pub(crate) async fn add(
 pub struct EditRequest {
     plant: i64,
     genome: Option<serde_json::Value>,
+    /// Field edits on the stored genome (exact: a page's JSON numbers lose digits past 2^53).
+    #[serde(default)]
+    fields: Vec<FieldEdit>,
     seed: Option<u64>,
+}
+
+/// One field's new value, by its path (`branches[0].waves`, as `GET /api/plants/{id}` lists).
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct FieldEdit {
+    path: String,
+    value: serde_json::Value,
+}
+
+/// Sets the value at `path` (`a.b[2].c`) in a genome's JSON; the path must exist.
+fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Option<()> {
+    let mut at = genome;
+    for part in path.split('.') {
+        let (name, indices) = match part.find('[') {
+            Some(i) => (&part[..i], &part[i..]),
+            None => (part, ""),
+        };
+        if !name.is_empty() {
+            at = at.get_mut(name)?;
+        }
+        for index in indices.split(['[', ']']).filter(|s| !s.is_empty()) {
+            at = at.get_mut(index.parse::<usize>().ok()?)?;
+        }
+    }
+    if at.is_object() || at.is_array() {
+        return None;
+    }
+    *at = value;
+    Some(())
 }
 
 /// `POST /api/sessions/{id}/edit`: an edited genome or another seed.
@@ -705,10 +747,30 @@ pub(crate) async fn edit(
     let (row, state) = breed_state(&studio, id)?;
     let old = archived(&studio, &[request.plant], &row.model, "plant")?.remove(0);
     let original = genome_of(&old)?;
-    let genome = match &request.genome {
-        None => original.clone(),
-        Some(serde_json::Value::String(text)) => parse_genome(text, "genome")?,
-        Some(value) => parse_genome(&value.to_string(), "genome")?,
+    let genome = match (&request.genome, request.fields.is_empty()) {
+        (None, true) => original.clone(),
+        (None, false) => {
+            let mut value: serde_json::Value = serde_json::from_str(&old.genome).map_err(|e| {
+                ApiError::internal(format!("plant {}'s stored genome: {e}", old.id))
+            })?;
+            for (i, edit) in request.fields.iter().enumerate() {
+                set_field(&mut value, &edit.path, edit.value.clone()).ok_or_else(|| {
+                    ApiError::bad(
+                        format!("fields[{i}].path"),
+                        format!("the genome has no field {:?}", edit.path),
+                    )
+                })?;
+            }
+            parse_genome(&value.to_string(), "fields")?
+        }
+        (Some(serde_json::Value::String(text)), true) => parse_genome(text, "genome")?,
+        (Some(value), true) => parse_genome(&value.to_string(), "genome")?,
+        (Some(_), false) => {
+            return Err(ApiError::bad(
+                "fields",
+                "give either a genome or field edits, not both",
+            ));
+        }
     };
     if genome.model() != row.model {
         return Err(ApiError::unprocessable(
@@ -760,6 +822,18 @@ pub(crate) async fn edit(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fields_are_set_by_path_and_only_leaves() {
+        let mut g = serde_json::json!({"a": {"b": [1, {"c": 2}]}, "seed": 18446744073709551615u64});
+        assert!(set_field(&mut g, "a.b[1].c", json!(5)).is_some());
+        assert!(set_field(&mut g, "a.b[0]", json!(7)).is_some());
+        assert_eq!(g["a"]["b"], json!([7, {"c": 5}]));
+        assert!(set_field(&mut g, "a.b", json!(0)).is_none());
+        assert!(set_field(&mut g, "a.x", json!(0)).is_none());
+        assert!(set_field(&mut g, "a.b[9]", json!(0)).is_none());
+        assert_eq!(g["seed"].as_u64(), Some(u64::MAX));
+    }
 
     #[test]
     fn the_least_dominant_fall_off() {

@@ -32,9 +32,12 @@ pub struct SessionView {
     pub can_undo: bool,
     /// Whether there is a step to redo.
     pub can_redo: bool,
-    /// Every step, in order.
+    /// The last [`HISTORY_SHOWN`] steps, in order.
     pub history: Vec<StepRow>,
 }
+
+/// Steps a session's view lists: the most recent (the archive keeps them all).
+pub const HISTORY_SHOWN: u32 = 100;
 
 /// A session's view, read from the archive.
 pub fn view(studio: &Studio, id: i64) -> Result<SessionView, ApiError> {

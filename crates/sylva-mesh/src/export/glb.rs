@@ -315,10 +315,8 @@ impl Writer {
         if let Some(&t) = self.texture_of.get(&id) {
             return Ok(t);
         }
-        let texture = crate::texture::texture(id);
-        let png = texture
-            .png()
-            .map_err(|source| ExportError::Png { id, source })?;
+        let png =
+            crate::texture::texture_png(id).map_err(|source| ExportError::Png { id, source })?;
         let start = self.bin.len();
         self.bin.extend_from_slice(&png);
         let view = self.untargeted_view(start);
@@ -328,7 +326,7 @@ impl Writer {
             "mimeType": "image/png",
             "name": format!("{IMAGE_NAME_PREFIX}{id}"),
         }));
-        let repeats = texture.info().family.repeats_v();
+        let repeats = crate::texture::texture_info(id).family.repeats_v();
         let slot = usize::from(!repeats);
         let sampler = match self.sampler_of[slot] {
             Some(s) => s,
@@ -344,7 +342,7 @@ impl Writer {
             }
         };
         self.textures.push(json!({
-            "name": texture.info().name,
+            "name": crate::texture::texture_info(id).name,
             "sampler": sampler,
             "source": self.images.len() - 1,
         }));

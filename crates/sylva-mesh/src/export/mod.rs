@@ -264,10 +264,9 @@ pub fn texture_files(scene: &Scene, stem: &str) -> Result<Vec<(String, Vec<u8>)>
     used_textures(scene)
         .into_iter()
         .map(|id| {
-            let png = crate::texture::texture(id)
-                .png()
+            let png = crate::texture::texture_png(id)
                 .map_err(|source| ExportError::Png { id, source })?;
-            Ok((crate::texture::texture_file_name(&stem, id), png))
+            Ok((crate::texture::texture_file_name(&stem, id), png.to_vec()))
         })
         .collect()
 }
