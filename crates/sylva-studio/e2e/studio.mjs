@@ -1,0 +1,627 @@
+// End-to-end test of the studio, as a person would use it: Debian's chromium driven by
+// playwright-core (software WebGL), against a real `sylva studio` on a fresh database.
+//
+//   npm ci --prefix crates/sylva-studio/web && npm ci --prefix tools/gltf-validator
+//   cargo build && node crates/sylva-studio/e2e/studio.mjs
+//
+// Environment: SYLVA_BIN (default target/debug/sylva), SYLVA_E2E_PORT (default 0: a free port),
+// SYLVA_E2E_OUT (default target/studio-e2e: screenshots and exported files),
+// SYLVA_E2E_HEADED=1 to watch. Exits non-zero, saying what failed, on any failure.
+
+import { spawn, spawnSync } from "node:child_process";
+import { createRequire } from "node:module";
+import { fileURLToPath } from "node:url";
+import fs from "node:fs";
+import os from "node:os";
+import path from "node:path";
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const repo = path.resolve(here, "../../..");
+const web = path.resolve(here, "../web");
+const out = path.resolve(repo, process.env.SYLVA_E2E_OUT || "target/studio-e2e");
+const bin = path.resolve(repo, process.env.SYLVA_BIN || "target/debug/sylva");
+const CHROMIUM = "/usr/bin/chromium";
+const T0 = Date.now();
+
+// ---- helpers --------------------------------------------------------------------------------------
+
+class Failure extends Error {}
+function check(cond, message) {
+  if (!cond) throw new Failure(message);
+}
+function log(...a) {
+  console.log(`[${((Date.now() - T0) / 1000).toFixed(1).padStart(5)}s]`, ...a);
+}
+async function step(name, fn) {
+  const t = Date.now();
+  try {
+    const r = await fn();
+    log(`ok   ${name} (${Date.now() - t} ms)`);
+    return r;
+  } catch (e) {
+    e.step = name;
+    throw e;
+  }
+}
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// ---- the server ---------------------------------------------------------------------------------
+
+let server = null;
+let serverLog = "";
+
+async function startServer(port, db) {
+  check(fs.existsSync(bin), `no studio binary at ${bin}: run \`cargo build\` (or set SYLVA_BIN)`);
+  for (let attempt = 0; attempt < 20; attempt++) {
+    const child = spawn(bin, ["studio", "--port", String(port), "--db", db], {
+      cwd: repo,
+      stdio: ["ignore", "pipe", "pipe"],
+    });
+    serverLog = "";
+    const address = await new Promise((resolve) => {
+      let stdout = "";
+      const timer = setTimeout(() => resolve(null), 90_000);
+      child.stdout.on("data", (d) => {
+        stdout += d;
+        serverLog += d;
+        const m = stdout.match(/https?:\/\/[^\s]+/);
+        if (m) {
+          clearTimeout(timer);
+          resolve(m[0]);
+        }
+      });
+      child.stderr.on("data", (d) => (serverLog += d));
+      child.on("exit", () => {
+        clearTimeout(timer);
+        resolve(null);
+      });
+    });
+    if (address) {
+      server = child;
+      child.on("exit", (code, signal) => {
+        if (server === child) log(`the studio exited (${code ?? signal})`);
+      });
+      return address.replace(/\/$/, "");
+    }
+    child.kill("SIGKILL");
+    // a port still held by the killed server: try again shortly
+    if (/address already in use|AddrInUse|os error 98/i.test(serverLog)) {
+      await sleep(250);
+      continue;
+    }
+    throw new Failure(`the studio did not print its address:\n${serverLog}`);
+  }
+  throw new Failure(`port ${port} stayed in use:\n${serverLog}`);
+}
+
+function killServer() {
+  return new Promise((resolve) => {
+    if (!server || server.exitCode !== null || server.signalCode !== null) return resolve();
+    const s = server;
+    server = null;
+    s.on("exit", () => resolve());
+    s.kill("SIGKILL");
+  });
+}
+
+// ---- the browser ----------------------------------------------------------------------------------
+
+function ensureChromium() {
+  if (fs.existsSync(CHROMIUM)) return;
+  log("chromium is missing: apt-get install -y chromium");
+  let r = spawnSync("apt-get", ["install", "-y", "chromium"], { stdio: "inherit" });
+  if (r.status !== 0) {
+    spawnSync("apt-get", ["update"], { stdio: "inherit" });
+    r = spawnSync("apt-get", ["install", "-y", "chromium"], { stdio: "inherit" });
+  }
+  check(fs.existsSync(CHROMIUM), `no ${CHROMIUM}, and \`apt-get install -y chromium\` failed`);
+}
+
+function loadPlaywright() {
+  const require = createRequire(path.join(web, "package.json"));
+  try {
+    return require("playwright-core");
+  } catch (e) {
+    throw new Failure(`cannot load playwright-core (${e.message}): run \`npm ci --prefix crates/sylva-studio/web\``);
+  }
+}
+
+// ---- the test ---------------------------------------------------------------------------------------
+
+const results = {};
+
+async function main() {
+  fs.mkdirSync(out, { recursive: true });
+  check(fs.existsSync(path.join(web, "node_modules/three/build/three.module.js")),
+    "three.js is not installed: run `npm ci --prefix crates/sylva-studio/web`");
+  ensureChromium();
+  const { chromium } = loadPlaywright();
+
+  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "sylva-studio-e2e-"));
+  const db = path.join(tmp, "studio.db");
+  // port 0: the studio picks a free one and prints it; the restart reuses it
+  const base = await step("start the studio", () => startServer(Number(process.env.SYLVA_E2E_PORT) || 0, db));
+  const port = Number(new URL(base).port);
+  log(`studio at ${base}`);
+
+  const context = await chromium.launchPersistentContext(path.join(tmp, "profile"), {
+    executablePath: CHROMIUM,
+    headless: !process.env.SYLVA_E2E_HEADED,
+    viewport: { width: 1440, height: 900 },
+    args: [
+      "--no-sandbox",
+      "--use-angle=swiftshader",
+      "--enable-unsafe-swiftshader",
+      "--disable-background-networking",
+      "--disable-gpu",
+      "--disable-quic",
+      "--no-first-run",
+      "--disable-component-update",
+      "--disable-sync",
+    ],
+  });
+  const page = context.pages()[0] || (await context.newPage());
+  browser = { context, page };
+  page.setDefaultTimeout(30_000);
+  const pageErrors = [];
+  page.on("pageerror", (e) => pageErrors.push(String(e)));
+  page.on("console", (m) => {
+    if (m.type() === "error") log(`page console: ${m.text()}`);
+  });
+  // no request may leave the machine
+  const offsite = [];
+  page.on("request", (r) => {
+    const u = new URL(r.url());
+    if (!["127.0.0.1", "localhost", "[::1]"].includes(u.hostname) && u.protocol !== "data:" && u.protocol !== "blob:") {
+      offsite.push(r.url());
+    }
+  });
+
+  const api = async (p, init) => {
+    const res = await fetch(base + p, init);
+    const text = await res.text();
+    check(res.ok, `GET ${p}: ${res.status} ${text.slice(0, 300)}`);
+    return JSON.parse(text);
+  };
+  const byTestId = (id) => page.locator(`[data-testid="${id}"]`);
+  // forms of the modes share test ids (new-create...): look inside one mode's view
+  const inMode = (mode, id) => page.locator(`#view-${mode} [data-testid="${id}"]`);
+  const shot = (name) => page.screenshot({ path: path.join(out, `${name}.png`) });
+  const noError = async (where) => {
+    const msg = byTestId("message");
+    if (await msg.isVisible()) {
+      const kind = await msg.getAttribute("data-kind");
+      const text = await msg.innerText();
+      check(kind !== "error", `${where}: the page shows an error: ${text}`);
+    }
+    check(pageErrors.length === 0, `${where}: script errors: ${pageErrors.join("; ")}`);
+  };
+  const probe = (name) => page.evaluate((n) => window.sylvaStudio.probe(n), name);
+  const checkPainted = async (name, minFraction, where) => {
+    const p = await probe(name);
+    check(p, `${where}: no ${name} stage`);
+    check(p.fraction >= minFraction && p.colors >= 8,
+      `${where}: the ${name} canvas looks blank: ${(p.fraction * 100).toFixed(2)}% plant pixels, ${p.colors} colours`);
+    return p;
+  };
+  const gridIds = () =>
+    page.evaluate(() => [...document.querySelectorAll('[data-testid^="grid-cell-"]')].map((c) => c.dataset.plant).filter(Boolean).map(Number));
+  const waitGridLoaded = () =>
+    page.waitForFunction(() => {
+      const cells = [...document.querySelectorAll('[data-testid^="grid-cell-"]')];
+      const filled = cells.filter((c) => c.dataset.plant);
+      return cells.length === 9 && filled.length > 0 && filled.every((c) => !c.classList.contains("loading"));
+    }, null, { timeout: 60_000 });
+
+  await step("open the page", async () => {
+    await page.goto(base + "/");
+    await page.waitForFunction(() => window.sylvaStudio && window.sylvaStudio.ready === true);
+    await noError("page load");
+  });
+
+  await step("open each mode", async () => {
+    for (const mode of ["garden", "family", "design", "breed"]) {
+      await byTestId(`mode-${mode}`).click();
+      await page.locator(`#view-${mode}`).waitFor({ state: "visible" });
+      check(await byTestId(`mode-${mode}`).getAttribute("aria-selected") === "true", `the ${mode} tab is not selected`);
+    }
+    await noError("modes");
+  });
+
+  // ---- Breed ----
+  let breedId = null;
+  let crossParents = [];
+  let crossChildren = [];
+  await step("breed: a session of the PlantMaker examples", async () => {
+    await byTestId("new-session").click();
+    await inMode("breed", "new-session-form").waitFor();
+    const models = await byTestId("new-model").locator("option").allTextContents();
+    check(models.length > 0, "no models in the model select");
+    await byTestId("new-model").selectOption("plantmaker");
+    await byTestId("new-start-examples").check();
+    await inMode("breed", "new-create").click();
+    await waitGridLoaded();
+    breedId = await page.evaluate(() => window.sylvaStudio.session().id);
+    await noError("new breed session");
+    const p = await checkPainted("breed", 0.004, "breed grid");
+    const views = p.views.filter((v) => v.plant);
+    const blank = views.filter((v) => v.fraction < 0.001);
+    check(views.length === 5, `breed grid: ${views.length} plants shown, not the five examples`);
+    check(blank.length === 0, `breed grid: ${blank.length} of the views are blank (${blank.map((v) => "#" + v.plant).join(" ")})`);
+    await shot("breed");
+  });
+
+  await step("breed: pick two and cross", async () => {
+    const before = await gridIds();
+    check(before.length === 5, `the grid holds ${before.length} plants, not the five examples`);
+    const h0 = await byTestId("history-item").count();
+    await byTestId("grid-cell-0").click();
+    const selectMs = await page.evaluate(() => window.sylvaStudio.lastSelectMs);
+    check(await byTestId("grid-cell-0").evaluate((e) => e.classList.contains("selected")), "cell 0 is not highlighted after a click");
+    const outline = await byTestId("grid-cell-0").evaluate((e) => getComputedStyle(e).outlineWidth);
+    check(parseFloat(outline) >= 2, `the selected cell has no visible outline (${outline})`);
+    check(selectMs !== null && selectMs < 100, `the highlight took ${selectMs} ms (over 100 ms)`);
+    results.selectMs = selectMs;
+    await byTestId("grid-cell-1").click();
+    await byTestId("dominance-0").fill("2");
+    crossParents = before.slice(0, 2);
+    await byTestId("level").selectOption("medium");
+    const n0 = await page.evaluate(() => window.sylvaStudio.paintCount);
+    const t = Date.now();
+    await byTestId("cross").click();
+    await page.waitForFunction((n) => window.sylvaStudio.paintCount > n ||
+      document.querySelector('[data-testid="message"]').dataset.kind === "error", n0, { timeout: 60_000 });
+    await noError("cross");
+    results.crossOutsideMs = Date.now() - t;
+    results.crossPaintMs = await page.evaluate(() => window.sylvaStudio.lastPaintMs);
+    results.crossStep = await page.evaluate(() => window.sylvaStudio.lastStep);
+    await waitGridLoaded();
+    await noError("cross");
+    const after = await gridIds();
+    crossChildren = after.filter((id) => !before.includes(id));
+    check(crossChildren.length >= 1, `the cross made no new plant in the grid (${before} → ${after})`);
+    for (const p of crossParents) check(after.includes(p), `parent #${p} left the grid after the cross`);
+    check(await byTestId("history-item").count() > h0, "the cross is not in the history");
+    results.afterCross = after;
+    await checkPainted("breed", 0.004, "after the cross");
+  });
+
+  await step("breed: a dominance below zero is refused, visibly", async () => {
+    await byTestId("grid-cell-0").click();
+    await byTestId("grid-cell-1").click();
+    await byTestId("dominance-0").fill("-1");
+    await byTestId("cross").click();
+    await page.waitForFunction(() => document.querySelector('[data-testid="message"]').dataset.kind === "error");
+    const text = await byTestId("message").innerText();
+    check(/dominance|parent/i.test(text), `the error does not say what was wrong: ${text}`);
+    await byTestId("message-close").click();
+    // unpick both
+    await byTestId("grid-cell-0").click();
+    await byTestId("grid-cell-1").click();
+    check((await page.locator(".cell.selected").count()) === 0, "cells stay picked");
+  });
+
+  await step("breed: pick a child and mutate", async () => {
+    const before = await gridIds();
+    const child = crossChildren[0];
+    const index = before.indexOf(child);
+    check(index >= 0, `child #${child} is not in the grid`);
+    await byTestId(`grid-cell-${index}`).click();
+    await byTestId("depth").evaluate((e) => {
+      e.value = "3";
+      e.dispatchEvent(new Event("input", { bubbles: true }));
+    });
+    const n0 = await page.evaluate(() => window.sylvaStudio.paintCount);
+    const t = Date.now();
+    await byTestId("mutate").click();
+    await page.waitForFunction((n) => window.sylvaStudio.paintCount > n ||
+      document.querySelector('[data-testid="message"]').dataset.kind === "error", n0, { timeout: 60_000 });
+    await noError("mutate");
+    results.mutateOutsideMs = Date.now() - t;
+    results.mutatePaintMs = await page.evaluate(() => window.sylvaStudio.lastPaintMs);
+    results.mutateStep = await page.evaluate(() => window.sylvaStudio.lastStep);
+    await waitGridLoaded();
+    await noError("mutate");
+    const after = await gridIds();
+    check(after.includes(child), "the mutated plant left the grid");
+    check(after.filter((id) => !before.includes(id)).length >= 1, "the mutation made no new plant");
+    results.afterMutate = after;
+    await checkPainted("breed", 0.004, "after the mutation");
+    await shot("breed-bred");
+  });
+
+  await step("breed: undo and redo (Ctrl+Z, Ctrl+Y)", async () => {
+    await page.locator("body").click({ position: { x: 5, y: 5 } });
+    await page.keyboard.press("Control+z");
+    await page.waitForFunction((want) => {
+      const ids = [...document.querySelectorAll('[data-testid^="grid-cell-"]')].map((c) => Number(c.dataset.plant));
+      return JSON.stringify(ids) === JSON.stringify(want);
+    }, results.afterCross);
+    await page.keyboard.press("Control+y");
+    await page.waitForFunction((want) => {
+      const ids = [...document.querySelectorAll('[data-testid^="grid-cell-"]')].map((c) => Number(c.dataset.plant));
+      return JSON.stringify(ids) === JSON.stringify(want);
+    }, results.afterMutate);
+    await waitGridLoaded();
+    await noError("undo/redo");
+  });
+
+  let child = null;
+  await step("breed: the lineage of a child shows its parents", async () => {
+    child = crossChildren[0];
+    await page.locator(`[data-testid="population-item"][data-plant="${child}"]`).click();
+    await byTestId("plant-detail").waitFor();
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), child);
+    const fields = await byTestId("fields").locator("tr").count();
+    check(fields > 0, "the plant panel lists no genome fields");
+    await byTestId("lineage-open").click();
+    await byTestId("lineage").waitFor();
+    await page.waitForFunction(() => document.querySelectorAll('[data-testid="lineage-node"]').length >= 3);
+    const nodes = await page.$$eval('[data-testid="lineage-node"]', (els) => els.map((e) => Number(e.dataset.plant)));
+    for (const p of crossParents) check(nodes.includes(p), `the lineage of #${child} lacks parent #${p} (nodes ${nodes})`);
+    const edges = await page.$$eval('[data-testid="lineage-edge"]', (els) => els.map((e) => [Number(e.dataset.child), Number(e.dataset.parent)]));
+    for (const p of crossParents) {
+      check(edges.some(([c, q]) => c === child && q === p), `no edge from #${child} to its parent #${p}`);
+    }
+    await page.waitForFunction(() => [...document.querySelectorAll('[data-testid="lineage-node"] img')].every((i) => i.complete && i.naturalWidth > 0), null, { timeout: 60_000 });
+    await shot("lineage");
+    await byTestId("lineage-close").click();
+    await noError("lineage");
+  });
+
+  await step("breed: export the child as GLB and validate it", async () => {
+    const href = await byTestId("export-glb").getAttribute("href");
+    check(href && href.includes(String(child)), `the GLB link does not name plant #${child}: ${href}`);
+    const res = await fetch(new URL(href, base));
+    check(res.ok, `GET ${href}: ${res.status}`);
+    const bytes = Buffer.from(await res.arrayBuffer());
+    check(bytes.subarray(0, 4).toString() === "glTF", `${href} is not a GLB`);
+    const file = path.join(out, `plant-${child}.glb`);
+    fs.writeFileSync(file, bytes);
+    const v = spawnSync(process.execPath, ["tools/gltf-validator/validate.mjs", file], { cwd: repo, encoding: "utf8" });
+    log(`  ${(v.stdout || "").trim().split("\n").join("\n  ")}`);
+    check(v.status === 0, `the Khronos validator rejects ${file} (exit ${v.status}):\n${v.stdout}${v.stderr}`);
+    // every exported node carries its origin in extras
+    const len = bytes.readUInt32LE(12);
+    const json = JSON.parse(bytes.subarray(20, 20 + len).toString("utf8"));
+    const extras = (json.nodes || []).map((n) => n.extras).filter(Boolean);
+    check(extras.length > 0, "no node of the GLB has extras (origin: genome, seed, parents, operator)");
+    const origin = JSON.stringify(extras);
+    check(/seed/.test(origin), `the GLB's extras do not carry the seed: ${origin.slice(0, 200)}`);
+    for (const link of ["export-obj", "export-mtl", "export-png", "export-genome"]) {
+      const u = await byTestId(link).getAttribute("href");
+      const r = await fetch(new URL(u, base));
+      check(r.ok, `${link}: GET ${u}: ${r.status}`);
+      fs.writeFileSync(path.join(out, `plant-${child}${path.extname(new URL(u, base).pathname)}`), Buffer.from(await r.arrayBuffer()));
+    }
+  });
+
+  await step("breed: edit a genome field, then regrow with another seed", async () => {
+    const before = await gridIds();
+    const index = before.indexOf(child);
+    check(index >= 0, `child #${child} left the grid`);
+    const inputs = page.locator('[data-testid="fields"] input');
+    const n = await inputs.count();
+    let edited = null;
+    for (let i = 0; i < n && !edited; i++) {
+      const v = await inputs.nth(i).inputValue();
+      if (/^\d+$/.test(v) && Number(v) >= 2 && Number(v) < 1000) {
+        await inputs.nth(i).fill(String(Number(v) - 1));
+        edited = { path: await inputs.nth(i).getAttribute("data-path"), from: Number(v) };
+      }
+    }
+    check(edited, "no small whole-number field to edit in the plant panel");
+    await byTestId("apply-fields").click();
+    await page.waitForFunction(([i, old]) => {
+      if (document.querySelector('[data-testid="message"]').dataset.kind === "error") return true;
+      const c = document.querySelector(`[data-testid="grid-cell-${i}"]`);
+      return c.dataset.plant && Number(c.dataset.plant) !== old;
+    }, [index, child], { timeout: 60_000 });
+    await noError(`editing ${edited.path}`);
+    const editedId = (await gridIds())[index];
+    const e = await api(`/api/plants/${editedId}`);
+    check(e.operator === "edit", `the edited plant's operator is ${e.operator}, not edit`);
+    const f = e.fields.find((x) => x.path === edited.path);
+    check(f && Number(f.value) === edited.from - 1, `${edited.path} is ${f && f.value}, not ${edited.from - 1}`);
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), editedId);
+    await byTestId("regrow-seed").fill("4242");
+    await byTestId("regrow").click();
+    await page.waitForFunction(([i, old]) => {
+      if (document.querySelector('[data-testid="message"]').dataset.kind === "error") return true;
+      const c = document.querySelector(`[data-testid="grid-cell-${i}"]`);
+      return c.dataset.plant && Number(c.dataset.plant) !== old;
+    }, [index, editedId], { timeout: 60_000 });
+    await noError("regrow");
+    const r = await api(`/api/plants/${(await gridIds())[index]}`);
+    check(r.operator === "regrow" && Number(r.seed) === 4242, `the regrown plant is ${r.operator} with seed ${r.seed}`);
+    await waitGridLoaded();
+  });
+
+  // ---- Garden ----
+  await step("garden: a new garden, pick a child as the mother", async () => {
+    await byTestId("mode-garden").click();
+    await inMode("garden", "new-session-form").waitFor();
+    await inMode("garden", "new-create").click();
+    await page.waitForFunction(() => document.querySelectorAll('[data-testid^="specimen-"]').length >= 2, null, { timeout: 90_000 });
+    await page.waitForFunction(() => window.sylvaStudio.stages.garden && window.sylvaStudio.stages.garden.views[0].content.children.length > 0, null, { timeout: 60_000 });
+    await noError("new garden");
+    await checkPainted("garden", 0.002, "garden");
+    const cards = await page.$$eval('[data-testid^="specimen-"]', (els) => els.map((e) => ({ id: e.dataset.testid, plant: Number(e.dataset.plant), mother: e.dataset.mother === "true" })));
+    const mother = cards.find((c) => c.mother);
+    check(mother, "no specimen is marked as the mother");
+    const next = cards.find((c) => !c.mother);
+    check(next, "the garden has no children to pick");
+    await shot("garden");
+    await byTestId(next.id).click();
+    await page.waitForFunction((want) => {
+      const m = document.querySelector('[data-testid^="specimen-"][data-mother="true"]');
+      return m && Number(m.dataset.plant) === want;
+    }, next.plant, { timeout: 90_000 });
+    const s = await page.evaluate(() => window.sylvaStudio.session());
+    check(s.state.mother === next.plant, `the mother is #${s.state.mother}, not the picked #${next.plant}`);
+    check(s.state.mother !== mother.plant, "the mother did not change");
+    await page.waitForFunction(() => !document.querySelector('[data-testid="busy"]') || document.querySelector('[data-testid="busy"]').hidden);
+    await noError("pick");
+    await checkPainted("garden", 0.002, "garden after the pick");
+    await shot("garden-picked");
+  });
+
+  // ---- Family ----
+  await step("family: g, j, ], s, J", async () => {
+    await byTestId("mode-family").click();
+    await inMode("family", "new-session-form").waitFor();
+    await byTestId("family-new-population").fill("40");
+    await inMode("family", "new-create").click();
+    await page.waitForFunction(() => document.querySelector('[data-testid="family-generation"]').textContent === "0", null, { timeout: 60_000 });
+    await page.waitForFunction(() => document.querySelector('[data-testid="family-member"]').dataset.plant);
+    const chart0 = await byTestId("family-chart").evaluate((c) => c.toDataURL());
+    await page.locator("body").click({ position: { x: 5, y: 5 } });
+    await page.keyboard.press("g");
+    await page.waitForFunction(() => document.querySelector('[data-testid="family-generation"]').textContent === "1", null, { timeout: 60_000 });
+    const batch = Number(await byTestId("family-batch").innerText()) || 1;
+    await page.keyboard.press("j");
+    await page.waitForFunction((want) => Number(document.querySelector('[data-testid="family-generation"]').textContent) === want, 1 + batch, { timeout: 90_000 });
+    const member0 = await byTestId("family-member").getAttribute("data-plant");
+    await page.keyboard.press("]");
+    await page.waitForFunction((m0) => {
+      const m = document.querySelector('[data-testid="family-member"]');
+      return m.textContent.startsWith("2 of") && m.dataset.plant !== m0;
+    }, member0);
+    await page.keyboard.press("s");
+    await byTestId("family-stats-panel").waitFor({ state: "visible" });
+    const stats = await api(`/api/sessions/${await page.evaluate(() => window.sylvaStudio.session().id)}/stats`);
+    check(stats.generations.length >= 2 + batch, `stats has ${stats.generations.length} generations after ${1 + batch} steps`);
+    await page.waitForTimeout(100);
+    const chart1 = await byTestId("family-chart").evaluate((c) => c.toDataURL());
+    check(chart1 !== chart0, "the fitness chart did not change after running generations");
+    await byTestId("family-J").click();
+    await byTestId("family-batch-input").fill("3");
+    await byTestId("family-batch-ok").click();
+    await page.waitForFunction(() => document.querySelector('[data-testid="family-batch"]').textContent === "3");
+    await noError("family");
+    await checkPainted("family", 0.002, "family tree");
+    await shot("family");
+  });
+
+  // ---- Design ----
+  let designId = null;
+  await step("design: a small run followed live to its end", async () => {
+    await byTestId("mode-design").click();
+    await byTestId("design-form").waitFor();
+    await byTestId("design-population").fill("50");
+    await byTestId("design-generations").fill("5");
+    await byTestId("design-start").click();
+    await page.waitForFunction(() => window.sylvaStudio.session() && window.sylvaStudio.session().mode === "design");
+    designId = await page.evaluate(() => window.sylvaStudio.session().id);
+    await page.waitForFunction(() => document.querySelector('[data-testid="design-status"]').dataset.status === "done", null, { timeout: 90_000 });
+    const run = await api(`/api/sessions/${designId}/run`);
+    check(run.status === "done", `the run ended as ${run.status}`);
+    const rows = await page.locator('[data-testid="design-table"] tbody tr').count();
+    check(rows === run.rows.length && rows >= 5, `the table shows ${rows} generations, the run has ${run.rows.length}`);
+    const headers = await page.locator('[data-testid="design-table"] thead th').allTextContents();
+    for (const t of run.terms) check(headers.includes(t), `the table lacks the ${t} column`);
+    const last = run.rows[run.rows.length - 1];
+    await page.waitForFunction((id) => document.querySelector('#view-design .view-el').dataset.plant === String(id), last.plant, { timeout: 60_000 });
+    await noError("design");
+    await checkPainted("design", 0.002, "design view");
+    await shot("design");
+  });
+
+  let longRun = null;
+  await step("design: stop and resume a longer run", async () => {
+    // large enough that a generation takes a moment
+    await byTestId("design-population").fill("2000");
+    await byTestId("design-generations").fill("1000");
+    await byTestId("design-start").click();
+    await page.waitForFunction((old) => window.sylvaStudio.session().id !== old, designId);
+    const id = await page.evaluate(() => window.sylvaStudio.session().id);
+    await page.waitForFunction(() => document.querySelectorAll('[data-testid="design-table"] tbody tr').length >= 1, null, { timeout: 90_000 });
+    await byTestId("design-stop").click();
+    await page.waitForFunction(() => document.querySelector('[data-testid="design-status"]').dataset.status === "stopped");
+    // the run's thread ends after the generation it is making; then nothing moves
+    await sleep(1500);
+    const g0 = (await api(`/api/sessions/${id}/run`)).generation;
+    await sleep(1500);
+    const g1 = (await api(`/api/sessions/${id}/run`)).generation;
+    check(g1 === g0, `a stopped run went on from generation ${g0} to ${g1}`);
+    await byTestId("design-resume").click();
+    await page.waitForFunction((g) => {
+      const s = document.querySelector('[data-testid="design-status"]');
+      return s.dataset.status === "running" && Number(s.dataset.generation) > g;
+    }, g1, { timeout: 90_000 });
+    // left running: the restart below must bring it back
+    longRun = { id, generation: Number(await byTestId("design-status").getAttribute("data-generation")) };
+    await noError("stop/resume");
+    await shot("design-running");
+  });
+
+  // ---- restart ----
+  await step("the archive survives a killed server (and the running design run resumes)", async () => {
+    const before = await api(`/api/sessions/${breedId}`);
+    const plantsBefore = await api(`/api/plants?session=${breedId}&limit=1000`);
+    await killServer();
+    const again = await startServer(port, db);
+    check(again === base, `the studio came back at ${again}, not ${base}`);
+    // the design run that was running goes on from its last checkpoint
+    let run = await api(`/api/sessions/${longRun.id}/run`);
+    check(run.status === "running", `the design run that was running came back ${run.status}`);
+    const deadline = Date.now() + 60_000;
+    while (run.generation <= longRun.generation && Date.now() < deadline) {
+      await sleep(250);
+      run = await api(`/api/sessions/${longRun.id}/run`);
+    }
+    check(run.generation > longRun.generation, `the design run did not go on after the restart (generation ${run.generation})`);
+    const stopped = await fetch(`${base}/api/sessions/${longRun.id}/stop`, { method: "POST" });
+    check(stopped.ok, `stopping the resumed run: ${stopped.status}`);
+    await page.goto(`${base}/#/breed/${breedId}`);
+    await page.waitForFunction(() => window.sylvaStudio && window.sylvaStudio.ready === true);
+    await page.reload();
+    await page.waitForFunction(() => window.sylvaStudio && window.sylvaStudio.ready === true);
+    await waitGridLoaded();
+    const after = await api(`/api/sessions/${breedId}`);
+    check(JSON.stringify(after.history) === JSON.stringify(before.history), "the session's history changed across the restart");
+    check(JSON.stringify(after.state) === JSON.stringify(before.state), "the session's grid changed across the restart");
+    const items = await byTestId("history-item").count();
+    check(items === before.history.length, `the page lists ${items} steps, the session had ${before.history.length}`);
+    await page.waitForFunction((n) => document.querySelector('[data-testid="population-total"]').textContent === `(${n})`, plantsBefore.total);
+    const ids = await gridIds();
+    check(JSON.stringify(ids) === JSON.stringify(before.state.grid.map((g) => g.plant)), `the grid shows ${ids}, the session had ${before.state.grid.map((g) => g.plant)}`);
+    await checkPainted("breed", 0.004, "breed grid after the restart");
+    await noError("after the restart");
+    await shot("breed-restarted");
+  });
+
+  check(offsite.length === 0, `the page asked the network for ${offsite.join(", ")}`);
+  await context.close();
+  await killServer();
+  fs.rmSync(tmp, { recursive: true, force: true });
+
+  console.log("");
+  const split = (s) => (s ? ` = answer ${s.answerMs.toFixed(0)} + ${s.newPlants} GLBs loaded ${s.loadMs.toFixed(0)} + drawn ${s.drawMs.toFixed(0)}` : "");
+  console.log(`click to paint, Cross:  ${results.crossPaintMs?.toFixed(0)} ms in the page${split(results.crossStep)} (${results.crossOutsideMs} ms seen by the test)`);
+  console.log(`click to paint, Mutate: ${results.mutatePaintMs?.toFixed(0)} ms in the page${split(results.mutateStep)} (${results.mutateOutsideMs} ms seen by the test)`);
+  console.log(`click to highlight:     ${results.selectMs?.toFixed(1)} ms`);
+  console.log(`screenshots in ${path.relative(repo, out)}/`);
+  console.log(`studio e2e: all passed in ${((Date.now() - T0) / 1000).toFixed(1)} s`);
+}
+
+let browser = null;
+main().then(
+  () => process.exit(0),
+  async (e) => {
+    console.error("");
+    console.error(`studio e2e FAILED${e.step ? ` at "${e.step}"` : ""}: ${e instanceof Failure ? e.message : e.stack || e}`);
+    if (serverLog) console.error(`--- studio output (last 2000 characters) ---\n${serverLog.slice(-2000)}`);
+    if (browser) {
+      try {
+        await browser.page.screenshot({ path: path.join(out, "failure.png"), timeout: 10_000 });
+        console.error(`the page as it was: ${path.relative(repo, path.join(out, "failure.png"))}`);
+      } catch {
+        /* no picture */
+      }
+      await Promise.race([browser.context.close(), sleep(10_000)]).catch(() => {});
+    }
+    await killServer();
+    process.exit(1);
+  },
+);

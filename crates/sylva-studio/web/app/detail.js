@@ -1,0 +1,203 @@
+// The plant panel: an archived plant's origin, genome fields and packed string, an editable
+// genome with Regrow, exports, Branch from here and its lineage.
+
+import { api, seedValue, BigInteger } from "./api.js";
+import { h, add, clear, fmtNum, summarize } from "./dom.js";
+
+export function createDetail(ctx, panel) {
+  let current = null;
+  let token = 0;
+
+  function close() {
+    current = null;
+    panel.hidden = true;
+    document.body.classList.remove("detail-open");
+    clear(panel);
+  }
+
+  async function open(id) {
+    const mine = ++token;
+    const plant = await ctx.act(() => api.plant(id));
+    if (!plant || mine !== token) return;
+    current = plant;
+    render(plant);
+    panel.hidden = false;
+    document.body.classList.add("detail-open");
+  }
+
+  function render(p) {
+    clear(panel);
+    const enc = encodeURIComponent(p.id);
+    const parents = (p.parents || []).map((q) =>
+      h("a", { href: "#", class: "plant-link", testid: "detail-parent", onclick: (e) => { e.preventDefault(); open(q.plant); } },
+        `#${q.plant}`, q.dominance !== undefined && q.dominance !== null ? ` (dominance ${fmtNum(q.dominance)})` : ""),
+    );
+
+    // genome fields, editable
+    const fieldRows = (p.fields || []).map((f) => {
+      const input = h("input", {
+        type: "text",
+        value: typeof f.value === "string" ? f.value : JSON.stringify(f.value),
+        dataset: { path: f.path },
+        testid: `field-${f.path}`,
+      });
+      input.original = f.value;
+      input.initial = input.value;
+      return h("tr", {}, h("th", { title: f.path }, f.path), h("td", {}, input));
+    });
+    const fieldsTable = h("table", { class: "fields", testid: "fields" }, h("tbody", {}, fieldRows));
+
+    const genomeText = h("textarea", { testid: "genome-text", spellcheck: "false", rows: 10 });
+    genomeText.value = p.genome_text ?? JSON.stringify(p.genome, null, 2);
+    const seed = h("input", { type: "text", inputmode: "numeric", testid: "regrow-seed", value: String(p.seed ?? 1), style: { width: "13em" } });
+
+    const isLsystem = (p.model || "").startsWith("lsystem");
+    const exportLink = (file, label, testid, download) =>
+      h("a", { href: api.plantUrl(p.id, file), download, testid, class: "button" }, label);
+
+    const title = h("div", { class: "detail-head" },
+      h("h2", {}, `Plant #${p.id}`),
+      h("button", { class: "close", testid: "detail-close", title: "Close", onclick: close }, "×"));
+
+    add(panel,
+      title,
+      p.title ? h("div", { class: "detail-title" }, p.title) : null,
+      h("img", { class: "thumb", src: api.pngUrl(p.id, "320x320"), alt: `plant ${p.id}`, width: 320, height: 320, testid: "detail-thumb" }),
+      h("table", { class: "facts" }, h("tbody", {},
+        h("tr", {}, h("th", {}, "model"), h("td", {}, p.model)),
+        h("tr", {}, h("th", {}, "operator"), h("td", { testid: "detail-operator" }, p.operator || "–")),
+        h("tr", {}, h("th", {}, "settings"), h("td", { class: "mono" }, summarize(p.settings, 400) || "–")),
+        h("tr", {}, h("th", {}, "seed"), h("td", {}, String(p.seed ?? "–"))),
+        h("tr", {}, h("th", {}, "parents"), h("td", { testid: "detail-parents" }, parents.length ? parents.flatMap((a, i) => (i ? [", ", a] : [a])) : "none")),
+        h("tr", {}, h("th", {}, "session"), h("td", {}, p.session !== null && p.session !== undefined ? `#${p.session}` : "–")),
+        h("tr", {}, h("th", {}, "created"), h("td", {}, p.created || "–")),
+      )),
+      h("div", { class: "buttons" },
+        h("button", { testid: "lineage-open", onclick: () => ctx.openLineage(p.id) }, "Lineage"),
+        h("button", { testid: "branch", title: "A new breeding session that starts from this plant", onclick: () => branch("breed") }, "Branch from here"),
+        isLsystem ? h("button", { testid: "branch-garden", title: "A new garden with this plant as the mother", onclick: () => branch("garden") }, "Branch to a garden") : null,
+        h("button", { testid: "add-to-grid", title: "Put this plant back in the current breeding grid", onclick: addToGrid }, "Add to grid"),
+      ),
+      h("h3", {}, "Export"),
+      h("div", { class: "buttons exports" },
+        exportLink("plant.glb", "GLB", "export-glb", `plant-${p.id}.glb`),
+        exportLink("plant.obj", "OBJ", "export-obj", `plant-${p.id}.obj`),
+        exportLink("plant.mtl", "MTL", "export-mtl", `plant-${p.id}.mtl`),
+        h("a", { href: `/api/plants/${enc}/plant.png?view=iso&size=1024x1024`, download: `plant-${p.id}.png`, testid: "export-png", class: "button" }, "PNG"),
+        exportLink("genome.json", "genome.json", "export-genome", `plant-${p.id}.genome.json`),
+      ),
+      p.packed ? h("div", {}, h("h3", {}, "Packed string"), h("pre", { class: "packed", testid: "packed" }, p.packed)) : null,
+      h("h3", {}, "Genome fields"),
+      fieldRows.length ? fieldsTable : h("p", { class: "hint" }, "no fields"),
+      fieldRows.length
+        ? h("div", { class: "buttons" }, h("button", { testid: "apply-fields", onclick: () => applyFields(fieldsTable, seed) }, "Apply field edits"))
+        : null,
+      h("h3", {}, "Genome"),
+      genomeText,
+      h("div", { class: "buttons" },
+        h("label", { class: "field" }, h("span", {}, "Seed"), seed),
+        h("button", { class: "primary", testid: "regrow", title: "Grow the edited genome (or the same one with another seed) in this plant's place", onclick: () => regrow(genomeText.value, seed) }, "Regrow"),
+      ),
+    );
+  }
+
+  function breedSession() {
+    const s = ctx.session;
+    if (!s || s.mode !== "breed") {
+      const e = new Error("editing needs an open breeding session (Branch from here makes one from this plant)");
+      e.field = "session";
+      throw e;
+    }
+    return s;
+  }
+
+  async function regrow(text, seedInput) {
+    const p = current;
+    const s = await ctx.act(() => {
+      const session = breedSession();
+      const body = { plant: p.id, genome: text };
+      if (seedInput.value.trim() !== "") body.seed = seedValue(seedInput.value);
+      return api.edit(session.id, body);
+    });
+    if (s) await afterEdit(s, p.id);
+  }
+
+  async function applyFields(table, seedInput) {
+    const p = current;
+    const s = await ctx.act(() => {
+      const session = breedSession();
+      // the studio sets the fields on the stored genome itself, so no digit is lost
+      const fields = [];
+      for (const input of table.querySelectorAll("input[data-path]")) {
+        if (input.value === input.initial) continue;
+        fields.push({ path: input.dataset.path, value: parseValue(input.value, input.original, input.dataset.path) });
+      }
+      if (fields.length === 0) {
+        const e = new Error("no field was changed");
+        e.field = "fields";
+        throw e;
+      }
+      const body = { plant: p.id, fields };
+      if (seedInput.value.trim() !== "") body.seed = seedValue(seedInput.value);
+      return api.edit(session.id, body);
+    });
+    if (s) await afterEdit(s, p.id);
+  }
+
+  async function afterEdit(session, oldId) {
+    await ctx.setSession(session);
+    // the new plant is the newest of the session
+    const list = await ctx.act(() => api.plants(session.id, 0, 1));
+    const newest = list && list.plants && list.plants[0];
+    if (newest && newest.id !== oldId) await open(newest.id);
+  }
+
+  async function branch(mode) {
+    const p = current;
+    const s = await ctx.act(() => api.branch(p.id, mode));
+    if (s) await ctx.sessionCreated(s);
+  }
+
+  async function addToGrid() {
+    const p = current;
+    const s = await ctx.act(() => api.add(breedSession().id, { plants: [p.id] }));
+    if (s) await ctx.setSession(s);
+  }
+
+  return {
+    open,
+    close,
+    get current() {
+      return current;
+    },
+  };
+}
+
+/** A field's new value from its text, of the type its old value had. */
+function parseValue(text, original, path) {
+  const t = text.trim();
+  if (typeof original === "number" || original instanceof BigInteger) {
+    if (/^-?\d+$/.test(t) && !Number.isSafeInteger(Number(t))) return new BigInteger(t);
+    const n = Number(t);
+    if (t === "" || !Number.isFinite(n)) {
+      const e = new Error(`${path} must be a number (got "${text}")`);
+      e.field = path;
+      throw e;
+    }
+    return n;
+  }
+  if (typeof original === "string") return text;
+  if (typeof original === "boolean") {
+    if (t === "true" || t === "false") return t === "true";
+    const e = new Error(`${path} must be true or false (got "${text}")`);
+    e.field = path;
+    throw e;
+  }
+  try {
+    return JSON.parse(t);
+  } catch {
+    const e = new Error(`${path}: "${text}" is not a JSON value`);
+    e.field = path;
+    throw e;
+  }
+}

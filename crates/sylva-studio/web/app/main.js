@@ -1,0 +1,425 @@
+// The studio page: modes as tabs, sessions, undo and redo, the population and the history of the
+// open session, the plant panel, the lineage view, and the message area where every error from
+// the studio is shown.
+
+import { api, onBusy } from "./api.js";
+import { h, clear, summarize } from "./dom.js";
+import { stats } from "./stats.js";
+import { createBreedMode } from "./breed.js";
+import { createGardenMode } from "./garden.js";
+import { createFamilyMode } from "./family.js";
+import { createDesignMode } from "./design.js";
+import { createDetail } from "./detail.js";
+import { createLineage } from "./lineage.js";
+
+const MODES = ["breed", "garden", "family", "design"];
+const $ = (id) => document.getElementById(id);
+
+const ui = {
+  sessionSelect: $("session-select"),
+  newSession: $("new-session"),
+  undo: $("undo"),
+  redo: $("redo"),
+  busy: $("busy"),
+  message: $("message"),
+  messageText: $("message-text"),
+  population: $("population"),
+  populationTotal: $("population-total"),
+  populationMore: $("population-more"),
+  history: $("history"),
+};
+
+// ---- messages ----------------------------------------------------------------------------------
+
+let infoTimer = 0;
+function showError(err, context = "") {
+  console.error(context, err);
+  const field = err && err.field ? ` (field: ${err.field})` : "";
+  const status = err && err.status ? ` [${err.status}]` : "";
+  const text = `${context ? context + ": " : ""}${err && err.message ? err.message : String(err)}${field}${status}`;
+  ui.message.dataset.kind = "error";
+  ui.messageText.textContent = text;
+  ui.message.hidden = false;
+  clearTimeout(infoTimer);
+}
+function showInfo(text) {
+  if (!ui.message.hidden && ui.message.dataset.kind === "error") return;
+  ui.message.dataset.kind = "info";
+  ui.messageText.textContent = text;
+  ui.message.hidden = false;
+  clearTimeout(infoTimer);
+  infoTimer = setTimeout(() => {
+    if (ui.message.dataset.kind === "info") ui.message.hidden = true;
+  }, 4000);
+}
+function clearMessage() {
+  ui.message.hidden = true;
+  ui.messageText.textContent = "";
+  delete ui.message.dataset.kind;
+}
+$("message-close").addEventListener("click", clearMessage);
+window.addEventListener("unhandledrejection", (e) => showError(e.reason, "unexpected"));
+window.addEventListener("error", (e) => showError(e.error || new Error(e.message), "script error"));
+// a new click on a button starts a new action: the last error has been read
+document.addEventListener(
+  "click",
+  (e) => {
+    const b = e.target.closest && e.target.closest("button");
+    if (b && b.id !== "message-close" && ui.message.dataset.kind === "error") clearMessage();
+  },
+  true,
+);
+onBusy((n) => (ui.busy.hidden = n === 0));
+
+// ---- the context the modes share ---------------------------------------------------------------
+
+const ctx = {
+  models: [],
+  examples: [],
+  sessions: [],
+  session: null,
+  mode: null,
+  showError,
+  showInfo,
+  /** Runs `fn`, showing any error it throws; returns its result, or undefined on error. */
+  async act(fn) {
+    try {
+      return await fn();
+    } catch (err) {
+      showError(err);
+      return undefined;
+    }
+  },
+  setSession,
+  openSession,
+  sessionCreated,
+  refreshPopulation,
+  openPlant: (id) => detail.open(id),
+  openLineage: (id) => lineage.open(id),
+};
+stats.session = () => ctx.session;
+
+const modes = {
+  breed: createBreedMode(ctx, $("view-breed")),
+  garden: createGardenMode(ctx, $("view-garden")),
+  family: createFamilyMode(ctx, $("view-family")),
+  design: createDesignMode(ctx, $("view-design")),
+};
+const detail = createDetail(ctx, $("detail"));
+const lineage = createLineage(ctx, $("lineage"));
+const lastByMode = {};
+
+// ---- sessions ----------------------------------------------------------------------------------
+
+async function refreshSessions() {
+  const list = await ctx.act(() => api.sessions());
+  if (list) ctx.sessions = list;
+  fillSessionSelect();
+}
+
+function fillSessionSelect() {
+  const sel = ui.sessionSelect;
+  clear(sel);
+  const mine = ctx.sessions.filter((s) => s.mode === ctx.mode);
+  sel.append(h("option", { value: "" }, mine.length ? "— choose a session —" : "— no sessions yet —"));
+  for (const s of mine) {
+    sel.append(
+      h("option", { value: String(s.id) },
+        `#${s.id} ${s.title || s.mode}${s.model ? ` · ${s.model}` : ""} · ${s.steps ?? 0} steps`),
+    );
+  }
+  sel.value = ctx.session && ctx.session.mode === ctx.mode ? String(ctx.session.id) : "";
+}
+
+ui.sessionSelect.addEventListener("change", () => {
+  const id = ui.sessionSelect.value;
+  if (id) openSession(id);
+});
+
+async function openSession(id) {
+  const s = await ctx.act(() => api.session(id));
+  if (s) return setSession(s);
+  return false;
+}
+
+async function sessionCreated(s) {
+  await refreshSessions();
+  const r = await setSession(s);
+  showInfo(`session #${s.id} started`);
+  return r;
+}
+
+/** Shows session `s` (an answer of the studio) in its mode; resolves when it is drawn. */
+async function setSession(s) {
+  if (!s || typeof s !== "object" || s.id === undefined) {
+    showError(new Error("the studio answered without a session"));
+    return false;
+  }
+  const changed = !ctx.session || ctx.session.id !== s.id;
+  ctx.session = s;
+  lastByMode[s.mode] = s.id;
+  if (ctx.mode !== s.mode) switchMode(s.mode, { open: false });
+  showWorkspace(s.mode);
+  if (!ctx.sessions.some((x) => x.id === s.id)) await refreshSessions();
+  else {
+    const entry = ctx.sessions.find((x) => x.id === s.id);
+    if (entry) entry.steps = (s.history || []).length;
+    fillSessionSelect();
+  }
+  setHash(s.mode, s.id);
+  ui.undo.disabled = !s.can_undo;
+  ui.redo.disabled = !s.can_redo;
+  renderHistory(s);
+  if (changed) populationLimit = 100;
+  const mode = modes[s.mode];
+  if (!mode) {
+    showError(new Error(`unknown mode "${s.mode}"`));
+    return false;
+  }
+  const drawn = mode.render(s);
+  refreshPopulation();
+  return drawn;
+}
+
+function renderHistory(s) {
+  clear(ui.history);
+  for (const step of s.history || []) {
+    ui.history.append(
+      h("li", { class: step.undone ? "undone" : "", testid: "history-item", dataset: { seq: String(step.seq) }, title: JSON.stringify(step.action) },
+        h("span", { class: "seq" }, `${step.seq}.`), " ", describeAction(step.action), step.undone ? " (undone)" : ""),
+    );
+  }
+  ui.history.scrollTop = ui.history.scrollHeight;
+}
+
+function describeAction(a) {
+  if (a === null || a === undefined) return "–";
+  if (typeof a !== "object") return String(a);
+  for (const k of ["action", "op", "type", "kind"]) {
+    if (typeof a[k] === "string") {
+      const rest = { ...a };
+      delete rest[k];
+      const s = summarize(rest, 70);
+      return s ? `${a[k]}: ${s}` : a[k];
+    }
+  }
+  const keys = Object.keys(a);
+  if (keys.length === 1 && a[keys[0]] && typeof a[keys[0]] === "object") return `${keys[0]}: ${summarize(a[keys[0]], 70)}`;
+  return summarize(a, 80);
+}
+
+// ---- population --------------------------------------------------------------------------------
+
+let populationLimit = 100;
+let populationBusy = null;
+let populationDirty = false;
+
+async function refreshPopulation() {
+  if (populationBusy) {
+    populationDirty = true;
+    return populationBusy;
+  }
+  populationBusy = (async () => {
+    do {
+      populationDirty = false;
+      await loadPopulation();
+    } while (populationDirty);
+  })();
+  try {
+    await populationBusy;
+  } finally {
+    populationBusy = null;
+  }
+}
+
+async function loadPopulation() {
+  const s = ctx.session;
+  if (!s) {
+    clear(ui.population);
+    ui.populationTotal.textContent = "";
+    ui.populationMore.hidden = true;
+    return;
+  }
+  const list = await ctx.act(() => api.plants(s.id, 0, Math.min(populationLimit, 1000)));
+  if (!list || !ctx.session || ctx.session.id !== s.id) return;
+  const inGrid = new Set(((s.state && s.state.grid) || []).map((g) => g.plant));
+  const specimens = new Set(((s.state && s.state.specimens) || []).map((g) => g.plant));
+  clear(ui.population);
+  ui.populationTotal.textContent = `(${list.total})`;
+  for (const p of list.plants || []) {
+    const shown = inGrid.has(p.id) || specimens.has(p.id);
+    ui.population.append(
+      h("li", {},
+        h("button", {
+          class: "pop-item" + (shown ? " shown" : "") + (detail.current && detail.current.id === p.id ? " current" : ""),
+          testid: "population-item",
+          dataset: { plant: String(p.id) },
+          title: shown ? "on screen now" : "",
+          onclick: () => detail.open(p.id),
+        },
+        h("img", { src: api.pngUrl(p.id, "48x48"), width: 48, height: 48, alt: "", loading: "lazy" }),
+        h("span", { class: "pop-text" },
+          h("b", {}, `#${p.id}`), " ", p.operator || "",
+          h("span", { class: "dim" }, (p.parents && p.parents.length ? ` ← ${p.parents.map((x) => "#" + x).join(" ")}` : "") + ` · seed ${p.seed}`))),
+      ),
+    );
+  }
+  ui.populationMore.hidden = !(list.total > (list.plants || []).length && populationLimit < 1000);
+}
+ui.populationMore.addEventListener("click", () => {
+  populationLimit = Math.min(populationLimit + 100, 1000);
+  refreshPopulation();
+});
+
+// ---- modes ---------------------------------------------------------------------------------------
+
+function showWorkspace(mode) {
+  const m = modes[mode];
+  clear(m.formHolder);
+  m.formHolder.hidden = true;
+  m.workspace.hidden = false;
+}
+
+function showNewSessionForm(mode) {
+  const m = modes[mode];
+  const hasSession = ctx.session && ctx.session.mode === mode;
+  const form = m.newSessionForm({
+    cancel: hasSession ? () => showWorkspace(mode) : null,
+  });
+  if (!form) {
+    // the mode's workspace is its own form (design): leave the open session
+    if (hasSession) {
+      ctx.session = null;
+      m.reset();
+      afterSessionClosed(mode);
+    }
+    showWorkspace(mode);
+    return;
+  }
+  clear(m.formHolder);
+  m.formHolder.append(form);
+  m.formHolder.hidden = false;
+  m.workspace.hidden = true;
+}
+
+function afterSessionClosed(mode) {
+  ui.undo.disabled = ui.redo.disabled = true;
+  clear(ui.history);
+  refreshPopulation();
+  fillSessionSelect();
+  setHash(mode, null);
+}
+
+/** Shows mode `mode`; with `open`, opens its last (or newest) session or the new-session form. */
+function switchMode(mode, { open = true } = {}) {
+  if (!MODES.includes(mode)) mode = "breed";
+  const previous = ctx.mode;
+  ctx.mode = mode;
+  for (const b of document.querySelectorAll(".modes [data-mode]")) {
+    const on = b.dataset.mode === mode;
+    b.classList.toggle("active", on);
+    b.setAttribute("aria-selected", on ? "true" : "false");
+  }
+  for (const m of MODES) $(`view-${m}`).hidden = m !== mode;
+  if (previous && previous !== mode) modes[previous].hide();
+  modes[mode].show();
+  fillSessionSelect();
+  if (!open) return;
+  if (ctx.session && ctx.session.mode === mode) return;
+  const id = lastByMode[mode] ?? (ctx.sessions.find((s) => s.mode === mode) || {}).id;
+  if (id !== undefined) {
+    openSession(id);
+  } else {
+    ctx.session = null;
+    modes[mode].reset();
+    afterSessionClosed(mode);
+    showNewSessionForm(mode);
+  }
+}
+
+for (const b of document.querySelectorAll(".modes [data-mode]")) {
+  b.addEventListener("click", () => {
+    // the plant panel belongs to what was on screen; another mode gets the room
+    if (b.dataset.mode !== ctx.mode) detail.close();
+    switchMode(b.dataset.mode);
+  });
+}
+ui.newSession.addEventListener("click", () => showNewSessionForm(ctx.mode));
+
+// ---- undo and redo -------------------------------------------------------------------------------
+
+async function undoRedo(which) {
+  const s0 = ctx.session;
+  if (!s0) return;
+  const s = await ctx.act(() => (which === "undo" ? api.undo(s0.id) : api.redo(s0.id)));
+  if (s) await setSession(s);
+}
+ui.undo.addEventListener("click", () => undoRedo("undo"));
+ui.redo.addEventListener("click", () => undoRedo("redo"));
+
+document.addEventListener("keydown", (e) => {
+  const t = e.target;
+  const typing = t && (t.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(t.tagName));
+  if (e.key === "Escape") {
+    if (lineage.isOpen) lineage.close();
+    else if (!$("detail").hidden) detail.close();
+    return;
+  }
+  if (typing) return;
+  const mod = e.ctrlKey || e.metaKey;
+  if (mod && !e.altKey && (e.key === "z" || e.key === "Z")) {
+    e.preventDefault();
+    undoRedo(e.shiftKey ? "redo" : "undo");
+    return;
+  }
+  if (mod && !e.altKey && (e.key === "y" || e.key === "Y")) {
+    e.preventDefault();
+    undoRedo("redo");
+    return;
+  }
+  if (lineage.isOpen) return;
+  if (modes[ctx.mode] && modes[ctx.mode].onKey(e)) e.preventDefault();
+});
+
+// ---- the address: #/mode/session ---------------------------------------------------------------
+
+let settingHash = false;
+function setHash(mode, id) {
+  const want = id === null || id === undefined ? `#/${mode}` : `#/${mode}/${id}`;
+  if (location.hash === want) return;
+  settingHash = true;
+  history.replaceState(null, "", `${location.pathname}${location.search}${want}`);
+  settingHash = false;
+}
+function parseHash() {
+  const m = location.hash.match(/^#\/(\w+)(?:\/(\d+))?/);
+  return m ? { mode: m[1], id: m[2] } : { mode: null, id: null };
+}
+window.addEventListener("hashchange", () => {
+  if (settingHash) return;
+  navigate();
+});
+async function navigate() {
+  const { mode, id } = parseHash();
+  if (id) {
+    const ok = await openSession(id);
+    if (ok !== false && ctx.session) return;
+  }
+  switchMode(MODES.includes(mode) ? mode : "breed");
+}
+
+// ---- start ---------------------------------------------------------------------------------------
+
+async function init() {
+  const [models, examples] = await Promise.all([
+    ctx.act(() => api.models()),
+    ctx.act(() => api.examples()),
+    refreshSessions(),
+  ]);
+  ctx.models = models || [];
+  ctx.examples = examples || [];
+  await navigate();
+  stats.ready = true;
+  document.body.dataset.ready = "true";
+}
+init();

@@ -1,0 +1,26 @@
+// Figures the end-to-end test reads: `window.sylvaStudio`.
+//
+// paintCount / lastPaintMs: after a Breed step (Cross, Mutate, Add), the time from the click to
+// the frame that has all nine plants drawn, and how many such steps were painted.
+// lastSelectMs: from a click on a grid cell to its highlight being applied.
+// probe(name): draws stage `name` ("breed", "garden", "family", "design") and counts the
+// pixels that differ from the background (gl.readPixels, same task as the draw).
+
+import { timings } from "./viewer.js";
+
+export const stats = {
+  timings,
+  paintCount: 0,
+  lastPaintMs: null,
+  lastSelectMs: null,
+  history: [],
+  stages: {},
+  ready: false,
+  probe(name) {
+    const stage = stats.stages[name];
+    if (!stage) return null;
+    return stage.probe();
+  },
+};
+
+window.sylvaStudio = stats;
