@@ -314,6 +314,7 @@ fn hostile_requests_get_a_4xx_that_names_the_field() {
         ("POST", "/api/sessions".into(), br#"{"mode": "breed", "start": {"genomes": ["{\"model\": \"bintree\", \"format\": 1, \"depth\": -4}"]}}"#.to_vec(), 422, "start.genomes[0]"),
         ("POST", "/api/sessions".into(), br#"{"mode": "breed", "colour": "red"}"#.to_vec(), 400, ""),
         ("POST", "/api/sessions".into(), br#"{"mode": "family", "config": {"run": {"population": -3}}}"#.to_vec(), 422, "config.run.population"),
+        ("POST", "/api/sessions".into(), br#"{"mode": "family", "config": {"run": {"population": 20000}}}"#.to_vec(), 400, "config.run.population"),
         ("POST", "/api/sessions".into(), br#"{"mode": "design", "design": {"population": 5}}"#.to_vec(), 400, "design.population"),
         ("POST", "/api/sessions".into(), br#"{"mode": "design", "design": {"target": {"shape": "sphere", "radius": -1}}}"#.to_vec(), 422, "design.target.radius"),
         ("POST", "/api/sessions".into(), br#"{"mode": "garden", "settings": {"elevation": 91}}"#.to_vec(), 400, "settings.elevation"),
@@ -337,6 +338,8 @@ fn hostile_requests_get_a_4xx_that_names_the_field() {
         ("GET", format!("/api/plants/{}/lineage?depth=0", p[0]), b"".to_vec(), 400, "depth"),
         ("GET", "/api/plants?limit=100000".into(), b"".to_vec(), 400, "limit"),
         ("GET", "/api/nothing".into(), b"".to_vec(), 404, ""),
+        ("GET", format!("/api/plants/{}/plant_tex99999.png", p[0]), b"".to_vec(), 404, ""),
+        ("GET", format!("/api/plants/{}/secrets.txt", p[0]), b"".to_vec(), 404, ""),
         ("GET", "/vendor/three/../../../../etc/passwd".into(), b"".to_vec(), 404, ""),
         ("GET", "/vendor/three/build/three.module.js".into(), b"".to_vec(), 200, ""),
     ];

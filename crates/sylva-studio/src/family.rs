@@ -26,6 +26,9 @@ use crate::sessions::{SessionView, session_of, view};
 
 const BINTREE: &str = BinTreeModel::NAME;
 
+/// The largest family population.
+pub const MAX_POPULATION: u64 = 10_000;
+
 /// The most generations one request runs.
 pub const MAX_BATCH: u32 = 1000;
 
@@ -105,7 +108,14 @@ pub struct FamilyState {
 /// The config a family request asks for: the example's defaults under its sections.
 fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     let mut run = request.run.clone().unwrap_or_default();
-    run.entry("population").or_insert(json!(100));
+    let population = run.entry("population").or_insert(json!(100));
+    // The page lists every member: a family is a browsable population, not a large search.
+    if population.as_u64().is_some_and(|p| p > MAX_POPULATION) {
+        return Err(ApiError::bad(
+            "config.run.population",
+            format!("a family holds at most {MAX_POPULATION} trees, got {population}"),
+        ));
+    }
     // The studio steps the run by hand; `generations` only has to be valid.
     run.insert("generations".into(), json!(1));
     let mut doc = json!({ "model": BINTREE, "run": run });

@@ -185,6 +185,7 @@ pub fn router(studio: Studio) -> Router {
         .route("/plants/{id}/plant.mtl", get(plants::mtl))
         .route("/plants/{id}/plant.png", get(plants::png))
         .route("/plants/{id}/genome.json", get(plants::genome))
+        .route("/plants/{id}/{file}", get(plants::texture))
         .route("/plants/{id}/lineage", get(plants::lineage))
         .route("/plants/{id}/branch", post(plants::branch))
         .fallback(|| async { ApiError::not_found("no such endpoint") });

@@ -25,17 +25,21 @@ use crate::error::ApiError;
 use crate::http::Body;
 use crate::sessions::SessionView;
 
-/// Recently served GLBs, by plant and whether roots are shown; the oldest go first.
+/// Recently served GLBs, by plant and whether roots are shown; the oldest go first when
+/// there are more than [`CACHED_MESHES`] or their bytes pass [`CACHED_BYTES`].
 #[derive(Default)]
 pub struct MeshCache {
     inner: Mutex<CachedMeshes>,
 }
 
+/// The most bytes of GLBs kept in memory (a random PlantMaker plant's GLB can be 40 MB).
+const CACHED_BYTES: usize = 512 << 20;
+
 /// A plant and whether its roots are shown.
 type MeshKey = (i64, bool);
 
-/// The GLBs and the order they came in.
-type CachedMeshes = (HashMap<MeshKey, Arc<Vec<u8>>>, VecDeque<MeshKey>);
+/// The GLBs, the order they came in, and their bytes.
+type CachedMeshes = (HashMap<MeshKey, Arc<Vec<u8>>>, VecDeque<MeshKey>, usize);
 
 /// GLBs kept in memory.
 const CACHED_MESHES: usize = 256;
@@ -50,13 +54,17 @@ impl MeshCache {
     /// Keeps a GLB.
     pub fn put(&self, key: MeshKey, glb: Arc<Vec<u8>>) {
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        let (map, order) = &mut *inner;
-        if map.insert(key, glb).is_none() {
-            order.push_back(key);
+        let (map, order, bytes) = &mut *inner;
+        *bytes += glb.len();
+        match map.insert(key, glb) {
+            Some(old) => *bytes -= old.len(),
+            None => order.push_back(key),
         }
-        while order.len() > CACHED_MESHES {
-            if let Some(old) = order.pop_front() {
-                map.remove(&old);
+        while order.len() > CACHED_MESHES || (*bytes > CACHED_BYTES && order.len() > 1) {
+            if let Some(old) = order.pop_front()
+                && let Some(glb) = map.remove(&old)
+            {
+                *bytes -= glb.len();
             }
         }
     }
@@ -232,6 +240,20 @@ fn parse_size(s: &str) -> Result<(u32, u32), ApiError> {
     } else {
         Err(bad())
     }
+}
+
+/// `GET /api/plants/{id}/plant_tex{N}.png`: a texture the OBJ's materials name (the same
+/// for every plant; the path only puts it beside the `.mtl`).
+pub(crate) async fn texture(Path((id, file)): Path<(i64, String)>) -> Result<Response, ApiError> {
+    let texture = file
+        .strip_prefix("plant_tex")
+        .and_then(|f| f.strip_suffix(".png"))
+        .and_then(|n| n.parse::<u16>().ok())
+        .ok_or_else(|| ApiError::not_found(format!("`/api/plants/{id}/{file}`")))?;
+    let png = tokio::task::spawn_blocking(move || sylva_mesh::texture::texture_png(texture))
+        .await?
+        .map_err(ApiError::internal)?;
+    Ok(([(header::CONTENT_TYPE, "image/png")], png.to_vec()).into_response())
 }
 
 /// `GET /api/plants/{id}/genome.json`.
@@ -499,4 +521,23 @@ pub(crate) async fn branch(
         }
     };
     Ok(Json(crate::sessions::view(&studio, session)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cache_keeps_its_bytes_bounded() {
+        let cache = MeshCache::default();
+        let big = Arc::new(vec![0u8; CACHED_BYTES / 3]);
+        for id in 0..5 {
+            cache.put((id, false), big.clone());
+        }
+        assert!(cache.get((0, false)).is_none() && cache.get((1, false)).is_none());
+        assert!(cache.get((4, false)).is_some());
+        let inner = cache.inner.lock().unwrap_or_else(|p| p.into_inner());
+        assert!(inner.2 <= CACHED_BYTES);
+        assert_eq!(inner.2, inner.0.values().map(|g| g.len()).sum::<usize>());
+    }
 }
