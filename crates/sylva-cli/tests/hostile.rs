@@ -3,34 +3,10 @@
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-fn sylva(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sylva"))
-        .args(args)
-        .output()
-        .expect("the sylva binary runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sylva-hostile-{}-{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn example(path: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples")
-        .join(path)
-        .display()
-        .to_string()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod support;
+use support::{example, s, sylva, temp_dir};
 
 /// Runs sylva and expects a clean refusal: `code`, no panic, and `mention` in what it says.
 fn refused(args: &[&str], code: i32, mention: &str) -> String {

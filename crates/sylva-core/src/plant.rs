@@ -138,6 +138,13 @@ impl MaterialKind {
         }
     }
 
+    /// Whether segments of this kind are wood (bark and root): what the pipe model
+    /// ([`crate::taper`]) re-thickens and counts tips of, unlike leaves or petals drawn as
+    /// segments.
+    pub fn is_woody(self) -> bool {
+        matches!(self, MaterialKind::Bark | MaterialKind::Root)
+    }
+
     /// Sylva's default colour for this kind (linear RGB).
     pub fn default_color(self) -> [f32; 3] {
         match self {

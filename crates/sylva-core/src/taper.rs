@@ -62,7 +62,7 @@ impl PipeTaper {
             .iter()
             .map(|s| {
                 let kind = plant.materials().get(s.material.index()).map(|m| m.kind);
-                matches!(kind, Some(MaterialKind::Bark | MaterialKind::Root))
+                kind.is_some_and(MaterialKind::is_woody)
             })
             .collect();
         let segments = plant.segments_mut();

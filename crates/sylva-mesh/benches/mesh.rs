@@ -7,6 +7,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
+use sylva_mesh::wind;
 use sylva_mesh::{Mesh, Scene, SceneNode, export};
 
 #[path = "../tests/common/mod.rs"]
@@ -48,6 +49,27 @@ fn mesh_tree(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("to_glb", |b| {
         b.iter(|| export::to_glb(black_box(&scene)).expect("the bench mesh exports"))
+    });
+    // Meshing and writing, without and with wind (the sources recorded, the rig built and
+    // its skin and clip written): the wind's cost on the whole path to a GLB.
+    group.bench_function("mesh_and_glb", |b| {
+        b.iter(|| {
+            let mesh = mesher
+                .mesh(black_box(&plant))
+                .expect("the bench tree meshes");
+            export::to_glb(&Scene::single(SceneNode::new("tree", &mesh))).expect("exports")
+        })
+    });
+    group.bench_function("mesh_and_glb_wind", |b| {
+        b.iter(|| {
+            let (mesh, sources) = mesher
+                .mesh_with_sources(black_box(&plant))
+                .expect("the bench tree meshes");
+            let rig = wind::rig(&plant, &mesh, &sources, &wind::WindOptions::default());
+            let mut node = SceneNode::new("tree", &mesh);
+            node.rig = Some(&rig);
+            export::to_glb(&Scene::single(node)).expect("exports")
+        })
     });
     group.finish();
 }

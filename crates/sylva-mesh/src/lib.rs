@@ -19,6 +19,7 @@ pub mod mesher;
 pub mod render;
 pub mod scene;
 pub mod texture;
+pub mod wind;
 
 pub use mesh::{Mesh, Primitive};
 pub use scene::{Scene, SceneNode};

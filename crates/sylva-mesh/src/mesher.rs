@@ -231,6 +231,22 @@ pub struct Mesher {
     slots: Vec<u32>,
     /// Index buffers recycled from earlier outputs.
     pool: Vec<Vec<u32>>,
+    /// Per vertex, where it came from ([`Mesher::mesh_with_sources`]), while recording.
+    sources: Option<Vec<u32>>,
+}
+
+/// Marks a vertex of [`Mesher::mesh_with_sources`] as an organ's (leaf, flower, root tip);
+/// the low bits hold the organ's parent segment, or [`NO_SEGMENT`].
+pub const ORGAN_SOURCE: u32 = 1 << 31;
+/// The source segment of an organ without a parent.
+pub const NO_SEGMENT: u32 = ORGAN_SOURCE - 1;
+
+/// Records that the vertices added since the last mark came from `source`.
+#[inline]
+fn mark(sources: &mut Option<Vec<u32>>, out: &Mesh, source: u32) {
+    if let Some(s) = sources {
+        s.resize(out.positions.len(), source);
+    }
 }
 
 /// The octahedron of a root tip: 6 vertices (bottom, top, +X, +Z, -X, -Z), 8 faces.
@@ -353,6 +369,7 @@ impl Mesher {
             material_triangles: Vec::new(),
             slots: Vec::new(),
             pool: Vec::new(),
+            sources: None,
         })
     }
 
@@ -399,12 +416,18 @@ impl Mesher {
             }
         }
 
+        let mut sources = self.sources.take().map(|mut s| {
+            s.clear();
+            s.reserve(vertices);
+            s
+        });
         for start in 0..plant.segments().len() {
             if self.starts_axis(plant, start) {
-                self.tube(plant, start, out);
+                self.tube(plant, start, out, &mut sources);
             }
         }
-        self.organs(plant, out);
+        self.organs(plant, out, &mut sources);
+        self.sources = sources;
 
         debug_assert_eq!(out.positions.len(), vertices);
         debug_assert_eq!(out.triangle_count(), triangles);
@@ -420,6 +443,16 @@ impl Mesher {
         self.link(plant);
         let (vertices, triangles) = self.count(plant)?;
         Ok(mesh_bytes(vertices as u64, triangles as u64))
+    }
+
+    /// Meshes `plant` into a new mesh, and says where each vertex came from: the index of
+    /// its tube's segment, or [`ORGAN_SOURCE`] with the organ's parent segment (or
+    /// [`NO_SEGMENT`]). Skinning (wind) weights vertices by it.
+    pub fn mesh_with_sources(&mut self, plant: &Plant) -> Result<(Mesh, Vec<u32>), MeshError> {
+        self.sources = Some(Vec::new());
+        let result = self.mesh(plant);
+        let sources = self.sources.take().unwrap_or_default();
+        Ok((result?, sources))
     }
 
     /// Meshes `plant` into a new mesh.
@@ -504,7 +537,7 @@ impl Mesher {
     }
 
     /// Meshes the axis beginning at segment `start`: rings, quads and caps.
-    fn tube(&self, plant: &Plant, start: usize, out: &mut Mesh) {
+    fn tube(&self, plant: &Plant, start: usize, out: &mut Mesh, sources: &mut Option<Vec<u32>>) {
         let segs = &plant.segments();
         let r = self.options.radial_segments;
         let first = &segs[start];
@@ -529,6 +562,7 @@ impl Mesher {
         // Texture v: metres along the axis over the circumference there (see the docs).
         let (mut tex_v, mut r_prev) = (0.0f32, first.start_radius);
         self.ring(&ring, tex_v, out);
+        mark(sources, out, start as u32);
 
         let mut cur = start;
         loop {
@@ -566,6 +600,7 @@ impl Mesher {
             let circumference = TAU * (0.5 * (r_prev + radius)).max(MIN_UV_RADIUS);
             tex_v += (x - x_prev).length() / circumference;
             self.ring(&ring, tex_v, out);
+            mark(sources, out, cur as u32);
             let slot = self.slots[seg.material.index()] as usize;
             out.primitives[slot]
                 .indices
@@ -576,6 +611,7 @@ impl Mesher {
             if next == NONE {
                 if self.options.cap_ends && radius > 0.0 {
                     self.cap(&ring, n, seg.material.index(), false, out);
+                    mark(sources, out, cur as u32);
                 }
                 break;
             }
@@ -668,8 +704,9 @@ impl Mesher {
     }
 
     /// Appends every organ.
-    fn organs(&self, plant: &Plant, out: &mut Mesh) {
+    fn organs(&self, plant: &Plant, out: &mut Mesh, sources: &mut Option<Vec<u32>>) {
         for o in plant.organs() {
+            let source = ORGAN_SOURCE | o.parent.map_or(NO_SEGMENT, |p| p.0.min(NO_SEGMENT));
             // A plant's orientations are unit quaternions; normalising removes rounding.
             let q = o.orientation.normalize();
             let slot = self.slots[o.material.index()] as usize;
@@ -752,6 +789,7 @@ impl Mesher {
                         .extend(ROOT_TIP_INDICES.iter().map(|&i| i + base));
                 }
             }
+            mark(sources, out, source);
         }
     }
 }
@@ -1019,6 +1057,47 @@ mod tests {
             material,
             parent: None,
         }
+    }
+
+    #[test]
+    fn sources_name_each_vertex_s_segment_or_organ() {
+        let mut p = chain(&[Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 2.0, 0.5)], 0.1);
+        p.add_organ(Organ {
+            position: Vec3::new(0.0, 2.0, 0.5),
+            parent: Some(sylva_core::SegmentId(1)),
+            ..organ(
+                OrganKind::Leaf,
+                Quat::IDENTITY,
+                Vec2::new(0.3, 0.1),
+                Plant::LEAF,
+            )
+        })
+        .unwrap();
+        let mut mesher = Mesher::new(MeshOptions::default()).unwrap();
+        let (mesh, sources) = mesher.mesh_with_sources(&p).unwrap();
+        assert_eq!(mesh, mesher.mesh(&p).unwrap(), "recording changes nothing");
+        assert_eq!(sources.len(), mesh.positions.len());
+        let organ = sources.iter().filter(|&&s| s == ORGAN_SOURCE | 1).count();
+        assert!(organ > 0);
+        assert!(
+            sources
+                .iter()
+                .all(|&s| s == 0 || s == 1 || s == ORGAN_SOURCE | 1)
+        );
+        // Tube vertices lie near their segment.
+        for (v, &s) in mesh.positions.iter().zip(&sources) {
+            if s & ORGAN_SOURCE == 0 {
+                let seg = &p.segments()[s as usize];
+                let d = distance_to_segment(Vec3::from_array(*v), seg.start, seg.end);
+                assert!(d < 0.2, "vertex {v:?} is {d} m from its segment {s}");
+            }
+        }
+    }
+
+    fn distance_to_segment(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+        let ab = b - a;
+        let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+        (a + ab * t - p).length()
     }
 
     #[test]

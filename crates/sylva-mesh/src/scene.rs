@@ -10,6 +10,7 @@ use sylva_core::{
 };
 
 use crate::mesh::Mesh;
+use crate::wind::Rig;
 
 /// One placed mesh.
 #[derive(Clone, Debug)]
@@ -24,6 +25,8 @@ pub struct SceneNode<'a> {
     pub rotation: Quat,
     /// Origin data stored with the node (glTF `extras`): genome, seed, Sylva version.
     pub extras: Option<serde_json::Value>,
+    /// A skin and wind clip for the mesh ([`crate::wind`]); GLB only.
+    pub rig: Option<&'a Rig>,
 }
 
 impl<'a> SceneNode<'a> {
@@ -35,6 +38,7 @@ impl<'a> SceneNode<'a> {
             translation: Vec3::ZERO,
             rotation: Quat::IDENTITY,
             extras: None,
+            rig: None,
         }
     }
 

@@ -118,6 +118,14 @@ impl Plant {
         to_py(py, &serde_json::to_value(m).unwrap_or_default())
     }
 
+    /// The plant as data: what `sylva grow -o PLANT.skeleton.json` writes (segments, organs,
+    /// materials, origin, taper), as a dict. See docs/skeleton.md.
+    fn skeleton<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = sylva::Skeleton::of_grown(&self.grown).to_json();
+        // Through Python's own reader, so floats come out as the file writes them.
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
     /// The mesh, as read-only numpy arrays that view the plant's own memory (no copy).
     #[getter]
     fn mesh(this: &Bound<'_, Self>) -> PyResult<Mesh> {

@@ -152,6 +152,22 @@ def test_the_pipe_taper_thickens_the_trunk_and_keeps_the_twigs():
             genome.grow(taper=bad)
 
 
+def test_the_skeleton_is_the_plant_as_data():
+    genome = sylva.Genome.load(EXAMPLES / "lsystem" / "tree.json")
+    plant = genome.grow(roots=False, taper=2.5)
+    skeleton = plant.skeleton()
+    assert (skeleton["kind"], skeleton["format"]) == ("sylva-skeleton", 1)
+    assert skeleton["origin"]["model"] == "lsystem" and skeleton["origin"]["seed"] == plant.seed
+    assert skeleton["taper"] == {"pipe_exponent": 2.5} and skeleton["roots"] is False
+    segments = skeleton["segments"]
+    assert len(segments) == plant.segments and len(skeleton["organs"]) == plant.organs
+    assert not any(s["kind"] == "root" for s in segments)
+    for i, s in enumerate(segments):
+        assert s["parent"] is None or s["parent"] < i
+        assert s["end_radius"] <= s["start_radius"] or not s["woody"]
+    assert skeleton == genome.grow(roots=False, taper=2.5).skeleton()
+
+
 def test_cross_keeps_models_apart():
     with pytest.raises(sylva.InputError, match="plantmaker|bintree|model"):
         sylva.cross([sylva.Genome.load(GENOMES["plantmaker"]),

@@ -17,6 +17,7 @@ use sylva_evolve::IndividualId;
 use sylva_mesh::export::{self, Format};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::render::{self, RenderOptions, View};
+use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_model::{MeshHint, Model};
 use sylva_plantmaker::{Garden, PlantMakerModel};
@@ -80,6 +81,10 @@ pub struct Grown {
     pub mesh: Mesh,
     /// The pipe-model taper applied before meshing, if any.
     pub taper: Option<PipeTaper>,
+    /// Whether the roots were kept (`false`: left out of the plant, its mesh and exports).
+    pub roots: bool,
+    /// The wind skin and clip, if asked for ([`Grown::with_wind`]).
+    pub rig: Option<Rig>,
 }
 
 impl Grown {
@@ -96,13 +101,7 @@ impl Grown {
         roots: bool,
         taper: Option<PipeTaper>,
     ) -> Result<Grown, Error> {
-        let mut plant = genome.develop(seed)?;
-        if !roots {
-            plant = plant.without(MaterialKind::Root);
-        }
-        if let Some(taper) = taper {
-            taper.apply(&mut plant);
-        }
+        let plant = grow_plant(&genome, seed, roots, taper)?;
         let mesh = Mesher::new(mesh_options(genome.mesh_hint()))?.mesh(&plant)?;
         Ok(Grown {
             genome,
@@ -110,6 +109,35 @@ impl Grown {
             plant,
             mesh,
             taper,
+            roots,
+            rig: None,
+        })
+    }
+
+    /// As [`Grown::with_taper`], with a wind skin and clip when `wind` is given (meshed once,
+    /// recording where each vertex came from).
+    pub fn with_wind(
+        genome: Genome,
+        seed: u64,
+        roots: bool,
+        taper: Option<PipeTaper>,
+        wind: Option<WindOptions>,
+    ) -> Result<Grown, Error> {
+        let Some(wind) = wind else {
+            return Grown::with_taper(genome, seed, roots, taper);
+        };
+        let plant = grow_plant(&genome, seed, roots, taper)?;
+        let (mesh, sources) =
+            Mesher::new(mesh_options(genome.mesh_hint()))?.mesh_with_sources(&plant)?;
+        let rig = sylva_mesh::wind::rig(&plant, &mesh, &sources, &wind);
+        Ok(Grown {
+            genome,
+            seed,
+            plant,
+            mesh,
+            taper,
+            roots,
+            rig: Some(rig),
         })
     }
 
@@ -121,9 +149,43 @@ impl Grown {
         if let Some(taper) = self.taper {
             extras["taper"] = json!({ "pipe_exponent": taper.exponent });
         }
+        if let Some(rig) = &self.rig {
+            extras["wind"] = wind_extras(rig);
+            node.rig = Some(rig);
+        }
         node.extras = Some(extras);
         Scene::single(node)
     }
+}
+
+/// Grows a genome into its plant, unmeshed, as [`Grown::with_taper`] does: the roots left
+/// out when `roots` is false, then the pipe model's radii with a `taper`. For the work that
+/// needs the skeleton only (such as [`crate::skeleton`]).
+pub fn grow_plant(
+    genome: &Genome,
+    seed: u64,
+    roots: bool,
+    taper: Option<PipeTaper>,
+) -> Result<Plant, Error> {
+    let mut plant = genome.develop(seed)?;
+    if !roots {
+        plant = plant.without(MaterialKind::Root);
+    }
+    if let Some(taper) = taper {
+        taper.apply(&mut plant);
+    }
+    Ok(plant)
+}
+
+/// What a wind GLB's extras say of its rig: the clip, its period and the joints.
+fn wind_extras(rig: &Rig) -> serde_json::Value {
+    json!({
+        "clip": "wind",
+        "period": rig.times.last().copied().unwrap_or(0.0),
+        "joints": rig.joints.len(),
+        "joints_left_out": rig.dropped,
+        "flutter_attribute": "_WIND",
+    })
 }
 
 /// A plant put in a scene.
@@ -160,6 +222,7 @@ impl<'a> Placed<'a> {
 /// Meshes of placed plants, ready to be lent out as a scene.
 pub struct SceneAssets {
     meshes: Vec<Mesh>,
+    rigs: Vec<Option<Rig>>,
     nodes: Vec<(String, Vec3, Quat, Option<serde_json::Value>)>,
 }
 
@@ -167,6 +230,15 @@ impl SceneAssets {
     /// Meshes every plant (one mesher per set of options, its buffers reused), after
     /// checking that all the meshes together fit the memory budget.
     pub fn mesh(placed: &[Placed<'_>]) -> Result<SceneAssets, Error> {
+        SceneAssets::mesh_with_wind(placed, None)
+    }
+
+    /// As [`SceneAssets::mesh`], each plant with a wind skin and clip when `wind` is given
+    /// (one clip, `wind`, moves them all).
+    pub fn mesh_with_wind(
+        placed: &[Placed<'_>],
+        wind: Option<WindOptions>,
+    ) -> Result<SceneAssets, Error> {
         let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
         let mut needed = 0u64;
         for p in placed {
@@ -180,14 +252,37 @@ impl SceneAssets {
         )
         .map_err(sylva_mesh::mesher::MeshError::from)?;
         let mut meshes = Vec::with_capacity(placed.len());
+        let mut rigs = Vec::with_capacity(placed.len());
         for p in placed {
-            meshes.push(mesher_for(&mut meshers, p.hint)?.mesh(p.plant)?);
+            let mesher = mesher_for(&mut meshers, p.hint)?;
+            match wind {
+                None => {
+                    meshes.push(mesher.mesh(p.plant)?);
+                    rigs.push(None);
+                }
+                Some(wind) => {
+                    let (mesh, sources) = mesher.mesh_with_sources(p.plant)?;
+                    rigs.push(Some(sylva_mesh::wind::rig(p.plant, &mesh, &sources, &wind)));
+                    meshes.push(mesh);
+                }
+            }
         }
         let nodes = placed
             .iter()
-            .map(|p| (p.name.clone(), p.translation, p.rotation, p.extras.clone()))
+            .zip(&rigs)
+            .map(|(p, rig)| {
+                let mut extras = p.extras.clone();
+                if let (Some(rig), Some(e)) = (rig, extras.as_mut()) {
+                    e["wind"] = wind_extras(rig);
+                }
+                (p.name.clone(), p.translation, p.rotation, extras)
+            })
             .collect();
-        Ok(SceneAssets { meshes, nodes })
+        Ok(SceneAssets {
+            meshes,
+            rigs,
+            nodes,
+        })
     }
 
     /// The meshes, in the order the plants were given.
@@ -201,8 +296,10 @@ impl SceneAssets {
             .meshes
             .iter()
             .zip(&self.nodes)
-            .map(|(mesh, (name, translation, rotation, extras))| {
+            .zip(&self.rigs)
+            .map(|((mesh, (name, translation, rotation, extras)), rig)| {
                 let mut node = SceneNode::new(name.clone(), mesh);
+                node.rig = rig.as_ref();
                 node.translation = *translation;
                 node.rotation = *rotation;
                 node.extras = extras.clone();
@@ -217,6 +314,15 @@ impl SceneAssets {
 /// each standing at its placement and carrying its genome and seed. Errors name `source`,
 /// the garden's file (or whatever a front end calls it).
 pub fn garden_assets(garden: &Garden, source: &Path) -> Result<SceneAssets, Error> {
+    garden_assets_with_wind(garden, source, None)
+}
+
+/// As [`garden_assets`], each plant with a wind skin when `wind` is given.
+pub fn garden_assets_with_wind(
+    garden: &Garden,
+    source: &Path,
+    wind: Option<WindOptions>,
+) -> Result<SceneAssets, Error> {
     let grown = garden
         .grow()
         .map_err(|e| InputError::file_error(source, &e))?;
@@ -240,7 +346,7 @@ pub fn garden_assets(garden: &Garden, source: &Path) -> Result<SceneAssets, Erro
             }
         })
         .collect();
-    SceneAssets::mesh(&placed).map_err(|e| e.in_file(source))
+    SceneAssets::mesh_with_wind(&placed, wind).map_err(|e| e.in_file(source))
 }
 
 /// The mesher for plants of `hint`, made the first time it is asked for.

@@ -147,6 +147,9 @@ pub enum Error {
     /// A picture could not be drawn or written.
     #[error("drawing a picture")]
     Render(#[from] sylva_mesh::render::RenderError),
+    /// Work that would not fit in the memory budget (`--max-memory`).
+    #[error("not enough memory")]
+    Budget(#[from] sylva_core::budget::OverBudget),
     /// A plot could not be drawn.
     #[error(transparent)]
     Plot(#[from] crate::report::PlotError),

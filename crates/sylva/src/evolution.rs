@@ -45,6 +45,7 @@ use sylva_evolve::{
     Checkpoint, Fitness, GenerationStats, IndividualId, Origin, Problem, Run, RunSettings,
 };
 use sylva_mesh::render::View;
+use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
 
 use crate::error::{Error, InputError};
@@ -107,12 +108,49 @@ pub struct OutputConfig {
     /// (evolution scores the plants as grown, without it).
     #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "taper")]
     pub taper: Option<f64>,
+    /// A wind skin and clip in `best.glb`, as `sylva grow --wind`: `wind = {}` for the
+    /// defaults, or `wind = { strength = 2.0, period = 3.0 }`. Default none.
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "wind")]
+    pub wind: Option<WindConfig>,
+}
+
+/// `[output] wind`: the wind of `best.glb`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WindConfig {
+    /// Sway, 0 to 10. Default 1.
+    pub strength: f32,
+    /// Seconds of the clip, 0.5 to 60. Default 4.
+    pub period: f32,
+}
+
+impl Default for WindConfig {
+    fn default() -> Self {
+        let d = WindOptions::default();
+        WindConfig {
+            strength: d.strength,
+            period: d.period,
+        }
+    }
+}
+
+/// Reads `wind`, its numbers checked.
+fn wind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<WindConfig>, D::Error> {
+    let wind = WindConfig::deserialize(d)?;
+    WindOptions::new(wind.strength, wind.period).map_err(serde::de::Error::custom)?;
+    Ok(Some(wind))
 }
 
 impl OutputConfig {
     /// The taper the outputs are grown with, if any.
     pub fn pipe_taper(&self) -> Option<PipeTaper> {
         self.taper.and_then(|e| PipeTaper::new(e).ok())
+    }
+
+    /// The wind of `best.glb`, if any.
+    pub fn wind_options(&self) -> Option<WindOptions> {
+        self.wind
+            .and_then(|w| WindOptions::new(w.strength, w.period).ok())
     }
 }
 
@@ -123,6 +161,7 @@ impl Default for OutputConfig {
             view: View::Iso,
             sheet_size: 48,
             taper: None,
+            wind: None,
         }
     }
 }

@@ -156,14 +156,18 @@ impl Outputs {
         Ok(())
     }
 
-    /// Renames every file into place, in the order added.
+    /// Renames every file into place, in the order added. A file that cannot be renamed
+    /// (its destination is a folder, say) leaves no temporary file behind, nor do the ones
+    /// after it.
     pub fn commit(mut self) -> Result<(), Error> {
-        for (temp, path) in std::mem::take(&mut self.staged) {
-            std::fs::rename(&temp, &path).map_err(|source| Error::Io {
+        while let Some((temp, path)) = self.staged.first() {
+            // On an error, this file and the rest stay staged, and the drop removes them.
+            std::fs::rename(temp, path).map_err(|source| Error::Io {
                 action: "writing",
-                path,
+                path: path.clone(),
                 source,
             })?;
+            self.staged.remove(0);
         }
         self.made.clear();
         Ok(())
@@ -203,6 +207,25 @@ mod tests {
         out.commit().unwrap();
         assert_eq!(std::fs::read(dir.join("run/a.txt")).unwrap(), b"a");
         assert_eq!(std::fs::read_dir(dir.join("run")).unwrap().count(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_failed_rename_leaves_no_temporary_file() {
+        let dir = temp_dir("rename");
+        std::fs::create_dir_all(dir.join("taken.json")).unwrap();
+        let mut out = Outputs::new();
+        out.add(&dir.join("a.txt"), b"a").unwrap();
+        out.add(&dir.join("taken.json"), b"b").unwrap();
+        out.add(&dir.join("c.txt"), b"c").unwrap();
+        let e = out.commit().unwrap_err();
+        assert!(e.to_string().contains("taken.json"), "{e}");
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["a.txt", "taken.json"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

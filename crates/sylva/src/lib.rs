@@ -7,6 +7,8 @@
 //!   hand with the model's own operators ([`Genome::mutate`], [`Genome::cross`]).
 //! - [`assets`]: grown plants as meshes carrying their origin, scenes of many plants,
 //!   exports (GLB, OBJ, VRML97) and pictures.
+//! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
+//!   origin, written as `PLANT.skeleton.json`.
 //! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
 //!   step, browse, checkpoint, resume.
 //! - [`report`]: `stats.csv`, `fitness.svg` and experiment reports.
@@ -38,9 +40,11 @@ pub mod files;
 pub mod genome;
 pub mod registry;
 pub mod report;
+pub mod skeleton;
 
 pub use assets::{Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
 pub use genome::{Genome, load_genome, parse_genome};
 pub use registry::{ModelEntry, Registry};
+pub use skeleton::Skeleton;

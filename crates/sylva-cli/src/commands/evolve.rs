@@ -142,7 +142,8 @@ fn write_results(
     files.add(&out.join("best.json"), best.genome.to_json().as_bytes())?;
     let seed = best.genome.default_seed();
     let taper = config.output().pipe_taper();
-    let grown = Grown::with_taper(best.genome.clone(), seed, true, taper)?;
+    let wind = config.output().wind_options();
+    let grown = Grown::with_wind(best.genome.clone(), seed, true, taper, wind)?;
     files.add_scene(&out.join("best.glb"), &grown.scene())?;
     let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
     let mut scene = grown.scene();

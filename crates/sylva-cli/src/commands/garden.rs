@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{asset_format, check_png, garden_assets, picture};
+use sylva::assets::{asset_format, check_png, garden_assets_with_wind, picture};
 use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
 use sylva::{Genome, InputError};
@@ -34,6 +34,8 @@ pub struct GardenArgs {
     /// Also render a picture.
     #[arg(long)]
     png: Option<PathBuf>,
+    #[command(flatten)]
+    wind: super::WindArgs,
 }
 
 /// What gardens grow, for errors.
@@ -43,6 +45,7 @@ const PURPOSE: &str = "gardens grow";
 /// scene (one node per plant, each carrying its genome and seed) and the garden file.
 pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
     asset_format(&args.output)?;
+    let wind = args.wind.options(&args.output)?;
     if let Some(png) = &args.png {
         check_png(png)?;
     }
@@ -79,7 +82,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         }
         garden
     };
-    let assets = garden_assets(&garden, first)?;
+    let assets = garden_assets_with_wind(&garden, first, wind)?;
     let scene = assets.scene();
     let mut out = Outputs::new();
     out.add_scene(&args.output, &scene).in_file(first)?;

@@ -2,9 +2,10 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{asset_format, check_png, picture};
+use sylva::assets::{check_png, picture};
 use sylva::files::Outputs;
-use sylva::{Grown, load_genome};
+use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
+use sylva::{Genome, Grown, load_genome};
 use sylva_mesh::render::View;
 
 use super::InFile;
@@ -14,7 +15,7 @@ use super::InFile;
 pub struct GrowArgs {
     /// Genome JSON.
     genome: PathBuf,
-    /// Output asset.
+    /// Output: a 3D asset (.glb, .obj, .wrl), or the skeleton as data (.skeleton.json).
     #[arg(short, long)]
     output: PathBuf,
     /// Also render a picture.
@@ -31,18 +32,24 @@ pub struct GrowArgs {
     /// Leave the roots out.
     #[arg(long)]
     hide_roots: bool,
+    #[command(flatten)]
+    wind: super::WindArgs,
 }
 
 /// `sylva grow`.
 pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
-    asset_format(&args.output)?;
+    let output = GrowOutput::of(&args.output)?;
+    let wind = args.wind.options(&args.output)?;
     if let Some(png) = &args.png {
         check_png(png)?;
     }
     let genome = load_genome(&args.genome)?;
     let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+    if output == GrowOutput::Skeleton {
+        return skeleton(args, &genome, seed);
+    }
     let grown =
-        Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.genome)?;
+        Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind).in_file(&args.genome)?;
     let mut out = Outputs::new();
     out.add_scene(&args.output, &grown.scene())
         .in_file(&args.genome)?;
@@ -57,6 +64,54 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         grown.plant.organs().len(),
         grown.mesh.vertex_count(),
         grown.mesh.triangle_count()
+    );
+    if let Some(rig) = &grown.rig {
+        println!(
+            "wind: {} joints, clip `wind` of {} s{}",
+            rig.joints.len(),
+            rig.times.last().copied().unwrap_or(0.0),
+            if rig.dropped > 0 {
+                format!(
+                    " ({} finer joints left out: at most {})",
+                    rig.dropped,
+                    sylva_mesh::wind::MAX_JOINTS
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
+}
+
+/// `sylva grow -o PLANT.skeleton.json`: the plant as data, unmeshed unless a picture is
+/// asked for too.
+fn skeleton(args: &GrowArgs, genome: &Genome, seed: u64) -> anyhow::Result<()> {
+    let roots = !args.hide_roots;
+    let (skeleton, png) = match &args.png {
+        None => {
+            let skeleton = grow_skeleton(genome, seed, roots, args.taper).in_file(&args.genome)?;
+            (skeleton, None)
+        }
+        Some(png) => {
+            let grown =
+                Grown::with_taper(genome.clone(), seed, roots, args.taper).in_file(&args.genome)?;
+            sylva::skeleton::check_budget(&grown.plant).in_file(&args.genome)?;
+            let picture = picture(&grown.scene(), View::Iso, (800, 800))?;
+            (Skeleton::of_grown(&grown), Some((png, picture)))
+        }
+    };
+    let mut out = Outputs::new();
+    out.add(&args.output, skeleton.to_json().as_bytes())?;
+    if let Some((path, bytes)) = png {
+        out.add(path, &bytes)?;
+    }
+    out.commit()?;
+    println!(
+        "wrote {}: {} segments, {} organs",
+        args.output.display(),
+        skeleton.segments.len(),
+        skeleton.organs.len()
     );
     Ok(())
 }

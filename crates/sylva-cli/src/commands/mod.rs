@@ -23,6 +23,58 @@ impl<T> InFile<T> for Result<T, sylva::Error> {
     }
 }
 
+/// The wind flags of `grow` and `garden`.
+#[derive(clap::Args, Debug, Default)]
+pub struct WindArgs {
+    /// Add a wind skin and a looping animation clip named `wind` (GLB only): joints along
+    /// the trunk and branches, a sway that falls with branch radius, a phase per branch, and
+    /// a `_WIND` flutter weight on leaves for engines that add shader flutter.
+    #[arg(long)]
+    wind: bool,
+    /// Wind strength, 0 to 10 (1, the default, is a breeze).
+    #[arg(long, value_name = "S", requires = "wind")]
+    wind_strength: Option<f32>,
+    /// Seconds one sway takes (the clip's length), 0.5 to 60; default 4.
+    #[arg(long, value_name = "SECONDS", requires = "wind")]
+    wind_period: Option<f32>,
+}
+
+impl WindArgs {
+    /// The wind asked for, if any, checked against the output (a GLB).
+    pub fn options(
+        &self,
+        output: &Path,
+    ) -> Result<Option<sylva_mesh::wind::WindOptions>, sylva::InputError> {
+        if !self.wind {
+            return Ok(None);
+        }
+        let is_glb = output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+        if !is_glb {
+            return Err(sylva::InputError::new(
+                "--wind",
+                format!(
+                    "wind needs a .glb output (skins and animation clips are glTF's); got {}",
+                    output.display()
+                ),
+            ));
+        }
+        let defaults = sylva_mesh::wind::WindOptions::default();
+        let strength = self.wind_strength.unwrap_or(defaults.strength);
+        let period = self.wind_period.unwrap_or(defaults.period);
+        sylva_mesh::wind::WindOptions::new(strength, period)
+            .map(Some)
+            .map_err(|e| {
+                let flag = match e {
+                    sylva_mesh::wind::WindError::Strength(_) => "--wind-strength",
+                    sylva_mesh::wind::WindError::Period(_) => "--wind-period",
+                };
+                sylva::InputError::new(flag, e)
+            })
+    }
+}
+
 /// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
 pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
 

@@ -32,6 +32,7 @@ use sylva_core::glam::{Quat, Vec3};
 use super::{ExportError, check_scene};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::wind::Rig;
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const GLB_VERSION: u32 = 2;
@@ -40,6 +41,7 @@ const CHUNK_BIN: u32 = 0x004E_4942; // "BIN\0"
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
+const UNSIGNED_BYTE: u32 = 5121;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const LINEAR: u32 = 9729;
@@ -65,7 +67,8 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         .filter(|n| seen.insert(n.mesh as *const Mesh))
         .map(|n| {
             let m = n.mesh;
-            (m.positions.len() as u64 * 32).saturating_add(
+            let rigged = if n.rig.is_some() { 12 } else { 0 };
+            (m.positions.len() as u64 * (32 + rigged)).saturating_add(
                 m.primitives
                     .iter()
                     .map(|p| p.indices.len() as u64 * 4)
@@ -82,15 +85,18 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         "export fewer or smaller plants",
     )?;
     let mut w = Writer::default();
-    let mut mesh_of: HashMap<*const Mesh, Option<usize>> = HashMap::new();
+    let mut mesh_of: HashMap<(*const Mesh, *const Rig), Option<usize>> = HashMap::new();
     let mut nodes = Vec::with_capacity(scene.nodes.len());
+    // Rigs go after the plants' nodes: (node index, rig, the node's transform).
+    let mut rigs: Vec<(usize, &Rig, Vec3, Quat)> = Vec::new();
     for node in &scene.nodes {
         // Addresses only find a mesh already written; indices follow first appearance.
-        let key: *const Mesh = node.mesh;
+        let rig_key: *const Rig = node.rig.map_or(std::ptr::null(), |r| r as *const Rig);
+        let key = (node.mesh as *const Mesh, rig_key);
         let mesh = match mesh_of.get(&key) {
             Some(&m) => m,
             None => {
-                let m = w.mesh(node.mesh, &node.name)?;
+                let m = w.mesh(node.mesh, &node.name, node.rig)?;
                 mesh_of.insert(key, m);
                 m
             }
@@ -99,6 +105,20 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         n.insert("name".into(), json!(node.name));
         if let Some(m) = mesh {
             n.insert("mesh".into(), json!(m));
+        }
+        if let (Some(rig), Some(_)) = (node.rig, mesh) {
+            // A skinned mesh ignores its node's transform: the rig's root node carries it.
+            rigs.push((
+                nodes.len(),
+                rig,
+                node.translation,
+                node.rotation.normalize(),
+            ));
+            if let Some(extras) = &node.extras {
+                n.insert("extras".into(), extras.clone());
+            }
+            nodes.push(Value::Object(n));
+            continue;
         }
         if node.translation != Vec3::ZERO {
             n.insert(
@@ -116,13 +136,80 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         nodes.push(Value::Object(n));
     }
 
+    let plant_nodes = nodes.len();
+    let mut scene_nodes: Vec<usize> = (0..plant_nodes).collect();
+    let mut skins = Vec::new();
+    let mut channels = Vec::new();
+    let mut samplers = Vec::new();
+    for (node, rig, translation, rotation) in rigs {
+        let name = nodes[node]["name"].as_str().unwrap_or("plant").to_owned();
+        // The rig's root: a plain node with the plant's place, parent of its root joints.
+        let root_node = nodes.len();
+        let mut root_json = json!({ "name": format!("{name}-rig") });
+        if translation != Vec3::ZERO {
+            root_json["translation"] = json!(translation.to_array().map(short));
+        }
+        if rotation != Quat::IDENTITY {
+            root_json["rotation"] = json!(rotation.to_array().map(short));
+        }
+        nodes.push(root_json);
+        scene_nodes.push(root_node);
+        let first = nodes.len();
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); rig.joints.len()];
+        let mut roots = Vec::new();
+        for (j, joint) in rig.joints.iter().enumerate() {
+            let local = match joint.parent {
+                Some(p) => {
+                    children[p].push(first + j);
+                    joint.position - rig.joints[p].position
+                }
+                None => {
+                    roots.push(first + j);
+                    joint.position
+                }
+            };
+            let mut n = json!({ "name": format!("{name}-joint-{j}") });
+            if local != Vec3::ZERO {
+                n["translation"] = json!(local.to_array());
+            }
+            nodes.push(n);
+        }
+        for (j, c) in children.into_iter().enumerate() {
+            if !c.is_empty() {
+                nodes[first + j]["children"] = json!(c);
+            }
+        }
+        nodes[root_node]["children"] = json!(roots);
+        let ibm = w.inverse_binds(rig);
+        skins.push(json!({
+            "name": format!("{name}-skin"),
+            "inverseBindMatrices": ibm,
+            "joints": (first..first + rig.joints.len()).collect::<Vec<_>>(),
+            "skeleton": root_node,
+        }));
+        nodes[node]["skin"] = json!(skins.len() - 1);
+        let input = w.times(&rig.times);
+        for (j, keys) in rig.rotations.iter().enumerate() {
+            let output = w.rotations(keys);
+            samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+            channels.push(json!({
+                "sampler": samplers.len() - 1,
+                "target": { "node": first + j, "path": "rotation" },
+            }));
+        }
+    }
+    let animations = if channels.is_empty() {
+        Vec::new()
+    } else {
+        vec![json!({ "name": "wind", "channels": channels, "samplers": samplers })]
+    };
+
     let mut root = Map::new();
     root.insert(
         "asset".into(),
         json!({ "version": "2.0", "generator": concat!("Sylva ", env!("CARGO_PKG_VERSION")) }),
     );
     root.insert("scene".into(), json!(0));
-    let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
     root.insert(
         "scenes".into(),
         if scene_nodes.is_empty() {
@@ -136,6 +223,8 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
     let arrays = [
         ("nodes", nodes),
         ("meshes", w.meshes),
+        ("skins", skins),
+        ("animations", animations),
         ("materials", w.materials),
         ("textures", w.textures),
         ("images", w.images),
@@ -203,7 +292,12 @@ struct Writer {
 
 impl Writer {
     /// Writes a mesh's data and returns its glTF mesh index; `None` when it has no triangles.
-    fn mesh(&mut self, mesh: &Mesh, name: &str) -> Result<Option<usize>, ExportError> {
+    fn mesh(
+        &mut self,
+        mesh: &Mesh,
+        name: &str,
+        rig: Option<&Rig>,
+    ) -> Result<Option<usize>, ExportError> {
         if mesh.primitives.iter().all(|p| p.indices.is_empty()) {
             return Ok(None);
         }
@@ -255,6 +349,11 @@ impl Writer {
             None
         };
 
+        let skin = match rig {
+            Some(rig) if rig.vertex_joints.len() == count => Some(self.skin_attributes(rig)),
+            _ => None,
+        };
+
         let wide = count > U16_VERTICES;
         let mut primitives = Vec::new();
         for p in mesh.primitives.iter().filter(|p| !p.indices.is_empty()) {
@@ -282,6 +381,11 @@ impl Writer {
             if let (Some(t), true) = (texcoord, textured(p)) {
                 attributes["TEXCOORD_0"] = json!(t);
             }
+            if let Some((joints, weights, flutter)) = skin {
+                attributes["JOINTS_0"] = json!(joints);
+                attributes["WEIGHTS_0"] = json!(weights);
+                attributes["_WIND"] = json!(flutter);
+            }
             primitives.push(json!({
                 "attributes": attributes,
                 "indices": indices,
@@ -291,6 +395,85 @@ impl Writer {
         self.meshes
             .push(json!({ "name": name, "primitives": primitives }));
         Ok(Some(self.meshes.len() - 1))
+    }
+
+    /// A rigged mesh's JOINTS_0, WEIGHTS_0 and `_WIND` accessors.
+    fn skin_attributes(&mut self, rig: &Rig) -> (usize, usize, usize) {
+        let count = rig.vertex_joints.len();
+        let start = self.bin.len();
+        for j in &rig.vertex_joints {
+            self.bin.extend_from_slice(j);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let joints = self.accessor(json!({
+            "bufferView": view, "componentType": UNSIGNED_BYTE, "count": count, "type": "VEC4",
+        }));
+        let start = self.bin.len();
+        for w in &rig.vertex_weights {
+            self.bin.extend_from_slice(w);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let weights = self.accessor(json!({
+            "bufferView": view, "componentType": UNSIGNED_BYTE, "normalized": true,
+            "count": count, "type": "VEC4",
+        }));
+        let start = self.bin.len();
+        for f in &rig.flutter {
+            self.bin.extend_from_slice(&f.to_le_bytes());
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let flutter = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "SCALAR",
+        }));
+        (joints, weights, flutter)
+    }
+
+    /// A rig's inverse bind matrices: each joint's rest place undone (rest rotations are
+    /// the identity), column-major.
+    fn inverse_binds(&mut self, rig: &Rig) -> usize {
+        let start = self.bin.len();
+        for joint in &rig.joints {
+            let m = sylva_core::glam::Mat4::from_translation(-joint.position);
+            for c in m.to_cols_array() {
+                self.bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let view = self.untargeted_view(start);
+        self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": rig.joints.len(), "type": "MAT4",
+        }))
+    }
+
+    /// An animation's key times.
+    fn times(&mut self, times: &[f32]) -> usize {
+        let start = self.bin.len();
+        for t in times {
+            self.bin.extend_from_slice(&t.to_le_bytes());
+        }
+        let view = self.untargeted_view(start);
+        let (min, max) = times
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": times.len(), "type": "SCALAR",
+            "min": [min], "max": [max],
+        }))
+    }
+
+    /// An animation's rotations, one unit quaternion (x, y, z, w) per key.
+    fn rotations(&mut self, keys: &[Quat]) -> usize {
+        let start = self.bin.len();
+        for q in keys {
+            for c in q.normalize().to_array() {
+                self.bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let view = self.untargeted_view(start);
+        self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": keys.len(), "type": "VEC4",
+        }))
     }
 
     /// A buffer view over `bin[start..]`, which starts on a 4-byte boundary.

@@ -103,6 +103,8 @@ class Plant:
     def total_length(self) -> float: ...
     def measures(self) -> dict[str, float]:
         """The measures of Susinno's paper, as a dict."""
+    def skeleton(self) -> dict[str, Any]:
+        """The plant as data (docs/skeleton.md): segments, organs, materials, origin, taper."""
     @property
     def mesh(self) -> Mesh: ...
     def export(self, path: _Path) -> None:

@@ -1,0 +1,40 @@
+//! Helpers shared by the tests that drive the `sylva` binary.
+#![allow(dead_code)] // Each test file uses some of them.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the binary the tests are built with.
+pub fn sylva(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(args)
+        .output()
+        .expect("the sylva binary runs")
+}
+
+/// A fresh folder for one test: `sylva-<test file>-<process>-<name>` in the temp folder.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "sylva-{}-{}-{name}",
+        env!("CARGO_CRATE_NAME"),
+        std::process::id()
+    ));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// An example file's path.
+pub fn example(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(path)
+        .display()
+        .to_string()
+}
+
+/// A path as the `&str` an argument list takes.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
