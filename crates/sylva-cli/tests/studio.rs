@@ -362,6 +362,43 @@ fn hostile_requests_get_a_4xx_that_names_the_field() {
 }
 
 #[test]
+fn two_tabs_breeding_one_session_at_once_take_turns() {
+    let dir = temp_dir("tabs");
+    let server = start(&dir, "127.0.0.1");
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "breed", "model": "bintree"}),
+    );
+    let id = session["id"].as_i64().unwrap();
+    let g = grid(&session);
+    let path = format!("/api/sessions/{id}/mutate");
+    let answers: Vec<Value> = std::thread::scope(|scope| {
+        let tabs: Vec<_> = g[..4]
+            .iter()
+            .map(|&plant| {
+                let (server, path) = (&server, &path);
+                scope.spawn(move || post(server, path, json!({"plant": plant, "children": 3})))
+            })
+            .collect();
+        tabs.into_iter().map(|t| t.join().unwrap()).collect()
+    });
+    // Each step saw the one before it: four steps in the history, numbered 1 to 4, and the
+    // grid holds the last step's parent and children at its head.
+    let last = get(&server, &format!("/api/sessions/{id}"));
+    let seqs: Vec<i64> = last["history"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| h["seq"].as_i64().unwrap())
+        .collect();
+    assert_eq!(seqs, [1, 2, 3, 4]);
+    assert!(answers.iter().any(|a| a["state"] == last["state"]));
+    let plants = get(&server, &format!("/api/plants?session={id}&limit=1000"));
+    assert_eq!(plants["total"], g.len() + 4 * 3);
+}
+
+#[test]
 fn beyond_loopback_every_request_needs_the_printed_token() {
     let dir = temp_dir("token");
     let server = start(&dir, "0.0.0.0");

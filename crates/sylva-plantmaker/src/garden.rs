@@ -74,6 +74,21 @@ pub struct Garden {
     pub max_tries: u32,
     /// The genomes, each with one seed per plant.
     pub plants: Vec<GardenPlants>,
+    /// Grow only the first `variants` seeds of each genome, 1 to 1000, and make every
+    /// plant of it one of those (plant `i` is variant `i mod variants`), so a scene holds a
+    /// few meshes placed many times. Absent (the default): every plant its own seed.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "some_variants"
+    )]
+    pub variants: Option<u32>,
+}
+
+sylva_core::ranged!(variants: u32, "variants", 1, 1000);
+
+fn some_variants<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    variants(d).map(Some)
 }
 
 /// Plants of one genome: one per seed.
@@ -95,6 +110,8 @@ pub struct Placement {
     pub index: usize,
     /// The seed it grows from.
     pub seed: u64,
+    /// Its plant in [`GrownGarden::plants`] (shared by the plants of one variant).
+    pub plant: usize,
     /// Where its base stands (y = 0), metres.
     pub translation: Vec3,
     /// Its turn about +Y, radians.
@@ -111,7 +128,8 @@ impl Placement {
 }
 
 /// A grown garden: plants and their placements, in file order (genome by genome, seed by
-/// seed).
+/// seed). Without variants there is one plant per placement, in the same order; with
+/// variants, one per variant, which the placements share.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GrownGarden {
     /// Where each plant stands.
@@ -279,6 +297,7 @@ impl Garden {
             placement_seed: seed,
             max_tries: DEFAULT_TRIES,
             plants: Vec::new(),
+            variants: None,
         };
         garden.add(genome, count);
         garden
@@ -319,38 +338,51 @@ impl Garden {
         if count > MAX_PLANTS {
             return Err(GardenError::TooManyPlants(count));
         }
-        let mut plants = Vec::with_capacity(count);
+        let mut plants = Vec::new();
+        // Per placement: (group, index, seed, plant).
         let mut ids = Vec::with_capacity(count);
         let mut estimate = 0u64;
         for (group, g) in self.plants.iter().enumerate() {
+            let grown = g
+                .seeds
+                .len()
+                .min(self.variants.map_or(usize::MAX, |v| v as usize));
+            let first = plants.len();
             for (index, &seed) in g.seeds.iter().enumerate() {
-                let plant = g
-                    .genome
-                    .develop(seed)
-                    .map_err(|source| GardenError::Develop {
-                        group,
-                        index,
-                        source,
-                    })?;
-                if index == 0 {
-                    estimate = estimate
-                        .saturating_add(plant_bytes(&plant).saturating_mul(g.seeds.len() as u64));
-                    sylva_core::budget::check(
-                        estimate,
-                        format_args!("a garden of {count} plants (its genomes' counts)"),
-                        "plant fewer",
-                    )?;
+                if index < grown {
+                    let plant = g
+                        .genome
+                        .develop(seed)
+                        .map_err(|source| GardenError::Develop {
+                            group,
+                            index,
+                            source,
+                        })?;
+                    if index == 0 {
+                        estimate = estimate
+                            .saturating_add(plant_bytes(&plant).saturating_mul(grown as u64));
+                        sylva_core::budget::check(
+                            estimate,
+                            format_args!("a garden of {count} plants (its genomes' counts)"),
+                            "plant fewer",
+                        )?;
+                    }
+                    plants.push(plant);
                 }
-                plants.push(plant);
-                ids.push((group, index, seed));
+                let variant = index % grown;
+                ids.push((group, index, g.seeds[variant], first + variant));
             }
         }
         if plants.is_empty() {
             return Err(GardenError::Empty);
         }
-        let radii: Vec<f32> = plants.iter().map(footprint).collect();
+        let footprints: Vec<f32> = plants.iter().map(footprint).collect();
+        let radii: Vec<f32> = ids
+            .iter()
+            .map(|&(_, _, _, plant)| footprints[plant])
+            .collect();
         let [width, depth] = self.area;
-        for (&r, &(group, index, _)) in radii.iter().zip(&ids) {
+        for (&r, &(group, index, _, _)) in radii.iter().zip(&ids) {
             if f64::from(2.0 * r) > width.min(depth) {
                 return Err(GardenError::TooWide {
                     group,
@@ -369,21 +401,24 @@ impl Garden {
         )
         .map_err(|e| GardenError::DoesNotFit {
             placed: e.placed,
-            count: plants.len(),
+            count: ids.len(),
             tries: self.max_tries,
         })?;
         let placements = spots
             .iter()
             .zip(&radii)
             .zip(&ids)
-            .map(|((&(p, yaw), &radius), &(group, index, seed))| Placement {
-                group,
-                index,
-                seed,
-                translation: Vec3::new(p.x, 0.0, p.y),
-                yaw,
-                radius,
-            })
+            .map(
+                |((&(p, yaw), &radius), &(group, index, seed, plant))| Placement {
+                    group,
+                    index,
+                    seed,
+                    plant,
+                    translation: Vec3::new(p.x, 0.0, p.y),
+                    yaw,
+                    radius,
+                },
+            )
             .collect();
         Ok(GrownGarden { placements, plants })
     }

@@ -309,7 +309,7 @@ impl Scene {
     /// Plants in the scene.
     #[getter]
     fn plants(&self) -> usize {
-        self.assets.meshes().len()
+        self.assets.placed()
     }
 
     /// Triangles of all plants.
@@ -324,7 +324,8 @@ impl Scene {
         self.garden.as_deref()
     }
 
-    /// Each plant's mesh, in its own coordinates (read-only views, as `Plant.mesh`).
+    /// Each distinct plant's mesh, in its own coordinates (read-only views, as `Plant.mesh`);
+    /// plants placed more than once (a garden's variants) share one.
     fn meshes(this: &Bound<'_, Self>) -> PyResult<Vec<Mesh>> {
         let scene = this.get();
         let meshes = scene.assets.meshes();

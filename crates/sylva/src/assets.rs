@@ -219,11 +219,13 @@ impl<'a> Placed<'a> {
     }
 }
 
-/// Meshes of placed plants, ready to be lent out as a scene.
+/// Meshes of placed plants, ready to be lent out as a scene. Placements that borrow the same
+/// plant share one mesh (and rig), which a GLB writes once.
 pub struct SceneAssets {
     meshes: Vec<Mesh>,
     rigs: Vec<Option<Rig>>,
-    nodes: Vec<(String, Vec3, Quat, Option<serde_json::Value>)>,
+    /// Per node: name, place, turn, extras and its mesh.
+    nodes: Vec<(String, Vec3, Quat, Option<serde_json::Value>, usize)>,
 }
 
 impl SceneAssets {
@@ -239,9 +241,22 @@ impl SceneAssets {
         placed: &[Placed<'_>],
         wind: Option<WindOptions>,
     ) -> Result<SceneAssets, Error> {
+        // Each distinct plant (by address) once, in order of first appearance.
+        let mut index_of: std::collections::HashMap<*const Plant, usize> =
+            std::collections::HashMap::new();
+        let mut distinct: Vec<&Placed<'_>> = Vec::new();
+        let mesh_of: Vec<usize> = placed
+            .iter()
+            .map(|p| {
+                *index_of.entry(p.plant as *const Plant).or_insert_with(|| {
+                    distinct.push(p);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
         let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
         let mut needed = 0u64;
-        for p in placed {
+        for p in &distinct {
             let mesher = mesher_for(&mut meshers, p.hint)?;
             needed = needed.saturating_add(mesher.bytes_for(p.plant)?);
         }
@@ -251,9 +266,9 @@ impl SceneAssets {
             "place fewer or smaller plants",
         )
         .map_err(sylva_mesh::mesher::MeshError::from)?;
-        let mut meshes = Vec::with_capacity(placed.len());
-        let mut rigs = Vec::with_capacity(placed.len());
-        for p in placed {
+        let mut meshes = Vec::with_capacity(distinct.len());
+        let mut rigs = Vec::with_capacity(distinct.len());
+        for p in &distinct {
             let mesher = mesher_for(&mut meshers, p.hint)?;
             match wind {
                 None => {
@@ -269,13 +284,13 @@ impl SceneAssets {
         }
         let nodes = placed
             .iter()
-            .zip(&rigs)
-            .map(|(p, rig)| {
+            .zip(mesh_of)
+            .map(|(p, m)| {
                 let mut extras = p.extras.clone();
-                if let (Some(rig), Some(e)) = (rig, extras.as_mut()) {
+                if let (Some(rig), Some(e)) = (&rigs[m], extras.as_mut()) {
                     e["wind"] = wind_extras(rig);
                 }
-                (p.name.clone(), p.translation, p.rotation, extras)
+                (p.name.clone(), p.translation, p.rotation, extras, m)
             })
             .collect();
         Ok(SceneAssets {
@@ -285,7 +300,12 @@ impl SceneAssets {
         })
     }
 
-    /// The meshes, in the order the plants were given.
+    /// Plants placed (nodes of the scene).
+    pub fn placed(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The meshes, one per distinct plant, in the order the plants were first given.
     pub fn meshes(&self) -> &[Mesh] {
         &self.meshes
     }
@@ -293,13 +313,11 @@ impl SceneAssets {
     /// The scene: one node per plant.
     pub fn scene(&self) -> Scene<'_> {
         let nodes = self
-            .meshes
+            .nodes
             .iter()
-            .zip(&self.nodes)
-            .zip(&self.rigs)
-            .map(|((mesh, (name, translation, rotation, extras)), rig)| {
-                let mut node = SceneNode::new(name.clone(), mesh);
-                node.rig = rig.as_ref();
+            .map(|(name, translation, rotation, extras, m)| {
+                let mut node = SceneNode::new(name.clone(), &self.meshes[*m]);
+                node.rig = self.rigs[*m].as_ref();
                 node.translation = *translation;
                 node.rotation = *rotation;
                 node.extras = extras.clone();
@@ -330,9 +348,9 @@ pub fn garden_assets_with_wind(
     let placed: Vec<Placed> = grown
         .placements
         .iter()
-        .zip(&grown.plants)
         .enumerate()
-        .map(|(i, (placement, plant))| {
+        .map(|(i, placement)| {
+            let plant = &grown.plants[placement.plant];
             let genome = &garden.plants[placement.group].genome;
             let origin = Origin::of(
                 &Genome::new(PlantMakerModel, genome.clone()),

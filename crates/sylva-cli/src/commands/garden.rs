@@ -34,6 +34,10 @@ pub struct GardenArgs {
     /// Also render a picture.
     #[arg(long)]
     png: Option<PathBuf>,
+    /// Grow K seeds of each genome and make every plant one of them, so the scene holds a
+    /// few meshes placed many times (1 to 1000; recorded in the garden file).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    variants: Option<u32>,
     #[command(flatten)]
     wind: super::WindArgs,
 }
@@ -64,6 +68,13 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
             )
             .into());
         }
+        if args.variants.is_some() {
+            return Err(InputError::new(
+                "--variants",
+                "a garden file keeps the variants it was planted with; give genome files to plant a new garden",
+            )
+            .into());
+        }
         Garden::from_json(&text).map_err(|e| InputError::genome(first, &text, e))?
     } else {
         // The first file is already read.
@@ -80,6 +91,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
                 args.count as usize,
             );
         }
+        garden.variants = args.variants;
         garden
     };
     let assets = garden_assets_with_wind(&garden, first, wind)?;
@@ -98,9 +110,10 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         println!("wrote {}", garden_path.display());
     }
     println!(
-        "wrote {}: {} plants, {} triangles",
+        "wrote {}: {} plants ({} meshes), {} triangles",
         args.output.display(),
         scene.nodes.len(),
+        assets.meshes().len(),
         scene.triangle_count()
     );
     Ok(())
