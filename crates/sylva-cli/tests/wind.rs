@@ -92,6 +92,57 @@ fn grow_garden_and_evolve_write_wind_that_plays() {
 }
 
 #[test]
+fn render_draws_a_strip_of_the_wind_clip() {
+    let dir = temp("strip");
+    let png = dir.join("strip.png");
+    let palm = example("plantmaker/palm.json");
+    let args = [
+        "render",
+        &palm,
+        "-o",
+        png.to_str().unwrap(),
+        "--wind",
+        "--wind-frames",
+        "4",
+        "--size",
+        "400x100",
+    ];
+    let out = sylva(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let first = std::fs::read(&png).unwrap();
+    assert_eq!(&first[1..4], b"PNG");
+    // The frames differ from a strip of the plant at rest (strength 0), and repeat exactly.
+    let still = dir.join("still.png");
+    let mut calm = args.to_vec();
+    calm[3] = still.to_str().unwrap();
+    calm.extend(["--wind-strength", "0"]);
+    assert!(sylva(&calm).status.success());
+    assert_ne!(std::fs::read(&still).unwrap(), first);
+    assert!(sylva(&args).status.success());
+    assert_eq!(std::fs::read(&png).unwrap(), first);
+    for bad in [
+        &["--wind-frames", "1"][..],
+        &["--wind-frames", "33"],
+        &["--wind-frames", "4", "--wind-period", "0.1"],
+    ] {
+        let mut a = vec![
+            "render",
+            palm.as_str(),
+            "-o",
+            png.to_str().unwrap(),
+            "--wind",
+        ];
+        a.extend_from_slice(bad);
+        assert_eq!(sylva(&a).status.code(), Some(2), "{bad:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn bad_wind_is_refused_before_any_work() {
     let dir = temp("bad");
     let glb = dir.join("x.glb");

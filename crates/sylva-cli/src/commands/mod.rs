@@ -51,11 +51,15 @@ impl WindArgs {
         let is_glb = output
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-        if !is_glb {
+        if !is_glb
+            && !output
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
             return Err(sylva::InputError::new(
                 "--wind",
                 format!(
-                    "wind needs a .glb output (skins and animation clips are glTF's); got {}",
+                    "wind needs a .glb output (skins and animation clips are glTF's), or a .png of `sylva render --wind-frames`; got {}",
                     output.display()
                 ),
             ));

@@ -36,6 +36,13 @@ pub struct RenderArgs {
     /// Leave the roots out (genomes only).
     #[arg(long)]
     hide_roots: bool,
+    /// With `--wind` (genomes only): a strip of N frames (2 to 32) of the wind clip, side by
+    /// side, each the plant posed at an even step through one period, as a glTF viewer
+    /// skins it.
+    #[arg(long, value_name = "N", requires = "wind", value_parser = clap::value_parser!(u32).range(2..=32))]
+    wind_frames: Option<u32>,
+    #[command(flatten)]
+    wind: super::WindArgs,
 }
 
 /// `sylva render`.
@@ -45,7 +52,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    if is_glb {
+    if let Some(frames) = args.wind_frames {
+        if is_glb {
+            return Err(InputError::new(
+                "--wind-frames",
+                "wind frames are drawn from a genome (the GLB reader takes the rest pose)",
+            )
+            .into());
+        }
+        let wind = args.wind.options(&args.output)?;
+        let genome = load_genome(&args.file)?;
+        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let grown = Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind)
+            .in_file(&args.file)?;
+        let png = wind_strip(&grown, frames as usize, args.view, args.size)?;
+        sylva::files::write(&args.output, &png)?;
+    } else if is_glb {
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
         let imported = sylva_mesh::import::read_glb(&bytes)
             .map_err(|e| InputError::file_error(&args.file, &e))?;
@@ -59,4 +81,33 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     println!("wrote {}", args.output.display());
     Ok(())
+}
+
+/// The plant posed at `frames` even steps through its wind clip, side by side along +X.
+fn wind_strip(
+    grown: &Grown,
+    frames: usize,
+    view: View,
+    size: (u32, u32),
+) -> Result<Vec<u8>, sylva::Error> {
+    let Some(rig) = &grown.rig else {
+        return sylva::assets::picture(&grown.scene(), view, size);
+    };
+    let period = rig.times.last().copied().unwrap_or(0.0);
+    let posed: Vec<_> = (0..frames)
+        .map(|k| rig.pose(&grown.mesh, period * k as f32 / frames as f32))
+        .collect();
+    let bounds =
+        sylva_mesh::Scene::single(sylva_mesh::SceneNode::new("plant", &grown.mesh)).bounds();
+    let step = 1.15 * (bounds.max.x - bounds.min.x).max(0.25 * (bounds.max.y - bounds.min.y));
+    let nodes = posed
+        .iter()
+        .enumerate()
+        .map(|(k, mesh)| {
+            let mut node = sylva_mesh::SceneNode::new(format!("frame-{k}"), mesh);
+            node.translation = sylva_core::glam::Vec3::X * (k as f32 * step);
+            node
+        })
+        .collect();
+    sylva::assets::picture(&sylva_mesh::Scene { nodes }, view, size)
 }
