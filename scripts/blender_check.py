@@ -1,15 +1,71 @@
-"""Imports GLBs with Blender's own glTF importer (bpy) and checks what a wind GLB must give an
-artist: an armature per plant with the `wind` action, the meshes bound to it, vertex groups
-named after joints, materials, and the origin extras as custom properties. Run by
-scripts/check-blender."""
+"""Imports GLBs with Blender's own glTF importer (bpy) and checks what they must give an artist.
+Run by scripts/check-blender; what is checked depends on the file's name:
+- NAME-wind.glb: an armature per plant with the `wind` action, the meshes bound to it, vertex
+  groups named after joints, materials, and the origin extras as custom properties;
+- NAME-lean.glb (with NAME.skeleton.json beside it): lean materials, one per organ kind and
+  texture, whose base colour times the imported vertex colours gives back every colour the
+  plant's own materials have."""
+import json
+import os
 import sys
 
 import bpy
+
+
+def lean(path):
+    """Checks that the colours of a lean-material GLB survive Blender's import."""
+    skeleton = json.load(open(path.replace("-lean.glb", ".skeleton.json")))
+    wanted = {tuple(m["color"]) for m in skeleton["materials"]}
+    meshes = [o for o in bpy.data.objects if o.type == "MESH"]
+    problems = []
+    shades = set()
+    wired = 0
+    for material in bpy.data.materials:
+        nodes = material.node_tree.nodes if material.node_tree else []
+        if any(n.type == "VERTEX_COLOR" and n.outputs["Color"].is_linked for n in nodes):
+            wired += 1
+    for obj in meshes:
+        mesh = obj.data
+        if not mesh.color_attributes:
+            problems.append(f"{obj.name} has no colour attribute")
+            continue
+        colours = mesh.color_attributes[0]
+        for poly in mesh.polygons:
+            material = mesh.materials[poly.material_index]
+            factor = next(
+                (n.inputs[7].default_value[:3] for n in material.node_tree.nodes if n.label == "Color Factor"),
+                (1.0, 1.0, 1.0),
+            )
+            if colours.domain == "CORNER":
+                c = colours.data[poly.loop_indices[0]].color
+            else:
+                c = colours.data[poly.vertices[0]].color
+            shades.add(tuple(round(f * x, 4) for f, x in zip(factor, c[:3])))
+    close = lambda a, b: all(abs(x - y) <= 0.004 + 0.02 * y for x, y in zip(a, b))
+    missing = [w for w in wanted if not any(close(s, w) for s in shades)]
+    strays = [s for s in shades if not any(close(s, w) for w in wanted)]
+    if missing:
+        problems.append(f"{len(missing)} of the plant's {len(wanted)} colours not found, e.g. {missing[0]}")
+    if strays:
+        problems.append(f"{len(strays)} imported shades match no plant colour, e.g. {strays[0]}")
+    if wired != len(bpy.data.materials):
+        problems.append(f"vertex colours wired into {wired} of {len(bpy.data.materials)} materials")
+    print(
+        f"{path}: {len(meshes)} mesh(es), {len(bpy.data.materials)} materials "
+        f"({', '.join(sorted(m.name for m in bpy.data.materials))}), vertex colours wired into {wired}, "
+        f"{len(shades)} distinct shades after import for the plant's {len(wanted)} colours: "
+        + ("FAILED: " + "; ".join(problems) if problems else "ok")
+    )
+    return bool(problems)
+
 
 failed = False
 for path in sys.argv[1:]:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_scene.gltf(filepath=path)
+    if path.endswith("-lean.glb"):
+        failed = lean(path) or failed
+        continue
     objects = list(bpy.data.objects)
     armatures = [o for o in objects if o.type == "ARMATURE"]
     # The importer draws bones with a shared shape mesh (an icosphere); it is not a plant.

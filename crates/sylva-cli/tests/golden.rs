@@ -108,7 +108,7 @@ fn one_plant_of_each_model() {
             ("automata.obj", 0x4cda_bedd_4962_f381),
             ("automata.wrl", 0x5940_a067_7cd5_0df9),
             ("automata.png", 0x68b6_e8e4_8498_f113),
-            ("plantmaker.glb", 0xbb3f_0ec7_bc49_aba4),
+            ("plantmaker.glb", 0x275a_ec47_574a_872e),
             ("plantmaker.obj", 0x745c_00a4_4fa6_e209),
             ("plantmaker.wrl", 0x0c1b_ecb8_58ed_505c),
             ("plantmaker.png", 0x2516_d62a_ccf2_381e),
@@ -142,7 +142,7 @@ fn a_plantmaker_garden() {
     check(
         &dir,
         &[
-            ("garden.glb", 0xa3a3_1920_e494_8a7d),
+            ("garden.glb", 0xe413_2dc4_87ee_8404),
             ("garden.garden.json", 0x8e6c_21a1_29f0_ba42),
             ("garden.png", 0xd5f5_7a1f_3656_2915),
         ],
@@ -209,7 +209,7 @@ fn a_small_plantmaker_run() {
         &[
             ("stats.csv", 0x7bfa_8165_d4fb_7972),
             ("best.json", 0x5657_b9ef_f216_00c3),
-            ("best.glb", 0xd3b8_5dcd_b3ca_9270),
+            ("best.glb", 0xbfa6_97ec_f0f6_6095),
             ("best.png", 0xd757_4006_b50a_44ca),
             ("population.png", 0x26e7_33ba_ec34_664d),
         ],

@@ -5,7 +5,10 @@
 //! composed down the hierarchy), triangle primitives with `FLOAT` `VEC3` positions and
 //! optional normals (flat normals are computed when missing), optional `TEXCOORD_0` (`FLOAT`,
 //! or normalised `UNSIGNED_BYTE` or `SHORT`; `(0, 0)` when missing), `UNSIGNED_BYTE`, `SHORT`
-//! or `INT` indices (or none), and each material's base colour. A base colour texture whose
+//! or `INT` indices (or none), each material's base colour, and `COLOR_0` (`FLOAT`, or
+//! normalised `UNSIGNED_BYTE` or `SHORT`, RGB or RGBA), which splits a primitive into one
+//! material per shade (base colour × vertex colour, each triangle taking its first vertex's
+//! colour), as Sylva's lean materials are written. A base colour texture whose
 //! image is named `sylva-texture-<id>` (as Sylva's GLB writer names them) gives the
 //! material that texture id back; other textures, skins, morph targets, sparse accessors and
 //! non-triangle modes are ignored. Every node's transform is baked into
@@ -302,11 +305,48 @@ impl Reader<'_> {
                     base
                 }
             };
-            out.primitives.push(Primitive {
-                material: out.materials.len(),
-                indices: indices[..usable].iter().map(|i| i + base).collect(),
-            });
-            out.materials.push(self.material(prim.get("material"))?);
+            let material = self.material(prim.get("material"))?;
+            let Some(colors) = prim["attributes"].get("COLOR_0") else {
+                out.primitives.push(Primitive {
+                    material: out.materials.len(),
+                    indices: indices[..usable].iter().map(|i| i + base).collect(),
+                });
+                out.materials.push(material);
+                continue;
+            };
+            // Vertex colours (lean materials): one material per shade, each triangle taking
+            // the colour of its first vertex.
+            let colors = self.colors(self.item("accessors", colors)?)?;
+            if colors.len() != positions.len() {
+                return Err(invalid("COLOR_0 and POSITION counts differ"));
+            }
+            let first_shade = out.primitives.len();
+            for t in indices[..usable].chunks_exact(3) {
+                let shade = colors[t[0] as usize];
+                let color: [f32; 3] = std::array::from_fn(|c| material.color[c] * shade[c]);
+                let slot = match out.materials[first_shade..]
+                    .iter()
+                    .position(|m| m.color == color)
+                {
+                    Some(s) => first_shade + s,
+                    None => {
+                        let [r, g, b] = color.map(|c| (c * 255.0).round() as u8);
+                        out.materials.push(Material {
+                            name: format!("{}-{r:02x}{g:02x}{b:02x}", material.name),
+                            color,
+                            ..material.clone()
+                        });
+                        out.primitives.push(Primitive {
+                            material: out.materials.len() - 1,
+                            indices: Vec::new(),
+                        });
+                        out.materials.len() - 1
+                    }
+                };
+                out.primitives[slot]
+                    .indices
+                    .extend(t.iter().map(|i| i + base));
+            }
         }
         Ok(out)
     }
@@ -442,29 +482,49 @@ impl Reader<'_> {
         if accessor["type"] != "VEC2" {
             return Err(invalid("TEXCOORD_0 must be VEC2"));
         }
+        let flat = self.unit_floats(accessor, 2, "TEXCOORD_0")?;
+        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+    }
+
+    /// `COLOR_0` as RGB (alpha is dropped: Sylva's materials are opaque).
+    fn colors(&self, accessor: &Value) -> Result<Vec<[f32; 3]>, ImportError> {
+        let n = match accessor["type"].as_str() {
+            Some("VEC3") => 3,
+            Some("VEC4") => 4,
+            _ => return Err(invalid("COLOR_0 must be VEC3 or VEC4")),
+        };
+        let flat = self.unit_floats(accessor, n, "COLOR_0")?;
+        Ok(flat
+            .chunks_exact(n)
+            .map(|c| [c[0], c[1], c[2]].map(|x| x.clamp(0.0, 1.0)))
+            .collect())
+    }
+
+    /// An accessor of `n` components per element as floats: FLOAT, or normalised
+    /// UNSIGNED_BYTE or SHORT mapped to 0..=1.
+    fn unit_floats(&self, accessor: &Value, n: usize, what: &str) -> Result<Vec<f32>, ImportError> {
         let normalized = accessor["normalized"].as_bool().unwrap_or(false);
         let (size, scale) = match accessor["componentType"].as_u64() {
             Some(5126) => (4, 1.0),
             Some(5121) if normalized => (1, 1.0 / 255.0),
             Some(5123) if normalized => (2, 1.0 / 65_535.0),
             _ => {
-                return Err(invalid(
-                    "TEXCOORD_0 must be FLOAT, or normalised UNSIGNED_BYTE or SHORT",
-                ));
+                return Err(invalid(format!(
+                    "{what} must be FLOAT, or normalised UNSIGNED_BYTE or SHORT"
+                )));
             }
         };
-        let (data, stride, count) = self.view(accessor, 2 * size)?;
+        let (data, stride, count) = self.view(accessor, n * size)?;
         Ok((0..count)
-            .map(|i| {
-                let c = |k: usize| {
+            .flat_map(|i| {
+                (0..n).map(move |k| {
                     let b = &data[i * stride + size * k..i * stride + size * (k + 1)];
                     match size {
                         1 => f32::from(b[0]) * scale,
                         2 => f32::from(u16::from_le_bytes([b[0], b[1]])) * scale,
                         _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
                     }
-                };
-                [c(0), c(1)]
+                })
             })
             .collect())
     }
@@ -605,6 +665,37 @@ mod tests {
         // Untextured materials need no texture coordinates, so none are written.
         assert_eq!(back.meshes[0].1.uvs, [[0.0; 2]; 3]);
         assert_eq!(back.meshes[0].1.materials[0].texture, None);
+    }
+
+    #[test]
+    fn lean_materials_come_back_as_one_material_per_shade() {
+        // Two shades of leaf on separate triangles: written as one leaf material with
+        // COLOR_0, read back as two materials whose colours are the shades, to a byte.
+        let mut mesh = triangle_mesh();
+        mesh.positions.extend_from_within(..);
+        mesh.normals.extend_from_within(..);
+        mesh.uvs.extend_from_within(..);
+        let mut dark = mesh.materials[0].clone();
+        dark.color = [0.05, 0.2, 0.02];
+        mesh.materials.push(dark);
+        mesh.primitives.push(Primitive {
+            material: 1,
+            indices: vec![3, 4, 5],
+        });
+        let glb = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let back = read_glb(&glb).unwrap();
+        let m = &back.meshes[0].1;
+        assert_eq!(m.materials.len(), 2);
+        assert_eq!(m.triangle_count(), 2);
+        for (got, want) in m.materials.iter().zip(&mesh.materials) {
+            assert_eq!(got.kind, MaterialKind::Leaf);
+            for c in 0..3 {
+                assert!(
+                    (got.color[c] - want.color[c]).abs() < 1.0 / 255.0,
+                    "{got:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -38,3 +38,24 @@ pub fn example(path: &str) -> String {
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// What three.js's GLTFLoader (under Node) made of each GLB: one JSON object per file, as
+/// `tools/three-check/scene.mjs` prints them.
+pub fn three_scene(files: &[PathBuf]) -> Vec<serde_json::Value> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let out = Command::new("node")
+        .arg(root.join("tools/three-check/scene.mjs"))
+        .args(files)
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}

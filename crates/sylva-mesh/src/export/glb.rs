@@ -12,6 +12,11 @@
 //! are written once. They are not `doubleSided`: leaves and petals already carry a back face,
 //! and a double-sided material would draw both coincident faces from either side.
 //!
+//! Lean materials ([`super::lean`]): when a mesh has several colours of one organ kind and
+//! texture, they become one primitive and one material per kind and texture, with the
+//! colours in a `COLOR_0` attribute (normalised `u8` RGBA, after TEXCOORD_0 and the skin's
+//! attributes); other meshes are written with one primitive per material as above.
+//!
 //! A material with a texture id also gets `baseColorTexture`: each distinct id used is one
 //! PNG ([`crate::texture`]) embedded in its own buffer view (no `target`), an `image` named
 //! `sylva-texture-<id>` (which [`crate::import`] reads back as the id), and a `texture`
@@ -354,17 +359,46 @@ impl Writer {
             _ => None,
         };
 
+        // What is drawn: each primitive with its material, or lean materials' merged ones.
+        let lean = super::lean::LeanPlan::of(mesh);
+        let color = lean.as_ref().map(|plan| {
+            let start = self.bin.len();
+            for rgba in &plan.colors {
+                self.bin.extend_from_slice(rgba);
+            }
+            let view = self.view(start, ARRAY_BUFFER);
+            self.accessor(json!({
+                "bufferView": view, "componentType": UNSIGNED_BYTE, "normalized": true,
+                "count": count, "type": "VEC4",
+            }))
+        });
+        let draws: Vec<(&sylva_core::Material, Vec<&crate::Primitive>)> = match &lean {
+            Some(plan) => plan
+                .materials
+                .iter()
+                .zip(&plan.members)
+                .map(|(m, group)| (m, group.iter().map(|&p| &mesh.primitives[p]).collect()))
+                .collect(),
+            None => mesh
+                .primitives
+                .iter()
+                .filter(|p| !p.indices.is_empty())
+                .map(|p| (&mesh.materials[p.material], vec![p]))
+                .collect(),
+        };
+
         let wide = count > U16_VERTICES;
         let mut primitives = Vec::new();
-        for p in mesh.primitives.iter().filter(|p| !p.indices.is_empty()) {
+        for (material, group) in draws {
             let start = self.bin.len();
+            let indices = group.iter().flat_map(|p| p.indices.iter().copied());
             if wide {
-                for i in &p.indices {
+                for i in indices {
                     self.bin.extend_from_slice(&i.to_le_bytes());
                 }
             } else {
                 // check_scene put every index below count <= 65 535.
-                for &i in &p.indices {
+                for i in indices {
                     self.bin.extend_from_slice(&(i as u16).to_le_bytes());
                 }
             }
@@ -373,13 +407,17 @@ impl Writer {
             let indices = self.accessor(json!({
                 "bufferView": view,
                 "componentType": if wide { UNSIGNED_INT } else { UNSIGNED_SHORT },
-                "count": p.indices.len(),
+                "count": group.iter().map(|p| p.indices.len()).sum::<usize>(),
                 "type": "SCALAR",
             }));
-            let material = self.material(&mesh.materials[p.material])?;
+            let textured = material.texture.is_some();
+            let material = self.material(material)?;
             let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
-            if let (Some(t), true) = (texcoord, textured(p)) {
+            if let (Some(t), true) = (texcoord, textured) {
                 attributes["TEXCOORD_0"] = json!(t);
+            }
+            if let Some(c) = color {
+                attributes["COLOR_0"] = json!(c);
             }
             if let Some((joints, weights, flutter)) = skin {
                 attributes["JOINTS_0"] = json!(joints);
@@ -669,6 +707,38 @@ mod tests {
         assert_eq!(json["nodes"][2]["mesh"], 0);
         // Identical materials are shared too.
         assert_eq!(json["materials"].as_array().unwrap().len(), 3);
+    }
+
+    #[test]
+    fn shades_of_one_kind_share_a_material_and_carry_vertex_colours() {
+        let mut mesh = small_mesh();
+        let plain = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let (json, _) = chunks(&plain);
+        assert!(json.to_string().find("COLOR_0").is_none());
+        let shade = mesh.primitives[0].material;
+        let mut darker = mesh.materials[shade].clone();
+        darker.color = darker.color.map(|c| c * 0.5);
+        darker.name.push_str("-dark");
+        mesh.materials.push(darker);
+        let half = mesh.primitives[0].indices.len() / 6 * 3;
+        let moved = mesh.primitives[0].indices.split_off(half);
+        mesh.primitives.push(crate::Primitive {
+            material: mesh.materials.len() - 1,
+            indices: moved,
+        });
+        let (json, _) = chunks(&to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap());
+        let prims = json["meshes"][0]["primitives"].as_array().unwrap();
+        assert_eq!(
+            prims.len(),
+            mesh.primitives.len() - 1,
+            "the two shades merged"
+        );
+        let color = prims[0]["attributes"]["COLOR_0"].as_u64().unwrap() as usize;
+        assert_eq!(json["accessors"][color]["componentType"], UNSIGNED_BYTE);
+        assert_eq!(json["accessors"][color]["normalized"], true);
+        assert!(prims.iter().all(|p| p["attributes"]["COLOR_0"] == color));
+        let kind = mesh.materials[shade].kind.name();
+        assert_eq!(json["materials"][0]["name"], kind);
     }
 
     #[test]

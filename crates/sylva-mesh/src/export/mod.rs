@@ -29,6 +29,7 @@
 //! ```
 
 mod glb;
+mod lean;
 mod obj;
 mod vrml;
 
