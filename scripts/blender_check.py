@@ -4,7 +4,9 @@ Run by scripts/check-blender; what is checked depends on the file's name:
   groups named after joints, materials, and the origin extras as custom properties;
 - NAME-lean.glb (with NAME.skeleton.json beside it): lean materials, one per organ kind and
   texture, whose base colour times the imported vertex colours gives back every colour the
-  plant's own materials have."""
+  plant's own materials have;
+- NAME-lod.glb (a `sylva grow --lod N` scene): objects NAME-lod_LOD0 ... as siblings, each
+  with its level's screen coverage among its custom properties, triangles halving."""
 import json
 import os
 import sys
@@ -59,12 +61,51 @@ def lean(path):
     return bool(problems)
 
 
+def lod(path):
+    """Checks that a levels-of-detail scene imports as named sibling objects."""
+    name = os.path.basename(path)[: -len(".glb")]
+    levels = sorted(
+        (o for o in bpy.data.objects if o.type == "MESH" and o.name.startswith(f"{name}_LOD")),
+        key=lambda o: o.name,
+    )
+    problems = []
+    triangles = []
+    coverage = []
+    for k, obj in enumerate(levels):
+        if obj.name != f"{name}_LOD{k}":
+            problems.append(f"object {obj.name} where {name}_LOD{k} was expected")
+        if obj.parent is not None and obj.parent.type != "ARMATURE":
+            problems.append(f"{obj.name} is not at the root")
+        info = obj.get("lod")
+        if info is None:
+            problems.append(f"{obj.name} has no lod custom property")
+        else:
+            coverage.append(round(info["screen_coverage"], 4))
+        obj.data.calc_loop_triangles()
+        triangles.append(len(obj.data.loop_triangles))
+    if len(levels) < 2:
+        problems.append(f"{len(levels)} level objects")
+    if any(b > a for a, b in zip(triangles, triangles[1:])):
+        problems.append(f"triangles do not fall: {triangles}")
+    if coverage != sorted(coverage, reverse=True):
+        problems.append(f"coverage does not fall: {coverage}")
+    print(
+        f"{path}: {len(levels)} level objects ({', '.join(o.name for o in levels)}), "
+        f"triangles {triangles}, screen coverage {coverage}: "
+        + ("FAILED: " + "; ".join(problems) if problems else "ok")
+    )
+    return bool(problems)
+
+
 failed = False
 for path in sys.argv[1:]:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_scene.gltf(filepath=path)
     if path.endswith("-lean.glb"):
         failed = lean(path) or failed
+        continue
+    if path.endswith("-lod.glb"):
+        failed = lod(path) or failed
         continue
     objects = list(bpy.data.objects)
     armatures = [o for o in objects if o.type == "ARMATURE"]

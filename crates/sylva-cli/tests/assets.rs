@@ -41,3 +41,134 @@ fn shades_become_vertex_colours_of_one_material_per_kind() {
     assert_eq!(seen[1]["colored"], 0);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn levels_of_detail_halve_and_load_as_named_siblings() {
+    let dir = temp_dir("lod");
+    let tree = dir.join("tree.glb");
+    let run = sylva(&[
+        "grow",
+        &example("lsystem/tree.json"),
+        "-o",
+        s(&tree),
+        "--lod",
+        "4",
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let levels: Vec<_> = (0..4)
+        .map(|k| dir.join(format!("tree_LOD{k}.glb")))
+        .collect();
+    let mut all = levels.clone();
+    all.push(tree.clone());
+    common::validate(&all);
+    let seen = three_scene(&all);
+    let group = &seen[4];
+    let names: Vec<&str> = group["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["tree_LOD0", "tree_LOD1", "tree_LOD2", "tree_LOD3"]);
+    let full = seen[0]["triangles"].as_f64().unwrap();
+    let mut coverage = f64::INFINITY;
+    for k in 0..4 {
+        // Each file holds its level alone, and the group's node says the same of it.
+        let triangles = seen[k]["triangles"].as_f64().unwrap();
+        let aim = full / f64::from(1u32 << k);
+        assert!(
+            triangles <= aim && triangles >= 0.7 * aim,
+            "LOD{k}: {triangles} for {aim}"
+        );
+        let lod = &group["extras"][k]["lod"];
+        assert_eq!(lod["level"], k);
+        assert_eq!(lod["triangles"].as_f64().unwrap(), triangles);
+        assert_eq!(seen[k]["nodes"][0], format!("tree_LOD{k}"));
+        let c = lod["screen_coverage"].as_f64().unwrap();
+        assert!(c < coverage && c > 0.0, "coverage falls level by level");
+        coverage = c;
+        assert!(
+            group["extras"][k]["genome"].is_null(),
+            "scene.mjs leaves the genome out"
+        );
+        assert_eq!(group["extras"][k]["seed"], 0);
+    }
+    assert!(
+        (coverage - 0.01).abs() < 1e-6,
+        "the last level is culled at 1%"
+    );
+
+    // The same bytes again; with wind, every level rigged and still valid.
+    let first = std::fs::read(&tree).unwrap();
+    assert!(
+        sylva(&[
+            "grow",
+            &example("lsystem/tree.json"),
+            "-o",
+            s(&tree),
+            "--lod",
+            "4"
+        ])
+        .status
+        .success()
+    );
+    assert_eq!(std::fs::read(&tree).unwrap(), first);
+    let windy = dir.join("windy.glb");
+    let run = sylva(&[
+        "grow",
+        &example("plantmaker/flowering-bush.json"),
+        "-o",
+        s(&windy),
+        "--lod",
+        "3",
+        "--wind",
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    common::validate(&[windy.clone(), dir.join("windy_LOD2.glb")]);
+
+    // Refused before any work: a format without levels, and counts out of range.
+    for (output, lod) in [("tree.obj", "3"), ("tree.glb", "1"), ("tree.glb", "9")] {
+        let out = dir.join("refused").join(output);
+        let run = sylva(&[
+            "grow",
+            &example("lsystem/tree.json"),
+            "-o",
+            s(&out),
+            "--lod",
+            lod,
+        ]);
+        assert_eq!(run.status.code(), Some(2), "{output} --lod {lod}");
+        assert!(String::from_utf8_lossy(&run.stderr).contains("--lod"));
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_strip_of_the_levels_is_drawn_side_by_side() {
+    let dir = temp_dir("lod-strip");
+    let strip = dir.join("strip.png");
+    let run = sylva(&[
+        "render",
+        &example("bintree/oak.json"),
+        "--lod",
+        "3",
+        "--size",
+        "120x100",
+        "-o",
+        s(&strip),
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let png = std::fs::read(&strip).unwrap();
+    // PNG header: width and height, big-endian, at bytes 16 and 20.
+    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    assert_eq!(width, 3 * 120);
+    let glb = dir.join("oak.glb");
+    assert!(
+        sylva(&["grow", &example("bintree/oak.json"), "-o", s(&glb)])
+            .status
+            .success()
+    );
+    let run = sylva(&["render", s(&glb), "--lod", "3", "-o", s(&strip)]);
+    assert_eq!(run.status.code(), Some(2));
+    std::fs::remove_dir_all(dir).unwrap();
+}

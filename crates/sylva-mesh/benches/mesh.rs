@@ -7,8 +7,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
-use sylva_mesh::wind;
 use sylva_mesh::{Mesh, Scene, SceneNode, export};
+use sylva_mesh::{lod, wind};
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -69,6 +69,28 @@ fn mesh_tree(c: &mut Criterion) {
             let mut node = SceneNode::new("tree", &mesh);
             node.rig = Some(&rig);
             export::to_glb(&Scene::single(node)).expect("exports")
+        })
+    });
+    // Levels of detail: the chain of four found, each level meshed and written as its own
+    // GLB; against `mesh_and_glb`, the cost of LOD0 to LOD3 together.
+    group.bench_function("lod4_levels_only", |b| {
+        b.iter(|| lod::lod_levels(black_box(&plant), &MeshOptions::default(), 4).expect("levels"))
+    });
+    group.bench_function("lod4_meshes_and_glbs", |b| {
+        b.iter(|| {
+            let chain = lod::lod_levels(black_box(&plant), &MeshOptions::default(), 4)
+                .expect("the bench tree has levels");
+            chain
+                .iter()
+                .map(|level| {
+                    let mesh = Mesher::new(level.options.clone())
+                        .and_then(|mut m| m.mesh(&level.plant))
+                        .expect("levels mesh");
+                    export::to_glb(&Scene::single(SceneNode::new("tree", &mesh)))
+                        .expect("exports")
+                        .len()
+                })
+                .sum::<usize>()
         })
     });
     group.finish();

@@ -7,6 +7,7 @@
 //! - [`scene`]: [`Scene`], meshes placed in the world with their origin data.
 //! - [`export`]: GLB (glTF 2.0 binary), OBJ with MTL, VRML97.
 //! - [`import`]: GLB files read back, for pictures of any GLB.
+//! - [`lod`]: levels of detail, a chain of simplified plants at about half the triangles each.
 //! - [`render`]: a software z-buffer renderer writing PNG, and contact sheets.
 //! - [`texture`]: bark, leaf and petal textures generated from a material's texture id.
 //!
@@ -14,6 +15,7 @@
 
 pub mod export;
 pub mod import;
+pub mod lod;
 pub mod mesh;
 pub mod mesher;
 pub mod render;

@@ -94,6 +94,10 @@ use crate::mesh::{Mesh, Primitive};
 pub struct MeshOptions {
     /// Vertices per tube ring. Default 12; legal `3..=64`.
     pub radial_segments: u32,
+    /// Vertices per tube ring for axes of branch order 0, 1, 2, …, the last entry holding
+    /// for every higher order (levels of detail thin twigs first). Default empty:
+    /// `radial_segments` for every order. Each legal `3..=64`; at most 16 entries.
+    pub radial_segments_by_order: Vec<u32>,
     /// Close each axis's start and tip with a flat cap. Default `true`.
     pub cap_ends: bool,
     /// Round the caps: the cap's centre is raised by the ring's radius and shaded smoothly,
@@ -115,6 +119,7 @@ impl Default for MeshOptions {
     fn default() -> Self {
         MeshOptions {
             radial_segments: 12,
+            radial_segments_by_order: Vec::new(),
             cap_ends: true,
             round_caps: false,
             max_triangles: 50_000_000,
@@ -202,19 +207,10 @@ struct Petal {
 #[derive(Clone, Debug)]
 pub struct Mesher {
     options: MeshOptions,
-    /// `(cos, sin)` of each ring vertex's angle; `R + 1` entries, the last (the seam) a copy
-    /// of the first, so both have bit-identical positions and normals.
-    circle: Vec<(f32, f32)>,
-    /// Indices of one tube segment's quads, relative to the first vertex of its lower ring.
-    quad_pattern: Vec<u32>,
-    /// Texture `u` of each ring vertex: `k / R`, the seam vertex `R` at 1.
-    ring_u: Vec<f32>,
-    /// Texture coordinates of a cap's centre and ring vertices (a planar disc).
-    cap_uv: Vec<[f32; 2]>,
-    /// Fan indices of a start cap (facing back) relative to its centre vertex.
-    start_cap_pattern: Vec<u32>,
-    /// Fan indices of a tip cap (facing forward) relative to its centre vertex.
-    tip_cap_pattern: Vec<u32>,
+    /// The tables of each ring size in use.
+    rings: Vec<RingTables>,
+    /// Per branch order, the index into `rings` (the last entry holds for higher orders).
+    rings_of_order: Vec<usize>,
     /// Leaf outline stations: (half width for a unit width, height for a unit length).
     leaf_profile: Vec<(f32, f32)>,
     /// Both sides of a blade, relative to its first vertex.
@@ -233,6 +229,94 @@ pub struct Mesher {
     pool: Vec<Vec<u32>>,
     /// Per vertex, where it came from ([`Mesher::mesh_with_sources`]), while recording.
     sources: Option<Vec<u32>>,
+}
+
+/// The precomputed tables of one ring size `R`.
+#[derive(Clone, Debug)]
+struct RingTables {
+    /// `R`.
+    r: u32,
+    /// `(cos, sin)` of each ring vertex's angle; `R + 1` entries, the last (the seam) a copy
+    /// of the first, so both have bit-identical positions and normals.
+    circle: Vec<(f32, f32)>,
+    /// Indices of one tube segment's quads, relative to the first vertex of its lower ring.
+    quad_pattern: Vec<u32>,
+    /// Texture `u` of each ring vertex: `k / R`, the seam vertex `R` at 1.
+    ring_u: Vec<f32>,
+    /// Texture coordinates of a cap's centre and ring vertices (a planar disc).
+    cap_uv: Vec<[f32; 2]>,
+    /// Fan indices of a start cap (facing back) relative to its centre vertex.
+    start_cap_pattern: Vec<u32>,
+    /// Fan indices of a tip cap (facing forward) relative to its centre vertex.
+    tip_cap_pattern: Vec<u32>,
+}
+
+impl RingTables {
+    fn new(r: u32) -> Self {
+        let mut circle: Vec<(f32, f32)> = (0..r)
+            .map(|k| {
+                let (s, c) = (TAU * k as f32 / r as f32).sin_cos();
+                (c, s)
+            })
+            .collect();
+        circle.push(circle[0]);
+        let ring_u = (0..=r).map(|k| k as f32 / r as f32).collect();
+        let cap_uv = std::iter::once([0.5, 0.5])
+            .chain(
+                circle[..r as usize]
+                    .iter()
+                    .map(|&(c, s)| [0.5 + 0.5 * c, 0.5 + 0.5 * s]),
+            )
+            .collect();
+        // Quad k joins vertices k, k+1 of the lower ring to the same ones of the upper ring
+        // (rings have r + 1 vertices); with (u, v, tangent) right-handed, (a, b, d) and
+        // (a, d, c) wind counter-clockwise seen from outside. Caps have no seam: their ring
+        // is r vertices after the centre.
+        let mut quad_pattern = Vec::with_capacity(6 * r as usize);
+        let mut start_cap_pattern = Vec::with_capacity(3 * r as usize);
+        let mut tip_cap_pattern = Vec::with_capacity(3 * r as usize);
+        for k in 0..r {
+            let (a, b) = (k, k + 1);
+            let (c, d) = (a + r + 1, b + r + 1);
+            quad_pattern.extend_from_slice(&[a, b, d, a, d, c]);
+            let b = (k + 1) % r;
+            start_cap_pattern.extend_from_slice(&[0, 1 + b, 1 + a]);
+            tip_cap_pattern.extend_from_slice(&[0, 1 + a, 1 + b]);
+        }
+        RingTables {
+            r,
+            circle,
+            quad_pattern,
+            ring_u,
+            cap_uv,
+            start_cap_pattern,
+            tip_cap_pattern,
+        }
+    }
+
+    /// Appends a ring's vertices, at texture `v`.
+    #[inline]
+    fn ring(&self, ring: &Ring, v: f32, out: &mut Mesh) {
+        let Ring {
+            center,
+            pu,
+            pv,
+            nu,
+            nv,
+            nt,
+        } = *ring;
+        out.positions.extend(
+            self.circle
+                .iter()
+                .map(|&(c, s)| (center + pu * c + pv * s).to_array()),
+        );
+        out.normals.extend(
+            self.circle
+                .iter()
+                .map(|&(c, s)| (nu * c + nv * s + nt).to_array()),
+        );
+        out.uvs.extend(self.ring_u.iter().map(|&u| [u, v]));
+    }
 }
 
 /// Marks a vertex of [`Mesher::mesh_with_sources`] as an organ's (leaf, flower, root tip);
@@ -274,38 +358,32 @@ impl Mesher {
         check_range("radial_segments", options.radial_segments, 3, 64, "3..=64")?;
         check_range("leaf_stations", options.leaf_stations, 1, 32, "1..=32")?;
         check_range("flower_petals", options.flower_petals, 3, 32, "3..=32")?;
-        let r = options.radial_segments;
-
-        let mut circle: Vec<(f32, f32)> = (0..r)
-            .map(|k| {
-                let (s, c) = (TAU * k as f32 / r as f32).sin_cos();
-                (c, s)
+        if options.radial_segments_by_order.len() > 16 {
+            return Err(MeshError::BadOption {
+                option: "radial_segments_by_order",
+                value: options.radial_segments_by_order.len() as u64,
+                expected: "at most 16 entries",
+            });
+        }
+        for &r in &options.radial_segments_by_order {
+            check_range("radial_segments_by_order", r, 3, 64, "3..=64")?;
+        }
+        let sizes: Vec<u32> = if options.radial_segments_by_order.is_empty() {
+            vec![options.radial_segments]
+        } else {
+            options.radial_segments_by_order.clone()
+        };
+        let mut rings: Vec<RingTables> = Vec::new();
+        let rings_of_order = sizes
+            .iter()
+            .map(|&r| match rings.iter().position(|t| t.r == r) {
+                Some(i) => i,
+                None => {
+                    rings.push(RingTables::new(r));
+                    rings.len() - 1
+                }
             })
             .collect();
-        circle.push(circle[0]);
-        let ring_u = (0..=r).map(|k| k as f32 / r as f32).collect();
-        let cap_uv = std::iter::once([0.5, 0.5])
-            .chain(
-                circle[..r as usize]
-                    .iter()
-                    .map(|&(c, s)| [0.5 + 0.5 * c, 0.5 + 0.5 * s]),
-            )
-            .collect();
-        // Quad k joins vertices k, k+1 of the lower ring to the same ones of the upper ring
-        // (rings have r + 1 vertices); with (u, v, tangent) right-handed, (a, b, d) and
-        // (a, d, c) wind counter-clockwise seen from outside. Caps have no seam: their ring
-        // is r vertices after the centre.
-        let mut quad_pattern = Vec::with_capacity(6 * r as usize);
-        let mut start_cap_pattern = Vec::with_capacity(3 * r as usize);
-        let mut tip_cap_pattern = Vec::with_capacity(3 * r as usize);
-        for k in 0..r {
-            let (a, b) = (k, k + 1);
-            let (c, d) = (a + r + 1, b + r + 1);
-            quad_pattern.extend_from_slice(&[a, b, d, a, d, c]);
-            let b = (k + 1) % r;
-            start_cap_pattern.extend_from_slice(&[0, 1 + b, 1 + a]);
-            tip_cap_pattern.extend_from_slice(&[0, 1 + a, 1 + b]);
-        }
 
         // Lanceolate half-width sqrt(s)·(1 - s), normalised to 1/2 at its widest (s = 1/3).
         let n = options.leaf_stations;
@@ -355,12 +433,8 @@ impl Mesher {
 
         Ok(Mesher {
             options,
-            circle,
-            ring_u,
-            cap_uv,
-            quad_pattern,
-            start_cap_pattern,
-            tip_cap_pattern,
+            rings,
+            rings_of_order,
             leaf_profile,
             leaf_pattern,
             leaf_uv,
@@ -376,6 +450,13 @@ impl Mesher {
     /// The options this mesher was made with.
     pub fn options(&self) -> &MeshOptions {
         &self.options
+    }
+
+    /// The ring tables for axes of branch `order`.
+    #[inline]
+    fn rings_for(&self, order: u16) -> &RingTables {
+        let last = self.rings_of_order.len() - 1;
+        &self.rings[self.rings_of_order[usize::from(order).min(last)]]
     }
 
     /// Meshes `plant` into `out`, replacing its contents but reusing its buffers' capacity.
@@ -445,6 +526,17 @@ impl Mesher {
         Ok(mesh_bytes(vertices as u64, triangles as u64))
     }
 
+    /// The exact vertex and triangle counts of the mesh of `plant`, without meshing it; an
+    /// error if it is over [`MeshOptions::max_triangles`].
+    pub fn counts(&mut self, plant: &Plant) -> Result<MeshStats, MeshError> {
+        self.link(plant);
+        let (vertices, triangles) = self.count(plant)?;
+        Ok(MeshStats {
+            vertices,
+            triangles,
+        })
+    }
+
     /// Meshes `plant` into a new mesh, and says where each vertex came from: the index of
     /// its tube's segment, or [`ORGAN_SOURCE`] with the organ's parent segment (or
     /// [`NO_SEGMENT`]). Skinning (wind) weights vertices by it.
@@ -479,12 +571,13 @@ impl Mesher {
     /// Exact vertex and triangle counts (and triangles per material), checked against the
     /// limits before anything is allocated.
     fn count(&mut self, plant: &Plant) -> Result<(usize, usize), MeshError> {
-        let r = u64::from(self.options.radial_segments);
         let caps = self.options.cap_ends;
         self.material_triangles.clear();
         self.material_triangles.resize(plant.materials().len(), 0);
         let (mut vertices, mut triangles) = (0u64, 0u64);
         for (i, s) in plant.segments().iter().enumerate() {
+            // An axis keeps its first segment's order (a continuation has its parent's).
+            let r = u64::from(self.rings_for(s.order).r);
             let mut tris = 2 * r;
             vertices += r + 1;
             if self.starts_axis(plant, i) {
@@ -539,8 +632,9 @@ impl Mesher {
     /// Meshes the axis beginning at segment `start`: rings, quads and caps.
     fn tube(&self, plant: &Plant, start: usize, out: &mut Mesh, sources: &mut Option<Vec<u32>>) {
         let segs = &plant.segments();
-        let r = self.options.radial_segments;
         let first = &segs[start];
+        let tables = self.rings_for(first.order);
+        let r = tables.r;
 
         // A branch starts inside its parent (see the module docs).
         let mut x_prev = first.start;
@@ -556,12 +650,12 @@ impl Mesher {
 
         let mut ring = Ring::new(x_prev, n_prev, u_prev, first.start_radius, slope_cur, None);
         if self.options.cap_ends && first.start_radius > 0.0 {
-            self.cap(&ring, -n_prev, first.material.index(), true, out);
+            self.cap(tables, &ring, -n_prev, first.material.index(), true, out);
         }
         let mut base = out.positions.len() as u32;
         // Texture v: metres along the axis over the circumference there (see the docs).
         let (mut tex_v, mut r_prev) = (0.0f32, first.start_radius);
-        self.ring(&ring, tex_v, out);
+        tables.ring(&ring, tex_v, out);
         mark(sources, out, start as u32);
 
         let mut cur = start;
@@ -599,18 +693,18 @@ impl Mesher {
             ring = Ring::new(x, n, u, radius, slope, stretch);
             let circumference = TAU * (0.5 * (r_prev + radius)).max(MIN_UV_RADIUS);
             tex_v += (x - x_prev).length() / circumference;
-            self.ring(&ring, tex_v, out);
+            tables.ring(&ring, tex_v, out);
             mark(sources, out, cur as u32);
             let slot = self.slots[seg.material.index()] as usize;
             out.primitives[slot]
                 .indices
-                .extend(self.quad_pattern.iter().map(|&i| i + base));
+                .extend(tables.quad_pattern.iter().map(|&i| i + base));
             base += r + 1;
             r_prev = radius;
 
             if next == NONE {
                 if self.options.cap_ends && radius > 0.0 {
-                    self.cap(&ring, n, seg.material.index(), false, out);
+                    self.cap(tables, &ring, n, seg.material.index(), false, out);
                     mark(sources, out, cur as u32);
                 }
                 break;
@@ -639,36 +733,20 @@ impl Mesher {
             .unwrap_or(Vec3::Y)
     }
 
-    /// Appends a ring's vertices, at texture `v`.
-    #[inline]
-    fn ring(&self, ring: &Ring, v: f32, out: &mut Mesh) {
-        let Ring {
-            center,
-            pu,
-            pv,
-            nu,
-            nv,
-            nt,
-        } = *ring;
-        out.positions.extend(
-            self.circle
-                .iter()
-                .map(|&(c, s)| (center + pu * c + pv * s).to_array()),
-        );
-        out.normals.extend(
-            self.circle
-                .iter()
-                .map(|&(c, s)| (nu * c + nv * s + nt).to_array()),
-        );
-        out.uvs.extend(self.ring_u.iter().map(|&u| [u, v]));
-    }
-
     /// Appends a flat cap over `ring`: a centre vertex, the ring again with `normal`, and a
     /// fan facing along `normal`.
-    fn cap(&self, ring: &Ring, normal: Vec3, material: usize, start: bool, out: &mut Mesh) {
+    fn cap(
+        &self,
+        tables: &RingTables,
+        ring: &Ring,
+        normal: Vec3,
+        material: usize,
+        start: bool,
+        out: &mut Mesh,
+    ) {
         let center_index = out.positions.len() as u32;
         let Ring { center, pu, pv, .. } = *ring;
-        let ring_circle = &self.circle[..self.circle.len() - 1];
+        let ring_circle = &tables.circle[..tables.circle.len() - 1];
         let n = normal.to_array();
         if self.options.round_caps {
             // A dome: the centre rises by the radius, and the rim keeps the tube's radial
@@ -691,11 +769,11 @@ impl Mesher {
             out.normals
                 .extend(std::iter::repeat_n(n, ring_circle.len() + 1));
         }
-        out.uvs.extend_from_slice(&self.cap_uv);
+        out.uvs.extend_from_slice(&tables.cap_uv);
         let pattern = if start {
-            &self.start_cap_pattern
+            &tables.start_cap_pattern
         } else {
-            &self.tip_cap_pattern
+            &tables.tip_cap_pattern
         };
         let slot = self.slots[material] as usize;
         out.primitives[slot]
@@ -1145,6 +1223,20 @@ mod tests {
                     ..Default::default()
                 },
                 "radial_segments",
+            ),
+            (
+                MeshOptions {
+                    radial_segments_by_order: vec![12, 2],
+                    ..Default::default()
+                },
+                "radial_segments_by_order",
+            ),
+            (
+                MeshOptions {
+                    radial_segments_by_order: vec![3; 17],
+                    ..Default::default()
+                },
+                "radial_segments_by_order",
             ),
             (
                 MeshOptions {

@@ -7,6 +7,8 @@
 //!   hand with the model's own operators ([`Genome::mutate`], [`Genome::cross`]).
 //! - [`assets`]: grown plants as meshes carrying their origin, scenes of many plants,
 //!   exports (GLB, OBJ, VRML97) and pictures.
+//! - [`lod`]: a grown plant's levels of detail as assets ([`LodAssets`]): one mesh per
+//!   level at about half the triangles of the one before, as files or one scene.
 //! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
 //!   origin, written as `PLANT.skeleton.json`.
 //! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
@@ -38,6 +40,7 @@ pub mod error;
 pub mod evolution;
 pub mod files;
 pub mod genome;
+pub mod lod;
 pub mod registry;
 pub mod report;
 pub mod skeleton;
@@ -46,5 +49,6 @@ pub use assets::{Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
 pub use genome::{Genome, load_genome, parse_genome};
+pub use lod::LodAssets;
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;

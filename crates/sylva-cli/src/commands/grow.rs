@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use sylva::assets::{check_png, picture};
 use sylva::files::Outputs;
 use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
-use sylva::{Genome, Grown, load_genome};
+use sylva::{Genome, Grown, InputError, LodAssets, load_genome};
 use sylva_mesh::render::View;
 
 use super::InFile;
@@ -32,6 +32,11 @@ pub struct GrowArgs {
     /// Leave the roots out.
     #[arg(long)]
     hide_roots: bool,
+    /// Levels of detail, 2 to 8 (GLB only): writes NAME_LOD0.glb … beside the output, each
+    /// at about half the triangles of the one before, and the output as one scene with
+    /// every level as a sibling node (NAME_LOD0, …) carrying its screen coverage.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=8))]
+    lod: Option<u32>,
     #[command(flatten)]
     wind: super::WindArgs,
 }
@@ -40,6 +45,13 @@ pub struct GrowArgs {
 pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let output = GrowOutput::of(&args.output)?;
     let wind = args.wind.options(&args.output)?;
+    if args.lod.is_some() && output != GrowOutput::Asset(sylva_mesh::export::Format::Glb) {
+        return Err(InputError::new(
+            "--lod",
+            "levels of detail are written as GLB files: give an output ending in .glb",
+        )
+        .into());
+    }
     if let Some(png) = &args.png {
         check_png(png)?;
     }
@@ -50,6 +62,9 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     }
     let grown =
         Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind).in_file(&args.genome)?;
+    if let Some(levels) = args.lod {
+        return lod(args, grown, levels as usize, wind.as_ref());
+    }
     let mut out = Outputs::new();
     out.add_scene(&args.output, &grown.scene())
         .in_file(&args.genome)?;
@@ -79,6 +94,55 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
             } else {
                 String::new()
             }
+        );
+    }
+    Ok(())
+}
+
+/// `sylva grow --lod N`: NAME_LOD0.glb … beside the output, and the output as one scene of
+/// every level.
+fn lod(
+    args: &GrowArgs,
+    grown: Grown,
+    levels: usize,
+    wind: Option<&sylva_mesh::wind::WindOptions>,
+) -> anyhow::Result<()> {
+    let (segments, organs) = (grown.plant.segments().len(), grown.plant.organs().len());
+    let chain = LodAssets::new(grown, levels, wind).in_file(&args.genome)?;
+    let name = args
+        .output
+        .file_stem()
+        .map_or("plant".into(), |s| s.to_string_lossy().into_owned());
+    let mut out = Outputs::new();
+    let mut files = Vec::new();
+    for k in 0..chain.levels.len() {
+        let path = args.output.with_file_name(format!("{name}_LOD{k}.glb"));
+        out.add_scene(&path, &chain.level_scene(k, &name))
+            .in_file(&args.genome)?;
+        files.push(path);
+    }
+    out.add_scene(&args.output, &chain.group_scene(&name))
+        .in_file(&args.genome)?;
+    if let Some(png) = &args.png {
+        out.add(
+            png,
+            &picture(&chain.level_scene(0, &name), View::Iso, (800, 800))?,
+        )?;
+    }
+    out.commit()?;
+    println!(
+        "wrote {} ({} levels of detail as sibling nodes): {segments} segments, {organs} organs",
+        args.output.display(),
+        chain.levels.len()
+    );
+    let full = chain.levels[0].mesh.triangle_count().max(1) as f64;
+    for (asset, path) in chain.levels.iter().zip(&files) {
+        let triangles = asset.mesh.triangle_count();
+        println!(
+            "  {}: {triangles} triangles ({:.1}% of LOD0), drawn down to {:.1}% of the screen's height",
+            path.display(),
+            100.0 * triangles as f64 / full,
+            100.0 * asset.level.screen_coverage
         );
     }
     Ok(())

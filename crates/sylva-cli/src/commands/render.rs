@@ -41,6 +41,11 @@ pub struct RenderArgs {
     /// skins it.
     #[arg(long, value_name = "N", requires = "wind", value_parser = clap::value_parser!(u32).range(2..=32))]
     wind_frames: Option<u32>,
+    /// Levels of detail (genomes only): a strip of the N levels (2 to 8) side by side, each
+    /// captioned with its triangles, as `sylva grow --lod N` writes them. The size is one
+    /// level's picture.
+    #[arg(long, value_name = "N", conflicts_with = "wind_frames", value_parser = clap::value_parser!(u32).range(2..=8))]
+    lod: Option<u32>,
     #[command(flatten)]
     wind: super::WindArgs,
 }
@@ -52,7 +57,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    if let Some(frames) = args.wind_frames {
+    if let Some(levels) = args.lod {
+        if is_glb {
+            return Err(InputError::new(
+                "--lod",
+                "levels of detail are drawn from a genome, not a GLB",
+            )
+            .into());
+        }
+        let genome = load_genome(&args.file)?;
+        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let grown =
+            Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
+        let chain = sylva::LodAssets::new(grown, levels as usize, None).in_file(&args.file)?;
+        let png = lod_strip(&chain, args.view, args.size)?;
+        sylva::files::write(&args.output, &png)?;
+    } else if let Some(frames) = args.wind_frames {
         if is_glb {
             return Err(InputError::new(
                 "--wind-frames",
@@ -81,6 +101,34 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     println!("wrote {}", args.output.display());
     Ok(())
+}
+
+/// The levels of `chain` side by side, each captioned with its triangle count.
+fn lod_strip(
+    chain: &sylva::LodAssets,
+    view: View,
+    (width, height): (u32, u32),
+) -> anyhow::Result<Vec<u8>> {
+    use sylva_mesh::render::{self, SheetCell, SheetOptions};
+    let cells: Vec<SheetCell> = (0..chain.levels.len())
+        .map(|k| SheetCell {
+            scene: chain.level_scene(k, "plant"),
+            caption: format!(
+                "LOD{k}  {} triangles",
+                chain.levels[k].mesh.triangle_count()
+            ),
+        })
+        .collect();
+    let options = SheetOptions {
+        columns: cells.len() as u32,
+        cell_width: width,
+        cell_height: height + render::CAPTION_HEIGHT,
+        view,
+        title: None,
+    };
+    let image = render::contact_sheet(&cells, &options, &sylva_core::par::Pool::Serial)
+        .map_err(sylva::Error::from)?;
+    Ok(render::encode_png(&image).map_err(sylva::Error::from)?)
 }
 
 /// The plant posed at `frames` even steps through its wind clip, side by side along +X.

@@ -1,0 +1,104 @@
+//! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_mesh::lod`]),
+//! each alone in its own scene, or all of them as sibling nodes named `NAME_LOD0`,
+//! `NAME_LOD1`, … (the Unity naming convention) with each level's screen coverage in its
+//! node's extras.
+
+use serde_json::json;
+use sylva_mesh::lod::{LodError, LodLevel, lod_levels};
+use sylva_mesh::mesher::Mesher;
+use sylva_mesh::wind::{Rig, WindOptions};
+use sylva_mesh::{Mesh, Scene, SceneNode};
+
+use crate::assets::{Grown, mesh_options};
+use crate::error::{Error, InputError};
+
+/// One level, meshed.
+pub struct LodAsset {
+    /// The level's plant, options, detail, triangles and screen coverage.
+    pub level: LodLevel,
+    /// Its mesh.
+    pub mesh: Mesh,
+    /// Its wind skin and clip, when the plant has wind.
+    pub rig: Option<Rig>,
+}
+
+/// A grown plant's chain of levels of detail.
+pub struct LodAssets {
+    /// Level 0 (the plant as grown) first.
+    pub levels: Vec<LodAsset>,
+    /// The extras every level's node carries (genome, seed, taper, wind), before its own.
+    extras: serde_json::Value,
+}
+
+impl LodAssets {
+    /// The chain of `levels` levels of `grown` (level 0 is its own mesh and rig), each
+    /// further level rigged for `wind` when `grown` has wind.
+    pub fn new(grown: Grown, levels: usize, wind: Option<&WindOptions>) -> Result<Self, Error> {
+        let options = mesh_options(grown.genome.mesh_hint());
+        let extras = grown.scene().nodes[0].extras.clone().unwrap_or(json!({}));
+        let chain = lod_levels(&grown.plant, &options, levels).map_err(|e| match e {
+            LodError::Mesh(e) => Error::Mesh(e),
+            LodError::Levels(n) => Error::Input(InputError::new(
+                "--lod",
+                format!(
+                    "{n} levels asked for, expected 2 to {}",
+                    sylva_mesh::lod::MAX_LEVELS
+                ),
+            )),
+            other => Error::Input(InputError::new("--lod", other.to_string())),
+        })?;
+        let Grown { mesh, rig, .. } = grown;
+        let mut first = Some((mesh, rig));
+        let levels = chain
+            .into_iter()
+            .map(|level| {
+                let (mesh, rig) = match first.take() {
+                    Some(grown) => grown,
+                    None => {
+                        let mut mesher = Mesher::new(level.options.clone())?;
+                        match wind {
+                            Some(wind) => {
+                                let (mesh, sources) = mesher.mesh_with_sources(&level.plant)?;
+                                let rig =
+                                    sylva_mesh::wind::rig(&level.plant, &mesh, &sources, wind);
+                                (mesh, Some(rig))
+                            }
+                            None => (mesher.mesh(&level.plant)?, None),
+                        }
+                    }
+                };
+                Ok(LodAsset { level, mesh, rig })
+            })
+            .collect::<Result<Vec<_>, Error>>()?;
+        Ok(LodAssets { levels, extras })
+    }
+
+    /// The node of level `k`, named `NAME_LODk`.
+    fn node(&self, k: usize, name: &str) -> SceneNode<'_> {
+        let asset = &self.levels[k];
+        let mut node = SceneNode::new(format!("{name}_LOD{k}"), &asset.mesh);
+        let mut extras = self.extras.clone();
+        extras["lod"] = json!({
+            "level": k,
+            "levels": self.levels.len(),
+            "screen_coverage": asset.level.screen_coverage,
+            "triangles": asset.mesh.triangle_count(),
+            "detail": asset.level.detail,
+        });
+        node.extras = Some(extras);
+        node.rig = asset.rig.as_ref();
+        node
+    }
+
+    /// Level `k` alone, its node named `NAME_LODk`.
+    pub fn level_scene(&self, k: usize, name: &str) -> Scene<'_> {
+        Scene::single(self.node(k, name))
+    }
+
+    /// Every level as sibling nodes at the origin, `NAME_LOD0` first.
+    pub fn group_scene(&self, name: &str) -> Scene<'_> {
+        Scene {
+            nodes: (0..self.levels.len()).map(|k| self.node(k, name)).collect(),
+        }
+    }
+}
