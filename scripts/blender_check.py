@@ -6,7 +6,12 @@ Run by scripts/check-blender; what is checked depends on the file's name:
   texture, whose base colour times the imported vertex colours gives back every colour the
   plant's own materials have;
 - NAME-lod.glb (a `sylva grow --lod N` scene): objects NAME-lod_LOD0 ... as siblings, each
-  with its level's screen coverage among its custom properties, triangles halving."""
+  with its level's screen coverage among its custom properties, triangles halving;
+- NAME-....-instanced.glb and NAME-....-quantized.glb (forests of variants with
+  EXT_mesh_gpu_instancing or KHR_mesh_quantization): compared with NAME-plain.glb beside them
+  (the same forest as plain nodes and floats): as many plant objects, sharing as many mesh
+  datablocks, each in the same place (its world-space box within a millimetre), and the
+  origin extras on each plant or its parent."""
 import json
 import os
 import sys
@@ -97,6 +102,46 @@ def lod(path):
     return bool(problems)
 
 
+def forest_summary():
+    """The imported plants: each mesh object's world-space box, the mesh datablocks they
+    share, the empties, and the plants whose origin extras (seed) are on them or a parent."""
+    plants = [o for o in bpy.data.objects if o.type == "MESH"]
+    boxes = []
+    for obj in plants:
+        world = [obj.matrix_world @ v.co for v in obj.data.vertices]
+        boxes.append(tuple(round(f(c[k] for c in world), 4) for f in (min, max) for k in range(3)))
+    extras = sum(1 for o in plants if "seed" in o.keys() or (o.parent and "seed" in o.parent.keys()))
+    empties = sum(1 for o in bpy.data.objects if o.type == "EMPTY")
+    return sorted(boxes), len({o.data.name for o in plants}), empties, extras
+
+
+def forest(path):
+    """Checks an instanced or quantised forest against the plain float one beside it."""
+    name = os.path.basename(path)
+    reference = os.path.join(os.path.dirname(path), name.split("-")[0] + "-plain.glb")
+    boxes, shared, empties, extras = forest_summary()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.gltf(filepath=reference)
+    want, want_shared, _, _ = forest_summary()
+    problems = []
+    if len(boxes) != len(want):
+        problems.append(f"{len(boxes)} plant objects, {len(want)} in {reference}")
+    if shared != want_shared:
+        problems.append(f"{shared} mesh datablocks, {want_shared} in {reference}")
+    worst = max((abs(a - b) for x, y in zip(boxes, want) for a, b in zip(x, y)), default=0.0)
+    if worst > 1e-3:
+        problems.append(f"a plant's box is {worst:.3g} m away from its place in {reference}")
+    if extras != len(boxes):
+        problems.append(f"origin extras on {extras} of {len(boxes)} plants")
+    print(
+        f"{path}: {len(boxes)} plant objects sharing {shared} mesh datablocks ({want_shared} in "
+        f"{os.path.basename(reference)}), {empties} empties, every box within {worst:.2g} m of the "
+        f"plain forest's, origin extras on {extras}: "
+        + ("FAILED: " + "; ".join(problems) if problems else "ok")
+    )
+    return bool(problems)
+
+
 failed = False
 for path in sys.argv[1:]:
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -106,6 +151,9 @@ for path in sys.argv[1:]:
         continue
     if path.endswith("-lod.glb"):
         failed = lod(path) or failed
+        continue
+    if path.endswith(("-instanced.glb", "-quantized.glb")):
+        failed = forest(path) or failed
         continue
     objects = list(bpy.data.objects)
     armatures = [o for o in objects if o.type == "ARMATURE"]

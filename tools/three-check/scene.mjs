@@ -1,7 +1,8 @@
 // Loads GLBs with three.js's own GLTFLoader under Node and prints, per file, one line of JSON
 // saying what three.js made of it: the names of the scene's top nodes, the meshes, instanced
 // meshes and their instance counts, the distinct geometries, the materials and whether they
-// use vertex colours, and how many geometries carry a colour attribute. Tests read the lines.
+// use vertex colours, how many geometries carry a colour attribute, and the world-space box
+// of every vertex (instances and quantised positions included). Tests read the lines.
 // Usage: node tools/three-check/scene.mjs FILE.glb...
 // three.js comes from the studio's pinned install: npm ci --prefix crates/sylva-studio/web
 import fs from "node:fs";
@@ -14,7 +15,7 @@ if (!fs.existsSync(path.join(three, "build/three.module.js"))) {
   console.error("three.js is not installed: run `npm ci --prefix crates/sylva-studio/web`");
   process.exit(2);
 }
-await import(pathToFileURL(path.join(three, "build/three.module.js")).href);
+const { Box3 } = await import(pathToFileURL(path.join(three, "build/three.module.js")).href);
 const { GLTFLoader } = await import(pathToFileURL(path.join(three, "examples/jsm/loaders/GLTFLoader.js")).href);
 
 // GLTFLoader reads `self.URL`, as in a browser. Textures need a DOM to decode: their failures
@@ -47,6 +48,8 @@ for (const file of process.argv.slice(2)) {
     for (const m of [o.material].flat()) materials.set(m.uuid, { name: m.name, vertexColors: m.vertexColors });
   });
   const colored = [...geometries].filter((g) => g.attributes.color).length;
+  gltf.scene.updateMatrixWorld(true);
+  const box = new Box3().setFromObject(gltf.scene, true);
   console.log(JSON.stringify({
     file,
     nodes: gltf.scene.children.map((c) => c.name),
@@ -57,6 +60,7 @@ for (const file of process.argv.slice(2)) {
     geometries: geometries.size,
     colored,
     triangles,
+    box: box.isEmpty() ? null : [box.min.toArray(), box.max.toArray()],
     materials: [...materials.values()],
   }));
 }

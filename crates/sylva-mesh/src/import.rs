@@ -2,13 +2,16 @@
 //! simple ones from elsewhere.
 //!
 //! What is read: the default scene's node tree (translation, rotation, scale or matrix,
-//! composed down the hierarchy), triangle primitives with `FLOAT` `VEC3` positions and
-//! optional normals (flat normals are computed when missing), optional `TEXCOORD_0` (`FLOAT`,
-//! or normalised `UNSIGNED_BYTE` or `SHORT`; `(0, 0)` when missing), `UNSIGNED_BYTE`, `SHORT`
-//! or `INT` indices (or none), each material's base colour, and `COLOR_0` (`FLOAT`, or
-//! normalised `UNSIGNED_BYTE` or `SHORT`, RGB or RGBA), which splits a primitive into one
-//! material per shade (base colour × vertex colour, each triangle taking its first vertex's
-//! colour), as Sylva's lean materials are written. A base colour texture whose
+//! composed down the hierarchy), with `EXT_mesh_gpu_instancing` (a copy of the node's mesh
+//! per instance, at the instance's `TRANSLATION`, `ROTATION` and `SCALE` under the node's
+//! transform), triangle primitives with `VEC3` positions and optional normals (flat normals
+//! are computed when missing), optional `TEXCOORD_0` (`(0, 0)` when missing), `UNSIGNED_BYTE`,
+//! `SHORT` or `INT` indices (or none), each material's base colour, and `COLOR_0` (RGB or
+//! RGBA). Attributes may be `FLOAT` or any integer type, normalised or not, as
+//! `KHR_mesh_quantization` allows. `COLOR_0` splits a primitive into one
+//! material per shade (base colour × vertex colour to a byte, each triangle taking its first
+//! vertex's colour; at most 1024 shades a primitive, further ones in the base colour), as
+//! Sylva's lean materials are written. A base colour texture whose
 //! image is named `sylva-texture-<id>` (as Sylva's GLB writer names them) gives the
 //! material that texture id back; other textures, skins, morph targets, sparse accessors and
 //! non-triangle modes are ignored. Every node's transform is baked into
@@ -23,6 +26,10 @@ use sylva_core::{Material, MaterialKind};
 
 use crate::mesh::{Mesh, Primitive};
 use crate::scene::{Scene, SceneNode};
+
+/// Most shades one primitive's `COLOR_0` is split into; triangles of further shades keep
+/// the material's base colour (Sylva's own files have a few dozen).
+const MAX_SHADES: usize = 1024;
 
 /// Why a GLB could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -201,11 +208,22 @@ impl Reader<'_> {
         let roots = self.roots()?;
         let placed = self.placed_nodes(&roots)?;
         let nodes = self.list("nodes");
-        // Count the work before doing it: every node gets its own world-space copy of its
-        // mesh, whose primitives share their vertices when they share an accessor.
+        // Each instance of an instanced node, with its world transform.
+        let mut instances: HashMap<usize, Vec<Mat4>> = HashMap::new();
+        for &(i, world) in &placed {
+            if nodes[i].get("mesh").is_some()
+                && let Some(ext) = nodes[i]["extensions"].get("EXT_mesh_gpu_instancing")
+            {
+                let local = self.instances(ext)?;
+                instances.insert(i, local.into_iter().map(|m| world * m).collect());
+            }
+        }
+        // Count the work before doing it: every node (or instance) gets its own world-space
+        // copy of its mesh, whose primitives share their vertices when they share an accessor.
         let (mut vertices, mut indices) = (0u64, 0u64);
         let mut sizes: HashMap<u64, (u64, u64)> = HashMap::new();
         for &(i, _) in &placed {
+            let copies = instances.get(&i).map_or(1, |m| m.len() as u64);
             if let Some(mesh) = nodes[i].get("mesh") {
                 let key = mesh.as_u64().unwrap_or(u64::MAX);
                 let (v, n) = match sizes.get(&key) {
@@ -216,8 +234,8 @@ impl Reader<'_> {
                         size
                     }
                 };
-                vertices = vertices.saturating_add(v);
-                indices = indices.saturating_add(n);
+                vertices = vertices.saturating_add(v.saturating_mul(copies));
+                indices = indices.saturating_add(n.saturating_mul(copies));
             }
         }
         if indices / 3 > MAX_TRIANGLES as u64 {
@@ -237,12 +255,64 @@ impl Reader<'_> {
         for (i, world) in placed {
             let node = &nodes[i];
             if let Some(mesh) = node.get("mesh") {
-                let name = node["name"].as_str().unwrap_or("node").to_owned();
-                let mesh = self.mesh(self.item("meshes", mesh)?, world)?;
-                out.meshes.push((name, mesh));
+                let name = node["name"].as_str().unwrap_or("node");
+                let mesh = self.item("meshes", mesh)?;
+                match instances.get(&i) {
+                    None => out.meshes.push((name.to_owned(), self.mesh(mesh, world)?)),
+                    Some(worlds) => {
+                        for (k, &world) in worlds.iter().enumerate() {
+                            out.meshes
+                                .push((format!("{name}-{k}"), self.mesh(mesh, world)?));
+                        }
+                    }
+                }
             }
         }
         Ok(out)
+    }
+
+    /// The local transforms of an `EXT_mesh_gpu_instancing` extension's instances.
+    fn instances(&self, ext: &Value) -> Result<Vec<Mat4>, ImportError> {
+        let attribute = |name: &str, n: usize| -> Result<Option<Vec<f32>>, ImportError> {
+            let Some(index) = ext["attributes"].get(name) else {
+                return Ok(None);
+            };
+            let accessor = self.item("accessors", index)?;
+            let want = if n == 4 { "VEC4" } else { "VEC3" };
+            if accessor["type"] != want {
+                return Err(invalid(format!("instance {name} must be {want}")));
+            }
+            let values = self.floats(accessor, n, name)?;
+            if !values.iter().all(|v| v.is_finite()) {
+                return Err(invalid(format!("instance {name} is not finite")));
+            }
+            Ok(Some(values))
+        };
+        let t = attribute("TRANSLATION", 3)?;
+        let r = attribute("ROTATION", 4)?;
+        let s = attribute("SCALE", 3)?;
+        let counts: Vec<usize> = [(&t, 3), (&r, 4), (&s, 3)]
+            .iter()
+            .filter_map(|(a, n)| a.as_ref().map(|a| a.len() / n))
+            .collect();
+        let count = counts.first().copied().unwrap_or(0);
+        if counts.iter().any(|&c| c != count) {
+            return Err(invalid("instance attributes have different counts"));
+        }
+        Ok((0..count)
+            .map(|i| {
+                let t = t
+                    .as_ref()
+                    .map_or(Vec3::ZERO, |t| Vec3::from_slice(&t[3 * i..]));
+                let r = r.as_ref().map_or(Quat::IDENTITY, |r| {
+                    Quat::from_slice(&r[4 * i..]).normalize()
+                });
+                let s = s
+                    .as_ref()
+                    .map_or(Vec3::ONE, |s| Vec3::from_slice(&s[3 * i..]));
+                Mat4::from_scale_rotation_translation(s, r, t)
+            })
+            .collect())
     }
 
     /// Vertices (one copy per distinct vertex-attribute accessors) and indices a mesh holds
@@ -320,17 +390,27 @@ impl Reader<'_> {
             if colors.len() != positions.len() {
                 return Err(invalid("COLOR_0 and POSITION counts differ"));
             }
-            let first_shade = out.primitives.len();
+            // Shades by their colour to a byte (a file may give every triangle its own):
+            // at most MAX_SHADES per primitive, the rest drawn in the base colour.
+            let mut shades: HashMap<[u8; 3], usize> = HashMap::new();
+            let mut unshaded = None;
             for t in indices[..usable].chunks_exact(3) {
                 let shade = colors[t[0] as usize];
                 let color: [f32; 3] = std::array::from_fn(|c| material.color[c] * shade[c]);
-                let slot = match out.materials[first_shade..]
-                    .iter()
-                    .position(|m| m.color == color)
-                {
-                    Some(s) => first_shade + s,
+                let key = color.map(|c| (c * 255.0).round() as u8);
+                let known = shades.get(&key).copied();
+                let slot = match known {
+                    Some(s) => s,
+                    None if shades.len() >= MAX_SHADES => *unshaded.get_or_insert_with(|| {
+                        out.materials.push(material.clone());
+                        out.primitives.push(Primitive {
+                            material: out.materials.len() - 1,
+                            indices: Vec::new(),
+                        });
+                        out.materials.len() - 1
+                    }),
                     None => {
-                        let [r, g, b] = color.map(|c| (c * 255.0).round() as u8);
+                        let [r, g, b] = key;
                         out.materials.push(Material {
                             name: format!("{}-{r:02x}{g:02x}{b:02x}", material.name),
                             color,
@@ -340,6 +420,7 @@ impl Reader<'_> {
                             material: out.materials.len() - 1,
                             indices: Vec::new(),
                         });
+                        shades.insert(key, out.materials.len() - 1);
                         out.materials.len() - 1
                     }
                 };
@@ -463,26 +544,18 @@ impl Reader<'_> {
     }
 
     fn vec3s(&self, accessor: &Value) -> Result<Vec<Vec3>, ImportError> {
-        if accessor["componentType"].as_u64() != Some(5126) || accessor["type"] != "VEC3" {
-            return Err(invalid("positions and normals must be FLOAT VEC3"));
+        if accessor["type"] != "VEC3" {
+            return Err(invalid("positions and normals must be VEC3"));
         }
-        let (data, stride, count) = self.view(accessor, 12)?;
-        Ok((0..count)
-            .map(|i| {
-                let f = |k: usize| {
-                    let b = &data[i * stride + 4 * k..i * stride + 4 * k + 4];
-                    f32::from_le_bytes([b[0], b[1], b[2], b[3]])
-                };
-                Vec3::new(f(0), f(1), f(2))
-            })
-            .collect())
+        let flat = self.floats(accessor, 3, "POSITION or NORMAL")?;
+        Ok(flat.chunks_exact(3).map(Vec3::from_slice).collect())
     }
 
     fn vec2s(&self, accessor: &Value) -> Result<Vec<[f32; 2]>, ImportError> {
         if accessor["type"] != "VEC2" {
             return Err(invalid("TEXCOORD_0 must be VEC2"));
         }
-        let flat = self.unit_floats(accessor, 2, "TEXCOORD_0")?;
+        let flat = self.floats(accessor, 2, "TEXCOORD_0")?;
         Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
 
@@ -493,38 +566,46 @@ impl Reader<'_> {
             Some("VEC4") => 4,
             _ => return Err(invalid("COLOR_0 must be VEC3 or VEC4")),
         };
-        let flat = self.unit_floats(accessor, n, "COLOR_0")?;
+        let flat = self.floats(accessor, n, "COLOR_0")?;
         Ok(flat
             .chunks_exact(n)
             .map(|c| [c[0], c[1], c[2]].map(|x| x.clamp(0.0, 1.0)))
             .collect())
     }
 
-    /// An accessor of `n` components per element as floats: FLOAT, or normalised
-    /// UNSIGNED_BYTE or SHORT mapped to 0..=1.
-    fn unit_floats(&self, accessor: &Value, n: usize, what: &str) -> Result<Vec<f32>, ImportError> {
+    /// An accessor of `n` components per element as floats: `FLOAT`, or any integer type,
+    /// normalised (signed ones as `max(c / max, -1)`, as glTF says) or as it is.
+    fn floats(&self, accessor: &Value, n: usize, what: &str) -> Result<Vec<f32>, ImportError> {
         let normalized = accessor["normalized"].as_bool().unwrap_or(false);
-        let (size, scale) = match accessor["componentType"].as_u64() {
-            Some(5126) => (4, 1.0),
-            Some(5121) if normalized => (1, 1.0 / 255.0),
-            Some(5123) if normalized => (2, 1.0 / 65_535.0),
-            _ => {
-                return Err(invalid(format!(
-                    "{what} must be FLOAT, or normalised UNSIGNED_BYTE or SHORT"
-                )));
-            }
+        let Some(kind @ (5120..=5123 | 5126)) = accessor["componentType"].as_u64() else {
+            return Err(invalid(format!(
+                "{what} must be FLOAT, BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT"
+            )));
+        };
+        let size = match kind {
+            5120 | 5121 => 1,
+            5122 | 5123 => 2,
+            _ => 4,
         };
         let (data, stride, count) = self.view(accessor, n * size)?;
+        let decode = |b: &[u8]| -> f32 {
+            let (value, max) = match kind {
+                5120 => (f32::from(b[0] as i8), 127.0),
+                5121 => (f32::from(b[0]), 255.0),
+                5122 => (f32::from(i16::from_le_bytes([b[0], b[1]])), 32_767.0),
+                5123 => (f32::from(u16::from_le_bytes([b[0], b[1]])), 65_535.0),
+                _ => return f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            };
+            if normalized {
+                (value / max).max(-1.0)
+            } else {
+                value
+            }
+        };
         Ok((0..count)
             .flat_map(|i| {
-                (0..n).map(move |k| {
-                    let b = &data[i * stride + size * k..i * stride + size * (k + 1)];
-                    match size {
-                        1 => f32::from(b[0]) * scale,
-                        2 => f32::from(u16::from_le_bytes([b[0], b[1]])) * scale,
-                        _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-                    }
-                })
+                (0..n)
+                    .map(move |k| decode(&data[i * stride + size * k..i * stride + size * (k + 1)]))
             })
             .collect())
     }
@@ -699,6 +780,34 @@ mod tests {
     }
 
     #[test]
+    fn a_shade_for_every_triangle_is_bounded() {
+        // 2000 triangles, each its own colour: at most MAX_SHADES materials, plus one for
+        // the rest in the base colour, and every triangle still drawn.
+        let mut mesh = Mesh::default();
+        for k in 0..2000u32 {
+            mesh.positions.extend_from_slice(&[
+                [k as f32, 0.0, 0.0],
+                [k as f32, 1.0, 0.0],
+                [k as f32, 0.0, 1.0],
+            ]);
+            mesh.normals.extend_from_slice(&[[1.0, 0.0, 0.0]; 3]);
+            let mut m = Material::of_kind(MaterialKind::Leaf);
+            m.color = [k as f32 / 2000.0, 0.5, (k % 7) as f32 / 7.0];
+            mesh.materials.push(m);
+            mesh.primitives.push(Primitive {
+                material: k as usize,
+                indices: vec![3 * k, 3 * k + 1, 3 * k + 2],
+            });
+        }
+        let glb = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let back = read_glb(&glb).unwrap();
+        let m = &back.meshes[0].1;
+        assert_eq!(m.triangle_count(), 2000);
+        assert!(m.materials.len() <= MAX_SHADES + 1, "{}", m.materials.len());
+        assert_eq!(m.materials.len(), m.primitives.len());
+    }
+
+    #[test]
     fn uvs_and_texture_ids_round_trip() {
         let mut mesh = crate::export::tests::small_mesh();
         mesh.materials[0].texture = Some(2);
@@ -814,6 +923,33 @@ mod tests {
                 .len(),
             1
         );
+    }
+
+    #[test]
+    fn instanced_nodes_give_a_mesh_per_instance_and_bad_instances_are_refused() {
+        let instanced = |attributes: serde_json::Value| {
+            let node = serde_json::json!({
+                "name": "i", "mesh": 0, "translation": [0.0, 0.0, 5.0],
+                "extensions": { "EXT_mesh_gpu_instancing": { "attributes": attributes } },
+            });
+            read_glb(&shared_mesh(1, serde_json::json!([node])))
+        };
+        // The triangle's own corners as three instances' translations.
+        let scene = instanced(serde_json::json!({ "TRANSLATION": 0 })).unwrap();
+        let names: Vec<&str> = scene.meshes.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["i-0", "i-1", "i-2"]);
+        assert_eq!(scene.meshes[1].1.positions[2], [1.0, 1.0, 5.0]);
+        for (attributes, why) in [
+            (serde_json::json!({ "ROTATION": 0 }), "must be VEC4"),
+            (serde_json::json!({ "TRANSLATION": 9 }), "does not exist"),
+            (
+                serde_json::json!({ "TRANSLATION": "x" }),
+                "not a whole number",
+            ),
+        ] {
+            let e = instanced(attributes).unwrap_err();
+            assert!(e.to_string().contains(why), "{e}");
+        }
     }
 
     #[test]

@@ -83,6 +83,16 @@ pub struct Garden {
         deserialize_with = "some_variants"
     )]
     pub variants: Option<u32>,
+    /// How the garden's GLB draws a forest of variants: one node per variant with
+    /// `EXT_mesh_gpu_instancing` (absent or `true`, the default), or each plant as a plain
+    /// node sharing its variant's mesh (`false`). Growing ignores it; Sylva's GLB export
+    /// reads it, so that the file gives the same bytes again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instancing: Option<bool>,
+    /// Whether the garden's GLB quantises positions and normals (`KHR_mesh_quantization`).
+    /// Absent: no. Growing ignores it, as it does `instancing`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub quantize: bool,
 }
 
 sylva_core::ranged!(variants: u32, "variants", 1, 1000);
@@ -298,6 +308,8 @@ impl Garden {
             max_tries: DEFAULT_TRIES,
             plants: Vec::new(),
             variants: None,
+            instancing: None,
+            quantize: false,
         };
         garden.add(genome, count);
         garden

@@ -5,7 +5,8 @@
 //! scene, with the extras its node carries (usually its [`Origin`]: genome, seed, Sylva's
 //! version, and its parents when known); [`SceneAssets::mesh`] meshes many placed plants with one mesher per
 //! set of options, and [`SceneAssets::scene`] lends them out as a [`Scene`] to export or
-//! picture. Mesh options follow from each model's [`MeshHint`], never from its name.
+//! picture; [`placed_glb`] instead lays out their GLB to stream, meshing one plant at a time.
+//! Mesh options follow from each model's [`MeshHint`], never from its name.
 
 use std::path::Path;
 
@@ -14,13 +15,13 @@ use sylva_core::glam::{Quat, Vec3};
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
 use sylva_evolve::IndividualId;
-use sylva_mesh::export::{self, Format};
+use sylva_mesh::export::{self, Format, Glb, GlbNode, GlbOptions, MeshSource};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_model::{MeshHint, Model};
-use sylva_plantmaker::{Garden, PlantMakerModel};
+use sylva_plantmaker::{Garden, GrownGarden, PlantMakerModel};
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
@@ -341,11 +342,22 @@ pub fn garden_assets_with_wind(
     source: &Path,
     wind: Option<WindOptions>,
 ) -> Result<SceneAssets, Error> {
-    let grown = garden
+    let grown = grow_garden(garden, source)?;
+    SceneAssets::mesh_with_wind(&garden_placed(garden, &grown), wind).map_err(|e| e.in_file(source))
+}
+
+/// Grows every plant of a PlantMaker garden and places it, unmeshed. Errors name `source`.
+pub fn grow_garden(garden: &Garden, source: &Path) -> Result<GrownGarden, Error> {
+    Ok(garden
         .grow()
-        .map_err(|e| InputError::file_error(source, &e))?;
+        .map_err(|e| InputError::file_error(source, &e))?)
+}
+
+/// The plants of a grown garden as placed in its scene: one per placement (`plant-0`,
+/// `plant-1`, ...), each carrying its genome and seed; the plants of one variant share it.
+pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<'g>> {
     let hint = PlantMakerModel.mesh_hint();
-    let placed: Vec<Placed> = grown
+    grown
         .placements
         .iter()
         .enumerate()
@@ -363,8 +375,82 @@ pub fn garden_assets_with_wind(
                 ..Placed::new(format!("plant-{i}"), plant, hint)
             }
         })
-        .collect();
-    SceneAssets::mesh_with_wind(&placed, wind).map_err(|e| e.in_file(source))
+        .collect()
+}
+
+/// How a garden's GLB is laid out, as its file says: a forest of variants is instanced
+/// unless `"instancing": false`; positions are quantised with `"quantize": true`.
+pub fn garden_glb_options(garden: &Garden) -> GlbOptions {
+    GlbOptions {
+        instancing: garden.variants.is_some() && garden.instancing != Some(false),
+        quantize: garden.quantize,
+    }
+}
+
+/// The GLB of placed plants, laid out and ready to stream ([`Outputs::add_glb`]), whose
+/// meshes are made when they are needed and dropped after: one plant at a time, each twice
+/// (once to lay the file out, once to write its bytes). Memory holds the plants, the JSON
+/// and one mesh, rather than every mesh as [`SceneAssets`] does; the bytes are those of
+/// [`SceneAssets::scene`] written with the same options. No wind: a rig is made from its
+/// mesh, and the skins are written after every mesh.
+///
+/// [`Outputs::add_glb`]: crate::files::Outputs::add_glb
+pub fn placed_glb<'a>(placed: &'a [Placed<'a>], options: GlbOptions) -> Result<Glb<'a>, Error> {
+    let mut index_of: std::collections::HashMap<*const Plant, usize> =
+        std::collections::HashMap::new();
+    let mut plants: Vec<(&Plant, usize)> = Vec::new();
+    let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
+    let mut nodes = Vec::with_capacity(placed.len());
+    for p in placed {
+        let mesh = match index_of.get(&(p.plant as *const Plant)) {
+            Some(&m) => m,
+            None => {
+                let mesher = match meshers.iter().position(|(h, _)| *h == p.hint) {
+                    Some(m) => m,
+                    None => {
+                        meshers.push((p.hint, Mesher::new(mesh_options(p.hint))?));
+                        meshers.len() - 1
+                    }
+                };
+                plants.push((p.plant, mesher));
+                index_of.insert(p.plant, plants.len() - 1);
+                plants.len() - 1
+            }
+        };
+        nodes.push(GlbNode {
+            name: &p.name,
+            mesh,
+            rig: None,
+            translation: p.translation,
+            rotation: p.rotation,
+            extras: p.extras.as_ref(),
+        });
+    }
+    let source = PlantMeshes {
+        plants,
+        meshers: meshers.into_iter().map(|(_, m)| m).collect(),
+        mesh: Mesh::default(),
+    };
+    Ok(Glb::new(nodes, Box::new(source), options)?)
+}
+
+/// Meshes plants when the GLB writer asks for them, into one reused mesh.
+struct PlantMeshes<'a> {
+    /// Each distinct plant and its mesher.
+    plants: Vec<(&'a Plant, usize)>,
+    meshers: Vec<Mesher>,
+    mesh: Mesh,
+}
+
+impl MeshSource for PlantMeshes<'_> {
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_mesh::export::ExportError> {
+        let &(plant, mesher) = self
+            .plants
+            .get(index)
+            .ok_or(sylva_mesh::export::ExportError::NoSuchMesh { index })?;
+        self.meshers[mesher].mesh_into(plant, &mut self.mesh)?;
+        Ok(&self.mesh)
+    }
 }
 
 /// The mesher for plants of `hint`, made the first time it is asked for.

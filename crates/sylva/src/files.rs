@@ -3,7 +3,10 @@
 //! half-written file is ever left behind; and [`Outputs`], the files of one command, which
 //! appear together or not at all.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
+
+use sylva_mesh::export::{Format, Glb, GlbOptions};
 
 use crate::error::{Error, InputError};
 
@@ -123,6 +126,16 @@ impl Outputs {
 
     /// Adds a file: written now under a temporary name, renamed on commit.
     pub fn add(&mut self, path: &Path, bytes: &[u8]) -> Result<(), Error> {
+        self.add_with(path, |file| file.write_all(bytes))
+    }
+
+    /// Adds a file whose bytes `write` streams into it (so they need not be in memory at
+    /// once): written now under a temporary name, renamed on commit.
+    pub fn add_with(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> Result<(), Error> {
         let name = path
             .file_name()
             .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
@@ -134,9 +147,8 @@ impl Outputs {
         // Written whole and synced before the commit renames it; the destination is named in
         // errors (the temporary name is ours, not the user's).
         let written = (|| {
-            use std::io::Write;
             let mut file = std::fs::File::create(&temp)?;
-            file.write_all(bytes)?;
+            write(&mut file)?;
             file.sync_all()
         })();
         self.staged.push((temp, path.to_owned()));
@@ -148,12 +160,32 @@ impl Outputs {
         Ok(())
     }
 
-    /// Adds every file of a scene's export to `path` (an OBJ's MTL and textures too).
+    /// Adds every file of a scene's export to `path` (an OBJ's MTL and textures too); a GLB
+    /// is streamed into its file.
     pub fn add_scene(&mut self, path: &Path, scene: &sylva_mesh::Scene<'_>) -> Result<(), Error> {
+        self.add_scene_with(path, scene, &GlbOptions::default())
+    }
+
+    /// As [`Outputs::add_scene`], a GLB laid out as `options` say (instancing,
+    /// quantisation); other formats ignore them.
+    pub fn add_scene_with(
+        &mut self,
+        path: &Path,
+        scene: &sylva_mesh::Scene<'_>,
+        options: &GlbOptions,
+    ) -> Result<(), Error> {
+        if Format::from_path(path)? == Format::Glb {
+            return self.add_glb(path, &mut Glb::of_scene(scene, *options)?);
+        }
         for (file, bytes) in sylva_mesh::export::scene_files(path, scene)? {
             self.add(&file, &bytes)?;
         }
         Ok(())
+    }
+
+    /// Adds a GLB laid out beforehand, streamed into its file.
+    pub fn add_glb(&mut self, path: &Path, glb: &mut Glb<'_>) -> Result<(), Error> {
+        self.add_with(path, |file| glb.write_to(file))
     }
 
     /// Renames every file into place, in the order added. A file that cannot be renamed

@@ -3,10 +3,14 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{asset_format, check_png, garden_assets_with_wind, picture};
+use sylva::assets::{
+    SceneAssets, asset_format, check_png, garden_glb_options, garden_placed, grow_garden, picture,
+    placed_glb,
+};
 use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
 use sylva::{Genome, InputError};
+use sylva_mesh::export::Format;
 use sylva_mesh::render::View;
 use sylva_plantmaker::garden::GARDEN_MODEL;
 use sylva_plantmaker::{Garden, PlantMakerModel};
@@ -38,6 +42,12 @@ pub struct GardenArgs {
     /// few meshes placed many times (1 to 1000; recorded in the garden file).
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=1000))]
     variants: Option<u32>,
+    /// With --variants: write each plant as a plain node sharing its variant's mesh, rather
+    /// than one node per variant with EXT_mesh_gpu_instancing (recorded in the garden file).
+    #[arg(long)]
+    no_instancing: bool,
+    #[command(flatten)]
+    quantize: super::QuantizeArgs,
     #[command(flatten)]
     wind: super::WindArgs,
 }
@@ -46,10 +56,12 @@ pub struct GardenArgs {
 const PURPOSE: &str = "gardens grow";
 
 /// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
-/// scene (one node per plant, each carrying its genome and seed) and the garden file.
+/// scene (one node per plant, or per variant when instanced, each carrying its genome and
+/// seed) and the garden file.
 pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
-    asset_format(&args.output)?;
+    let format = asset_format(&args.output)?;
     let wind = args.wind.options(&args.output)?;
+    let quantize = args.quantize.check(&args.output, wind.is_some())?;
     if let Some(png) = &args.png {
         check_png(png)?;
     }
@@ -60,7 +72,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         model: String,
     }
     let is_garden = serde_json::from_str::<Header>(&text).is_ok_and(|h| h.model == GARDEN_MODEL);
-    let garden = if is_garden {
+    let mut garden = if is_garden {
         if args.inputs.len() > 1 {
             return Err(InputError::file(
                 first,
@@ -94,16 +106,55 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         garden.variants = args.variants;
         garden
     };
-    let assets = garden_assets_with_wind(&garden, first, wind)?;
-    let scene = assets.scene();
+    // The layout flags are recorded in a new garden file, and add to what a garden file says.
+    if args.no_instancing {
+        if garden.variants.is_none() {
+            return Err(InputError::new(
+                "--no-instancing",
+                "only forests of variants are instanced; add --variants K, or leave the flag out",
+            )
+            .into());
+        }
+        garden.instancing = Some(false);
+    }
+    garden.quantize |= quantize;
+    if garden.quantize && wind.is_some() {
+        return Err(InputError::new(
+            "--wind",
+            format!(
+                "{} asks for quantised positions (\"quantize\": true), which wind GLBs cannot have",
+                first.display()
+            ),
+        )
+        .into());
+    }
+    let options = garden_glb_options(&garden);
+    let grown = grow_garden(&garden, first)?;
+    let placed = garden_placed(&garden, &grown);
     let mut out = Outputs::new();
-    out.add_scene(&args.output, &scene).in_file(first)?;
+    let (triangles, png) = if format == Format::Glb && wind.is_none() && args.png.is_none() {
+        // Meshed one plant at a time as the GLB streams out: memory holds the plants, the
+        // JSON and one mesh, not the scene.
+        let mut glb = placed_glb(&placed, options).in_file(first)?;
+        out.add_glb(&args.output, &mut glb)?;
+        (glb.stats().triangles as usize, None)
+    } else {
+        let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
+        let scene = assets.scene();
+        out.add_scene_with(&args.output, &scene, &options)
+            .in_file(first)?;
+        let png = match &args.png {
+            Some(path) => Some((path, picture(&scene, View::Iso, SCENE_PICTURE)?)),
+            None => None,
+        };
+        (scene.triangle_count(), png)
+    };
     let garden_path = args.output.with_extension("garden.json");
     if !is_garden {
         out.add(&garden_path, garden.to_json().as_bytes())?;
     }
-    if let Some(png) = &args.png {
-        out.add(png, &picture(&scene, View::Iso, SCENE_PICTURE)?)?;
+    if let Some((path, bytes)) = png {
+        out.add(path, &bytes)?;
     }
     out.commit()?;
     if !is_garden {
@@ -112,9 +163,9 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
     println!(
         "wrote {}: {} plants ({} meshes), {} triangles",
         args.output.display(),
-        scene.nodes.len(),
-        assets.meshes().len(),
-        scene.triangle_count()
+        placed.len(),
+        grown.plants.len(),
+        triangles
     );
     Ok(())
 }

@@ -79,6 +79,44 @@ impl WindArgs {
     }
 }
 
+/// The `--quantize` flag of `grow` and `garden`.
+#[derive(clap::Args, Debug, Default)]
+pub struct QuantizeArgs {
+    /// Store positions as 16-bit and normals as 8-bit integers (glTF's KHR_mesh_quantization,
+    /// which a viewer must support to open the file): a smaller GLB, each position within
+    /// 1/65534 of its plant's size. GLB only; not with --wind.
+    #[arg(long)]
+    quantize: bool,
+}
+
+impl QuantizeArgs {
+    /// Whether to quantise, checked against the output (a GLB) and wind (refused with it).
+    pub fn check(&self, output: &Path, wind: bool) -> Result<bool, sylva::InputError> {
+        if !self.quantize {
+            return Ok(false);
+        }
+        if !output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        {
+            return Err(sylva::InputError::new(
+                "--quantize",
+                format!(
+                    "quantised positions are glTF's (KHR_mesh_quantization): give a .glb output; got {}",
+                    output.display()
+                ),
+            ));
+        }
+        if wind {
+            return Err(sylva::InputError::new(
+                "--quantize",
+                "wind GLBs are not quantised (a skinned mesh would need the dequantisation in its inverse bind matrices); drop --quantize or --wind",
+            ));
+        }
+        Ok(true)
+    }
+}
+
 /// Size of pictures of whole scenes (gardens, experiments): wide, for a plot of plants.
 pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
 

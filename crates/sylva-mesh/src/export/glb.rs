@@ -24,17 +24,45 @@
 //! petals, with trilinear filtering. The colour stays in `baseColorFactor`, which glTF
 //! multiplies with the texture.
 //!
-//! Each buffer view holds one tightly packed accessor (no `byteStride`), starts on a 4-byte
-//! boundary and has its `target` set. The JSON chunk is padded with spaces and the BIN chunk
-//! with zeros to 4 bytes. A mesh with no triangles gives a node without a mesh. The JSON is
-//! built with `serde_json`, whose maps keep a fixed key order, so output is deterministic.
+//! Each buffer view holds one tightly packed accessor (no `byteStride`, but for quantised
+//! attributes), starts on a 4-byte boundary and has its `target` set. The JSON chunk is
+//! padded with spaces and the BIN chunk with zeros to 4 bytes. A mesh with no triangles gives
+//! a node without a mesh. The JSON is built with `serde_json`, whose maps keep a fixed key
+//! order, so output is deterministic.
+//!
+//! [`GlbOptions`] add two extensions, each declared in `extensionsUsed` only when used:
+//!
+//! - **Instancing** (`EXT_mesh_gpu_instancing`, not required): the nodes that share a mesh
+//!   and equal extras, and have no rig, become one node (named after the first of them, with
+//!   their extras) whose extension lists each one's place as `TRANSLATION` and `ROTATION`
+//!   accessors (floats, in untargeted buffer views after the meshes' data). No `SCALE`: nodes
+//!   have none, and glTF's default is 1. Nodes with a rig stay plain (a skinned mesh ignores
+//!   its node's transform, and three.js does not instance skinned meshes).
+//! - **Quantisation** (`KHR_mesh_quantization`, required): positions are normalised `SHORT`s
+//!   (8 bytes per vertex with padding, `byteStride` 8) over the mesh's bounding box, and
+//!   normals normalised `BYTE`s (4 bytes with padding); texture coordinates, colours and
+//!   indices are as without. The dequantisation, a uniform scale `s` (the largest half
+//!   extent) about an offset `o` (the box's centre), goes into each node that shows the mesh:
+//!   a plain node's translation becomes `t + R o` with scale `s`; an instanced node carries
+//!   `o` and `s` itself, and each instance `D⁻¹ I D`: translation `(t − o + R o) / s`, the
+//!   same rotation. A position comes back within `s / 65534` (half a step) of its value.
+//!   Meshes with a rig are not quantised (the dequantisation would have to move into the
+//!   inverse bind matrices).
+//!
+//! [`to_glb`] and [`to_glb_with`] build the file in memory in one pass. [`Glb`] streams it:
+//! a first pass over the meshes computes the JSON (offsets, bounds) and the binary chunk's
+//! length without keeping any data, then [`Glb::write_to`] writes the header, the JSON and the
+//! binary chunk mesh by mesh through a buffer. Its meshes come from a [`MeshSource`], which
+//! may make each mesh when it is asked for (and drop it after), so memory holds one mesh at a
+//! time. Both give the same bytes.
 
 use std::collections::HashMap;
+use std::io::{self, BufWriter, Write};
 
 use serde_json::{Map, Value, json};
 use sylva_core::glam::{Quat, Vec3};
 
-use super::{ExportError, check_scene};
+use super::{ExportError, check_mesh, check_node, check_scene};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::wind::Rig;
@@ -46,23 +74,95 @@ const CHUNK_BIN: u32 = 0x004E_4942; // "BIN\0"
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
+const BYTE: u32 = 5120;
 const UNSIGNED_BYTE: u32 = 5121;
+const SHORT: u32 = 5122;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const LINEAR: u32 = 9729;
 const LINEAR_MIPMAP_LINEAR: u32 = 9987;
 const REPEAT: u32 = 10497;
 const CLAMP_TO_EDGE: u32 = 33071;
+/// The instancing extension's name.
+pub const EXT_MESH_GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
+/// The quantisation extension's name.
+pub const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
 /// The prefix of the glTF image names that carry a Sylva texture id.
 pub(crate) const IMAGE_NAME_PREFIX: &str = "sylva-texture-";
 /// Most vertices that `u16` indices can address (65 535 is reserved for primitive restart).
 const U16_VERTICES: usize = 65_535;
 /// Roughness of every material: plants are matte.
 const ROUGHNESS: f64 = 0.9;
+/// Largest normalised `SHORT`: quantised positions span -32 767 to 32 767.
+const SHORT_MAX: f32 = 32_767.0;
+
+/// How a GLB is laid out. The default is core glTF with float attributes, as [`to_glb`]
+/// writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct GlbOptions {
+    /// Nodes that share a mesh and equal extras (and have no rig) become one node with
+    /// `EXT_mesh_gpu_instancing`. Default `false`.
+    pub instancing: bool,
+    /// Positions and normals of meshes without a rig are quantised (`KHR_mesh_quantization`,
+    /// which a viewer must support to open the file). Default `false`.
+    pub quantize: bool,
+}
+
+/// What a GLB holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GlbStats {
+    /// Bytes of the file.
+    pub bytes: u64,
+    /// glTF meshes written (meshes with triangles).
+    pub meshes: usize,
+    /// Nodes carrying `EXT_mesh_gpu_instancing`.
+    pub instanced: usize,
+    /// Triangles shown, over every node and instance.
+    pub triangles: u64,
+}
+
+/// A node as the GLB writer takes it: a mesh by its index in a [`MeshSource`], placed.
+#[derive(Clone, Debug)]
+pub struct GlbNode<'a> {
+    /// The node's name.
+    pub name: &'a str,
+    /// Its mesh, by index in the [`MeshSource`]. Nodes with the same index share one glTF
+    /// mesh, so they must have the same rig.
+    pub mesh: usize,
+    /// A skin and wind clip for the mesh.
+    pub rig: Option<&'a Rig>,
+    /// Where the mesh's origin goes, metres.
+    pub translation: Vec3,
+    /// Rotation applied before the translation.
+    pub rotation: Quat,
+    /// The node's glTF `extras`.
+    pub extras: Option<&'a Value>,
+}
+
+/// Where a streamed GLB's meshes come from. [`Glb`] asks for each mesh twice, once per pass,
+/// and is done with one before it asks for the next, so a source may make each mesh when
+/// asked and reuse one buffer for all of them. It must give the same mesh both times.
+pub trait MeshSource {
+    /// Mesh `index`.
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, ExportError>;
+}
+
+impl MeshSource for Vec<&Mesh> {
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, ExportError> {
+        self.get(index)
+            .copied()
+            .ok_or(ExportError::NoSuchMesh { index })
+    }
+}
 
 /// Encodes `scene` as a GLB file. Fails only on a scene [`check_scene`] refuses or one too
 /// large for a GLB's 32-bit lengths.
 pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
+    to_glb_with(scene, &GlbOptions::default())
+}
+
+/// As [`to_glb`], laid out as `options` say.
+pub fn to_glb_with(scene: &Scene, options: &GlbOptions) -> Result<Vec<u8>, ExportError> {
     check_scene(scene)?;
     // The binary chunk is built, then copied into the file: about twice its size at once.
     let mut seen = std::collections::HashSet::new();
@@ -89,67 +189,359 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         ),
         "export fewer or smaller plants",
     )?;
-    let mut w = Writer::default();
-    let mut mesh_of: HashMap<(*const Mesh, *const Rig), Option<usize>> = HashMap::new();
-    let mut nodes = Vec::with_capacity(scene.nodes.len());
+    let (nodes, mut meshes) = scene_nodes(scene);
+    let (json, bin, _) = encode(&nodes, &mut meshes, options, false, Vec::new())?;
+    let total = glb_len(json.len(), bin.len());
+    let header = header(total, json.len(), bin.len())?;
+    let mut out = Vec::with_capacity(total as usize);
+    out.extend_from_slice(&header);
+    out.extend_from_slice(&json);
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+        out.extend_from_slice(&bin);
+    }
+    Ok(out)
+}
+
+/// A GLB laid out and ready to stream: its JSON is built and its length known; its binary
+/// data is made only while [`Glb::write_to`] writes it. Every check is done when it is made,
+/// so writing fails only on I/O.
+///
+/// ```
+/// use sylva_mesh::export::{Glb, GlbOptions, to_glb};
+/// use sylva_mesh::Scene;
+///
+/// let scene = Scene::default();
+/// let mut glb = Glb::of_scene(&scene, GlbOptions::default())?;
+/// let mut bytes = Vec::new();
+/// glb.write_to(&mut bytes)?;
+/// assert_eq!(bytes, to_glb(&scene)?);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub struct Glb<'a> {
+    nodes: Vec<GlbNode<'a>>,
+    meshes: Box<dyn MeshSource + 'a>,
+    options: GlbOptions,
+    json: Vec<u8>,
+    bin_len: usize,
+    stats: GlbStats,
+}
+
+impl<'a> Glb<'a> {
+    /// Lays out the GLB of `nodes`, whose meshes come from `meshes` (each asked for once),
+    /// checking every node and mesh as [`check_scene`] does.
+    pub fn new(
+        nodes: Vec<GlbNode<'a>>,
+        mut meshes: Box<dyn MeshSource + 'a>,
+        options: GlbOptions,
+    ) -> Result<Glb<'a>, ExportError> {
+        let (json, Counter(bin_len), mut stats) =
+            encode(&nodes, &mut *meshes, &options, true, Counter(0))?;
+        stats.bytes = glb_len(json.len(), bin_len);
+        header(stats.bytes, json.len(), bin_len)?;
+        Ok(Glb {
+            nodes,
+            meshes,
+            options,
+            json,
+            bin_len,
+            stats,
+        })
+    }
+
+    /// Lays out the GLB of a scene: the bytes [`to_glb_with`] gives.
+    pub fn of_scene(scene: &'a Scene<'a>, options: GlbOptions) -> Result<Glb<'a>, ExportError> {
+        let (nodes, meshes) = scene_nodes(scene);
+        Glb::new(nodes, Box::new(meshes), options)
+    }
+
+    /// What the file holds, and its size.
+    pub fn stats(&self) -> GlbStats {
+        self.stats
+    }
+
+    /// Writes the file to `out` through a buffer of its own (so `out` needs none), making
+    /// the binary data mesh by mesh.
+    pub fn write_to(&mut self, out: &mut dyn Write) -> io::Result<()> {
+        let mut out = BufWriter::with_capacity(1 << 20, out);
+        out.write_all(
+            &header(self.stats.bytes, self.json.len(), self.bin_len).map_err(io::Error::other)?,
+        )?;
+        out.write_all(&self.json)?;
+        if self.bin_len > 0 {
+            out.write_all(&(self.bin_len as u32).to_le_bytes())?;
+            out.write_all(&CHUNK_BIN.to_le_bytes())?;
+        }
+        let stream = Stream {
+            out,
+            len: 0,
+            error: None,
+        };
+        let (_, stream, _) = encode(&self.nodes, &mut *self.meshes, &self.options, false, stream)
+            .map_err(io::Error::other)?;
+        let Stream {
+            mut out,
+            len,
+            error,
+        } = stream;
+        if let Some(e) = error {
+            return Err(e);
+        }
+        if len != self.bin_len {
+            return Err(io::Error::other(
+                "the meshes changed between the GLB writer's two passes",
+            ));
+        }
+        out.flush()
+    }
+}
+
+/// The nodes of a scene for the writer, and their distinct meshes: one per (mesh, rig)
+/// pair, compared by address, in order of first appearance.
+fn scene_nodes<'a>(scene: &'a Scene<'a>) -> (Vec<GlbNode<'a>>, Vec<&'a Mesh>) {
+    let mut index_of: HashMap<(*const Mesh, *const Rig), usize> = HashMap::new();
+    let mut meshes = Vec::new();
+    let nodes = scene
+        .nodes
+        .iter()
+        .map(|node| {
+            let rig: *const Rig = node.rig.map_or(std::ptr::null(), |r| r as *const Rig);
+            let mesh = *index_of
+                .entry((node.mesh as *const Mesh, rig))
+                .or_insert_with(|| {
+                    meshes.push(node.mesh);
+                    meshes.len() - 1
+                });
+            GlbNode {
+                name: &node.name,
+                mesh,
+                rig: node.rig,
+                translation: node.translation,
+                rotation: node.rotation,
+                extras: node.extras.as_ref(),
+            }
+        })
+        .collect();
+    (nodes, meshes)
+}
+
+/// Bytes of a GLB with a JSON chunk of `json` bytes and a binary chunk of `bin` bytes.
+fn glb_len(json: usize, bin: usize) -> u64 {
+    12 + 8 + json as u64 + if bin > 0 { 8 + bin as u64 } else { 0 }
+}
+
+/// The file header and the JSON chunk's header.
+fn header(total: u64, json: usize, bin: usize) -> Result<[u8; 20], ExportError> {
+    let total32 = u32::try_from(total).map_err(|_| ExportError::TooLarge { bytes: total })?;
+    debug_assert_eq!(total, glb_len(json, bin));
+    let mut out = [0u8; 20];
+    for (i, word) in [GLB_MAGIC, GLB_VERSION, total32, json as u32, CHUNK_JSON]
+        .into_iter()
+        .enumerate()
+    {
+        out[4 * i..4 * i + 4].copy_from_slice(&word.to_le_bytes());
+    }
+    Ok(out)
+}
+
+/// Where the binary chunk's bytes go: memory, a stream, or nowhere (counted only).
+trait Sink {
+    /// Bytes put so far.
+    fn len(&self) -> usize;
+    /// Appends bytes.
+    fn put(&mut self, bytes: &[u8]);
+    /// Room for `additional` more bytes is wanted soon.
+    fn reserve(&mut self, _additional: usize) {}
+    /// Zeros up to the next multiple of 4.
+    fn pad4(&mut self) {
+        let n = self.len().next_multiple_of(4) - self.len();
+        self.put(&[0; 3][..n]);
+    }
+}
+
+impl Sink for Vec<u8> {
+    fn len(&self) -> usize {
+        Vec::len(self)
+    }
+    fn put(&mut self, bytes: &[u8]) {
+        self.extend_from_slice(bytes);
+    }
+    fn reserve(&mut self, additional: usize) {
+        Vec::reserve(self, additional);
+    }
+}
+
+/// Counts bytes without keeping them: the layout pass.
+struct Counter(usize);
+
+impl Sink for Counter {
+    fn len(&self) -> usize {
+        self.0
+    }
+    fn put(&mut self, bytes: &[u8]) {
+        self.0 += bytes.len();
+    }
+}
+
+/// Writes bytes through a buffer, keeping the first error (and writing nothing after it).
+struct Stream<W: Write> {
+    out: W,
+    len: usize,
+    error: Option<io::Error>,
+}
+
+impl<W: Write> Sink for Stream<W> {
+    fn len(&self) -> usize {
+        self.len
+    }
+    fn put(&mut self, bytes: &[u8]) {
+        self.len += bytes.len();
+        if self.error.is_none()
+            && let Err(e) = self.out.write_all(bytes)
+        {
+            self.error = Some(e);
+        }
+    }
+}
+
+/// A mesh once written: its glTF index (`None` without triangles), its dequantisation, and
+/// its triangles.
+#[derive(Clone, Copy, Debug)]
+struct Written {
+    index: Option<usize>,
+    dequant: Option<Dequant>,
+    triangles: u64,
+}
+
+/// Nodes drawn by one instanced node.
+struct Group {
+    /// Its place in the nodes array.
+    slot: usize,
+    /// The mesh as written.
+    mesh: Written,
+    /// The nodes it draws, by index; the first names it and gives its extras.
+    members: Vec<usize>,
+}
+
+/// Walks the nodes in order, putting the binary chunk's data into `sink`; returns the JSON
+/// chunk (padded), the sink and what the file holds (less its size). With `check`, each
+/// node, and each mesh when it is first used, is checked as [`check_scene`] does.
+fn encode<S: Sink>(
+    nodes: &[GlbNode<'_>],
+    meshes: &mut dyn MeshSource,
+    options: &GlbOptions,
+    check: bool,
+    sink: S,
+) -> Result<(Vec<u8>, S, GlbStats), ExportError> {
+    let mut w = Writer::new(sink, options.quantize);
+    let mut written: Vec<Option<Written>> = Vec::new();
+    let mut json_nodes = Vec::with_capacity(nodes.len());
+    let mut triangles = 0u64;
     // Rigs go after the plants' nodes: (node index, rig, the node's transform).
     let mut rigs: Vec<(usize, &Rig, Vec3, Quat)> = Vec::new();
-    for node in &scene.nodes {
-        // Addresses only find a mesh already written; indices follow first appearance.
-        let rig_key: *const Rig = node.rig.map_or(std::ptr::null(), |r| r as *const Rig);
-        let key = (node.mesh as *const Mesh, rig_key);
-        let mesh = match mesh_of.get(&key) {
-            Some(&m) => m,
+    let mut groups: Vec<Group> = Vec::new();
+    // Per source mesh, the groups drawing it.
+    let mut groups_of: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (i, node) in nodes.iter().enumerate() {
+        if check {
+            check_node(i, node.translation, node.rotation)?;
+        }
+        if written.len() <= node.mesh {
+            written.resize(node.mesh + 1, None);
+        }
+        // Indices follow first appearance.
+        let mesh = match written[node.mesh] {
+            Some(m) => m,
             None => {
-                let m = w.mesh(node.mesh, &node.name, node.rig)?;
-                mesh_of.insert(key, m);
+                let data = meshes.mesh(node.mesh)?;
+                if check {
+                    check_mesh(i, data)?;
+                }
+                let m = w.mesh(data, node.name, node.rig)?;
+                written[node.mesh] = Some(m);
                 m
             }
         };
+        triangles += mesh.triangles;
+        if options.instancing && node.rig.is_none() && mesh.index.is_some() {
+            let candidates = groups_of.entry(node.mesh).or_default();
+            match candidates
+                .iter()
+                .find(|&&g| nodes[groups[g].members[0]].extras == node.extras)
+            {
+                Some(&g) => groups[g].members.push(i),
+                None => {
+                    candidates.push(groups.len());
+                    groups.push(Group {
+                        slot: json_nodes.len(),
+                        mesh,
+                        members: vec![i],
+                    });
+                    // Filled in once every member is known.
+                    json_nodes.push(Value::Null);
+                }
+            }
+            continue;
+        }
         let mut n = Map::new();
         n.insert("name".into(), json!(node.name));
-        if let Some(m) = mesh {
+        if let Some(m) = mesh.index {
             n.insert("mesh".into(), json!(m));
         }
-        if let (Some(rig), Some(_)) = (node.rig, mesh) {
+        if let (Some(rig), Some(_)) = (node.rig, mesh.index) {
             // A skinned mesh ignores its node's transform: the rig's root node carries it.
             rigs.push((
-                nodes.len(),
+                json_nodes.len(),
                 rig,
                 node.translation,
                 node.rotation.normalize(),
             ));
-            if let Some(extras) = &node.extras {
-                n.insert("extras".into(), extras.clone());
-            }
-            nodes.push(Value::Object(n));
-            continue;
+        } else {
+            place(&mut n, node.translation, node.rotation, mesh.dequant);
         }
-        if node.translation != Vec3::ZERO {
-            n.insert(
-                "translation".into(),
-                json!(node.translation.to_array().map(short)),
-            );
-        }
-        let rotation = node.rotation.normalize();
-        if rotation != Quat::IDENTITY {
-            n.insert("rotation".into(), json!(rotation.to_array().map(short)));
-        }
-        if let Some(extras) = &node.extras {
+        if let Some(extras) = node.extras {
             n.insert("extras".into(), extras.clone());
         }
-        nodes.push(Value::Object(n));
+        json_nodes.push(Value::Object(n));
+    }
+    let mut nodes_json = json_nodes;
+    let instanced = groups.len();
+    for group in groups {
+        let first = &nodes[group.members[0]];
+        let mut n = Map::new();
+        n.insert("name".into(), json!(first.name));
+        n.insert("mesh".into(), json!(group.mesh.index));
+        place(&mut n, Vec3::ZERO, Quat::IDENTITY, group.mesh.dequant);
+        let (translation, rotation) = w.instances(
+            group.members.iter().map(|&k| &nodes[k]),
+            group.members.len(),
+            group.mesh.dequant,
+        );
+        n.insert(
+            "extensions".into(),
+            json!({ EXT_MESH_GPU_INSTANCING: { "attributes": {
+                "TRANSLATION": translation, "ROTATION": rotation,
+            } } }),
+        );
+        if let Some(extras) = first.extras {
+            n.insert("extras".into(), extras.clone());
+        }
+        nodes_json[group.slot] = Value::Object(n);
     }
 
-    let plant_nodes = nodes.len();
+    let plant_nodes = nodes_json.len();
     let mut scene_nodes: Vec<usize> = (0..plant_nodes).collect();
     let mut skins = Vec::new();
     let mut channels = Vec::new();
     let mut samplers = Vec::new();
     for (node, rig, translation, rotation) in rigs {
-        let name = nodes[node]["name"].as_str().unwrap_or("plant").to_owned();
+        let name = nodes_json[node]["name"]
+            .as_str()
+            .unwrap_or("plant")
+            .to_owned();
         // The rig's root: a plain node with the plant's place, parent of its root joints.
-        let root_node = nodes.len();
+        let root_node = nodes_json.len();
         let mut root_json = json!({ "name": format!("{name}-rig") });
         if translation != Vec3::ZERO {
             root_json["translation"] = json!(translation.to_array().map(short));
@@ -157,9 +549,9 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         if rotation != Quat::IDENTITY {
             root_json["rotation"] = json!(rotation.to_array().map(short));
         }
-        nodes.push(root_json);
+        nodes_json.push(root_json);
         scene_nodes.push(root_node);
-        let first = nodes.len();
+        let first = nodes_json.len();
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); rig.joints.len()];
         let mut roots = Vec::new();
         for (j, joint) in rig.joints.iter().enumerate() {
@@ -177,14 +569,14 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
             if local != Vec3::ZERO {
                 n["translation"] = json!(local.to_array());
             }
-            nodes.push(n);
+            nodes_json.push(n);
         }
         for (j, c) in children.into_iter().enumerate() {
             if !c.is_empty() {
-                nodes[first + j]["children"] = json!(c);
+                nodes_json[first + j]["children"] = json!(c);
             }
         }
-        nodes[root_node]["children"] = json!(roots);
+        nodes_json[root_node]["children"] = json!(roots);
         let ibm = w.inverse_binds(rig);
         skins.push(json!({
             "name": format!("{name}-skin"),
@@ -192,7 +584,7 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
             "joints": (first..first + rig.joints.len()).collect::<Vec<_>>(),
             "skeleton": root_node,
         }));
-        nodes[node]["skin"] = json!(skins.len() - 1);
+        nodes_json[node]["skin"] = json!(skins.len() - 1);
         let input = w.times(&rig.times);
         for (j, keys) in rig.rotations.iter().enumerate() {
             let output = w.rotations(keys);
@@ -214,6 +606,17 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         "asset".into(),
         json!({ "version": "2.0", "generator": concat!("Sylva ", env!("CARGO_PKG_VERSION")) }),
     );
+    let mut used = Vec::new();
+    if instanced > 0 {
+        used.push(EXT_MESH_GPU_INSTANCING);
+    }
+    if w.quantized {
+        used.push(KHR_MESH_QUANTIZATION);
+        root.insert("extensionsRequired".into(), json!([KHR_MESH_QUANTIZATION]));
+    }
+    if !used.is_empty() {
+        root.insert("extensionsUsed".into(), json!(used));
+    }
     root.insert("scene".into(), json!(0));
     root.insert(
         "scenes".into(),
@@ -223,10 +626,16 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
             json!([{ "nodes": scene_nodes }])
         },
     );
-    pad4(&mut w.bin, 0);
+    w.bin.pad4();
     let bin_len = w.bin.len();
+    let stats = GlbStats {
+        bytes: 0,
+        meshes: w.meshes.len(),
+        instanced,
+        triangles,
+    };
     let arrays = [
-        ("nodes", nodes),
+        ("nodes", nodes_json),
         ("meshes", w.meshes),
         ("skins", skins),
         ("animations", animations),
@@ -252,34 +661,111 @@ pub fn to_glb(scene: &Scene) -> Result<Vec<u8>, ExportError> {
         }
     }
     let mut json = serde_json::to_vec(&Value::Object(root))?;
-    pad4(&mut json, b' ');
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    Ok((json, w.bin, stats))
+}
 
-    let total = 12 + 8 + json.len() as u64 + if bin_len > 0 { 8 + bin_len as u64 } else { 0 };
-    let too_large = || ExportError::TooLarge { bytes: total };
-    let total32 = u32::try_from(total).map_err(|_| too_large())?;
-    let mut out = Vec::with_capacity(total as usize);
-    for word in [
-        GLB_MAGIC,
-        GLB_VERSION,
-        total32,
-        json.len() as u32,
-        CHUNK_JSON,
-    ] {
-        out.extend_from_slice(&word.to_le_bytes());
+/// Sets a node's transform: `translation` and `rotation`, after the mesh's dequantisation
+/// when it has one (translation `t + R o`, scale `s`). Identity parts are left out.
+fn place(n: &mut Map<String, Value>, translation: Vec3, rotation: Quat, dequant: Option<Dequant>) {
+    let rotation = rotation.normalize();
+    let translation = match dequant {
+        Some(d) => translation + rotation * d.offset,
+        None => translation,
+    };
+    if translation != Vec3::ZERO {
+        n.insert(
+            "translation".into(),
+            json!(translation.to_array().map(short)),
+        );
     }
-    out.extend_from_slice(&json);
-    if bin_len > 0 {
-        out.extend_from_slice(&(bin_len as u32).to_le_bytes());
-        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
-        out.extend_from_slice(&w.bin);
+    if rotation != Quat::IDENTITY {
+        n.insert("rotation".into(), json!(rotation.to_array().map(short)));
     }
-    Ok(out)
+    if let Some(d) = dequant {
+        n.insert("scale".into(), json!([d.scale, d.scale, d.scale]));
+    }
+}
+
+/// How a quantised mesh's positions come back: `offset + scale * q / 32767`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Dequant {
+    offset: Vec3,
+    scale: f32,
+}
+
+impl Dequant {
+    /// The dequantisation of positions in the box `min`..`max`: about its centre, by its
+    /// largest half extent (1 for a box of no extent).
+    fn of(min: Vec3, max: Vec3) -> Dequant {
+        let offset = 0.5 * (min + max);
+        let scale = (0.5 * (max - min)).max_element();
+        Dequant {
+            offset,
+            scale: if scale > 0.0 && scale.is_finite() {
+                scale
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// A position as normalised shorts.
+    fn quantize(&self, p: Vec3) -> [i16; 3] {
+        let q = (p - self.offset) / self.scale * SHORT_MAX;
+        q.to_array()
+            .map(|c| round(c.clamp(-SHORT_MAX, SHORT_MAX)) as i16)
+    }
+}
+
+/// A unit normal as normalised bytes: rounded, or, when that is too far from unit length
+/// (the validator allows 0.00674), the one of the eight roundings of its components up or
+/// down whose length is nearest 1, then nearest the normal.
+fn quantize_normal(n: Vec3) -> [i8; 3] {
+    let v = n * 127.0;
+    let rounded = Vec3::from_array(v.to_array().map(|c| round(c) as f32));
+    // |length - 1| is about half |length² - 1|: within 0.0045.
+    if (rounded.length_squared() / (127.0 * 127.0) - 1.0).abs() < 0.009 {
+        return rounded.to_array().map(|x| x as i8);
+    }
+    let (lo, hi) = (v.floor(), v.ceil());
+    let mut best = ([0i8; 3], f32::INFINITY);
+    for k in 0..8 {
+        let pick = |axis: usize, l: f32, h: f32| if (k >> axis) & 1 == 0 { l } else { h };
+        let c = Vec3::new(
+            pick(0, lo.x, hi.x),
+            pick(1, lo.y, hi.y),
+            pick(2, lo.z, hi.z),
+        )
+        .clamp(Vec3::splat(-127.0), Vec3::splat(127.0));
+        let back = c / 127.0;
+        let score = (back.length() - 1.0).abs() + 0.5 * back.distance(n);
+        if score < best.1 {
+            best = (c.to_array().map(|x| x as i8), score);
+        }
+    }
+    best.0
+}
+
+/// `x` rounded half away from zero, as `f32::round` does, without the call to the C
+/// library that it costs on x86-64's baseline (a third of a quantised write's time).
+/// `x` is at most 32 767 in size.
+fn round(x: f32) -> i32 {
+    let whole = x as i32;
+    // Exact: the fraction of a float is a float.
+    let fraction = x - whole as f32;
+    whole + i32::from(fraction >= 0.5) - i32::from(fraction <= -0.5)
 }
 
 /// The parts of the glTF document built while walking the scene.
-#[derive(Default)]
-struct Writer {
-    bin: Vec<u8>,
+struct Writer<S> {
+    bin: S,
+    /// Quantise meshes without a rig.
+    quantize: bool,
+    /// A mesh was quantised, so the file uses (and requires) the extension.
+    quantized: bool,
     views: Vec<Value>,
     accessors: Vec<Value>,
     meshes: Vec<Value>,
@@ -295,42 +781,50 @@ struct Writer {
     sampler_of: [Option<usize>; 2],
 }
 
-impl Writer {
-    /// Writes a mesh's data and returns its glTF mesh index; `None` when it has no triangles.
-    fn mesh(
-        &mut self,
-        mesh: &Mesh,
-        name: &str,
-        rig: Option<&Rig>,
-    ) -> Result<Option<usize>, ExportError> {
+impl<S: Sink> Writer<S> {
+    fn new(bin: S, quantize: bool) -> Self {
+        Writer {
+            bin,
+            quantize,
+            quantized: false,
+            views: Vec::new(),
+            accessors: Vec::new(),
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            images: Vec::new(),
+            samplers: Vec::new(),
+            material_of: HashMap::new(),
+            texture_of: HashMap::new(),
+            sampler_of: [None; 2],
+        }
+    }
+
+    /// Writes a mesh's data: its glTF mesh index (`None` when it has no triangles), and its
+    /// dequantisation when it was quantised.
+    fn mesh(&mut self, mesh: &Mesh, name: &str, rig: Option<&Rig>) -> Result<Written, ExportError> {
+        let triangles = mesh.triangle_count() as u64;
         if mesh.primitives.iter().all(|p| p.indices.is_empty()) {
-            return Ok(None);
+            return Ok(Written {
+                index: None,
+                dequant: None,
+                triangles,
+            });
         }
         let count = mesh.positions.len();
-        let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        let start = self.bin.len();
         let index_count: usize = mesh.primitives.iter().map(|p| p.indices.len() + 2).sum();
         self.bin.reserve(32 * count + 4 * index_count);
-        for p in &mesh.positions {
-            let p = Vec3::from_array(*p);
-            (min, max) = (min.min(p), max.max(p));
-            push_vec3(&mut self.bin, p);
-        }
-        let view = self.view(start, ARRAY_BUFFER);
-        let position = self.accessor(json!({
-            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
-            // Exact f32 values written as f64: the validator compares them exactly.
-            "min": min.to_array(), "max": max.to_array(),
-        }));
-        let start = self.bin.len();
-        for n in &mesh.normals {
-            // Renormalise: glTF requires unit normals, and a zero normal gets +Y.
-            push_vec3(&mut self.bin, Vec3::from_array(*n).normalize_or(Vec3::Y));
-        }
-        let view = self.view(start, ARRAY_BUFFER);
-        let normal = self.accessor(json!({
-            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
-        }));
+        let dequant = (self.quantize && rig.is_none()).then(|| {
+            let (min, max) = bounds(&mesh.positions);
+            Dequant::of(min, max)
+        });
+        let (position, normal) = match dequant {
+            None => self.float_positions_normals(mesh),
+            Some(d) => {
+                self.quantized = true;
+                self.quantized_positions_normals(mesh, d)
+            }
+        };
         let textured = |p: &crate::Primitive| {
             !p.indices.is_empty() && mesh.materials[p.material].texture.is_some()
         };
@@ -338,13 +832,16 @@ impl Writer {
             let start = self.bin.len();
             if mesh.uvs.len() == count {
                 for uv in &mesh.uvs {
-                    for c in uv {
-                        self.bin.extend_from_slice(&c.to_le_bytes());
-                    }
+                    let mut b = [0u8; 8];
+                    b[..4].copy_from_slice(&uv[0].to_le_bytes());
+                    b[4..].copy_from_slice(&uv[1].to_le_bytes());
+                    self.bin.put(&b);
                 }
             } else {
                 // check_scene allows only one per position or none.
-                self.bin.resize(start + 8 * count, 0);
+                for _ in 0..count {
+                    self.bin.put(&[0; 8]);
+                }
             }
             let view = self.view(start, ARRAY_BUFFER);
             Some(self.accessor(json!({
@@ -364,7 +861,7 @@ impl Writer {
         let color = lean.as_ref().map(|plan| {
             let start = self.bin.len();
             for rgba in &plan.colors {
-                self.bin.extend_from_slice(rgba);
+                self.bin.put(rgba);
             }
             let view = self.view(start, ARRAY_BUFFER);
             self.accessor(json!({
@@ -394,15 +891,15 @@ impl Writer {
             let indices = group.iter().flat_map(|p| p.indices.iter().copied());
             if wide {
                 for i in indices {
-                    self.bin.extend_from_slice(&i.to_le_bytes());
+                    self.bin.put(&i.to_le_bytes());
                 }
             } else {
                 // check_scene put every index below count <= 65 535.
                 for i in indices {
-                    self.bin.extend_from_slice(&(i as u16).to_le_bytes());
+                    self.bin.put(&(i as u16).to_le_bytes());
                 }
             }
-            pad4(&mut self.bin, 0);
+            self.bin.pad4();
             let view = self.view(start, ELEMENT_ARRAY_BUFFER);
             let indices = self.accessor(json!({
                 "bufferView": view,
@@ -432,7 +929,108 @@ impl Writer {
         }
         self.meshes
             .push(json!({ "name": name, "primitives": primitives }));
-        Ok(Some(self.meshes.len() - 1))
+        Ok(Written {
+            index: Some(self.meshes.len() - 1),
+            dequant,
+            triangles,
+        })
+    }
+
+    /// A mesh's POSITION and NORMAL accessors as floats.
+    fn float_positions_normals(&mut self, mesh: &Mesh) -> (usize, usize) {
+        let count = mesh.positions.len();
+        let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let start = self.bin.len();
+        for p in &mesh.positions {
+            let p = Vec3::from_array(*p);
+            (min, max) = (min.min(p), max.max(p));
+            push_vec3(&mut self.bin, p);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let position = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
+            // Exact f32 values written as f64: the validator compares them exactly.
+            "min": min.to_array(), "max": max.to_array(),
+        }));
+        let start = self.bin.len();
+        for n in &mesh.normals {
+            // Renormalise: glTF requires unit normals, and a zero normal gets +Y.
+            push_vec3(&mut self.bin, Vec3::from_array(*n).normalize_or(Vec3::Y));
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        let normal = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
+        }));
+        (position, normal)
+    }
+
+    /// A mesh's POSITION (normalised shorts) and NORMAL (normalised bytes) accessors, each
+    /// element padded to 4 bytes as glTF requires of vertex attributes.
+    fn quantized_positions_normals(&mut self, mesh: &Mesh, d: Dequant) -> (usize, usize) {
+        let count = mesh.positions.len();
+        let (mut min, mut max) = ([i16::MAX; 3], [i16::MIN; 3]);
+        let start = self.bin.len();
+        for p in &mesh.positions {
+            let q = d.quantize(Vec3::from_array(*p));
+            let mut b = [0u8; 8];
+            for (k, c) in q.iter().enumerate() {
+                min[k] = min[k].min(*c);
+                max[k] = max[k].max(*c);
+                b[2 * k..2 * k + 2].copy_from_slice(&c.to_le_bytes());
+            }
+            self.bin.put(&b);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        self.views[view]["byteStride"] = json!(8);
+        // A normalised accessor's bounds are its stored integers.
+        let position = self.accessor(json!({
+            "bufferView": view, "componentType": SHORT, "normalized": true, "count": count,
+            "type": "VEC3", "min": min, "max": max,
+        }));
+        let start = self.bin.len();
+        for n in &mesh.normals {
+            let [x, y, z] = quantize_normal(Vec3::from_array(*n).normalize_or(Vec3::Y));
+            self.bin.put(&[x as u8, y as u8, z as u8, 0]);
+        }
+        let view = self.view(start, ARRAY_BUFFER);
+        self.views[view]["byteStride"] = json!(4);
+        let normal = self.accessor(json!({
+            "bufferView": view, "componentType": BYTE, "normalized": true, "count": count,
+            "type": "VEC3",
+        }));
+        (position, normal)
+    }
+
+    /// An instanced node's TRANSLATION and ROTATION accessors: each node's place, through
+    /// the mesh's dequantisation `D` when it has one (`D⁻¹ I D`, as the node carries `D`).
+    fn instances<'n>(
+        &mut self,
+        nodes: impl Iterator<Item = &'n GlbNode<'n>> + Clone,
+        count: usize,
+        dequant: Option<Dequant>,
+    ) -> (usize, usize) {
+        let start = self.bin.len();
+        for node in nodes.clone() {
+            let rotation = node.rotation.normalize();
+            let t = match dequant {
+                Some(d) => (node.translation - d.offset + rotation * d.offset) / d.scale,
+                None => node.translation,
+            };
+            push_vec3(&mut self.bin, t);
+        }
+        let view = self.untargeted_view(start);
+        let translation = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3",
+        }));
+        let start = self.bin.len();
+        for node in nodes {
+            push_quat(&mut self.bin, node.rotation.normalize());
+        }
+        let view = self.untargeted_view(start);
+        let rotation = self.accessor(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC4",
+        }));
+        (translation, rotation)
     }
 
     /// A rigged mesh's JOINTS_0, WEIGHTS_0 and `_WIND` accessors.
@@ -440,7 +1038,7 @@ impl Writer {
         let count = rig.vertex_joints.len();
         let start = self.bin.len();
         for j in &rig.vertex_joints {
-            self.bin.extend_from_slice(j);
+            self.bin.put(j);
         }
         let view = self.view(start, ARRAY_BUFFER);
         let joints = self.accessor(json!({
@@ -448,7 +1046,7 @@ impl Writer {
         }));
         let start = self.bin.len();
         for w in &rig.vertex_weights {
-            self.bin.extend_from_slice(w);
+            self.bin.put(w);
         }
         let view = self.view(start, ARRAY_BUFFER);
         let weights = self.accessor(json!({
@@ -457,7 +1055,7 @@ impl Writer {
         }));
         let start = self.bin.len();
         for f in &rig.flutter {
-            self.bin.extend_from_slice(&f.to_le_bytes());
+            self.bin.put(&f.to_le_bytes());
         }
         let view = self.view(start, ARRAY_BUFFER);
         let flutter = self.accessor(json!({
@@ -473,7 +1071,7 @@ impl Writer {
         for joint in &rig.joints {
             let m = sylva_core::glam::Mat4::from_translation(-joint.position);
             for c in m.to_cols_array() {
-                self.bin.extend_from_slice(&c.to_le_bytes());
+                self.bin.put(&c.to_le_bytes());
             }
         }
         let view = self.untargeted_view(start);
@@ -486,7 +1084,7 @@ impl Writer {
     fn times(&mut self, times: &[f32]) -> usize {
         let start = self.bin.len();
         for t in times {
-            self.bin.extend_from_slice(&t.to_le_bytes());
+            self.bin.put(&t.to_le_bytes());
         }
         let view = self.untargeted_view(start);
         let (min, max) = times
@@ -504,9 +1102,7 @@ impl Writer {
     fn rotations(&mut self, keys: &[Quat]) -> usize {
         let start = self.bin.len();
         for q in keys {
-            for c in q.normalize().to_array() {
-                self.bin.extend_from_slice(&c.to_le_bytes());
-            }
+            push_quat(&mut self.bin, q.normalize());
         }
         let view = self.untargeted_view(start);
         self.accessor(json!({
@@ -514,14 +1110,15 @@ impl Writer {
         }))
     }
 
-    /// A buffer view over `bin[start..]`, which starts on a 4-byte boundary.
+    /// A buffer view over the bytes put since `start`, which is on a 4-byte boundary.
     fn view(&mut self, start: usize, target: u32) -> usize {
         let view = self.untargeted_view(start);
         self.views[view]["target"] = json!(target);
         view
     }
 
-    /// A buffer view without a target (for image data), over `bin[start..]`.
+    /// A buffer view without a target (for image, skin, animation and instance data), over
+    /// the bytes put since `start`.
     fn untargeted_view(&mut self, start: usize) -> usize {
         debug_assert_eq!(start % 4, 0);
         let length = self.bin.len() - start;
@@ -539,9 +1136,9 @@ impl Writer {
         let png =
             crate::texture::texture_png(id).map_err(|source| ExportError::Png { id, source })?;
         let start = self.bin.len();
-        self.bin.extend_from_slice(&png);
+        self.bin.put(&png);
         let view = self.untargeted_view(start);
-        pad4(&mut self.bin, 0);
+        self.bin.pad4();
         self.images.push(json!({
             "bufferView": view,
             "mimeType": "image/png",
@@ -599,16 +1196,30 @@ impl Writer {
     }
 }
 
-fn push_vec3(bin: &mut Vec<u8>, v: Vec3) {
-    for c in v.to_array() {
-        bin.extend_from_slice(&c.to_le_bytes());
-    }
+/// The smallest box holding `positions`.
+fn bounds(positions: &[[f32; 3]]) -> (Vec3, Vec3) {
+    positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(min, max), p| {
+            let p = Vec3::from_array(*p);
+            (min.min(p), max.max(p))
+        })
 }
 
-fn pad4(bytes: &mut Vec<u8>, fill: u8) {
-    while !bytes.len().is_multiple_of(4) {
-        bytes.push(fill);
+fn push_vec3(bin: &mut impl Sink, v: Vec3) {
+    let mut b = [0u8; 12];
+    for (k, c) in v.to_array().iter().enumerate() {
+        b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
     }
+    bin.put(&b);
+}
+
+fn push_quat(bin: &mut impl Sink, q: Quat) {
+    let mut b = [0u8; 16];
+    for (k, c) in q.to_array().iter().enumerate() {
+        b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
+    }
+    bin.put(&b);
 }
 
 /// The `f64` nearest the shortest decimal that reads back as `x`: `0.85f32` is written as
@@ -648,6 +1259,442 @@ mod tests {
         assert_eq!(rest.len(), 8 + bin_len);
         (json, Some(&rest[8..]))
     }
+
+    /// Meshes and rigs for the sample scenes: plain, lean, textured, rigged, wide, empty.
+    pub(crate) struct Samples {
+        plain: Mesh,
+        other: Mesh,
+        lean: Mesh,
+        textured: Mesh,
+        rigged: Mesh,
+        rig: Rig,
+        wide: Mesh,
+        empty: Mesh,
+    }
+
+    /// The small mesh with half of its first primitive's triangles in a darker shade of
+    /// the same material: what lean materials merge.
+    pub(crate) fn two_shades() -> Mesh {
+        let mut mesh = small_mesh();
+        let shade = mesh.primitives[0].material;
+        let mut darker = mesh.materials[shade].clone();
+        darker.color = darker.color.map(|c| c * 0.5);
+        darker.name.push_str("-dark");
+        mesh.materials.push(darker);
+        let half = mesh.primitives[0].indices.len() / 6 * 3;
+        let moved = mesh.primitives[0].indices.split_off(half);
+        mesh.primitives.push(crate::Primitive {
+            material: mesh.materials.len() - 1,
+            indices: moved,
+        });
+        mesh
+    }
+
+    pub(crate) fn samples() -> Samples {
+        let plant = crate::export::tests::small_plant();
+        let mut other = small_mesh();
+        for p in &mut other.positions {
+            p[1] *= 1.5;
+        }
+        let lean = two_shades();
+        let mut textured = small_mesh();
+        textured.materials[0].texture = Some(0);
+        textured.materials[1].texture = Some(3);
+        let (rigged, sources) = crate::mesher::Mesher::new(crate::mesher::MeshOptions::default())
+            .unwrap()
+            .mesh_with_sources(&plant)
+            .unwrap();
+        let rig = crate::wind::rig(
+            &plant,
+            &rigged,
+            &sources,
+            &crate::wind::WindOptions::default(),
+        );
+        let mut wide = Mesh {
+            materials: vec![sylva_core::Material::of_kind(
+                sylva_core::MaterialKind::Bark,
+            )],
+            ..Mesh::default()
+        };
+        for i in 0..70_000u32 {
+            wide.positions.push([i as f32 * 1e-3, (i % 3) as f32, 0.0]);
+            wide.normals.push([0.0, 0.0, 1.0]);
+        }
+        wide.primitives.push(crate::Primitive {
+            material: 0,
+            indices: vec![0, 1, 2, 69_997, 69_998, 69_999],
+        });
+        Samples {
+            plain: small_mesh(),
+            other,
+            lean,
+            textured,
+            rigged,
+            rig,
+            wide,
+            empty: Mesh::default(),
+        }
+    }
+
+    /// Named scenes over the samples, covering every part of the writer.
+    pub(crate) fn sample_scenes(s: &Samples) -> Vec<(&'static str, Scene<'_>)> {
+        let at = |name: &str, mesh, x: f32, yaw: f32| {
+            let mut node = SceneNode::new(name, mesh);
+            node.translation = Vec3::new(x, 0.0, -0.5 * x);
+            node.rotation = Quat::from_rotation_y(yaw);
+            node.extras = Some(json!({ "seed": x as u64, "genome": { "model": "m" } }));
+            node
+        };
+        let mut rigged = at("r1", &s.rigged, 2.0, 0.5);
+        rigged.rig = Some(&s.rig);
+        let mut rigged2 = at("r2", &s.rigged, -3.0, 1.5);
+        rigged2.rig = Some(&s.rig);
+        vec![
+            ("single", Scene::single(at("p", &s.plain, 1.0, 0.3))),
+            (
+                "shared",
+                Scene {
+                    nodes: vec![
+                        at("a1", &s.plain, 1.0, 0.1),
+                        at("b", &s.other, 2.0, 0.2),
+                        at("a2", &s.plain, 3.0, 0.3),
+                        at("b2", &s.other, 4.0, 0.0),
+                        SceneNode::new("a3", &s.plain),
+                    ],
+                },
+            ),
+            ("lean", Scene::single(at("l", &s.lean, 0.0, 0.0))),
+            ("textured", Scene::single(at("t", &s.textured, 5.0, 2.0))),
+            (
+                "wind",
+                Scene {
+                    nodes: vec![rigged, at("p", &s.plain, 7.0, 0.0), rigged2],
+                },
+            ),
+            ("wide", Scene::single(at("w", &s.wide, 0.0, 0.0))),
+            ("empty", Scene::default()),
+            ("empty-mesh", Scene::single(SceneNode::new("e", &s.empty))),
+            (
+                "mixed",
+                Scene {
+                    nodes: vec![
+                        at("t", &s.textured, 1.0, 0.0),
+                        at("l1", &s.lean, 2.0, 1.0),
+                        at("e", &s.empty, 3.0, 0.0),
+                        at("l2", &s.lean, 4.0, 2.0),
+                        at("t2", &s.textured, 5.0, 3.0),
+                    ],
+                },
+            ),
+        ]
+    }
+
+    /// The bytes `to_glb` wrote for the sample scenes before the streaming writer (the hash
+    /// of each file), so that no rewrite of the writer changes them.
+    #[test]
+    fn sample_scenes_keep_their_bytes() {
+        let s = samples();
+        let found: Vec<(&str, u64)> = sample_scenes(&s)
+            .iter()
+            .map(|(name, scene)| {
+                (
+                    *name,
+                    sylva_core::hash::stable_hash(&to_glb(scene).unwrap()),
+                )
+            })
+            .collect();
+        assert_eq!(found, GOLDEN);
+    }
+
+    const ALL_OPTIONS: [GlbOptions; 4] = [
+        GlbOptions {
+            instancing: false,
+            quantize: false,
+        },
+        GlbOptions {
+            instancing: true,
+            quantize: false,
+        },
+        GlbOptions {
+            instancing: false,
+            quantize: true,
+        },
+        GlbOptions {
+            instancing: true,
+            quantize: true,
+        },
+    ];
+
+    fn streamed(glb: &mut Glb<'_>) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        glb.write_to(&mut bytes).unwrap();
+        assert_eq!(bytes.len() as u64, glb.stats().bytes);
+        bytes
+    }
+
+    #[test]
+    fn streaming_gives_the_bytes_of_the_in_memory_writer() {
+        let s = samples();
+        let dir = tempfile::tempdir().unwrap();
+        for (name, scene) in sample_scenes(&s) {
+            for options in ALL_OPTIONS {
+                let in_memory = to_glb_with(&scene, &options).unwrap();
+                let mut glb = Glb::of_scene(&scene, options).unwrap();
+                assert_eq!(streamed(&mut glb), in_memory, "{name} {options:?}");
+                // Twice from one layout: the second write is the same.
+                assert_eq!(streamed(&mut glb), in_memory, "{name} {options:?}");
+                assert_eq!(glb.stats().triangles, scene.triangle_count() as u64);
+            }
+            // And to a file, through the atomic write.
+            let path = dir.path().join(format!("{name}.glb"));
+            crate::export::write_scene(&path, &scene).unwrap();
+            assert_eq!(
+                std::fs::read(&path).unwrap(),
+                to_glb(&scene).unwrap(),
+                "{name}"
+            );
+        }
+    }
+
+    /// Makes each mesh when asked, into one buffer, noting the requests.
+    struct Making<'m> {
+        meshes: Vec<&'m Mesh>,
+        buffer: Mesh,
+        asked: std::rc::Rc<std::cell::RefCell<Vec<usize>>>,
+    }
+
+    impl MeshSource for Making<'_> {
+        fn mesh(&mut self, index: usize) -> Result<&Mesh, ExportError> {
+            self.asked.borrow_mut().push(index);
+            self.buffer = self
+                .meshes
+                .get(index)
+                .copied()
+                .cloned()
+                .ok_or(ExportError::NoSuchMesh { index })?;
+            Ok(&self.buffer)
+        }
+    }
+
+    #[test]
+    fn meshes_made_on_demand_give_the_same_bytes_asked_once_per_pass() {
+        let s = samples();
+        let scenes = sample_scenes(&s);
+        let scene = &scenes.iter().find(|(n, _)| *n == "mixed").unwrap().1;
+        let (nodes, meshes) = scene_nodes(scene);
+        let n = meshes.len();
+        for options in ALL_OPTIONS {
+            let asked = std::rc::Rc::default();
+            let source = Making {
+                meshes: meshes.clone(),
+                buffer: Mesh::default(),
+                asked: std::rc::Rc::clone(&asked),
+            };
+            let mut glb = Glb::new(nodes.clone(), Box::new(source), options).unwrap();
+            assert_eq!(*asked.borrow(), (0..n).collect::<Vec<_>>());
+            assert_eq!(streamed(&mut glb), to_glb_with(scene, &options).unwrap());
+            assert_eq!(asked.borrow().len(), 2 * n, "each mesh once per pass");
+        }
+        // A source without the mesh asked for is an error, not a panic.
+        let mut nodes = nodes;
+        nodes[0].mesh = 99;
+        let e = Glb::new(nodes, Box::new(meshes), GlbOptions::default())
+            .err()
+            .unwrap();
+        assert!(matches!(e, ExportError::NoSuchMesh { index: 99 }), "{e}");
+    }
+
+    #[test]
+    fn instancing_draws_nodes_that_share_a_mesh_and_extras_with_one_node() {
+        let (a, b) = (small_mesh(), samples().other);
+        let same = json!({ "seed": 1 });
+        let other = json!({ "seed": 2 });
+        let node = |name: &str, mesh, x: f32, extras: &Value| {
+            let mut n = SceneNode::new(name, mesh);
+            n.translation = Vec3::new(x, 0.0, 1.0);
+            n.rotation = Quat::from_rotation_y(x);
+            n.extras = Some(extras.clone());
+            n
+        };
+        let scene = Scene {
+            nodes: vec![
+                node("a0", &a, 0.0, &same),
+                node("b0", &b, 1.0, &same),
+                node("a1", &a, 2.0, &same),
+                node("a2", &a, 3.0, &other),
+                node("a3", &a, 4.0, &same),
+            ],
+        };
+        let options = GlbOptions {
+            instancing: true,
+            quantize: false,
+        };
+        let bytes = to_glb_with(&scene, &options).unwrap();
+        let (json, bin) = chunks(&bytes);
+        let bin = bin.unwrap();
+        assert_eq!(json["extensionsUsed"], json!([EXT_MESH_GPU_INSTANCING]));
+        assert!(json.get("extensionsRequired").is_none());
+        let nodes = json["nodes"].as_array().unwrap();
+        // a0 (with a1 and a3), b0, a2: three nodes in order of first appearance, two meshes.
+        assert_eq!(nodes.len(), 3);
+        assert_eq!(json["meshes"].as_array().unwrap().len(), 2);
+        let names: Vec<&str> = nodes.iter().map(|n| n["name"].as_str().unwrap()).collect();
+        assert_eq!(names, ["a0", "b0", "a2"]);
+        assert_eq!(nodes[0]["extras"], same);
+        assert_eq!(nodes[2]["extras"], other);
+        assert_eq!(nodes[0]["mesh"], nodes[2]["mesh"]);
+        let attributes = &nodes[0]["extensions"][EXT_MESH_GPU_INSTANCING]["attributes"];
+        assert!(attributes.get("SCALE").is_none());
+        let floats = |accessor: &Value| -> Vec<f32> {
+            let a = &json["accessors"][accessor.as_u64().unwrap() as usize];
+            let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+            assert!(view.get("target").is_none());
+            let start = view["byteOffset"].as_u64().unwrap() as usize;
+            let len = view["byteLength"].as_u64().unwrap() as usize;
+            bin[start..start + len]
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+                .collect()
+        };
+        let t = floats(&attributes["TRANSLATION"]);
+        assert_eq!(t, [0.0, 0.0, 1.0, 2.0, 0.0, 1.0, 4.0, 0.0, 1.0]);
+        let r = floats(&attributes["ROTATION"]);
+        assert_eq!(r[4..8], Quat::from_rotation_y(2.0).normalize().to_array());
+        // A lone node is an instanced node too; rigged ones never are.
+        let count = |attribute: &Value| {
+            json["accessors"][attribute.as_u64().unwrap() as usize]["count"].clone()
+        };
+        assert_eq!(count(&attributes["ROTATION"]), 3);
+        let s = samples();
+        let scenes = sample_scenes(&s);
+        let wind = &scenes.iter().find(|(n, _)| *n == "wind").unwrap().1;
+        let (json, _) = chunks(&to_glb_with(wind, &options).unwrap());
+        let nodes = json["nodes"].as_array().unwrap();
+        assert!(nodes[0]["skin"].is_u64() && nodes[2]["skin"].is_u64());
+        assert!(nodes[1]["extensions"][EXT_MESH_GPU_INSTANCING].is_object());
+    }
+
+    /// Every vertex of every node as Sylva's reader places it in the world.
+    fn world_vertices(glb: &[u8]) -> Vec<(Vec3, Vec3)> {
+        let scene = crate::import::read_glb(glb).unwrap();
+        scene
+            .meshes
+            .iter()
+            .flat_map(|(_, m)| {
+                m.positions
+                    .iter()
+                    .zip(&m.normals)
+                    .map(|(p, n)| (Vec3::from_array(*p), Vec3::from_array(*n)))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn quantised_positions_come_back_within_half_a_step() {
+        let s = samples();
+        for (name, scene) in sample_scenes(&s) {
+            let exact = world_vertices(&to_glb(&scene).unwrap());
+            for options in &ALL_OPTIONS[1..] {
+                let bytes = to_glb_with(&scene, options).unwrap();
+                let (json, _) = chunks(&bytes);
+                let back = world_vertices(&bytes);
+                assert_eq!(back.len(), exact.len(), "{name} {options:?}");
+                // The largest extent of any mesh bounds the error of every position.
+                let extent = scene
+                    .nodes
+                    .iter()
+                    .map(|n| {
+                        let (min, max) = bounds(&n.mesh.positions);
+                        (max - min).max_element()
+                    })
+                    .fold(0.0f32, f32::max);
+                let mut worst = (0.0f32, 0.0f32);
+                for ((p, n), (q, m)) in exact.iter().zip(&back) {
+                    worst.0 = worst.0.max((*p - *q).abs().max_element());
+                    worst.1 = worst.1.max(n.angle_between(*m));
+                }
+                // Rigged meshes stay floats; the wind scene's plain node is quantised.
+                let quantized = options.quantize && !name.starts_with("empty");
+                let bound = if quantized {
+                    // Per axis of the mesh, half a step is half of this (a step is the half
+                    // extent over 32767), and a turn about Y mixes two axes (√2 at most);
+                    // 2e-6 m allows for the floats' rounding in the transforms.
+                    extent / 65534.0 + 2e-6
+                } else {
+                    2e-6
+                };
+                assert!(
+                    worst.0 <= bound,
+                    "{name} {options:?}: {} > {bound}",
+                    worst.0
+                );
+                // Normals as bytes turn by at most about a degree.
+                assert!(
+                    worst.1 <= 0.02,
+                    "{name} {options:?}: normal off by {}",
+                    worst.1
+                );
+                if quantized {
+                    assert_eq!(json["extensionsRequired"], json!([KHR_MESH_QUANTIZATION]));
+                } else {
+                    assert!(json.get("extensionsRequired").is_none(), "{name}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn quantised_normals_are_unit_length_to_the_validators_tolerance() {
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            // Spread over the sphere (a Fibonacci lattice) and along the axes.
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
+            let a = i as f32 * 2.399_963;
+            let n = Vec3::new(
+                (1.0 - z * z).sqrt() * a.cos(),
+                z,
+                (1.0 - z * z).sqrt() * a.sin(),
+            );
+            for n in [n, Vec3::X, -Vec3::Y, Vec3::new(1.0, 1.0, 1.0).normalize()] {
+                let q = Vec3::from_array(quantize_normal(n).map(f32::from)) / 127.0;
+                worst = worst.max((q.length() - 1.0).abs());
+                assert!(q.angle_between(n) < 0.02, "{n}: {q}");
+            }
+        }
+        assert!(worst < 0.005, "{worst}");
+    }
+
+    #[test]
+    fn rounding_matches_the_standard_library() {
+        for x in [
+            0.0f32, 0.5, -0.5, 1.5, -2.5, 0.49999997, 126.5, -32_766.5, 1e-9, 3.7,
+        ] {
+            assert_eq!(round(x), x.round() as i32, "{x}");
+        }
+    }
+
+    #[test]
+    fn positions_quantise_to_the_full_range_of_shorts() {
+        let d = Dequant::of(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 8.0, 2.0));
+        assert_eq!(d.offset, Vec3::new(1.0, 4.0, 2.0));
+        assert_eq!(d.scale, 4.0);
+        assert_eq!(d.quantize(Vec3::new(-1.0, 0.0, 2.0)), [-16384, -32767, 0]);
+        assert_eq!(d.quantize(Vec3::new(3.0, 8.0, 2.0)), [16384, 32767, 0]);
+        // A box of no extent (one point) scales by 1.
+        assert_eq!(Dequant::of(Vec3::ONE, Vec3::ONE).scale, 1.0);
+    }
+
+    const GOLDEN: &[(&str, u64)] = &[
+        ("single", 0xf0cb2741ca6e59cf),
+        ("shared", 0x9073e6f609768fe5),
+        ("lean", 0x2084a482472e881a),
+        ("textured", 0xba278ea2d742ac86),
+        ("wind", 0x458683c498a31a73),
+        ("wide", 0xdd325f1cd0150298),
+        ("empty", 0xf2c6ab7472da058),
+        ("empty-mesh", 0x53fbbd7fb468edd6),
+        ("mixed", 0xbc46033f21986b14),
+    ];
 
     #[test]
     fn header_chunks_and_alignment() {
@@ -711,21 +1758,11 @@ mod tests {
 
     #[test]
     fn shades_of_one_kind_share_a_material_and_carry_vertex_colours() {
-        let mut mesh = small_mesh();
-        let plain = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let plain = to_glb(&Scene::single(SceneNode::new("p", &small_mesh()))).unwrap();
         let (json, _) = chunks(&plain);
         assert!(json.to_string().find("COLOR_0").is_none());
+        let mesh = two_shades();
         let shade = mesh.primitives[0].material;
-        let mut darker = mesh.materials[shade].clone();
-        darker.color = darker.color.map(|c| c * 0.5);
-        darker.name.push_str("-dark");
-        mesh.materials.push(darker);
-        let half = mesh.primitives[0].indices.len() / 6 * 3;
-        let moved = mesh.primitives[0].indices.split_off(half);
-        mesh.primitives.push(crate::Primitive {
-            material: mesh.materials.len() - 1,
-            indices: moved,
-        });
         let (json, _) = chunks(&to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap());
         let prims = json["meshes"][0]["primitives"].as_array().unwrap();
         assert_eq!(

@@ -2,7 +2,10 @@
 //!
 //! - [`to_glb`]: one glTF node per [`SceneNode`](crate::SceneNode), one glTF mesh per distinct
 //!   [`Mesh`] (nodes borrowing the same mesh share it), the node's extras kept as glTF
-//!   `extras`. Checked by the Khronos validator in the tests.
+//!   `extras`. Checked by the Khronos validator in the tests. [`to_glb_with`] and
+//!   [`GlbOptions`] add instancing (`EXT_mesh_gpu_instancing`) and quantisation
+//!   (`KHR_mesh_quantization`); [`Glb`] streams the same bytes to a file without holding
+//!   them, its meshes made one at a time if need be ([`MeshSource`]).
 //! - [`to_obj`]: world-space vertices, one object per node, one `usemtl` per primitive.
 //! - [`to_vrml`] / [`to_vrml_with_textures`]: one `Transform` per node, one `Shape` per
 //!   primitive.
@@ -40,7 +43,10 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 pub(crate) use glb::IMAGE_NAME_PREFIX;
-pub use glb::to_glb;
+pub use glb::{
+    EXT_MESH_GPU_INSTANCING, Glb, GlbNode, GlbOptions, GlbStats, KHR_MESH_QUANTIZATION, MeshSource,
+    to_glb, to_glb_with,
+};
 pub use obj::to_obj;
 pub use vrml::{DEFAULT_TEXTURE_STEM, to_vrml, to_vrml_with_textures};
 
@@ -160,6 +166,15 @@ pub enum ExportError {
     /// The glTF JSON could not be written.
     #[error("cannot write the glTF JSON")]
     Json(#[from] serde_json::Error),
+    /// A [`MeshSource`] was asked for a mesh it does not have.
+    #[error("no mesh {index} in the scene's meshes")]
+    NoSuchMesh {
+        /// The index asked for.
+        index: usize,
+    },
+    /// A [`MeshSource`] could not make a mesh.
+    #[error("meshing")]
+    Mesh(#[from] crate::mesher::MeshError),
 }
 
 /// A file format [`write_scene`] can write.
@@ -206,6 +221,16 @@ impl Format {
 /// [`scene_files`] for the files an OBJ or VRML97 export adds). The scene is checked first
 /// ([`check_scene`]), so no malformed file is written.
 pub fn write_scene(path: &Path, scene: &Scene) -> Result<(), ExportError> {
+    if Format::from_path(path)? == Format::Glb {
+        // Streamed: the file's bytes are never all in memory.
+        let mut glb = Glb::of_scene(scene, GlbOptions::default())?;
+        return sylva_core::io::write_atomic_with(path, |file| glb.write_to(file)).map_err(
+            |source| ExportError::Io {
+                path: path.to_owned(),
+                source,
+            },
+        );
+    }
     for (file, bytes) in scene_files(path, scene)? {
         sylva_core::io::write_atomic(&file, &bytes).map_err(|source| ExportError::Io {
             path: file.clone(),
@@ -294,22 +319,32 @@ fn used_textures(scene: &Scene) -> std::collections::BTreeSet<u16> {
 /// what is broken, so they never fail.
 pub fn check_scene(scene: &Scene) -> Result<(), ExportError> {
     for (node, n) in scene.nodes.iter().enumerate() {
-        if !n.translation.is_finite() {
-            return Err(ExportError::NotFinite {
-                node,
-                what: "translation",
-            });
-        }
-        if !n.rotation.is_finite() {
-            return Err(ExportError::NotFinite {
-                node,
-                what: "rotation",
-            });
-        }
-        if n.rotation.length_squared() < 1e-12 {
-            return Err(ExportError::ZeroRotation { node });
-        }
+        check_node(node, n.translation, n.rotation)?;
         check_mesh(node, n.mesh)?;
+    }
+    Ok(())
+}
+
+/// Checks a node's transform: finite, with a rotation that is not a zero quaternion.
+fn check_node(
+    node: usize,
+    translation: sylva_core::glam::Vec3,
+    rotation: sylva_core::glam::Quat,
+) -> Result<(), ExportError> {
+    if !translation.is_finite() {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "translation",
+        });
+    }
+    if !rotation.is_finite() {
+        return Err(ExportError::NotFinite {
+            node,
+            what: "rotation",
+        });
+    }
+    if rotation.length_squared() < 1e-12 {
+        return Err(ExportError::ZeroRotation { node });
     }
     Ok(())
 }
