@@ -172,3 +172,46 @@ fn a_strip_of_the_levels_is_drawn_side_by_side() {
     assert_eq!(run.status.code(), Some(2));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn grow_quantizes_single_plants_and_their_levels() {
+    let dir = temp_dir("grow-quantize");
+    let plain = dir.join("plain.glb");
+    let small = dir.join("small.glb");
+    let g = example("lsystem/tree.json");
+    assert!(sylva(&["grow", &g, "-o", s(&plain)]).status.success());
+    let run = sylva(&["grow", &g, "-o", s(&small), "--quantize", "--lod", "2"]);
+    assert!(run.status.success(), "{run:?}");
+    let files = [
+        plain.clone(),
+        small.clone(),
+        dir.join("small_LOD0.glb"),
+        dir.join("small_LOD1.glb"),
+    ];
+    common::validate(&files);
+    assert!(std::fs::metadata(&files[2]).unwrap().len() < std::fs::metadata(&plain).unwrap().len());
+    let seen = three_scene(&files[..3]);
+    // Quantised or not, three.js puts the plant in the same place, to a millimetre.
+    let (a, b) = (&seen[0]["box"], &seen[2]["box"]);
+    for corner in 0..2 {
+        for axis in 0..3 {
+            let (x, y) = (
+                a[corner][axis].as_f64().unwrap(),
+                b[corner][axis].as_f64().unwrap(),
+            );
+            assert!(
+                (x - y).abs() < 1e-3,
+                "corner {corner}, axis {axis}: {x} and {y}"
+            );
+        }
+    }
+    for (output, extra) in [("tree.obj", None), ("tree.glb", Some("--wind"))] {
+        let out = dir.join(output);
+        let mut args = vec!["grow", &g, "-o", s(&out), "--quantize"];
+        args.extend(extra);
+        let run = sylva(&args);
+        assert_eq!(run.status.code(), Some(2), "{output} {extra:?}");
+        assert!(String::from_utf8_lossy(&run.stderr).contains("--quantize"));
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

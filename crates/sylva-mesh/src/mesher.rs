@@ -227,8 +227,8 @@ pub struct Mesher {
     slots: Vec<u32>,
     /// Index buffers recycled from earlier outputs.
     pool: Vec<Vec<u32>>,
-    /// Per vertex, where it came from ([`Mesher::mesh_with_sources`]), while recording.
-    sources: Option<Vec<u32>>,
+    /// Where each vertex came from ([`Mesher::mesh_with_sources`]), while recording.
+    sources: Option<VertexSources>,
 }
 
 /// The precomputed tables of one ring size `R`.
@@ -325,11 +325,59 @@ pub const ORGAN_SOURCE: u32 = 1 << 31;
 /// The source segment of an organ without a parent.
 pub const NO_SEGMENT: u32 = ORGAN_SOURCE - 1;
 
+/// Where each vertex of a mesh came from ([`Mesher::mesh_with_sources`]): the index of its
+/// tube's segment, or [`ORGAN_SOURCE`] with the organ's parent segment (or [`NO_SEGMENT`]).
+/// Kept as runs, one per ring, cap or organ, rather than a number per vertex: recording is
+/// then nearly free, and readers walk the vertices in order ([`VertexSources::iter`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct VertexSources {
+    /// `(end, source)`: the vertices from the previous run's end up to `end` (excluded) came
+    /// from `source`. Ends rise.
+    runs: Vec<(u32, u32)>,
+}
+
+impl VertexSources {
+    /// Vertices described.
+    pub fn len(&self) -> usize {
+        self.runs.last().map_or(0, |&(end, _)| end as usize)
+    }
+
+    /// Whether no vertex is described.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Where vertex `v` came from, if it is described.
+    pub fn get(&self, v: usize) -> Option<u32> {
+        let run = self.runs.partition_point(|&(end, _)| end as usize <= v);
+        self.runs.get(run).map(|&(_, source)| source)
+    }
+
+    /// The runs: `(end, source)`, the vertices from the previous run's end up to `end`
+    /// (excluded) having come from `source`.
+    pub fn runs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.runs.iter().copied()
+    }
+
+    /// Every vertex's source, in order.
+    pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        let mut start = 0;
+        self.runs.iter().flat_map(move |&(end, source)| {
+            let n = end - start;
+            start = end;
+            std::iter::repeat_n(source, n as usize)
+        })
+    }
+}
+
 /// Records that the vertices added since the last mark came from `source`.
 #[inline]
-fn mark(sources: &mut Option<Vec<u32>>, out: &Mesh, source: u32) {
+fn mark(sources: &mut Option<VertexSources>, out: &Mesh, source: u32) {
     if let Some(s) = sources {
-        s.resize(out.positions.len(), source);
+        let end = out.positions.len() as u32;
+        if end > s.runs.last().map_or(0, |&(e, _)| e) {
+            s.runs.push((end, source));
+        }
     }
 }
 
@@ -498,8 +546,7 @@ impl Mesher {
         }
 
         let mut sources = self.sources.take().map(|mut s| {
-            s.clear();
-            s.reserve(vertices);
+            s.runs.clear();
             s
         });
         for start in 0..plant.segments().len() {
@@ -537,11 +584,10 @@ impl Mesher {
         })
     }
 
-    /// Meshes `plant` into a new mesh, and says where each vertex came from: the index of
-    /// its tube's segment, or [`ORGAN_SOURCE`] with the organ's parent segment (or
-    /// [`NO_SEGMENT`]). Skinning (wind) weights vertices by it.
-    pub fn mesh_with_sources(&mut self, plant: &Plant) -> Result<(Mesh, Vec<u32>), MeshError> {
-        self.sources = Some(Vec::new());
+    /// Meshes `plant` into a new mesh, and says where each vertex came from
+    /// ([`VertexSources`]). Skinning (wind) weights vertices by it.
+    pub fn mesh_with_sources(&mut self, plant: &Plant) -> Result<(Mesh, VertexSources), MeshError> {
+        self.sources = Some(VertexSources::default());
         let result = self.mesh(plant);
         let sources = self.sources.take().unwrap_or_default();
         Ok((result?, sources))
@@ -630,7 +676,13 @@ impl Mesher {
     }
 
     /// Meshes the axis beginning at segment `start`: rings, quads and caps.
-    fn tube(&self, plant: &Plant, start: usize, out: &mut Mesh, sources: &mut Option<Vec<u32>>) {
+    fn tube(
+        &self,
+        plant: &Plant,
+        start: usize,
+        out: &mut Mesh,
+        sources: &mut Option<VertexSources>,
+    ) {
         let segs = &plant.segments();
         let first = &segs[start];
         let tables = self.rings_for(first.order);
@@ -782,7 +834,7 @@ impl Mesher {
     }
 
     /// Appends every organ.
-    fn organs(&self, plant: &Plant, out: &mut Mesh, sources: &mut Option<Vec<u32>>) {
+    fn organs(&self, plant: &Plant, out: &mut Mesh, sources: &mut Option<VertexSources>) {
         for o in plant.organs() {
             let source = ORGAN_SOURCE | o.parent.map_or(NO_SEGMENT, |p| p.0.min(NO_SEGMENT));
             // A plant's orientations are unit quaternions; normalising removes rounding.
@@ -1155,15 +1207,24 @@ mod tests {
         let (mesh, sources) = mesher.mesh_with_sources(&p).unwrap();
         assert_eq!(mesh, mesher.mesh(&p).unwrap(), "recording changes nothing");
         assert_eq!(sources.len(), mesh.positions.len());
-        let organ = sources.iter().filter(|&&s| s == ORGAN_SOURCE | 1).count();
+        assert_eq!(sources.iter().count(), mesh.positions.len());
+        let organ = sources.iter().filter(|&s| s == ORGAN_SOURCE | 1).count();
         assert!(organ > 0);
         assert!(
             sources
                 .iter()
-                .all(|&s| s == 0 || s == 1 || s == ORGAN_SOURCE | 1)
+                .all(|s| s == 0 || s == 1 || s == ORGAN_SOURCE | 1)
         );
+        for (v, s) in sources.iter().enumerate() {
+            assert_eq!(
+                sources.get(v),
+                Some(s),
+                "random access agrees with the walk"
+            );
+        }
+        assert_eq!(sources.get(mesh.positions.len()), None);
         // Tube vertices lie near their segment.
-        for (v, &s) in mesh.positions.iter().zip(&sources) {
+        for (v, s) in mesh.positions.iter().zip(sources.iter()) {
             if s & ORGAN_SOURCE == 0 {
                 let seg = &p.segments()[s as usize];
                 let d = distance_to_segment(Vec3::from_array(*v), seg.start, seg.end);

@@ -25,7 +25,7 @@
 //! let trunk = plant.add_segment(Vec3::ZERO, Vec3::Y * 2.0, (0.2, 0.1), None, false, Plant::BARK)?;
 //! plant.add_segment(Vec3::Y * 2.0, Vec3::new(1.0, 3.0, 0.0), (0.05, 0.02), Some(trunk), true, Plant::BARK)?;
 //! let (mesh, sources) = Mesher::new(MeshOptions::default())?.mesh_with_sources(&plant)?;
-//! let rig = rig(&plant, &mesh, &sources, &WindOptions::default());
+//! let rig = rig(&plant, &mesh, sources, &WindOptions::default());
 //! assert_eq!(rig.joints.len(), 2);
 //! assert_eq!(rig.rotations[0].first(), rig.rotations[0].last());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -37,7 +37,7 @@ use sylva_core::Plant;
 use sylva_core::glam::{Mat4, Quat, Vec3};
 
 use crate::mesh::Mesh;
-use crate::mesher::{NO_SEGMENT, ORGAN_SOURCE};
+use crate::mesher::{NO_SEGMENT, ORGAN_SOURCE, VertexSources};
 
 /// The most joints a rig has (glTF's unsigned-byte joint indices, and what game engines take
 /// per skinned mesh).
@@ -107,19 +107,43 @@ pub struct Joint {
 pub struct Rig {
     /// The joints, parents first.
     pub joints: Vec<Joint>,
-    /// Per vertex, four joint indices (unused ones 0).
-    pub vertex_joints: Vec<[u8; 4]>,
-    /// Per vertex, four weights in 255ths adding up to exactly 255 (unused ones 0): glTF's
-    /// normalised unsigned bytes, a quarter of the size of floats.
-    pub vertex_weights: Vec<[u8; 4]>,
-    /// Per vertex, the leaf flutter weight `_WIND`, 0 to 1.
-    pub flutter: Vec<f32>,
+    /// Per vertex of the mesh, where it came from ([`Mesher::mesh_with_sources`]).
+    ///
+    /// [`Mesher::mesh_with_sources`]: crate::mesher::Mesher::mesh_with_sources
+    sources: VertexSources,
+    /// Per segment of the plant, the joint that owns it (at most [`MAX_JOINTS`]: a byte).
+    owner: Vec<u8>,
+    /// Per joint, what weighing a vertex needs of it, packed for the per-vertex loop.
+    blends: Vec<Blend>,
     /// The clip's key times, seconds: [`KEYS`] from 0 to the period.
     pub times: Vec<f32>,
     /// Per joint, its rotation at each key (relative to its parent).
     pub rotations: Vec<Vec<Quat>>,
     /// Joints the plant would have had beyond [`MAX_JOINTS`].
     pub dropped: usize,
+}
+
+/// A joint as the per-vertex weighing reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Blend {
+    position: Vec3,
+    /// How far from the joint a vertex blends into its parent joint.
+    reach: f32,
+    /// The parent joint, if any.
+    parent: Option<u8>,
+}
+
+/// How one vertex follows the joints: what glTF's `JOINTS_0`, `WEIGHTS_0` and Sylva's
+/// `_WIND` hold for it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Influence {
+    /// Four joint indices (unused ones 0).
+    pub joints: [u8; 4],
+    /// Four weights in 255ths adding up to exactly 255 (unused ones 0): glTF's normalised
+    /// unsigned bytes, a quarter of the size of floats.
+    pub weights: [u8; 4],
+    /// The leaf flutter weight, 0 to 1 (0 on wood).
+    pub flutter: f32,
 }
 
 /// Joints each axis gets, by order, as fractions of its length from its start.
@@ -133,8 +157,9 @@ fn joint_places(order: u16) -> &'static [f32] {
 }
 
 /// Builds the rig of `plant` for its `mesh`, whose vertices came from `sources`
-/// ([`crate::mesher::Mesher::mesh_with_sources`]).
-pub fn rig(plant: &Plant, mesh: &Mesh, sources: &[u32], options: &WindOptions) -> Rig {
+/// ([`crate::mesher::Mesher::mesh_with_sources`]). Each vertex's influence is worked out when
+/// it is asked for ([`Rig::influence`]), as the GLB writer streams it, rather than stored.
+pub fn rig(plant: &Plant, mesh: &Mesh, sources: VertexSources, options: &WindOptions) -> Rig {
     let segs = plant.segments();
     let n = segs.len();
     // Each segment's axis, its distance along it, and each axis's length and order.
@@ -233,49 +258,21 @@ pub fn rig(plant: &Plant, mesh: &Mesh, sources: &[u32], options: &WindOptions) -
             radius: 1.0,
         });
     }
-    let owner_of = |segment: u32| -> usize {
-        (segment as usize)
-            .lt(&n)
-            .then(|| owner[segment as usize])
-            .flatten()
-            .unwrap_or(0)
-    };
-
-    // Weights: the owner, blended into its parent near the joint.
-    let count = mesh.positions.len();
-    let mut vertex_joints = Vec::with_capacity(count);
-    let mut vertex_weights = Vec::with_capacity(count);
-    let mut flutter = Vec::with_capacity(count);
-    for v in 0..count {
-        let source = sources.get(v).copied().unwrap_or(ORGAN_SOURCE | NO_SEGMENT);
-        let organ = source & ORGAN_SOURCE != 0;
-        let j = owner_of(source & !ORGAN_SOURCE);
-        let joint = &joints[j];
-        let own = match (organ, joint.parent) {
-            (false, Some(p)) => {
-                let span = joint.position.distance(joints[p].position);
-                let blend = (0.25 * span).max(1e-3);
-                let d = Vec3::from_array(mesh.positions[v]).distance(joint.position);
-                let t = (d / blend).clamp(0.0, 1.0);
-                let w = 0.5 + 0.5 * t * t * (3.0 - 2.0 * t);
-                Some((p, w))
-            }
-            _ => None,
-        };
-        let own_share = own.map_or(255, |(_, w)| (w * 255.0).round() as u8);
-        match own {
-            Some((p, _)) if own_share < 255 => {
-                vertex_joints.push([j as u8, p as u8, 0, 0]);
-                vertex_weights.push([own_share, 255 - own_share, 0, 0]);
-            }
-            _ => {
-                vertex_joints.push([j as u8, 0, 0, 0]);
-                vertex_weights.push([255, 0, 0, 0]);
-            }
-        }
-        let tip = mesh.uvs.get(v).map_or(0.0, |uv| uv[1].clamp(0.0, 1.0));
-        flutter.push(if organ { tip } else { 0.0 });
-    }
+    // Weights: the owner, blended into its parent near the joint, over a quarter of the
+    // span between them.
+    let blends = joints
+        .iter()
+        .map(|joint| Blend {
+            position: joint.position,
+            reach: joint.parent.map_or(0.0, |p| {
+                (0.25 * joint.position.distance(joints[p].position)).max(1e-3)
+            }),
+            // Joint indices fit a byte: there are at most MAX_JOINTS.
+            parent: joint.parent.map(|p| p as u8),
+        })
+        .collect();
+    let owner = owner.iter().map(|o| o.unwrap_or(0) as u8).collect();
+    debug_assert!(sources.len() <= mesh.positions.len() || mesh.positions.is_empty());
 
     // The clip.
     let times: Vec<f32> = (0..KEYS)
@@ -316,9 +313,9 @@ pub fn rig(plant: &Plant, mesh: &Mesh, sources: &[u32], options: &WindOptions) -
         .collect();
     Rig {
         joints,
-        vertex_joints,
-        vertex_weights,
-        flutter,
+        sources,
+        owner,
+        blends,
         times,
         rotations,
         dropped,
@@ -326,6 +323,86 @@ pub fn rig(plant: &Plant, mesh: &Mesh, sources: &[u32], options: &WindOptions) -
 }
 
 impl Rig {
+    /// Vertices the rig was made for (its mesh's).
+    pub fn vertices(&self) -> usize {
+        self.sources.len()
+    }
+
+    /// How vertex `v` of `mesh` (the mesh the rig was made for) follows the joints.
+    pub fn influence(&self, mesh: &Mesh, v: usize) -> Influence {
+        let source = self.sources.get(v).unwrap_or(ORGAN_SOURCE | NO_SEGMENT);
+        self.influence_from(mesh, v, source)
+    }
+
+    /// Every vertex's influence, in order.
+    pub fn influences<'a>(&'a self, mesh: &'a Mesh) -> impl Iterator<Item = Influence> + 'a {
+        let n = self.vertices().min(mesh.positions.len());
+        self.sources
+            .iter()
+            .take(n)
+            .enumerate()
+            .map(|(v, source)| self.influence_from(mesh, v, source))
+    }
+
+    /// Calls `f` with every vertex's influence, in order: as [`Rig::influences`], run by run
+    /// of vertices from one source (the GLB writer's loop).
+    pub fn for_each_influence(&self, mesh: &Mesh, mut f: impl FnMut(Influence)) {
+        let n = self.vertices().min(mesh.positions.len());
+        let mut v = 0;
+        for (end, source) in self.sources.runs() {
+            let end = (end as usize).min(n);
+            while v < end {
+                f(self.influence_from(mesh, v, source));
+                v += 1;
+            }
+        }
+    }
+
+    /// How vertex `v`, which came from `source`, follows the joints.
+    #[inline]
+    fn influence_from(&self, mesh: &Mesh, v: usize, source: u32) -> Influence {
+        let organ = source & ORGAN_SOURCE != 0;
+        let j = self
+            .owner
+            .get((source & !ORGAN_SOURCE) as usize)
+            .copied()
+            .unwrap_or(0);
+        let joint = &self.blends[usize::from(j)];
+        let (joints, weights) = match joint.parent {
+            // Beyond the blend (most vertices) the joint takes it all, as t = 1 would give;
+            // at the edge the share rounds to 255 either way.
+            Some(p)
+                if !organ
+                    && Vec3::from_array(mesh.positions[v]).distance_squared(joint.position)
+                        < joint.reach * joint.reach =>
+            {
+                let d = Vec3::from_array(mesh.positions[v]).distance(joint.position);
+                let t = (d / joint.reach).clamp(0.0, 1.0);
+                let w = 0.5 + 0.5 * t * t * (3.0 - 2.0 * t);
+                // w·255 lies in 127.5..=255, where this truncation is `round` without a
+                // call to libm.
+                let own = (w * 255.0 + 0.5) as u8;
+                if own < 255 {
+                    ([j, p, 0, 0], [own, 255 - own, 0, 0])
+                } else {
+                    ([j, 0, 0, 0], [255, 0, 0, 0])
+                }
+            }
+            _ => ([j, 0, 0, 0], [255, 0, 0, 0]),
+        };
+        // Only organs flutter: wood never reads its texture coordinates.
+        let flutter = if organ {
+            mesh.uvs.get(v).map_or(0.0, |uv| uv[1].clamp(0.0, 1.0))
+        } else {
+            0.0
+        };
+        Influence {
+            joints,
+            weights,
+            flutter,
+        }
+    }
+
     /// Each joint's rotation at `time` seconds (wrapped into the clip), keys interpolated
     /// as glTF's LINEAR does (spherically for rotations).
     pub fn rotations_at(&self, time: f32) -> Vec<Quat> {
@@ -371,14 +448,15 @@ impl Rig {
             .map(|(w, j)| *w * Mat4::from_translation(-j.position))
             .collect();
         let mut posed = mesh.clone();
-        for (v, (joints, weights)) in self
-            .vertex_joints
-            .iter()
-            .zip(&self.vertex_weights)
-            .enumerate()
+        for (
+            v,
+            Influence {
+                joints, weights, ..
+            },
+        ) in self.influences(mesh).enumerate()
         {
             let mut m = Mat4::ZERO;
-            for (&j, &w) in joints.iter().zip(weights) {
+            for (&j, &w) in joints.iter().zip(&weights) {
                 if w > 0 {
                     m += skin[j as usize] * (f32::from(w) / 255.0);
                 }
@@ -471,7 +549,7 @@ mod tests {
             .unwrap()
             .mesh_with_sources(p)
             .unwrap();
-        let rig = rig(p, &mesh, &sources, &WindOptions::default());
+        let rig = rig(p, &mesh, sources, &WindOptions::default());
         (mesh, rig)
     }
 
@@ -493,14 +571,22 @@ mod tests {
     #[test]
     fn weights_are_normalised_and_use_at_most_two_joints() {
         let (mesh, rig) = rigged(&tree());
-        assert_eq!(rig.vertex_weights.len(), mesh.positions.len());
-        for (w, j) in rig.vertex_weights.iter().zip(&rig.vertex_joints) {
+        assert_eq!(rig.vertices(), mesh.positions.len());
+        let all: Vec<Influence> = rig.influences(&mesh).collect();
+        assert_eq!(all.len(), mesh.positions.len());
+        for Influence {
+            joints: j,
+            weights: w,
+            ..
+        } in &all
+        {
             assert_eq!(w.iter().map(|&x| u32::from(x)).sum::<u32>(), 255);
             assert_eq!(w[2..], [0, 0]);
             assert!((j[0] as usize) < rig.joints.len() && (j[1] as usize) < rig.joints.len());
         }
-        let leafy = rig.flutter.iter().filter(|&&f| f > 0.0).count();
-        assert!(leafy > 0 && rig.flutter.iter().all(|f| (0.0..=1.0).contains(f)));
+        assert!(all.iter().any(|i| i.weights[1] > 0), "some vertices blend");
+        let leafy = all.iter().filter(|i| i.flutter > 0.0).count();
+        assert!(leafy > 0 && all.iter().all(|i| (0.0..=1.0).contains(&i.flutter)));
     }
 
     #[test]
@@ -536,12 +622,7 @@ mod tests {
             .unwrap()
             .mesh_with_sources(p)
             .unwrap();
-        rig(
-            p,
-            &mesh,
-            &sources,
-            &WindOptions::new(strength, 4.0).unwrap(),
-        )
+        rig(p, &mesh, sources, &WindOptions::new(strength, 4.0).unwrap())
     }
 
     #[test]
@@ -586,7 +667,7 @@ mod tests {
             assert!(Vec3::from_array(*a).distance(Vec3::from_array(*b)) < 1e-4);
         }
         // The leaf at the twig's tip moves, and on average towards +X (downwind).
-        let leaf = rig.flutter.iter().position(|&f| f > 0.0).unwrap();
+        let leaf = rig.influences(&mesh).position(|i| i.flutter > 0.0).unwrap();
         let mean_x: f32 = (0..KEYS - 1)
             .map(|k| rig.pose(&mesh, rig.times[k]).positions[leaf][0] - mesh.positions[leaf][0])
             .sum::<f32>()

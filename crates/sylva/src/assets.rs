@@ -130,7 +130,7 @@ impl Grown {
         let plant = grow_plant(&genome, seed, roots, taper)?;
         let (mesh, sources) =
             Mesher::new(mesh_options(genome.mesh_hint()))?.mesh_with_sources(&plant)?;
-        let rig = sylva_mesh::wind::rig(&plant, &mesh, &sources, &wind);
+        let rig = sylva_mesh::wind::rig(&plant, &mesh, sources, &wind);
         Ok(Grown {
             genome,
             seed,
@@ -278,7 +278,7 @@ impl SceneAssets {
                 }
                 Some(wind) => {
                     let (mesh, sources) = mesher.mesh_with_sources(p.plant)?;
-                    rigs.push(Some(sylva_mesh::wind::rig(p.plant, &mesh, &sources, &wind)));
+                    rigs.push(Some(sylva_mesh::wind::rig(p.plant, &mesh, sources, &wind)));
                     meshes.push(mesh);
                 }
             }

@@ -59,8 +59,7 @@ impl LodAssets {
                         match wind {
                             Some(wind) => {
                                 let (mesh, sources) = mesher.mesh_with_sources(&level.plant)?;
-                                let rig =
-                                    sylva_mesh::wind::rig(&level.plant, &mesh, &sources, wind);
+                                let rig = sylva_mesh::wind::rig(&level.plant, &mesh, sources, wind);
                                 (mesh, Some(rig))
                             }
                             None => (mesher.mesh(&level.plant)?, None),

@@ -39,12 +39,18 @@ pub struct GrowArgs {
     lod: Option<u32>,
     #[command(flatten)]
     wind: super::WindArgs,
+    #[command(flatten)]
+    quantize: super::QuantizeArgs,
 }
 
 /// `sylva grow`.
 pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let output = GrowOutput::of(&args.output)?;
     let wind = args.wind.options(&args.output)?;
+    let glb = sylva_mesh::export::GlbOptions {
+        quantize: args.quantize.check(&args.output, wind.is_some())?,
+        ..Default::default()
+    };
     if args.lod.is_some() && output != GrowOutput::Asset(sylva_mesh::export::Format::Glb) {
         return Err(InputError::new(
             "--lod",
@@ -63,10 +69,10 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let grown =
         Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind).in_file(&args.genome)?;
     if let Some(levels) = args.lod {
-        return lod(args, grown, levels as usize, wind.as_ref());
+        return lod(args, grown, levels as usize, wind.as_ref(), &glb);
     }
     let mut out = Outputs::new();
-    out.add_scene(&args.output, &grown.scene())
+    out.add_scene_with(&args.output, &grown.scene(), &glb)
         .in_file(&args.genome)?;
     if let Some(png) = &args.png {
         out.add(png, &picture(&grown.scene(), View::Iso, (800, 800))?)?;
@@ -106,6 +112,7 @@ fn lod(
     grown: Grown,
     levels: usize,
     wind: Option<&sylva_mesh::wind::WindOptions>,
+    glb: &sylva_mesh::export::GlbOptions,
 ) -> anyhow::Result<()> {
     let (segments, organs) = (grown.plant.segments().len(), grown.plant.organs().len());
     let chain = LodAssets::new(grown, levels, wind).in_file(&args.genome)?;
@@ -117,11 +124,11 @@ fn lod(
     let mut files = Vec::new();
     for k in 0..chain.levels.len() {
         let path = args.output.with_file_name(format!("{name}_LOD{k}.glb"));
-        out.add_scene(&path, &chain.level_scene(k, &name))
+        out.add_scene_with(&path, &chain.level_scene(k, &name), glb)
             .in_file(&args.genome)?;
         files.push(path);
     }
-    out.add_scene(&args.output, &chain.group_scene(&name))
+    out.add_scene_with(&args.output, &chain.group_scene(&name), glb)
         .in_file(&args.genome)?;
     if let Some(png) = &args.png {
         out.add(
