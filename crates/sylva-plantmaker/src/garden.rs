@@ -346,11 +346,38 @@ impl Garden {
     /// gardens planted from genomes: at most [`MAX_PLANTS`] plants, and plants that fit the
     /// memory budget (estimated from the first plant of each genome, before the others grow).
     pub fn grow(&self) -> Result<GrownGarden, GardenError> {
+        self.plan(true)
+    }
+
+    /// Where every plant stands, as [`Garden::grow`] places them, without keeping the
+    /// plants: each is grown to measure its footprint and dropped, so memory holds one plant
+    /// at a time. [`Garden::develop`] grows a placement's plant again.
+    pub fn placements(&self) -> Result<Vec<Placement>, GardenError> {
+        Ok(self.plan(false)?.placements)
+    }
+
+    /// The plant of `placement` (one of this garden's), grown again.
+    pub fn develop(&self, placement: &Placement) -> Result<Plant, GardenError> {
+        let group = self.plants.get(placement.group).ok_or(GardenError::Empty)?;
+        group
+            .genome
+            .develop(placement.seed)
+            .map_err(|source| GardenError::Develop {
+                group: placement.group,
+                index: placement.index,
+                source,
+            })
+    }
+
+    /// Grows and places the plants, keeping them when `keep` (else `plants` stays empty).
+    fn plan(&self, keep: bool) -> Result<GrownGarden, GardenError> {
         let count = self.count();
         if count > MAX_PLANTS {
             return Err(GardenError::TooManyPlants(count));
         }
         let mut plants = Vec::new();
+        // Per distinct plant, the radius of its footprint.
+        let mut footprints: Vec<f32> = Vec::new();
         // Per placement: (group, index, seed, plant).
         let mut ids = Vec::with_capacity(count);
         let mut estimate = 0u64;
@@ -359,7 +386,7 @@ impl Garden {
                 .seeds
                 .len()
                 .min(self.variants.map_or(usize::MAX, |v| v as usize));
-            let first = plants.len();
+            let first = footprints.len();
             for (index, &seed) in g.seeds.iter().enumerate() {
                 if index < grown {
                     let plant = g
@@ -370,7 +397,7 @@ impl Garden {
                             index,
                             source,
                         })?;
-                    if index == 0 {
+                    if index == 0 && keep {
                         estimate = estimate
                             .saturating_add(plant_bytes(&plant).saturating_mul(grown as u64));
                         sylva_core::budget::check(
@@ -379,16 +406,18 @@ impl Garden {
                             "plant fewer",
                         )?;
                     }
-                    plants.push(plant);
+                    footprints.push(footprint(&plant));
+                    if keep {
+                        plants.push(plant);
+                    }
                 }
                 let variant = index % grown;
                 ids.push((group, index, g.seeds[variant], first + variant));
             }
         }
-        if plants.is_empty() {
+        if footprints.is_empty() {
             return Err(GardenError::Empty);
         }
-        let footprints: Vec<f32> = plants.iter().map(footprint).collect();
         let radii: Vec<f32> = ids
             .iter()
             .map(|&(_, _, _, plant)| footprints[plant])

@@ -5,7 +5,8 @@
 //! scene, with the extras its node carries (usually its [`Origin`]: genome, seed, Sylva's
 //! version, and its parents when known); [`SceneAssets::mesh`] meshes many placed plants with one mesher per
 //! set of options, and [`SceneAssets::scene`] lends them out as a [`Scene`] to export or
-//! picture; [`placed_glb`] instead lays out their GLB to stream, meshing one plant at a time.
+//! picture; [`garden_glb`] instead lays out a garden's GLB from its placements alone, to
+//! stream, growing and meshing one plant at a time.
 //! Mesh options follow from each model's [`MeshHint`], never from its name.
 
 use std::path::Path;
@@ -21,7 +22,7 @@ use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_model::{MeshHint, Model};
-use sylva_plantmaker::{Garden, GrownGarden, PlantMakerModel};
+use sylva_plantmaker::{Garden, GrownGarden, Placement, PlantMakerModel};
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
@@ -353,6 +354,14 @@ pub fn grow_garden(garden: &Garden, source: &Path) -> Result<GrownGarden, Error>
         .map_err(|e| InputError::file_error(source, &e))?)
 }
 
+/// Where every plant of a PlantMaker garden stands, without keeping the plants
+/// ([`Garden::placements`]). Errors name `source`.
+pub fn garden_placements(garden: &Garden, source: &Path) -> Result<Vec<Placement>, Error> {
+    Ok(garden
+        .placements()
+        .map_err(|e| InputError::file_error(source, &e))?)
+}
+
 /// The plants of a grown garden as placed in its scene: one per placement (`plant-0`,
 /// `plant-1`, ...), each carrying its genome and seed; the plants of one variant share it.
 pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<'g>> {
@@ -361,21 +370,114 @@ pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<
         .placements
         .iter()
         .enumerate()
-        .map(|(i, placement)| {
-            let plant = &grown.plants[placement.plant];
-            let genome = &garden.plants[placement.group].genome;
-            let origin = Origin::of(
-                &Genome::new(PlantMakerModel, genome.clone()),
-                placement.seed,
-            );
-            Placed {
-                translation: placement.translation,
-                rotation: placement.rotation(),
-                extras: Some(origin.extras()),
-                ..Placed::new(format!("plant-{i}"), plant, hint)
-            }
+        .map(|(i, placement)| Placed {
+            translation: placement.translation,
+            rotation: placement.rotation(),
+            extras: Some(placement_extras(garden, placement)),
+            ..Placed::new(format!("plant-{i}"), &grown.plants[placement.plant], hint)
         })
         .collect()
+}
+
+/// The origin a garden plant's node carries: its genome and seed.
+fn placement_extras(garden: &Garden, placement: &Placement) -> serde_json::Value {
+    let genome = &garden.plants[placement.group].genome;
+    Origin::of(
+        &Genome::new(PlantMakerModel, genome.clone()),
+        placement.seed,
+    )
+    .extras()
+}
+
+/// The names and origin extras of a garden's nodes, one per placement (`plant-0`, …), which
+/// [`garden_glb`] lends to the GLB writer.
+pub struct GardenNodes {
+    names: Vec<String>,
+    extras: Vec<serde_json::Value>,
+}
+
+impl GardenNodes {
+    /// The nodes of `placements` (the garden's own).
+    pub fn of(garden: &Garden, placements: &[Placement]) -> GardenNodes {
+        GardenNodes {
+            names: (0..placements.len())
+                .map(|i| format!("plant-{i}"))
+                .collect(),
+            extras: placements
+                .iter()
+                .map(|p| placement_extras(garden, p))
+                .collect(),
+        }
+    }
+}
+
+/// The GLB of a garden from its placements alone ([`Garden::placements`]), laid out and ready
+/// to stream: each distinct plant is grown and meshed when the writer asks for it (twice:
+/// once to lay the file out, once to write its bytes) and dropped after, so memory holds the
+/// JSON, one plant and one mesh, however large the garden. The bytes are those of the grown
+/// garden's scene ([`garden_placed`]) written with the same options. No wind (a rig is made
+/// from its mesh, and the skins are written after every mesh).
+pub fn garden_glb<'a>(
+    garden: &'a Garden,
+    placements: &'a [Placement],
+    nodes: &'a GardenNodes,
+    options: GlbOptions,
+) -> Result<Glb<'a>, Error> {
+    // Meshes in order of first appearance, as the writer numbers shared ones.
+    let mut mesh_of: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    let mut plants: Vec<&Placement> = Vec::new();
+    let glb_nodes = placements
+        .iter()
+        .zip(&nodes.names)
+        .zip(&nodes.extras)
+        .map(|((p, name), extras)| {
+            let mesh = *mesh_of.entry(p.plant).or_insert_with(|| {
+                plants.push(p);
+                plants.len() - 1
+            });
+            GlbNode {
+                name,
+                mesh,
+                rig: None,
+                translation: p.translation,
+                rotation: p.rotation(),
+                extras: Some(extras),
+            }
+        })
+        .collect();
+    let source = GardenMeshes {
+        garden,
+        plants,
+        mesher: Mesher::new(mesh_options(PlantMakerModel.mesh_hint()))?,
+        mesh: Mesh::default(),
+    };
+    Ok(Glb::new(glb_nodes, Box::new(source), options)?)
+}
+
+/// Grows and meshes a garden's plants when the GLB writer asks for them, into one mesh.
+struct GardenMeshes<'a> {
+    garden: &'a Garden,
+    /// Per mesh, the first placement showing it.
+    plants: Vec<&'a Placement>,
+    mesher: Mesher,
+    mesh: Mesh,
+}
+
+impl MeshSource for GardenMeshes<'_> {
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_mesh::export::ExportError> {
+        let placement = self
+            .plants
+            .get(index)
+            .ok_or(sylva_mesh::export::ExportError::NoSuchMesh { index })?;
+        let plant = self.garden.develop(placement).map_err(|e| {
+            sylva_mesh::export::ExportError::Source {
+                index,
+                source: Box::new(e),
+            }
+        })?;
+        self.mesher.mesh_into(&plant, &mut self.mesh)?;
+        Ok(&self.mesh)
+    }
 }
 
 /// How a garden's GLB is laid out, as its file says: a forest of variants is instanced
@@ -384,72 +486,6 @@ pub fn garden_glb_options(garden: &Garden) -> GlbOptions {
     GlbOptions {
         instancing: garden.variants.is_some() && garden.instancing != Some(false),
         quantize: garden.quantize,
-    }
-}
-
-/// The GLB of placed plants, laid out and ready to stream ([`Outputs::add_glb`]), whose
-/// meshes are made when they are needed and dropped after: one plant at a time, each twice
-/// (once to lay the file out, once to write its bytes). Memory holds the plants, the JSON
-/// and one mesh, rather than every mesh as [`SceneAssets`] does; the bytes are those of
-/// [`SceneAssets::scene`] written with the same options. No wind: a rig is made from its
-/// mesh, and the skins are written after every mesh.
-///
-/// [`Outputs::add_glb`]: crate::files::Outputs::add_glb
-pub fn placed_glb<'a>(placed: &'a [Placed<'a>], options: GlbOptions) -> Result<Glb<'a>, Error> {
-    let mut index_of: std::collections::HashMap<*const Plant, usize> =
-        std::collections::HashMap::new();
-    let mut plants: Vec<(&Plant, usize)> = Vec::new();
-    let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
-    let mut nodes = Vec::with_capacity(placed.len());
-    for p in placed {
-        let mesh = match index_of.get(&(p.plant as *const Plant)) {
-            Some(&m) => m,
-            None => {
-                let mesher = match meshers.iter().position(|(h, _)| *h == p.hint) {
-                    Some(m) => m,
-                    None => {
-                        meshers.push((p.hint, Mesher::new(mesh_options(p.hint))?));
-                        meshers.len() - 1
-                    }
-                };
-                plants.push((p.plant, mesher));
-                index_of.insert(p.plant, plants.len() - 1);
-                plants.len() - 1
-            }
-        };
-        nodes.push(GlbNode {
-            name: &p.name,
-            mesh,
-            rig: None,
-            translation: p.translation,
-            rotation: p.rotation,
-            extras: p.extras.as_ref(),
-        });
-    }
-    let source = PlantMeshes {
-        plants,
-        meshers: meshers.into_iter().map(|(_, m)| m).collect(),
-        mesh: Mesh::default(),
-    };
-    Ok(Glb::new(nodes, Box::new(source), options)?)
-}
-
-/// Meshes plants when the GLB writer asks for them, into one reused mesh.
-struct PlantMeshes<'a> {
-    /// Each distinct plant and its mesher.
-    plants: Vec<(&'a Plant, usize)>,
-    meshers: Vec<Mesher>,
-    mesh: Mesh,
-}
-
-impl MeshSource for PlantMeshes<'_> {
-    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_mesh::export::ExportError> {
-        let &(plant, mesher) = self
-            .plants
-            .get(index)
-            .ok_or(sylva_mesh::export::ExportError::NoSuchMesh { index })?;
-        self.meshers[mesher].mesh_into(plant, &mut self.mesh)?;
-        Ok(&self.mesh)
     }
 }
 

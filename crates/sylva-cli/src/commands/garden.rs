@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use sylva::assets::{
-    SceneAssets, asset_format, check_png, garden_glb_options, garden_placed, grow_garden, picture,
-    placed_glb,
+    GardenNodes, SceneAssets, asset_format, check_png, garden_glb, garden_glb_options,
+    garden_placed, garden_placements, grow_garden, picture,
 };
 use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
@@ -129,26 +129,41 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         .into());
     }
     let options = garden_glb_options(&garden);
-    let grown = grow_garden(&garden, first)?;
-    let placed = garden_placed(&garden, &grown);
     let mut out = Outputs::new();
-    let (triangles, png) = if format == Format::Glb && wind.is_none() && args.png.is_none() {
-        // Meshed one plant at a time as the GLB streams out: memory holds the plants, the
-        // JSON and one mesh, not the scene.
-        let mut glb = placed_glb(&placed, options).in_file(first)?;
-        out.add_glb(&args.output, &mut glb)?;
-        (glb.stats().triangles as usize, None)
-    } else {
-        let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
-        let scene = assets.scene();
-        out.add_scene_with(&args.output, &scene, &options)
-            .in_file(first)?;
-        let png = match &args.png {
-            Some(path) => Some((path, picture(&scene, View::Iso, SCENE_PICTURE)?)),
-            None => None,
+    // (plants, distinct plants meshed, triangles, picture)
+    let (plants, meshes, triangles, png) =
+        if format == Format::Glb && wind.is_none() && args.png.is_none() {
+            // Grown, meshed and dropped one plant at a time as the GLB streams out: memory
+            // holds the placements, the JSON and one plant with its mesh, not the scene.
+            let placements = garden_placements(&garden, first)?;
+            let nodes = GardenNodes::of(&garden, &placements);
+            let mut glb = garden_glb(&garden, &placements, &nodes, options).in_file(first)?;
+            out.add_glb(&args.output, &mut glb)?;
+            let meshes = placements.iter().map(|p| p.plant + 1).max().unwrap_or(0);
+            (
+                placements.len(),
+                meshes,
+                glb.stats().triangles as usize,
+                None,
+            )
+        } else {
+            let grown = grow_garden(&garden, first)?;
+            let placed = garden_placed(&garden, &grown);
+            let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
+            let scene = assets.scene();
+            out.add_scene_with(&args.output, &scene, &options)
+                .in_file(first)?;
+            let png = match &args.png {
+                Some(path) => Some((path, picture(&scene, View::Iso, SCENE_PICTURE)?)),
+                None => None,
+            };
+            (
+                placed.len(),
+                grown.plants.len(),
+                scene.triangle_count(),
+                png,
+            )
         };
-        (scene.triangle_count(), png)
-    };
     let garden_path = args.output.with_extension("garden.json");
     if !is_garden {
         out.add(&garden_path, garden.to_json().as_bytes())?;
@@ -161,11 +176,8 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         println!("wrote {}", garden_path.display());
     }
     println!(
-        "wrote {}: {} plants ({} meshes), {} triangles",
+        "wrote {}: {plants} plants ({meshes} meshes), {triangles} triangles",
         args.output.display(),
-        placed.len(),
-        grown.plants.len(),
-        triangles
     );
     Ok(())
 }

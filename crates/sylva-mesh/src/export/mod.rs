@@ -175,6 +175,15 @@ pub enum ExportError {
     /// A [`MeshSource`] could not make a mesh.
     #[error("meshing")]
     Mesh(#[from] crate::mesher::MeshError),
+    /// A [`MeshSource`] could not make the plant to mesh.
+    #[error("growing the plant of mesh {index}")]
+    Source {
+        /// The mesh asked for.
+        index: usize,
+        /// Why.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 /// A file format [`write_scene`] can write.
