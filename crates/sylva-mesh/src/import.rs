@@ -16,7 +16,8 @@
 //! material that texture id back; other textures, skins, morph targets, sparse accessors and
 //! non-triangle modes are ignored. Every node's transform is baked into
 //! a world-space copy of its mesh. Every offset and count is checked, so a truncated or
-//! hostile file is an error, never a panic.
+//! hostile file is an error, never a panic; the work is counted before it is done (at most
+//! 100 million triangles and a million instances a file, within the memory budget).
 
 use std::collections::{HashMap, HashSet};
 
@@ -79,6 +80,15 @@ impl ImportedScene {
 
 /// Most triangles read from one file.
 const MAX_TRIANGLES: usize = 100_000_000;
+/// Most instances (`EXT_mesh_gpu_instancing`) read from one file: each becomes a world-space
+/// copy of its mesh, so a small file of tiny meshes must not ask for millions of copies.
+const MAX_PLACED: usize = 1_000_000;
+
+fn too_many_placed() -> ImportError {
+    invalid(format!(
+        "more than {MAX_PLACED} instances of meshes (EXT_mesh_gpu_instancing); each is drawn as a copy"
+    ))
+}
 
 fn invalid(what: impl Into<String>) -> ImportError {
     ImportError::Invalid(what.into())
@@ -210,11 +220,16 @@ impl Reader<'_> {
         let nodes = self.list("nodes");
         // Each instance of an instanced node, with its world transform.
         let mut instances: HashMap<usize, Vec<Mat4>> = HashMap::new();
+        let mut copies = 0usize;
         for &(i, world) in &placed {
             if nodes[i].get("mesh").is_some()
                 && let Some(ext) = nodes[i]["extensions"].get("EXT_mesh_gpu_instancing")
             {
                 let local = self.instances(ext)?;
+                copies = copies.saturating_add(local.len());
+                if copies > MAX_PLACED {
+                    return Err(too_many_placed());
+                }
                 instances.insert(i, local.into_iter().map(|m| world * m).collect());
             }
         }
@@ -278,6 +293,13 @@ impl Reader<'_> {
                 return Ok(None);
             };
             let accessor = self.item("accessors", index)?;
+            // Refused before reading: each instance becomes a copy of the node's mesh.
+            if accessor["count"]
+                .as_u64()
+                .is_some_and(|c| c > MAX_PLACED as u64)
+            {
+                return Err(too_many_placed());
+            }
             let want = if n == 4 { "VEC4" } else { "VEC3" };
             if accessor["type"] != want {
                 return Err(invalid(format!("instance {name} must be {want}")));
@@ -950,6 +972,37 @@ mod tests {
             let e = instanced(attributes).unwrap_err();
             assert!(e.to_string().contains(why), "{e}");
         }
+        // A tiny file asking for millions of copies is refused before any is read or made:
+        // two nodes of 600,000 instances each (the second's count alone is under the cap).
+        let bin: Vec<u8> = vec![0; 36];
+        let node = |name: &str| {
+            serde_json::json!({ "name": name, "mesh": 0, "extensions": {
+                "EXT_mesh_gpu_instancing": { "attributes": { "TRANSLATION": 1 } } } })
+        };
+        let mut json = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{ "byteLength": 36 }],
+            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
+            "accessors": [
+                { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3" },
+                { "bufferView": 0, "componentType": 5126, "count": 2_000_000, "type": "VEC3" },
+            ],
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+            "nodes": [node("a")],
+        });
+        let e = read_glb(&glb(&json, &bin)).unwrap_err();
+        assert!(e.to_string().contains("instances"), "{e}");
+        let bin: Vec<u8> = vec![0; 36 + 12 * 600_000];
+        json["buffers"][0]["byteLength"] = serde_json::json!(bin.len());
+        json["bufferViews"] = serde_json::json!([
+            { "buffer": 0, "byteLength": 36 },
+            { "buffer": 0, "byteOffset": 36, "byteLength": 12 * 600_000 },
+        ]);
+        json["accessors"][1] = serde_json::json!(
+            { "bufferView": 1, "componentType": 5126, "count": 600_000, "type": "VEC3" });
+        json["nodes"] = serde_json::json!([node("a"), node("b")]);
+        let e = read_glb(&glb(&json, &bin)).unwrap_err();
+        assert!(e.to_string().contains("instances"), "{e}");
     }
 
     #[test]
