@@ -109,7 +109,7 @@ pub mod tree;
 pub use compile::{AtEnd, ElseEnd, Program, Semantics};
 pub use genome::{AutomataGenome, AutomataTag, Growth, MODEL};
 pub use gp::{Creation, GpConfig, SubtreeCrossover, SubtreeMutation, Weights};
-pub use problem::{AutomataProblem, AutomataSettings, AutomataStrategy};
+pub use problem::{AutomataProblem, AutomataSettings, AutomataStrategy, EvaluationDetail};
 pub use sexpr::ParseError;
 pub use sim::{
     BoundsHit, ChildVariables, Detail, GrowOptions, GrowthReport, Limits, Simulator, Stop,

@@ -10,11 +10,17 @@
 //! init_max_depth = 8
 //! max_depth = 17          # deepest tree breeding may make, 2 to 64
 //! max_size = 500          # most nodes of a tree, 20 to 5000
+//! detail = "chords"       # how evaluation grows a program: "chords" or "full" (below)
 //!
 //! [automata.breeding]     # tournament 7; crossover 0.88, reproduction 0.10, mutation 0.02
 //! [automata.growth]       # how programs grow (every field of an automata genome file)
 //! [automata.fitness]      # Poncin's terms: target shape, counts, spread, thickness, grid
 //! ```
+//!
+//! Evaluation grows chords (one segment per run between branch points), which carry every
+//! term but a taper inside a run. The bars and gradual thickness measures look for steps
+//! inside runs, so a config that uses them grows every step (`detail = "full"`, about
+//! twice the cost).
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -56,12 +62,31 @@ pub struct AutomataSettings {
     /// Most nodes of a tree, 20 to 5000. Default 500 (the paper's largest individuals).
     #[serde(deserialize_with = "max_size")]
     pub max_size: u32,
+    /// How evaluation grows a program: `"chords"` (the default) or `"full"` (every step a
+    /// segment, for thickness measures that look inside runs).
+    #[serde(skip_serializing_if = "is_chords")]
+    pub detail: EvaluationDetail,
     /// Tournament selection and the 88 / 10 / 2 operator rates.
     pub breeding: GenerationalSettings,
     /// How programs grow (written into every evolved genome).
     pub growth: Growth,
     /// Poncin's fitness: target shape, counts, spread, thickness and density grid.
     pub fitness: PoncinFitness,
+}
+
+/// How evaluation grows programs (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EvaluationDetail {
+    /// One segment per run between branch points ([`Detail::Chords`]).
+    #[default]
+    Chords,
+    /// Every step a segment ([`Detail::Full`]).
+    Full,
+}
+
+fn is_chords(detail: &EvaluationDetail) -> bool {
+    *detail == EvaluationDetail::Chords
 }
 
 /// Section 3's rule stays out of written configs unless chosen, so they keep their bytes.
@@ -78,6 +103,7 @@ impl Default for AutomataSettings {
             init_max_depth: 8,
             max_depth: 17,
             max_size: 500,
+            detail: EvaluationDetail::Chords,
             breeding: GenerationalSettings::default(),
             growth: Growth::default(),
             fitness: PoncinFitness::default(),
@@ -117,6 +143,7 @@ pub struct AutomataProblem {
     pub fitness: PoncinFitness,
     semantics: Semantics,
     grow: GrowOptions,
+    detail: Detail,
     /// Automaton-steps simulated by this problem and its clones, for speed reports.
     steps: Arc<AtomicU64>,
 }
@@ -148,6 +175,10 @@ impl AutomataProblem {
             fitness: settings.fitness.clone(),
             semantics: settings.growth.semantics(),
             grow: settings.growth.grow_options(),
+            detail: match settings.detail {
+                EvaluationDetail::Chords => Detail::Chords,
+                EvaluationDetail::Full => Detail::Full,
+            },
             steps: Arc::default(),
         }
     }
@@ -158,7 +189,8 @@ impl AutomataProblem {
         self.steps.load(Ordering::Relaxed)
     }
 
-    /// Grows a program the way evaluation does (chords only) and scores it.
+    /// Grows a program the way evaluation does (chords, unless the settings ask for every
+    /// step) and scores it.
     pub fn score(&self, tree: &GpTree) -> PoncinScore {
         SCRATCH.with(|cell| {
             let mut guard = cell.borrow_mut();
@@ -172,7 +204,7 @@ impl AutomataProblem {
             };
             let report = s
                 .simulator
-                .run(program, &self.grow, Detail::Chords, &mut s.plant);
+                .run(program, &self.grow, self.detail, &mut s.plant);
             self.steps
                 .fetch_add(report.automaton_steps, Ordering::Relaxed);
             // Pairs are exact up to 64 endpoints; beyond, the fixed seed keeps evaluation a

@@ -505,3 +505,35 @@ fn random_individuals_look_like_the_paper_s() {
     eprintln!("of 500 random trees: {drawn} draw, {branched} branch");
     assert!(drawn > 250 && branched > 25, "{drawn} {branched}");
 }
+
+/// `detail = "full"` makes evaluation grow every step, so a thickness measure sees a taper
+/// inside a run: ten halvings are gradual step by step, but one chord from 1 to the tip
+/// is a sudden step.
+#[test]
+fn evaluation_grows_every_step_when_the_settings_ask() {
+    let tree = GpTree::parse("(Top (Repeat 10 (Seq (Multiply Thickness 0.5) (Wait))))").unwrap();
+    let settings = |detail: &str| -> sylva_automata::AutomataSettings {
+        toml::from_str(&format!(
+            "automata = 1\ndetail = \"{detail}\"\n[fitness.thick]\nmeasure = \"bars\"\n\
+             [fitness.weights]\nthick = 1.0"
+        ))
+        .unwrap()
+    };
+    let score = |detail: &str| sylva_automata::AutomataProblem::new(&settings(detail)).score(&tree);
+    let (full, chords) = (score("full"), score("chords"));
+    let s = settings("full");
+    let (plant, report) = grow(
+        &tree.to_string(),
+        &s.growth.grow_options(),
+        &s.growth.semantics(),
+    );
+    let ctx = sylva_fitness::poncin::PoncinContext {
+        seed: 0,
+        negative_thickness: report.negative_thickness,
+    };
+    assert_eq!(full.thick, s.fitness.score_once(&plant, ctx).thick);
+    assert_eq!(full.thick, 0.0);
+    assert!(chords.thick > 0.3, "{}", chords.thick);
+    let err = toml::from_str::<sylva_automata::AutomataSettings>("detail = \"every\"").unwrap_err();
+    assert!(err.to_string().contains("chords"), "{err}");
+}

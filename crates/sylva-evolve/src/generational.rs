@@ -20,6 +20,15 @@
 //! Elitism (default 1) copies the best members first, so the best genome is never lost; 0 is
 //! lilgp's plain generational step.
 //!
+//! **Demes** (Sylva's, off by default). With [`GenerationalSettings::demes`] = D > 1 the
+//! population is cut into D equal runs of slots that breed apart: tournaments draw only from
+//! the slot's own deme and each deme keeps its own elites. Every
+//! [`GenerationalSettings::migrate_every`] generations the best
+//! [`GenerationalSettings::migrants`] of each deme are copied into the next one (a ring;
+//! operator "migrant"), after that deme's elites. A deme that has settled on a local optimum
+//! then cannot take the whole population with it, and good parts still spread. One deme is
+//! exactly the plain step.
+//!
 //! Slot `s` of generation `g` draws everything from `rng::stream(seed, g, s)` and is made and
 //! evaluated in one job of [`Pool::map`](crate::Pool::map), so a run is identical for any thread count and
 //! a resumed run continues exactly.
@@ -34,6 +43,7 @@
 //! generation) itself.
 
 use std::borrow::Cow;
+use std::ops::Range;
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
@@ -55,6 +65,12 @@ pub enum GenerationalError {
     /// A tournament of no one, or of more than [`MAX_TOURNAMENT`].
     #[error("`tournament` must be 1 to {MAX_TOURNAMENT}, got {0}")]
     Tournament(usize),
+    /// No deme, or more than [`MAX_DEMES`].
+    #[error("`demes` must be 1 to {MAX_DEMES}, got {0}")]
+    Demes(usize),
+    /// A migration interval of zero generations.
+    #[error("`migrate_every` must be at least 1 generation, got 0")]
+    MigrateEvery,
     /// A rate that is NaN, infinite or outside 0..=1.
     #[error("`{name}` rate must be a number from 0 to 1, got {value}")]
     BadRate {
@@ -103,6 +119,27 @@ pub struct GenerationalSettings {
     /// Re-evaluate copies (elites, reproductions) rather than reuse their fitness.
     /// Default `true` (see the module docs).
     pub reevaluate: bool,
+    /// Demes that breed apart, 1 to 1024 (at most the population is used). Default 1.
+    #[serde(deserialize_with = "deme_count", skip_serializing_if = "is_one")]
+    pub demes: usize,
+    /// Generations between migrations, 1 to 1,000,000. Default 10.
+    #[serde(deserialize_with = "migrate_every", skip_serializing_if = "is_ten")]
+    pub migrate_every: u32,
+    /// Best members of each deme copied into the next at a migration, 0 to 1,000,000.
+    /// Default 2.
+    #[serde(deserialize_with = "migrants", skip_serializing_if = "is_two")]
+    pub migrants: usize,
+}
+
+// Deme settings stay out of written configs at their defaults, so those keep their bytes.
+fn is_one(n: &usize) -> bool {
+    *n == 1
+}
+fn is_ten(n: &u32) -> bool {
+    *n == 10
+}
+fn is_two(n: &usize) -> bool {
+    *n == 2
 }
 
 /// Largest tournament: beyond, selection costs more and changes nothing (a tournament of
@@ -114,6 +151,12 @@ sylva_core::ranged!(crossover: f64, "crossover", 0.0, 1.0);
 sylva_core::ranged!(reproduction: f64, "reproduction", 0.0, 1.0);
 sylva_core::ranged!(mutation: f64, "mutation", 0.0, 1.0);
 sylva_core::ranged!(elitism: usize, "elitism", 0, 1_000_000);
+sylva_core::ranged!(deme_count: usize, "demes", 1, MAX_DEMES);
+sylva_core::ranged!(migrate_every: u32, "migrate_every", 1, 1_000_000);
+sylva_core::ranged!(migrants: usize, "migrants", 0, 1_000_000);
+
+/// Most demes: more would leave demes of a handful of members in any population Sylva runs.
+pub const MAX_DEMES: usize = 1024;
 
 impl Default for GenerationalSettings {
     fn default() -> Self {
@@ -124,6 +167,9 @@ impl Default for GenerationalSettings {
             mutation: 0.02,
             elitism: 1,
             reevaluate: true,
+            demes: 1,
+            migrate_every: 10,
+            migrants: 2,
         }
     }
 }
@@ -133,6 +179,12 @@ impl GenerationalSettings {
     pub fn validate(&self) -> Result<(), GenerationalError> {
         if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {
             return Err(GenerationalError::Tournament(self.tournament));
+        }
+        if !(1..=MAX_DEMES).contains(&self.demes) {
+            return Err(GenerationalError::Demes(self.demes));
+        }
+        if self.migrate_every == 0 {
+            return Err(GenerationalError::MigrateEvery);
         }
         for (name, value) in [
             ("crossover", self.crossover),
@@ -191,6 +243,7 @@ impl<X, M> Generational<X, M> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Operator {
     Elite,
+    Migrant,
     Crossover,
     Reproduction,
     Mutation,
@@ -200,6 +253,7 @@ impl Operator {
     fn name(self) -> &'static str {
         match self {
             Operator::Elite => "elite",
+            Operator::Migrant => "migrant",
             Operator::Crossover => "crossover",
             Operator::Reproduction => "reproduction",
             Operator::Mutation => "mutation",
@@ -226,15 +280,42 @@ fn fitter<G>(population: &[Individual<G>], a: usize, b: usize) -> bool {
         .is_gt()
 }
 
-/// The winner of a tournament of `size` members drawn with replacement.
+/// The population cut into `count` runs of consecutive slots whose sizes differ by at most one.
+struct Demes {
+    len: usize,
+    count: usize,
+}
+
+impl Demes {
+    fn new(len: usize, demes: usize) -> Demes {
+        Demes {
+            len,
+            count: demes.clamp(1, len.max(1)),
+        }
+    }
+
+    /// The deme of `slot`.
+    fn of(&self, slot: usize) -> usize {
+        slot * self.count / self.len
+    }
+
+    /// The slots of deme `d`: from ceil(d × len / count) on.
+    fn range(&self, d: usize) -> Range<usize> {
+        let start = |d: usize| (d * self.len).div_ceil(self.count);
+        start(d)..start(d + 1)
+    }
+}
+
+/// The winner of a tournament of `size` members of `deme` drawn with replacement.
 fn tournament<G, R: rand::Rng + ?Sized>(
     population: &[Individual<G>],
+    deme: Range<usize>,
     size: usize,
     rng: &mut R,
 ) -> usize {
-    let mut best = rng.random_range(0..population.len());
+    let mut best = rng.random_range(deme.clone());
     for _ in 1..size {
-        let other = rng.random_range(0..population.len());
+        let other = rng.random_range(deme.clone());
         if fitter(population, other, best) {
             best = other;
         }
@@ -258,8 +339,29 @@ where
             return 0;
         }
         let s = &self.settings;
-        let elite = fittest(population, s.elitism.min(population.len()));
         let (seed, generation) = (ctx.seed, ctx.generation);
+        let demes = Demes::new(population.len(), s.demes);
+        let migrating = demes.count > 1 && generation % s.migrate_every == 0;
+        // Slots filled by copies: each deme's elites first, then at a migration the best of
+        // the deme before it.
+        let mut copies: Vec<Option<(usize, Operator)>> = vec![None; population.len()];
+        for d in 0..demes.count {
+            let deme = demes.range(d);
+            let elites = fittest(&population[deme.clone()], s.elitism.min(deme.len()));
+            let mut slot = deme.start;
+            for e in elites {
+                copies[slot] = Some((deme.start + e, Operator::Elite));
+                slot += 1;
+            }
+            if migrating {
+                let from = demes.range((d + demes.count - 1) % demes.count);
+                let room = deme.end - slot;
+                for m in fittest(&population[from.clone()], s.migrants.min(room)) {
+                    copies[slot] = Some((from.start + m, Operator::Migrant));
+                    slot += 1;
+                }
+            }
+        }
         let old = &*population;
         let copy = |parent: usize, operator: Operator| {
             let genome = old[parent].genome.clone();
@@ -277,14 +379,15 @@ where
             }
         };
         let offspring = ctx.evaluator.map(old.len(), |slot| {
-            if let Some(&parent) = elite.get(slot) {
-                return copy(parent, Operator::Elite);
+            if let Some((parent, operator)) = copies[slot] {
+                return copy(parent, operator);
             }
+            let deme = demes.range(demes.of(slot));
             let mut rng = rng::stream(seed, generation, slot as u32);
             let draw: f64 = rng.random();
             if draw < s.crossover {
-                let a = tournament(old, s.tournament, &mut rng);
-                let b = tournament(old, s.tournament, &mut rng);
+                let a = tournament(old, deme.clone(), s.tournament, &mut rng);
+                let b = tournament(old, deme.clone(), s.tournament, &mut rng);
                 let genome = self
                     .crossover
                     .crossover(&old[a].genome, &old[b].genome, &mut rng);
@@ -297,11 +400,11 @@ where
                 }
             } else if draw < s.crossover + s.reproduction {
                 copy(
-                    tournament(old, s.tournament, &mut rng),
+                    tournament(old, deme.clone(), s.tournament, &mut rng),
                     Operator::Reproduction,
                 )
             } else {
-                let parent = tournament(old, s.tournament, &mut rng);
+                let parent = tournament(old, deme.clone(), s.tournament, &mut rng);
                 let mut genome = old[parent].genome.clone();
                 self.mutation.mutate(&mut genome, &mut rng);
                 Offspring {
@@ -363,11 +466,29 @@ mod tests {
             .collect();
         let mut rng = rng::seeded(3);
         let wins: usize = (0..1000)
-            .map(|_| tournament(&pop, 7, &mut rng))
+            .map(|_| tournament(&pop, 0..10, 7, &mut rng))
             .filter(|&w| w >= 7)
             .count();
         // P(winner in the top 3 of 10 with 7 draws) = 1 - 0.7^7 ≈ 0.92.
         assert!(wins > 880, "{wins}");
         assert_eq!(fittest(&pop, 3), vec![9, 8, 7]);
+    }
+
+    #[test]
+    fn demes_cut_the_population_into_near_equal_runs() {
+        for len in 1..40 {
+            for count in 1..12 {
+                let demes = Demes::new(len, count);
+                let mut next = 0;
+                for d in 0..demes.count {
+                    let r = demes.range(d);
+                    assert_eq!(r.start, next, "{len} {count}");
+                    assert!(r.len() == len / demes.count || r.len() == len.div_ceil(demes.count));
+                    assert!(r.clone().all(|slot| demes.of(slot) == d));
+                    next = r.end;
+                }
+                assert_eq!(next, len);
+            }
+        }
     }
 }

@@ -270,3 +270,112 @@ fn copies_reuse_fitness_only_when_asked() {
     assert_eq!(fewer, 500 - copies);
     assert!(copies > 20);
 }
+
+#[test]
+fn demes_breed_apart_and_migrate_in_a_ring() {
+    let demes = GenerationalSettings {
+        demes: 4,
+        migrate_every: 3,
+        migrants: 2,
+        ..GenerationalSettings::default()
+    };
+    let mut run = Run::new(Rugged, strategy(demes), Pool::Serial, settings(40)).unwrap();
+    // Slots 10d..10d+10 are deme d.
+    let deme = |slot: usize| slot / 10;
+    for generation in 1..=9u32 {
+        let before: HashMap<_, _> = run
+            .population()
+            .iter()
+            .enumerate()
+            .map(|(slot, i)| (i.id, (slot, i.total())))
+            .collect();
+        run.step();
+        let migration = generation % 3 == 0;
+        for (slot, ind) in run.population().iter().enumerate() {
+            let op = &*ind.origin.operator;
+            let from: Vec<usize> = ind.origin.parents.iter().map(|p| before[p].0).collect();
+            match slot % 10 {
+                0 => assert_eq!(op, "elite"),
+                1 | 2 if migration => {
+                    assert_eq!(op, "migrant");
+                    assert_eq!(deme(from[0]), (deme(slot) + 3) % 4, "ring");
+                }
+                _ => {
+                    assert!(op != "elite" && op != "migrant", "{op} in slot {slot}");
+                    assert!(
+                        from.iter().all(|&p| deme(p) == deme(slot)),
+                        "{from:?} {slot}"
+                    );
+                }
+            }
+            if op == "elite" {
+                // Each deme keeps its own best.
+                let best = before
+                    .values()
+                    .filter(|(s, _)| deme(*s) == deme(slot))
+                    .map(|(_, t)| *t)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                assert_eq!(ind.total(), best);
+            }
+        }
+    }
+}
+
+#[test]
+fn demes_are_the_same_for_one_and_two_threads_and_one_deme_is_the_plain_step() {
+    let demes = GenerationalSettings {
+        demes: 3,
+        migrate_every: 2,
+        ..GenerationalSettings::default()
+    };
+    let prints: Vec<String> = [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let ev = Pool::with_threads(threads).unwrap();
+            let mut run = Run::new(Rugged, strategy(demes.clone()), ev, settings(64)).unwrap();
+            run.run_batch(12, |_| {});
+            fingerprint(&run)
+        })
+        .collect();
+    assert_eq!(prints[0], prints[1]);
+    let plain = |s: GenerationalSettings| {
+        let mut run = Run::new(Rugged, strategy(s), Pool::Serial, settings(64)).unwrap();
+        run.run_batch(12, |_| {});
+        fingerprint(&run)
+    };
+    let one = GenerationalSettings {
+        demes: 1,
+        migrate_every: 1,
+        migrants: 5,
+        ..GenerationalSettings::default()
+    };
+    assert_eq!(plain(one), plain(GenerationalSettings::default()));
+    assert_ne!(prints[0], plain(GenerationalSettings::default()));
+}
+
+#[test]
+fn deme_settings_are_checked_and_stay_out_of_default_configs() {
+    for (text, field) in [
+        (r#"{"demes": 0}"#, "demes"),
+        (r#"{"demes": 5000}"#, "demes"),
+        (r#"{"migrate_every": 0}"#, "migrate_every"),
+        (r#"{"migrants": -1}"#, "migrants"),
+    ] {
+        let err = serde_json::from_str::<GenerationalSettings>(text).unwrap_err();
+        assert!(err.to_string().contains(field), "{text}: {err}");
+    }
+    let written = serde_json::to_string(&GenerationalSettings::default()).unwrap();
+    assert!(
+        !written.contains("demes") && !written.contains("migra"),
+        "{written}"
+    );
+    let bad = Generational::new(
+        OnePoint,
+        BitFlip { rate: 0.1 },
+        GenerationalSettings {
+            migrate_every: 0,
+            ..GenerationalSettings::default()
+        },
+    );
+    assert!(matches!(bad, Err(GenerationalError::MigrateEvery)));
+}

@@ -241,6 +241,65 @@ fn the_taper_measure_rewards_thinning_gradually_from_the_foot() {
 }
 
 #[test]
+fn the_bars_measure_is_zero_exactly_when_the_taper_bars_hold() {
+    // A trunk of four 1 m segments, radii given at each joint (thickness × 0.3 m), with a
+    // branch of two segments from the trunk's second joint.
+    let tree = |trunk: [f32; 5], branch: [f32; 3]| {
+        let mut p = Plant::new(PlantMeta::default());
+        let mut parent = None;
+        for k in 0..4 {
+            let (a, b) = (Vec3::Y * k as f32, Vec3::Y * (k + 1) as f32);
+            let r = (0.3 * trunk[k], 0.3 * trunk[k + 1]);
+            parent = Some(p.add_segment(a, b, r, parent, false, Plant::BARK).unwrap());
+        }
+        let mut parent = Some(SegmentId(1));
+        for k in 0..2 {
+            let a = Vec3::new(k as f32, 2.0, 0.0);
+            let r = (0.3 * branch[k], 0.3 * branch[k + 1]);
+            let lateral = k == 0;
+            let s = p.add_segment(a, a + Vec3::X, r, parent, lateral, Plant::BARK);
+            parent = Some(s.unwrap());
+        }
+        p
+    };
+    let bars = ThickOptions {
+        measure: ThickMeasure::Bars,
+        ..ThickOptions::default()
+    };
+    let gradual = tree([1.0, 0.7, 0.5, 0.35, 0.25], [0.5, 0.3, 0.2]);
+    assert_eq!(f_thick(&gradual, &bars, 0), 0.0);
+    // Each bar broken on its own: a step to less than half at the junction, a branch that
+    // thickens, a tip above a quarter of the foot.
+    let step = tree([1.0, 0.7, 0.5, 0.35, 0.25], [0.2, 0.15, 0.1]);
+    let thickens = tree([1.0, 0.7, 0.5, 0.35, 0.25], [0.3, 0.33, 0.2]);
+    let thick_tip = tree([1.0, 0.7, 0.5, 0.35, 0.25], [0.5, 0.4, 0.3]);
+    // Per tip (2): 0.5 − 0.2 / 0.5 = 0.1 (or a rise of 0.33 / 0.3 − 1 = 0.1, or a tip 0.05
+    // over 0.25) summed and halved, plus the worst.
+    close(f_thick(&step, &bars, 0), 0.1 / 2.0 + 0.1);
+    close(f_thick(&thickens, &bars, 0), 0.1 / 2.0 + 0.1);
+    close(f_thick(&thick_tip, &bars, 0), 0.05 / 2.0 + 0.05);
+    // A lower tip ratio leaves a margin: the gradual tree's trunk tip at 0.25 is then over.
+    let margin = ThickOptions {
+        tip_ratio: 0.2,
+        ..bars.clone()
+    };
+    close(f_thick(&gradual, &margin, 0), 0.05 / 2.0 + 0.05);
+    // Gradual adds the taper measure's deviation to the bars.
+    let both = ThickOptions {
+        measure: ThickMeasure::Gradual,
+        ..ThickOptions::default()
+    };
+    let taper = ThickOptions {
+        measure: ThickMeasure::Taper,
+        ..ThickOptions::default()
+    };
+    close(
+        f_thick(&step, &both, 0),
+        f_thick(&step, &taper, 0) + f_thick(&step, &bars, 0),
+    );
+}
+
+#[test]
 fn f_dist_and_f_angle_follow_the_pair_formula() {
     let p = two_branches();
     let exact = PairOptions {

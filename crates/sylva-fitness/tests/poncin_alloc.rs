@@ -55,7 +55,12 @@ fn scoring_does_not_allocate_once_warm() {
     })
     .unwrap();
     // Both pair modes, each with one of the thickness measures.
-    let measures = [ThickMeasure::Endpoints, ThickMeasure::Taper];
+    let measures = [
+        ThickMeasure::Endpoints,
+        ThickMeasure::Taper,
+        ThickMeasure::Bars,
+        ThickMeasure::Gradual,
+    ];
     let configs: Vec<PoncinFitness> = [PairMode::Exact, PairMode::Sampled]
         .into_iter()
         .zip(measures)

@@ -30,6 +30,7 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "automata/sphere.toml",
         "automata/box-above.toml",
         "automata/two-levels.toml",
+        "automata/pine.toml",
         "plantmaker/evolve.toml",
         "lsystem/evolve.toml",
     ] {

@@ -51,6 +51,9 @@ pub struct Endpoint {
 pub struct PoncinScratch {
     /// Per segment: whether any segment grows from it.
     has_child: Vec<bool>,
+    /// Per segment: whether any segment grows from it, whatever the endpoint rule (the bars
+    /// measure).
+    continued: Vec<bool>,
     /// Per segment: the first segment of its axis.
     axis: Vec<u32>,
     /// Per axis (indexed by its first segment): its last segment.
@@ -185,6 +188,83 @@ impl PoncinScratch {
             }
         }
         deviation / length
+    }
+
+    /// F_thick by a measure that reads the whole plant ([`super::ThickMeasure::Taper`],
+    /// [`super::ThickMeasure::Bars`] or [`super::ThickMeasure::Gradual`]; the endpoints
+    /// measure gives 0 here). `plant` must be the plant last [`read`](Self::read).
+    pub fn thick_measure(&mut self, plant: &Plant, thick: &super::ThickOptions) -> f64 {
+        match thick.measure {
+            super::ThickMeasure::Endpoints => 0.0,
+            super::ThickMeasure::Taper => self.taper_deviation(plant, thick),
+            super::ThickMeasure::Bars => self.bars_deviation(plant, thick.tip_ratio),
+            super::ThickMeasure::Gradual => {
+                self.taper_deviation(plant, thick) + self.bars_deviation(plant, thick.tip_ratio)
+            }
+        }
+    }
+
+    /// F_thick's bars measure ([`super::ThickMeasure::Bars`]): how far `plant` is from a
+    /// gradual taper. Along every path from the foot, per tip:
+    ///
+    /// - each rise in thickness, `max(0, b / a − 1)` (at most 1 each), from one radius `a`
+    ///   to the next `b` (a segment's start to its end, a parent's end to its child's start);
+    /// - each step to less than half, `max(0, 0.5 − b / a)`;
+    /// - the tip's excess over `tip_ratio` of the foot's radius, `max(0, tip / foot −
+    ///   tip_ratio)` (the bar's is 0.25, [`super::ThickOptions::tip_ratio`]).
+    ///
+    /// Rises and steps are summed over the plant and divided by the number of tips, the
+    /// excesses averaged over the tips; the worst of each is added, because the bars hold
+    /// for every path: one thick stub among hundreds of thin tips fails them. 0 exactly when the plant meets issue 14's taper
+    /// bars: it never thickens, no segment is less than half as thick as the one before
+    /// it, and every tip is at most `tip_ratio` of the foot. 0 for a plant without segments.
+    /// Needs every step drawn to see steps inside a run (the automata's `detail = "full"`).
+    pub fn bars_deviation(&mut self, plant: &Plant, tip_ratio: f64) -> f64 {
+        let segments = &plant.segments();
+        let foot = segments
+            .iter()
+            .enumerate()
+            .filter(|(i, s)| s.parent.is_none_or(|p| p.index() >= *i))
+            .map(|(_, s)| f64::from(s.start_radius))
+            .fold(0.0, f64::max);
+        if segments.is_empty() {
+            return 0.0;
+        }
+        let ratio = |a: f32, b: f32| {
+            if a > 0.0 {
+                f64::from(b) / f64::from(a)
+            } else {
+                1.0
+            }
+        };
+        let violation = |a: f32, b: f32| {
+            let r = ratio(a, b);
+            (r - 1.0).clamp(0.0, 1.0) + (0.5 - r).max(0.0)
+        };
+        self.continued.clear();
+        self.continued.resize(segments.len(), false);
+        let (mut broken, mut worst_break) = (0.0, 0.0f64);
+        for (i, s) in segments.iter().enumerate() {
+            let mut v = violation(s.start_radius, s.end_radius);
+            if let Some(p) = s.parent.map(|p| p.index()).filter(|&p| p < i) {
+                self.continued[p] = true;
+                v += violation(segments[p].end_radius, s.start_radius);
+            }
+            broken += v;
+            worst_break = worst_break.max(v);
+        }
+        let (mut tips, mut excess, mut worst_excess) = (0usize, 0.0, 0.0f64);
+        for (s, _) in segments.iter().zip(&self.continued).filter(|(_, c)| !**c) {
+            let e = if foot > 0.0 {
+                (f64::from(s.end_radius) / foot - tip_ratio).max(0.0)
+            } else {
+                0.0
+            };
+            tips += 1;
+            excess += e;
+            worst_excess = worst_excess.max(e);
+        }
+        (broken + excess) / tips.max(1) as f64 + worst_break + worst_excess
     }
 
     /// The endpoints of the last plant read.
