@@ -1,18 +1,24 @@
 //! Compile + simulate throughput of the automata model, one core, reused buffers.
 //!
-//! Run with `cargo bench -p sylva-automata --bench automata`. Groups:
+//! Run with `cargo bench -p sylva-automata --bench automata`. Every group measures the
+//! simulator beside its baseline, the simulator as it was before straight-line blocks
+//! ([`ReferenceSimulator`], kept as the test oracle), in the same run: `…_baseline` is the
+//! baseline, the other the simulator. Throughput is in automaton-steps (one automaton running
+//! one iteration), so criterion's time per element is the time per automaton-step. Groups:
 //! - `random_100`: 1000 random individuals of 80 to 120 nodes (default `GpConfig`, ramped
-//!   half-and-half), compiled and grown at `Detail::Chords` for 100 iterations; throughput in
-//!   individuals, then the same work in automaton-steps.
+//!   half-and-half), compiled and grown at `Detail::Chords` for 100 iterations.
 //! - `typical`: an individual shaped like the issue's typical one: a trunk of 100 steps
 //!   starting 33 branches that grow to the iteration limit (about 30 automata × 100
 //!   iterations), at `Chords` (fitness) and `Full` (meshing) detail.
+//! - `evolved`: the 40 individuals of `tests/data/evolved.txt`, from the last generation of
+//!   the typical run, at `Chords`.
 //! - `helix`: the helix of Figures 1-2 (1000 iterations, 15 automata), at `Full` detail.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sylva_automata::sim::reference::ReferenceSimulator;
 use sylva_automata::{
     AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
 };
@@ -20,6 +26,7 @@ use sylva_core::rng;
 use sylva_core::{Plant, PlantMeta};
 
 const HELIX: &str = include_str!("../../../examples/automata/helix.json");
+const EVOLVED: &str = include_str!("../tests/data/evolved.txt");
 
 /// A trunk that starts a branch every third step for 100 steps; branches bend and taper.
 const TYPICAL: &str = "(Top (Repeat 10 (Repeat 10 (Seq (RotateH 1.4) (Seq (Add Var1 1) \
@@ -30,6 +37,7 @@ const TYPICAL: &str = "(Top (Repeat 10 (Repeat 10 (Seq (RotateH 1.4) (Seq (Add V
 struct Work {
     program: Program,
     sim: Simulator,
+    reference: ReferenceSimulator,
     plant: Plant,
 }
 
@@ -38,17 +46,64 @@ impl Work {
         Work {
             program: Program::default(),
             sim: Simulator::new(),
+            reference: ReferenceSimulator::new(),
             plant: Plant::new(PlantMeta::default()),
         }
     }
 
-    /// Compiles and grows one tree; returns its automaton-steps.
-    fn grow(&mut self, tree: &GpTree, semantics: &Semantics, o: &GrowOptions, d: Detail) -> u64 {
+    /// Compiles and grows one tree, with the baseline or the simulator; returns its
+    /// automaton-steps.
+    fn grow(
+        &mut self,
+        baseline: bool,
+        tree: &GpTree,
+        semantics: &Semantics,
+        o: &GrowOptions,
+        d: Detail,
+    ) -> u64 {
         self.program.recompile(tree, semantics);
-        self.sim
-            .run(&self.program, o, d, &mut self.plant)
-            .automaton_steps
+        let report = if baseline {
+            self.reference.run(&self.program, o, d, &mut self.plant)
+        } else {
+            self.sim.run(&self.program, o, d, &mut self.plant)
+        };
+        report.automaton_steps
     }
+}
+
+/// Benchmarks growing `trees` with the baseline and the simulator, side by side.
+fn side_by_side(
+    c: &mut Criterion,
+    group: &str,
+    name: &str,
+    trees: &[GpTree],
+    (sem, o): (&Semantics, &GrowOptions),
+    detail: Detail,
+) {
+    let mut work = Work::new();
+    let steps: u64 = trees
+        .iter()
+        .map(|t| work.grow(false, t, sem, o, detail))
+        .sum();
+    let mut group = c.benchmark_group(group);
+    group.throughput(Throughput::Elements(steps));
+    for baseline in [true, false] {
+        let id = if baseline {
+            format!("{name}_baseline")
+        } else {
+            name.to_owned()
+        };
+        group.bench_function(id, |b| {
+            b.iter(|| {
+                let mut total = 0;
+                for t in trees {
+                    total += work.grow(baseline, black_box(t), sem, o, detail);
+                }
+                total
+            })
+        });
+    }
+    group.finish();
 }
 
 fn random_individuals(c: &mut Criterion) {
@@ -67,7 +122,7 @@ fn random_individuals(c: &mut Criterion) {
     let mut work = Work::new();
     let steps: u64 = trees
         .iter()
-        .map(|t| work.grow(t, &sem, &o, Detail::Chords))
+        .map(|t| work.grow(false, t, &sem, &o, Detail::Chords))
         .sum();
     let nodes: usize = trees.iter().map(GpTree::len).sum();
     eprintln!(
@@ -76,64 +131,54 @@ fn random_individuals(c: &mut Criterion) {
         nodes as f64 / trees.len() as f64,
         steps as f64 / trees.len() as f64
     );
-    let mut group = c.benchmark_group("random_100");
-    group.sample_size(20);
-    for (name, throughput) in [
-        ("individuals", Throughput::Elements(trees.len() as u64)),
-        ("automaton_steps", Throughput::Elements(steps)),
-    ] {
-        group.throughput(throughput);
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                let mut total = 0;
-                for t in &trees {
-                    total += work.grow(black_box(t), &sem, &o, Detail::Chords);
-                }
-                total
-            })
-        });
-    }
-    group.finish();
+    side_by_side(
+        c,
+        "random_100",
+        "chords",
+        &trees,
+        (&sem, &o),
+        Detail::Chords,
+    );
 }
 
 fn typical(c: &mut Criterion) {
     let tree = GpTree::parse(TYPICAL).unwrap();
     let (sem, o) = (Semantics::default(), GrowOptions::default());
     let mut work = Work::new();
-    let steps = work.grow(&tree, &sem, &o, Detail::Chords);
+    work.program.recompile(&tree, &sem);
     let report = work
         .sim
         .run(&work.program, &o, Detail::Chords, &mut work.plant);
     eprintln!(
-        "typical: {} automata, {steps} automaton-steps, {} states, {} chord segments",
-        report.automata, report.states, report.segments
+        "typical: {} automata, {} automaton-steps, {} states, {} chord segments",
+        report.automata, report.automaton_steps, report.states, report.segments
     );
-    let mut group = c.benchmark_group("typical");
-    for detail in [Detail::Chords, Detail::Full] {
-        group.throughput(Throughput::Elements(1));
-        group.bench_function(format!("{detail:?}_individuals"), |b| {
-            b.iter(|| work.grow(black_box(&tree), &sem, &o, detail))
-        });
-        group.throughput(Throughput::Elements(steps));
-        group.bench_function(format!("{detail:?}_automaton_steps"), |b| {
-            b.iter(|| work.grow(black_box(&tree), &sem, &o, detail))
-        });
-    }
-    group.finish();
+    let trees = [tree];
+    side_by_side(c, "typical", "chords", &trees, (&sem, &o), Detail::Chords);
+    side_by_side(c, "typical", "full", &trees, (&sem, &o), Detail::Full);
+}
+
+fn evolved(c: &mut Criterion) {
+    let trees: Vec<GpTree> = EVOLVED
+        .lines()
+        .filter(|l| l.starts_with('('))
+        .map(|l| GpTree::parse(l).unwrap())
+        .collect();
+    // The typical run's growth (examples/automata/sphere.toml).
+    let o = GrowOptions {
+        root_length: 2.5,
+        ..GrowOptions::default()
+    };
+    let sem = Semantics::default();
+    side_by_side(c, "evolved", "chords", &trees, (&sem, &o), Detail::Chords);
 }
 
 fn helix(c: &mut Criterion) {
     let genome = AutomataGenome::from_json(HELIX).unwrap();
     let (sem, o) = (genome.growth.semantics(), genome.growth.grow_options());
-    let mut work = Work::new();
-    let steps = work.grow(&genome.program, &sem, &o, Detail::Full);
-    let mut group = c.benchmark_group("helix");
-    group.throughput(Throughput::Elements(steps));
-    group.bench_function("full_automaton_steps", |b| {
-        b.iter(|| work.grow(black_box(&genome.program), &sem, &o, Detail::Full))
-    });
-    group.finish();
+    let trees = [genome.program];
+    side_by_side(c, "helix", "full", &trees, (&sem, &o), Detail::Full);
 }
 
-criterion_group!(benches, random_individuals, typical, helix);
+criterion_group!(benches, random_individuals, typical, evolved, helix);
 criterion_main!(benches);

@@ -3,8 +3,10 @@
 //! Every automaton of a [`Program`] is a set of [`State`]s in one shared array; a state says
 //! what to do ([`Op`]) and where to go next (`next`, and `alt` for the second way out of an
 //! `If` or a `Repeat` test). Index 0 is the shared [`Op::End`] state: "end of automaton
-//! reached". The interpreter runs a `match` over 20-byte states with no pointers to chase
-//! and no allocation, so compiling once per individual pays for itself within one iteration.
+//! reached". States are 20 bytes with no pointers to chase, so compiling once per individual
+//! pays for itself within one iteration. The [`Simulator`](crate::Simulator) regroups them
+//! into straight-line blocks as it first reaches them; the states stay the program's
+//! definition (and what [`Program::verify`] and the reference simulator read).
 //!
 //! The compiler works backwards, in continuation-passing style: each operator is compiled
 //! knowing the entry of what follows it, which is exactly how Figure 4 links a state's

@@ -1,355 +1,22 @@
-//! The simulator of section 2.2: automata instances step in parallel and draw the plant.
+//! The simulator as it was before straight-line blocks and running ahead: one dispatch per
+//! state, with the compiler's fused states (`RepeatWait`, `RepeatNest`, a loop entry's first
+//! test) and nothing else.
 //!
-//! ```text
-//! for each iteration:
-//!     for each automaton still alive (in creation order):
-//!         run states until Wait; Killme or the end of the automaton kills it
-//!         (a killed automaton does not move)
-//!         move one step of Length along H; record the position and the Thickness
-//! ```
-//!
-//! [`Simulator::run`] follows this exactly and writes the [`Plant`] as it goes. The
-//! simulator keeps its buffers between runs and refills the caller's plant, so evaluating a
-//! population allocates nothing once the buffers have grown.
-//!
-//! # Drawing
-//!
-//! - Positions are paper units; the plant is in metres: `position × unit`.
-//! - Each automaton instance draws one axis (`lateral = false` from segment to segment). A
-//!   created instance's first segment is lateral, and its parent is the creator's segment
-//!   ending at the creation point: the creator's current run is cut there
-//!   ([`Detail::Chords`]) so that branch points are always segment boundaries. An instance
-//!   that creates before it has drawn anything first draws a zero-length stub at its
-//!   position, so the child still hangs from a segment of the creator's level.
-//! - A Push/Pop that moved the turtle in between draws a fork: the path drawn inside ends
-//!   (an endpoint), and the automaton continues from the saved point, as a second
-//!   non-lateral child of the segment ending there (same branch level).
-//! - Radii: `radius × map(Thickness) × unit`, with `map` the remapping of section 5.2
-//!   ([`map_thickness`]): Thickness is clamped to 0.001..=1, then mapped linearly onto
-//!   0.1..=1, so even a vanishing branch stays visible.
-//! - `CreateAutomaton Leaf` and `Flower` add an organ at the current position (leaves near
-//!   horizontal by default, section 4.5); an organ's parent is the segment of its axis that
-//!   next leaves its position (or the last one, if the automaton never moves again).
-//!
-//! # Bounds
-//!
-//! Every runaway is bounded by [`Limits`] and counted in the [`GrowthReport`]; none panics
-//! and none is silent: an automaton running more than `states_per_step` states in one
-//! iteration is killed; creations beyond `automata` instances and organs beyond `organs`
-//! are skipped; growth stops once `points` positions or `states` states in total are
-//! reached; variables are clamped to ±[`VARIABLE_LIMIT`], so positions stay finite.
-//!
-//! # Speed
-//!
-//! Evolution grows tens of thousands of individuals a second, so: states are 20 bytes with
-//! rotations' sines and cosines precomputed; instances are stepped in place (children wait
-//! in a side buffer until the step ends); a frame is renormalised only when it moves after
-//! 16 turns, by one Newton step instead of square roots; [`Detail::Chords`]
-//! writes a segment only at branch points and tips; and no buffer is freed between runs
-//! (`tests/automata_alloc.rs` checks that a warm run allocates nothing).
-//! `benches/automata.rs` measures it.
+//! It is kept, unchanged, as the baseline and the test oracle of
+//! [`Simulator`](super::Simulator): `tests/automata_reference.rs` grows random, evolved and
+//! hand-made programs with both and requires the same [`Plant`] and [`GrowthReport`] bit for
+//! bit, and every group of `benches/automata.rs` measures both in one run. It is not meant
+//! for other uses.
 
 use glam::{Mat3, Quat, Vec2, Vec3};
-use serde::{Deserialize, Serialize};
-use sylva_core::{Frame, Organ, OrganKind, Plant, Segment, SegmentId};
+use sylva_core::{Frame, Organ, OrganKind, Plant, SegmentId};
 
+use super::{
+    ChildVariables, Detail, GOLDEN_ANGLE, GrowOptions, GrowthReport, LEAF_DROOP, LENGTH, NONE,
+    RENORMALISE, Stop, THICKNESS, VARIABLE_LIMIT, map_thickness,
+};
 use crate::compile::{Op, Program, State};
 use crate::tree::{VARIABLES, Var};
-
-/// Variables are clamped to `±VARIABLE_LIMIT` after each `Add` or `Multiply`.
-pub const VARIABLE_LIMIT: f32 = 1e6;
-
-const NONE: u32 = u32::MAX;
-const LENGTH: usize = 0;
-const THICKNESS: usize = 1;
-/// A frame is made orthonormal again when it moves after this many turns (or when anything
-/// else may have disturbed it). One turn with exact sine and cosine moves the vectors off
-/// unit length by about one ulp, so 16 turns stay within 1e-6 and each move costs a few
-/// multiplications instead of a renormalisation.
-const RENORMALISE: u8 = 16;
-/// The golden angle, radians: successive leaves turn by it about the vertical.
-const GOLDEN_ANGLE: f32 = 2.399_963_2;
-/// Leaves droop this far below horizontal, radians (10°).
-const LEAF_DROOP: f32 = 0.174_532_93;
-
-/// How finely the plant is drawn.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Detail {
-    /// Every recorded step is a segment: for meshing and pictures.
-    #[default]
-    Full,
-    /// One segment per run between branch points (creations, Push/Pop forks) and to each
-    /// tip: the same tips, leaves, levels and end thicknesses as [`Detail::Full`], far fewer
-    /// segments. Leaves and flowers keep their position and size but not their orientation
-    /// (left at identity: no fitness term reads it, and it costs more than the rest of an
-    /// organ). For fitness evaluation.
-    Chords,
-}
-
-/// The variables a created automaton starts with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ChildVariables {
-    /// The creator's Length and Thickness; general variables 0. Default: a branch continues
-    /// at the thickness of its junction, and its counters start fresh like the helix's.
-    #[default]
-    LengthThickness,
-    /// All of the creator's variables.
-    All,
-    /// The root's start: Length 1, Thickness 1, general variables 0.
-    Fresh,
-}
-
-/// Bounds on a run. Every field says its default and the range a genome file may give.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Limits {
-    /// States one automaton may run in one iteration before it is killed. Default 1000;
-    /// 1 to 1 000 000.
-    #[serde(deserialize_with = "states_per_step")]
-    pub states_per_step: u32,
-    /// States in the whole run; growth stops when reached. Default 2 000 000; 1 to 10^9
-    /// (about ten seconds of simulation).
-    #[serde(deserialize_with = "total_states")]
-    pub states: u64,
-    /// Automata instances in the whole run, the root included. Default 2000; 1 to 1 000 000.
-    #[serde(deserialize_with = "automata")]
-    pub automata: u32,
-    /// Recorded positions; growth stops when reached. Default 200 000; 1 to 10^8.
-    #[serde(deserialize_with = "points")]
-    pub points: u32,
-    /// Leaves and flowers. Default 20 000; 0 to 10^7.
-    #[serde(deserialize_with = "organs")]
-    pub organs: u32,
-}
-
-sylva_core::ranged!(states_per_step: u32, "limits.states_per_step", 1, 1_000_000);
-sylva_core::ranged!(automata: u32, "limits.automata", 1, 1_000_000);
-sylva_core::ranged!(points: u32, "limits.points", 1, 100_000_000);
-sylva_core::ranged!(organs: u32, "limits.organs", 0, 10_000_000);
-sylva_core::ranged!(total_states: u64, "limits.states", 1, 1_000_000_000);
-
-impl Limits {
-    /// Bytes a growth may hold at these bounds: a segment per point, the organs, and the
-    /// automaton instances.
-    pub fn memory_bound(&self) -> u64 {
-        let segment = std::mem::size_of::<Segment>() as u64;
-        let organ = std::mem::size_of::<Organ>() as u64 + 4;
-        let instance = std::mem::size_of::<Inst>() as u64 + 64;
-        u64::from(self.points) * segment
-            + u64::from(self.organs) * organ
-            + u64::from(self.automata) * instance
-    }
-
-    /// Refuses bounds whose growth may not fit in the memory budget.
-    pub fn check_budget(&self) -> Result<(), sylva_core::budget::OverBudget> {
-        sylva_core::budget::check(
-            self.memory_bound(),
-            format_args!(
-                "growth to `limits` of {} points, {} organs and {} automata",
-                self.points, self.organs, self.automata
-            ),
-            "lower `limits.points`, `limits.organs` or `limits.automata`",
-        )
-    }
-}
-
-impl Default for Limits {
-    fn default() -> Self {
-        Limits {
-            states_per_step: 1000,
-            states: 2_000_000,
-            automata: 2000,
-            points: 200_000,
-            organs: 20_000,
-        }
-    }
-}
-
-/// How a program grows. Every field says its default; [`Simulator::run`] replaces a value
-/// that is not finite, or is out of its range, by the nearest legal one (the default for NaN).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GrowOptions {
-    /// Iteration limit. Default 100 (section 5.1).
-    pub iterations: u32,
-    /// The root automaton's Length when it starts, paper units per step. Default 1; range
-    /// 0..=1e3. The paper does not give it; with 100 iterations, a Length of 2 to 3 lets
-    /// a tree reach across its 300-unit sphere, which evolution finds far more often than
-    /// learning to raise Length (see `examples/automata/sphere.toml`).
-    pub root_length: f32,
-    /// Metres per paper unit. Default 0.1, so the paper's sphere of radius 150 centred 200
-    /// up is 15 m wide and a 100-step trunk of Length 1 is 10 m tall. Range 1e-6..=1e3.
-    pub unit: f32,
-    /// Tropism towards the ground, degrees per step for a horizontal heading (scaled by
-    /// the sine of the angle to vertical, as in *The Algorithmic Beauty of Plants*).
-    /// Default 0 (off); Figure 17's pine bends. Range 0..=90.
-    pub gravity: f32,
-    /// Radius at mapped thickness 1, paper units. Default 3 (0.3 m at the default unit).
-    /// Range 0..=1e3.
-    pub radius: f32,
-    /// Leaf length, paper units (width 0.4 of it). Default 4.
-    pub leaf_length: f32,
-    /// Flower diameter, paper units. Default 4.
-    pub flower_size: f32,
-    /// Turn leaves near horizontal, face up (section 4.5). Default true; otherwise a leaf
-    /// points along the turtle's U.
-    pub horizontal_leaves: bool,
-    /// A created automaton's variables. Default [`ChildVariables::LengthThickness`].
-    pub child_variables: ChildVariables,
-    /// Runaway bounds.
-    pub limits: Limits,
-}
-
-impl Default for GrowOptions {
-    fn default() -> Self {
-        GrowOptions {
-            iterations: 100,
-            root_length: 1.0,
-            unit: 0.1,
-            gravity: 0.0,
-            radius: 3.0,
-            leaf_length: 4.0,
-            flower_size: 4.0,
-            horizontal_leaves: true,
-            child_variables: ChildVariables::LengthThickness,
-            limits: Limits::default(),
-        }
-    }
-}
-
-fn legal(value: f32, min: f32, max: f32, default: f32) -> f32 {
-    if value.is_nan() {
-        default
-    } else {
-        value.clamp(min, max)
-    }
-}
-
-impl GrowOptions {
-    /// The options with every value brought into its legal range.
-    pub fn sanitized(&self) -> GrowOptions {
-        let d = GrowOptions::default();
-        GrowOptions {
-            root_length: legal(self.root_length, 0.0, 1e3, d.root_length),
-            unit: legal(self.unit, 1e-6, 1e3, d.unit),
-            gravity: legal(self.gravity, 0.0, 90.0, d.gravity),
-            radius: legal(self.radius, 0.0, 1e3, d.radius),
-            leaf_length: legal(self.leaf_length, 0.0, 1e3, d.leaf_length),
-            flower_size: legal(self.flower_size, 0.0, 1e3, d.flower_size),
-            limits: Limits {
-                states_per_step: self.limits.states_per_step.max(1),
-                ..self.limits
-            },
-            ..*self
-        }
-    }
-
-    /// Radius in metres of a recorded Thickness.
-    pub fn radius_of(&self, thickness: f32) -> f32 {
-        map_thickness(thickness) * self.radius * self.unit
-    }
-
-    /// The mapped thickness (0.1..=1) of a segment radius in metres: the inverse of
-    /// [`GrowOptions::radius_of`] on mapped values, for fitness terms that read thickness
-    /// back from a [`Plant`].
-    pub fn thickness_of_radius(&self, radius: f32) -> f32 {
-        let scale = self.radius * self.unit;
-        if scale > 0.0 { radius / scale } else { 0.0 }
-    }
-}
-
-/// Section 5.2's remapping: Thickness clamped to 0.001..=1, then mapped linearly onto
-/// 0.1..=1.
-#[inline]
-pub fn map_thickness(thickness: f32) -> f32 {
-    0.1 + (0.9 / 0.999) * (thickness.clamp(0.001, 1.0) - 0.001)
-}
-
-/// Why growth ended.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stop {
-    /// Every automaton died.
-    #[default]
-    AllDead,
-    /// The iteration limit was reached with automata alive.
-    Iterations,
-    /// [`Limits::points`] was reached.
-    Points,
-    /// [`Limits::states`] was reached.
-    States,
-    /// A position went beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD) metres, which
-    /// no plant may hold.
-    Extent,
-}
-
-/// Which bounds were hit, and how often.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
-pub struct BoundsHit {
-    /// Automata killed for running more than [`Limits::states_per_step`] states in one
-    /// iteration.
-    pub state_limit_kills: u32,
-    /// Creations skipped at [`Limits::automata`].
-    pub automata_refused: u32,
-    /// Leaves and flowers skipped at [`Limits::organs`].
-    pub organs_refused: u32,
-    /// Variable values clamped to ±[`VARIABLE_LIMIT`].
-    pub clamped_values: u32,
-    /// Growth stopped at [`Limits::points`].
-    pub points: bool,
-    /// Growth stopped at [`Limits::states`].
-    pub states: bool,
-    /// Growth stopped at a position beyond ±[`MAX_COORD`](sylva_core::plant::MAX_COORD)
-    /// metres.
-    pub extent: bool,
-}
-
-impl BoundsHit {
-    /// Whether any bound was hit.
-    pub fn any(&self) -> bool {
-        self.state_limit_kills > 0
-            || self.automata_refused > 0
-            || self.organs_refused > 0
-            || self.clamped_values > 0
-            || self.points
-            || self.states
-            || self.extent
-    }
-}
-
-/// What a run did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
-pub struct GrowthReport {
-    /// Iterations run.
-    pub iterations: u32,
-    /// Why growth ended.
-    pub stop: Stop,
-    /// Automata instances created, the root included.
-    pub automata: u32,
-    /// Most automata alive at the end of an iteration.
-    pub peak_live: u32,
-    /// Automata alive when growth ended.
-    pub live_at_end: u32,
-    /// Automaton-steps: one automaton running one iteration.
-    pub automaton_steps: u64,
-    /// States run in total.
-    pub states: u64,
-    /// Most states one automaton ran in one iteration.
-    pub max_states_per_step: u32,
-    /// Positions recorded (steps moved).
-    pub points: u32,
-    /// Segments drawn.
-    pub segments: u32,
-    /// Leaves added.
-    pub leaves: u32,
-    /// Flowers added.
-    pub flowers: u32,
-    /// Positions recorded with a negative Thickness (drawn at the minimum; fitness may
-    /// penalise them, section 4.4.2).
-    pub negative_thickness: u32,
-    /// Bounds hit.
-    pub bounds: BoundsHit,
-}
 
 /// One live or dead automaton instance.
 #[derive(Clone, Copy, Debug)]
@@ -406,9 +73,10 @@ struct Cx<'a> {
     gravity: f32,
 }
 
-/// Runs compiled programs; keeps its buffers between runs.
+/// The baseline simulator: runs compiled programs state by state; keeps its buffers between
+/// runs.
 #[derive(Clone, Debug, Default)]
-pub struct Simulator {
+pub struct ReferenceSimulator {
     insts: Vec<Inst>,
     live: Vec<u32>,
     mem: Memory,
@@ -450,10 +118,10 @@ fn leaf_rotation(frame: &Frame, horizontal: bool, index: u32) -> Quat {
     if q.is_finite() { q } else { Quat::IDENTITY }
 }
 
-impl Simulator {
+impl ReferenceSimulator {
     /// An empty simulator.
-    pub fn new() -> Simulator {
-        Simulator::default()
+    pub fn new() -> ReferenceSimulator {
+        ReferenceSimulator::default()
     }
 
     /// Grows `program` into `plant` (its segments and organs are replaced; its metadata is
@@ -475,7 +143,7 @@ impl Simulator {
             gravity: options.gravity.to_radians(),
         };
         plant.clear_to_defaults();
-        let Simulator { insts, live, mem } = self;
+        let ReferenceSimulator { insts, live, mem } = self;
         insts.clear();
         live.clear();
         mem.stack.clear();
