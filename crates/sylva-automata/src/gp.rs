@@ -19,7 +19,9 @@
 //!   "the next level". After 8 tries without a legal pair the child is a copy of `a` (as
 //!   lilgp keeps a parent).
 //! - **Mutation** replaces a random subtree by a grown one of the same type, at most
-//!   [`GpConfig::mutation_depth`] deep, within the limits (a single terminal always fits).
+//!   [`GpConfig::mutation_depth`] deep, within the limits (a single terminal always fits),
+//!   or, for a share [`GpConfig::nudge`] of mutations (none by default), moves one value by
+//!   one or two value steps: a fine tuning that a freshly drawn value almost never gives.
 //!
 //! Random values are multiples of [`GpConfig::value_step`] (0.1: the paper's "fixed point
 //! values"), which also keeps printed trees short.
@@ -91,6 +93,10 @@ pub struct GpConfig {
     pub function_point_rate: f64,
     /// Deepest subtree mutation grows. Default 4.
     pub mutation_depth: u32,
+    /// Share of mutations that nudge one value of the tree by one or two value steps up or
+    /// down instead of replacing a subtree (when the tree has a value), 0 to 1. Default 0.
+    /// Subtree mutation almost never fine-tunes a constant: a new one is drawn from 201.
+    pub nudge: f64,
     /// Operator weights for initialisation and mutation.
     pub weights: Weights,
 }
@@ -109,6 +115,7 @@ impl Default for GpConfig {
             branching_rate: 0.75,
             function_point_rate: 0.9,
             mutation_depth: 4,
+            nudge: 0.0,
             weights: Weights::default(),
         }
     }
@@ -189,6 +196,18 @@ pub struct SubtreeCrossover {
 pub struct SubtreeMutation {
     /// Limits and how new subtrees grow.
     pub config: GpConfig,
+}
+
+/// The value `k` steps from 0, within -10..=10.
+fn value_at(k: f64, step: f64) -> f32 {
+    // Divide by a whole inverse when there is one, so 0.1 steps give 3.2, not 3.2000002.
+    let inverse = 1.0 / step;
+    let v = if (inverse - inverse.round()).abs() < 1e-4 * inverse {
+        k / inverse.round()
+    } else {
+        k * step
+    };
+    (v as f32).clamp(-VALUE_LIMIT, VALUE_LIMIT)
 }
 
 fn pick<T: Copy, R: Rng + ?Sized>(items: &[T], rng: &mut R) -> T {
@@ -328,14 +347,40 @@ impl GpConfig {
         }
         let steps = (f64::from(VALUE_LIMIT) / step).floor().max(1.0) as i64;
         let k = rng.random_range(-steps..=steps) as f64;
-        // Divide by a whole inverse when there is one, so 0.1 steps give 3.2, not 3.2000002.
-        let inverse = 1.0 / step;
-        let v = if (inverse - inverse.round()).abs() < 1e-4 * inverse {
-            k / inverse.round()
-        } else {
-            k * step
+        value_at(k, step)
+    }
+
+    /// Moves one random value of `tree` by one or two value steps (0.1 when the step is 0),
+    /// within -10..=10; false when the tree has no value.
+    fn nudge<R: Rng + ?Sized>(&self, tree: &mut GpTree, rng: &mut R, found: &mut Points) -> bool {
+        found.terminals.clear();
+        let values = tree.nodes().iter().enumerate();
+        found.terminals.extend(
+            values
+                .filter(|(_, n)| matches!(n, Node::Value(_)))
+                .map(|(i, _)| i as u32),
+        );
+        if found.terminals.is_empty() {
+            return false;
+        }
+        let i = found.terminals[rng.random_range(0..found.terminals.len())] as usize;
+        let Node::Value(value) = tree.nodes()[i] else {
+            return false;
         };
-        (v as f32).clamp(-VALUE_LIMIT, VALUE_LIMIT)
+        let step = f64::from(self.value_step);
+        let step = if step > 0.0 && step.is_finite() {
+            step
+        } else {
+            0.1
+        };
+        let by = [-2.0, -1.0, 1.0, 2.0][rng.random_range(0..4)];
+        let k = (f64::from(value) / step).round() + by;
+        let mut nodes = tree.nodes().to_vec();
+        nodes[i] = Node::Value(value_at(k, step));
+        if let Ok(t) = GpTree::new(nodes) {
+            *tree = t;
+        }
+        true
     }
 
     /// A random point of `tree` passing `keep`: a function point with probability
@@ -517,6 +562,13 @@ impl Mutate<GpTree> for SubtreeMutation {
 impl SubtreeMutation {
     fn mutate_with<R: Rng + ?Sized>(&self, tree: &mut GpTree, rng: &mut R, points: &mut Points) {
         let c = &self.config;
+        // Drawn only when nudges are on, so runs without them keep their bytes.
+        if c.nudge > 0.0
+            && rng.random_bool(sylva_core::rng::probability(c.nudge))
+            && c.nudge(tree, rng, points)
+        {
+            return;
+        }
         let info = tree.node_info();
         let Some(p) = c.point(tree, |i| i > 0, rng, points) else {
             return;
@@ -645,6 +697,56 @@ mod tests {
             assert!(v.abs() <= 10.0);
             assert!(v.to_string().len() <= 5, "{v}");
         }
+    }
+
+    #[test]
+    fn nudges_move_one_value_by_one_or_two_steps() {
+        let tree =
+            GpTree::parse("(Top (Seq (RotateH 3.2) (Multiply Thickness 0.4)) (Killme))").unwrap();
+        let nudge = SubtreeMutation {
+            config: GpConfig {
+                nudge: 1.0,
+                ..GpConfig::default()
+            },
+        };
+        let mut r = rng::seeded(2);
+        let mut seen = std::collections::BTreeSet::new();
+        for _ in 0..200 {
+            let mut child = tree.clone();
+            nudge.mutate(&mut child, &mut r);
+            let changed: Vec<(f32, f32)> = tree
+                .nodes()
+                .iter()
+                .zip(child.nodes())
+                .filter(|(a, b)| a != b)
+                .map(|pair| match pair {
+                    (Node::Value(a), Node::Value(b)) => (*a, *b),
+                    other => panic!("only values move: {other:?}"),
+                })
+                .collect();
+            assert_eq!(changed.len(), 1, "{child}");
+            seen.insert(changed[0].1.to_string());
+        }
+        // Both values, each by ±0.1 and ±0.2, printed on the grid (0.3, not 0.30000001).
+        let all = ["3", "3.1", "3.3", "3.4", "0.2", "0.3", "0.5", "0.6"];
+        assert_eq!(seen, all.iter().map(|v| v.to_string()).collect());
+
+        // Values stay within -10..=10, and a tree without values gets a subtree mutation.
+        let mut edge = GpTree::parse("(Top (RotateH 10) (Wait))").unwrap();
+        for _ in 0..20 {
+            nudge.mutate(&mut edge, &mut r);
+            assert!(edge.nodes().iter().all(|n| match n {
+                Node::Value(v) => v.abs() <= 10.0,
+                _ => true,
+            }));
+        }
+        let bare = GpTree::parse("(Top (Seq (Wait) (Wait)) (Killme))").unwrap();
+        let changed = (0..20).any(|_| {
+            let mut child = bare.clone();
+            nudge.mutate(&mut child, &mut r);
+            child != bare
+        });
+        assert!(changed, "no values: mutation replaces a subtree");
     }
 
     #[test]

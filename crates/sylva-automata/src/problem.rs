@@ -11,6 +11,7 @@
 //! max_depth = 17          # deepest tree breeding may make, 2 to 64
 //! max_size = 500          # most nodes of a tree, 20 to 5000
 //! detail = "chords"       # how evaluation grows a program: "chords" or "full" (below)
+//! nudge = 0.0             # share of mutations that move one constant by 0.1 or 0.2
 //!
 //! [automata.breeding]     # tournament 7; crossover 0.88, reproduction 0.10, mutation 0.02
 //! [automata.growth]       # how programs grow (every field of an automata genome file)
@@ -66,6 +67,10 @@ pub struct AutomataSettings {
     /// segment, for thickness measures that look inside runs).
     #[serde(skip_serializing_if = "is_chords")]
     pub detail: EvaluationDetail,
+    /// Share of mutations that nudge one constant by one or two value steps (0.1) instead
+    /// of replacing a subtree, 0 to 1. Default 0 (Sylva's: the paper only replaces).
+    #[serde(deserialize_with = "nudge", skip_serializing_if = "is_zero")]
+    pub nudge: f64,
     /// Tournament selection and the 88 / 10 / 2 operator rates.
     pub breeding: GenerationalSettings,
     /// How programs grow (written into every evolved genome).
@@ -83,6 +88,11 @@ pub enum EvaluationDetail {
     Chords,
     /// Every step a segment ([`Detail::Full`]).
     Full,
+}
+
+/// Settings that are off stay out of written configs, so they keep their bytes.
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn is_chords(detail: &EvaluationDetail) -> bool {
@@ -104,6 +114,7 @@ impl Default for AutomataSettings {
             max_depth: 17,
             max_size: 500,
             detail: EvaluationDetail::Chords,
+            nudge: 0.0,
             breeding: GenerationalSettings::default(),
             growth: Growth::default(),
             fitness: PoncinFitness::default(),
@@ -115,6 +126,7 @@ sylva_core::ranged!(automata_count: u32, "automata", 1, 8);
 sylva_core::ranged!(init_depth: u32, "init depth", 1, 16);
 sylva_core::ranged!(max_depth: u32, "max_depth", 2, 64);
 sylva_core::ranged!(max_size: u32, "max_size", 20, 5000);
+sylva_core::ranged!(nudge: f64, "nudge", 0.0, 1.0);
 
 impl AutomataSettings {
     /// The GP operators' limits.
@@ -126,6 +138,7 @@ impl AutomataSettings {
             max_init_depth: self.init_max_depth.max(self.init_min_depth),
             max_depth: self.max_depth,
             max_size: self.max_size,
+            nudge: self.nudge,
             ..GpConfig::default()
         }
     }

@@ -536,4 +536,12 @@ fn evaluation_grows_every_step_when_the_settings_ask() {
     assert!(chords.thick > 0.3, "{}", chords.thick);
     let err = toml::from_str::<sylva_automata::AutomataSettings>("detail = \"every\"").unwrap_err();
     assert!(err.to_string().contains("chords"), "{err}");
+    // Nudges and the step ratio are shares: out of 0..=1 they are refused by name.
+    for (text, field) in [
+        ("nudge = 1.5", "nudge"),
+        ("[fitness.thick]\nstep_ratio = -0.1", "step_ratio"),
+    ] {
+        let err = toml::from_str::<sylva_automata::AutomataSettings>(text).unwrap_err();
+        assert!(err.to_string().contains(field), "{err}");
+    }
 }

@@ -647,6 +647,64 @@ fn the_automata_examples_beat_the_trap_and_avoid_the_box() {
     fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Issue 14's taper bars on a grown skeleton, checked from outside as a user would: along
+/// every path from the foot through woody segments the radius never grows and no step is
+/// to less than half; returns the thickest tip as a share of the foot.
+fn taper_bars(skeleton: &sylva::skeleton::Skeleton) -> Result<f32, String> {
+    let segments = &skeleton.segments;
+    let foot = segments
+        .iter()
+        .filter(|s| s.woody && s.parent.is_none())
+        .map(|s| s.start_radius)
+        .fold(0.0, f32::max);
+    let mut continued = vec![false; segments.len()];
+    // Radii are 32-bit floats: equal thicknesses may differ in the last bit.
+    let eps = 1e-6;
+    for (i, s) in segments.iter().enumerate().filter(|(_, s)| s.woody) {
+        let mut chain = vec![s.start_radius, s.end_radius];
+        if let Some(p) = s.parent.map(|p| p as usize).filter(|&p| segments[p].woody) {
+            continued[p] = true;
+            chain.insert(0, segments[p].end_radius);
+        }
+        for w in chain.windows(2) {
+            if w[1] > w[0] * (1.0 + eps) {
+                return Err(format!("segment {i} thickens: {chain:?}"));
+            }
+            if w[1] < 0.5 * w[0] * (1.0 - eps) {
+                return Err(format!("segment {i} steps to less than half: {chain:?}"));
+            }
+        }
+    }
+    let tips = segments
+        .iter()
+        .zip(&continued)
+        .filter(|(s, c)| s.woody && !**c);
+    Ok(tips.map(|(s, _)| s.end_radius / foot).fold(0.0, f32::max))
+}
+
+/// Figure 17's pine as shipped: the shape bar for its cone (F_num at most 2, F_pos at most
+/// 20) at its last generation, and the taper bars on the grown tree (issue 14).
+#[test]
+fn the_pine_example_tapers_and_fits_its_cone() {
+    let dir = temp_dir("automata-pine");
+    let (f_pos, f_num) = (6, 7);
+    let pine = automata_example_stats("pine.toml", &dir);
+    let last = &pine[pine.len() - 1];
+    assert_eq!(pine.len(), 101);
+    assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{last:?}");
+    let skeleton = dir.join("pine.skeleton.json");
+    ok(&sylva(&[
+        "grow",
+        s(&dir.join("pine").join("best.json")),
+        "-o",
+        s(&skeleton),
+    ]));
+    let skeleton = sylva::skeleton::Skeleton::read(&skeleton).unwrap();
+    let tip = taper_bars(&skeleton).unwrap();
+    assert!(tip <= 0.25 + 1e-5, "the thickest tip is {tip} of the foot");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn plantmaker_evolves_without_a_person() {
     let dir = temp_dir("plantmaker-evolve");

@@ -284,6 +284,12 @@ fn the_bars_measure_is_zero_exactly_when_the_taper_bars_hold() {
         ..bars.clone()
     };
     close(f_thick(&gradual, &margin, 0), 0.05 / 2.0 + 0.05);
+    // So does a higher step ratio: the branch's step from 0.5 to 0.3 is then too sudden.
+    let step_margin = ThickOptions {
+        step_ratio: 0.65,
+        ..bars.clone()
+    };
+    close(f_thick(&gradual, &step_margin, 0), 0.05 / 2.0 + 0.05);
     // Gradual adds the taper measure's deviation to the bars.
     let both = ThickOptions {
         measure: ThickMeasure::Gradual,

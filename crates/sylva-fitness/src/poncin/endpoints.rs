@@ -197,9 +197,12 @@ impl PoncinScratch {
         match thick.measure {
             super::ThickMeasure::Endpoints => 0.0,
             super::ThickMeasure::Taper => self.taper_deviation(plant, thick),
-            super::ThickMeasure::Bars => self.bars_deviation(plant, thick.tip_ratio),
+            super::ThickMeasure::Bars => {
+                self.bars_deviation(plant, thick.tip_ratio, thick.step_ratio)
+            }
             super::ThickMeasure::Gradual => {
-                self.taper_deviation(plant, thick) + self.bars_deviation(plant, thick.tip_ratio)
+                self.taper_deviation(plant, thick)
+                    + self.bars_deviation(plant, thick.tip_ratio, thick.step_ratio)
             }
         }
     }
@@ -209,17 +212,19 @@ impl PoncinScratch {
     ///
     /// - each rise in thickness, `max(0, b / a − 1)` (at most 1 each), from one radius `a`
     ///   to the next `b` (a segment's start to its end, a parent's end to its child's start);
-    /// - each step to less than half, `max(0, 0.5 − b / a)`;
+    /// - each step to less than `step_ratio`, `max(0, step_ratio − b / a)` (the bar's is
+    ///   a half, [`super::ThickOptions::step_ratio`]);
     /// - the tip's excess over `tip_ratio` of the foot's radius, `max(0, tip / foot −
     ///   tip_ratio)` (the bar's is 0.25, [`super::ThickOptions::tip_ratio`]).
     ///
     /// Rises and steps are summed over the plant and divided by the number of tips, the
     /// excesses averaged over the tips; the worst of each is added, because the bars hold
-    /// for every path: one thick stub among hundreds of thin tips fails them. 0 exactly when the plant meets issue 14's taper
-    /// bars: it never thickens, no segment is less than half as thick as the one before
-    /// it, and every tip is at most `tip_ratio` of the foot. 0 for a plant without segments.
+    /// for every path: one thick stub among hundreds of thin tips fails them. 0 exactly
+    /// when the plant meets issue 14's taper bars (at ratios 0.25 and 0.5): it never
+    /// thickens, no segment is less than `step_ratio` as thick as the one before it, and
+    /// every tip is at most `tip_ratio` of the foot. 0 for a plant without segments.
     /// Needs every step drawn to see steps inside a run (the automata's `detail = "full"`).
-    pub fn bars_deviation(&mut self, plant: &Plant, tip_ratio: f64) -> f64 {
+    pub fn bars_deviation(&mut self, plant: &Plant, tip_ratio: f64, step_ratio: f64) -> f64 {
         let segments = &plant.segments();
         let foot = segments
             .iter()
@@ -239,7 +244,7 @@ impl PoncinScratch {
         };
         let violation = |a: f32, b: f32| {
             let r = ratio(a, b);
-            (r - 1.0).clamp(0.0, 1.0) + (0.5 - r).max(0.0)
+            (r - 1.0).clamp(0.0, 1.0) + (step_ratio - r).max(0.0)
         };
         self.continued.clear();
         self.continued.resize(segments.len(), false);

@@ -95,6 +95,7 @@ ranged!(gate: f64, "grid_gate", 0.0, 1e15, "");
 ranged!(radius_per_thickness: f64, "radius_per_thickness", 1e-6, 1e3, " metres");
 ranged!(penalty: f64, "negative_penalty", 0.0, 1e6, "");
 ranged!(tip_ratio: f64, "tip_ratio", 0.0, 1.0, "");
+ranged!(step_ratio: f64, "step_ratio", 0.0, 1.0, "");
 
 fn references<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
     sylva_core::ranged::list(d, "references", 0.0, 1.0, MAX_LEVELS)
@@ -392,11 +393,20 @@ pub struct ThickOptions {
     /// 0.25 (issue 14's bar); a little less leaves evolution a margin below the bar.
     #[serde(deserialize_with = "tip_ratio", skip_serializing_if = "is_quarter")]
     pub tip_ratio: f64,
+    /// The bars measure's smallest allowed step from one radius to the next along a path,
+    /// as a share of the one before, 0 to 1. Default 0.5 (issue 14's bar); a little more
+    /// leaves evolution a margin above the bar.
+    #[serde(deserialize_with = "step_ratio", skip_serializing_if = "is_half")]
+    pub step_ratio: f64,
 }
 
-/// The default tip ratio stays out of written configs, so they keep their bytes.
+/// The default ratios stay out of written configs, so they keep their bytes.
 fn is_quarter(ratio: &f64) -> bool {
     *ratio == 0.25
+}
+
+fn is_half(ratio: &f64) -> bool {
+    *ratio == 0.5
 }
 
 /// What F_thick compares with its references.
@@ -432,6 +442,7 @@ impl Default for ThickOptions {
             negative_penalty: 1.0,
             measure: ThickMeasure::Endpoints,
             tip_ratio: 0.25,
+            step_ratio: 0.5,
         }
     }
 }
