@@ -683,15 +683,16 @@ fn taper_bars(skeleton: &sylva::skeleton::Skeleton) -> Result<f32, String> {
 }
 
 /// Figure 17's pine as shipped: the shape bar for its cone (F_num at most 2, F_pos at most
-/// 20) at its last generation, and the taper bars on the grown tree (issue 14).
+/// 20) at its last generation, leaves, and the taper bars on the grown tree (issue 14).
 #[test]
 fn the_pine_example_tapers_and_fits_its_cone() {
     let dir = temp_dir("automata-pine");
-    let (f_pos, f_num) = (6, 7);
+    let (leaves, f_pos, f_num) = (4, 6, 7);
     let pine = automata_example_stats("pine.toml", &dir);
     let last = &pine[pine.len() - 1];
     assert_eq!(pine.len(), 101);
     assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{last:?}");
+    assert!(last[leaves] > 0.0, "a pine with leaves: {last:?}");
     let skeleton = dir.join("pine.skeleton.json");
     ok(&sylva(&[
         "grow",
