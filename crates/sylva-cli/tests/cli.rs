@@ -605,13 +605,28 @@ fn automata_runs_write_their_table_2_columns() {
 
 /// Runs an automata example as shipped (small pictures only); returns its stats rows.
 fn automata_example_stats(name: &str, dir: &Path) -> Vec<Vec<f64>> {
+    automata_example_run(name, dir, None)
+}
+
+/// Runs an automata example as shipped, with its own seed or another, into
+/// `dir/NAME` (`dir/NAME-seedS` for another seed); returns its stats rows.
+fn automata_example_run(name: &str, dir: &Path, seed: Option<u64>) -> Vec<Vec<f64>> {
     let config = dir.join(name);
     let text = fs::read_to_string(example(&format!("automata/{name}")))
         .unwrap()
         .replace("sheet_size = 24", "sheet_size = 2\nimage_size = 64");
     fs::write(&config, text).unwrap();
-    let out = dir.join(name.replace(".toml", ""));
-    ok(&sylva(&["evolve", s(&config), "--out", s(&out)]));
+    let stem = name.replace(".toml", "");
+    let out = match seed {
+        Some(seed) => dir.join(format!("{stem}-seed{seed}")),
+        None => dir.join(stem),
+    };
+    let seed = seed.map(|s| s.to_string());
+    let mut args = vec!["evolve", s(&config), "--out", s(&out)];
+    if let Some(seed) = &seed {
+        args.extend(["--seed", seed.as_str()]);
+    }
+    ok(&sylva(&args));
     fs::read_to_string(out.join("stats.csv"))
         .unwrap()
         .lines()
@@ -641,9 +656,16 @@ fn the_automata_examples_beat_the_trap_and_avoid_the_box() {
     let last = &box_above[box_above.len() - 1];
     assert_eq!(box_above.len(), 101);
     assert!(last[leaves] > 0.0 && last[forbidden] == 0.0, "{last:?}");
-    // Two levels: 8 branches with 4 sub-branches on each by generation 50.
-    let two_levels = automata_example_stats("two-levels.toml", &dir);
-    assert_eq!(two_levels[50][f_num], 0.0, "{:?}", two_levels[50]);
+    // Two levels: 8 branches with 4 sub-branches on each by generation 50, with the
+    // shipped seed (20) and another.
+    for seed in [None, Some(7)] {
+        let two_levels = automata_example_run("two-levels.toml", &dir, seed);
+        assert_eq!(
+            two_levels[50][f_num], 0.0,
+            "seed {seed:?}: {:?}",
+            two_levels[50]
+        );
+    }
     fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -688,21 +710,27 @@ fn taper_bars(skeleton: &sylva::skeleton::Skeleton) -> Result<f32, String> {
 fn the_pine_example_tapers_and_fits_its_cone() {
     let dir = temp_dir("automata-pine");
     let (leaves, f_pos, f_num) = (4, 6, 7);
-    let pine = automata_example_stats("pine.toml", &dir);
-    let last = &pine[pine.len() - 1];
-    assert_eq!(pine.len(), 101);
-    assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{last:?}");
-    assert!(last[leaves] > 0.0, "a pine with leaves: {last:?}");
-    let skeleton = dir.join("pine.skeleton.json");
-    ok(&sylva(&[
-        "grow",
-        s(&dir.join("pine").join("best.json")),
-        "-o",
-        s(&skeleton),
-    ]));
-    let skeleton = sylva::skeleton::Skeleton::read(&skeleton).unwrap();
-    let tip = taper_bars(&skeleton).unwrap();
-    assert!(tip <= 0.25 + 1e-5, "the thickest tip is {tip} of the foot");
+    // The shipped seed (3) and another.
+    for (seed, run) in [(None, "pine"), (Some(18), "pine-seed18")] {
+        let pine = automata_example_run("pine.toml", &dir, seed);
+        let last = &pine[pine.len() - 1];
+        assert_eq!(pine.len(), 101);
+        assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{run}: {last:?}");
+        assert!(last[leaves] > 0.0, "{run}, a pine with leaves: {last:?}");
+        let skeleton = dir.join(format!("{run}.skeleton.json"));
+        ok(&sylva(&[
+            "grow",
+            s(&dir.join(run).join("best.json")),
+            "-o",
+            s(&skeleton),
+        ]));
+        let skeleton = sylva::skeleton::Skeleton::read(&skeleton).unwrap();
+        let tip = taper_bars(&skeleton).unwrap_or_else(|e| panic!("{run}: {e}"));
+        assert!(
+            tip <= 0.25 + 1e-5,
+            "{run}: the thickest tip is {tip} of the foot"
+        );
+    }
     fs::remove_dir_all(&dir).unwrap();
 }
 
