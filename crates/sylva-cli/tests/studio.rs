@@ -35,25 +35,16 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// A folder that stands in for the installed three.js (the page's files are not under test
-/// here; the browser test loads the real one).
-fn three(dir: &Path) -> PathBuf {
-    let three = dir.join("three");
-    std::fs::create_dir_all(three.join("build")).unwrap();
-    std::fs::write(
-        three.join("build/three.module.js"),
-        "export const REVISION = 'test';\n",
-    )
-    .unwrap();
-    three
+fn start(dir: &Path, host: &str) -> Server {
+    start_with(dir, &["--host", host])
 }
 
-fn start(dir: &Path, host: &str) -> Server {
+/// A studio started with `args` (after `--port 0 --db FILE`); its printed address and token.
+fn start_with(dir: &Path, args: &[&str]) -> Server {
     let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
-        .args(["studio", "--port", "0", "--host", host, "--db"])
+        .args(["studio", "--port", "0", "--db"])
         .arg(dir.join("studio.db"))
-        .arg("--three")
-        .arg(three(dir))
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
@@ -75,30 +66,62 @@ fn start(dir: &Path, host: &str) -> Server {
     }
 }
 
-/// One HTTP/1.1 request; the status and the body.
+/// One HTTP/1.1 request as the page sends it (JSON, the server's own Host, the token); the
+/// status and the body.
 fn request(server: &Server, method: &str, path: &str, body: &[u8], auth: bool) -> (u16, Vec<u8>) {
-    let mut stream = TcpStream::connect(&server.address).unwrap();
+    let auth = match (&server.token, auth) {
+        (Some(t), true) => format!("Bearer {t}"),
+        _ => String::new(),
+    };
+    request_with(server, method, path, &[("Authorization", &auth)], body)
+}
+
+/// One HTTP/1.1 request with `headers` over the page's (Host, Content-Type): a header given
+/// here replaces the page's, and an empty value leaves it out.
+fn request_with(
+    server: &Server,
+    method: &str,
+    path: &str,
+    headers: &[(&str, &str)],
+    body: &[u8],
+) -> (u16, Vec<u8>) {
+    let mut all: Vec<(String, String)> = vec![
+        ("Host".into(), server.address.clone()),
+        ("Content-Type".into(), "application/json".into()),
+    ];
+    for (name, value) in headers {
+        all.retain(|(n, _)| !n.eq_ignore_ascii_case(name));
+        all.push(((*name).to_owned(), (*value).to_owned()));
+    }
+    let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\n");
+    for (name, value) in all.iter().filter(|(_, v)| !v.is_empty()) {
+        head.push_str(&format!("{name}: {value}\r\n"));
+    }
+    head.push_str(&format!("Content-Length: {}\r\n\r\n", body.len()));
+    let mut raw = head.into_bytes();
+    raw.extend_from_slice(body);
+    exchange(&server.address, &raw)
+}
+
+/// Sends `raw` bytes and reads the answer to the end: its status and body.
+fn exchange(address: &str, raw: &[u8]) -> (u16, Vec<u8>) {
+    let mut stream = TcpStream::connect(address).unwrap();
     stream
         .set_read_timeout(Some(Duration::from_secs(120)))
         .unwrap();
-    let auth = match (&server.token, auth) {
-        (Some(t), true) => format!("Authorization: Bearer {t}\r\n"),
-        _ => String::new(),
-    };
-    let head = format!(
-        "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n{auth}Content-Type: application/json\r\nContent-Length: {}\r\n\r\n",
-        server.address,
-        body.len()
-    );
-    stream.write_all(head.as_bytes()).unwrap();
-    // A server may answer (413) before reading the whole of a large body.
-    let _ = stream.write_all(body);
+    // A server may answer (413, 414, 431) before reading the whole request.
+    let _ = stream.write_all(raw);
     let mut response = Vec::new();
     let _ = stream.read_to_end(&mut response);
     let split = response
         .windows(4)
         .position(|w| w == b"\r\n\r\n")
-        .expect("a response head");
+        .unwrap_or_else(|| {
+            panic!(
+                "no response head in {:?}",
+                String::from_utf8_lossy(&response)
+            )
+        });
     let head = String::from_utf8_lossy(&response[..split]).to_string();
     let status: u16 = head.split(' ').nth(1).unwrap().parse().unwrap();
     let mut body = response[split + 4..].to_vec();
@@ -109,6 +132,19 @@ fn request(server: &Server, method: &str, path: &str, body: &[u8], auth: bool) -
         body = dechunk(&body);
     }
     (status, body)
+}
+
+/// Asserts an answer is the JSON error `{error, field}` with `status` and `field`.
+fn assert_refused(what: &str, (got, answer): (u16, Vec<u8>), status: u16, field: &str) {
+    let text = String::from_utf8_lossy(&answer);
+    assert_eq!(got, status, "{what}: {text}");
+    let answer: Value = serde_json::from_slice(&answer)
+        .unwrap_or_else(|_| panic!("{what}: JSON error, got {text}"));
+    assert!(
+        !answer["error"].as_str().unwrap_or("").is_empty(),
+        "{what}: {text}"
+    );
+    assert_eq!(answer["field"], field, "{what}: {text}");
 }
 
 fn dechunk(mut data: &[u8]) -> Vec<u8> {
@@ -292,8 +328,21 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
     assert_eq!(before["can_redo"], true);
 }
 
+/// A hostile case: method, path, body, the status expected and the field it must name.
+type Case = (&'static str, String, Vec<u8>, u16, &'static str);
+
+fn case(
+    method: &'static str,
+    path: impl Into<String>,
+    body: &str,
+    status: u16,
+    field: &'static str,
+) -> Case {
+    (method, path.into(), body.as_bytes().to_vec(), status, field)
+}
+
 #[test]
-fn hostile_requests_get_a_4xx_that_names_the_field() {
+fn hostile_requests_get_a_4xx_that_names_the_field_as_sent() {
     let dir = temp_dir("hostile");
     let server = start(&dir, "127.0.0.1");
     let session = post(
@@ -303,62 +352,513 @@ fn hostile_requests_get_a_4xx_that_names_the_field() {
     );
     let id = session["id"].as_i64().unwrap();
     let p = grid(&session);
-    let big = vec![b'x'; 2 << 20];
-    let cases: Vec<(&str, String, Vec<u8>, u16, &str)> = vec![
-        ("POST", "/api/sessions".into(), b"{".to_vec(), 400, ""),
-        ("POST", "/api/sessions".into(), br#"{"mode": "jungle"}"#.to_vec(), 400, "mode"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "model": "oak"}"#.to_vec(), 400, "model"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "start": {"random": 0}}"#.to_vec(), 400, "start.random"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "start": {"random": 1e99}}"#.to_vec(), 400, ""),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "start": {"examples": ["nope"]}}"#.to_vec(), 400, "start.examples[0]"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "start": {"genomes": ["{\"model\": \"bintree\", \"format\": 1, \"depth\": -4}"]}}"#.to_vec(), 422, "start.genomes[0]"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "breed", "colour": "red"}"#.to_vec(), 400, ""),
-        ("POST", "/api/sessions".into(), br#"{"mode": "family", "config": {"run": {"population": -3}}}"#.to_vec(), 422, "config.run.population"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "family", "config": {"run": {"population": 20000}}}"#.to_vec(), 400, "config.run.population"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "design", "design": {"population": 5}}"#.to_vec(), 400, "design.population"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "design", "design": {"target": {"shape": "sphere", "radius": -1}}}"#.to_vec(), 422, "design.target.radius"),
-        ("POST", "/api/sessions".into(), br#"{"mode": "garden", "settings": {"elevation": 91}}"#.to_vec(), 400, "settings.elevation"),
-        ("POST", "/api/sessions".into(), big.clone(), 413, ""),
-        ("POST", format!("/api/sessions/{id}/cross"), format!(r#"{{"parents": [{{"plant": {}}}]}}"#, p[0]).into_bytes(), 400, "parents"),
-        ("POST", format!("/api/sessions/{id}/cross"), format!(r#"{{"parents": [{{"plant": {}}}, {{"plant": {}, "dominance": -1}}]}}"#, p[0], p[1]).into_bytes(), 400, "parents[1].dominance"),
-        ("POST", format!("/api/sessions/{id}/cross"), format!(r#"{{"parents": [{{"plant": {}}}, {{"plant": {}}}], "children": 10}}"#, p[0], p[1]).into_bytes(), 400, "children"),
-        ("POST", format!("/api/sessions/{id}/cross"), format!(r#"{{"parents": [{{"plant": {}}}, {{"plant": {}}}], "level": "max"}}"#, p[0], p[1]).into_bytes(), 400, "level"),
-        ("POST", format!("/api/sessions/{id}/cross"), format!(r#"{{"parents": [{{"plant": {}}}, {{"plant": 999999}}]}}"#, p[0]).into_bytes(), 400, "parents[1]"),
-        ("POST", format!("/api/sessions/{id}/mutate"), format!(r#"{{"plant": {}, "depth": 11}}"#, p[0]).into_bytes(), 400, "depth"),
-        ("POST", format!("/api/sessions/{id}/mutate"), format!(r#"{{"plant": {}, "seed": -1}}"#, p[0]).into_bytes(), 400, "seed"),
-        ("POST", format!("/api/sessions/{id}/edit"), format!(r#"{{"plant": {}, "genome": "{{\"model\": \"bintree\"}}"}}"#, p[0]).into_bytes(), 422, "genome"),
-        ("POST", format!("/api/sessions/{id}/edit"), format!(r#"{{"plant": {}}}"#, p[0]).into_bytes(), 400, "genome"),
-        ("POST", format!("/api/sessions/{id}/grow"), b"{}".to_vec(), 409, ""),
-        ("POST", format!("/api/sessions/{id}/redo"), b"".to_vec(), 409, ""),
-        ("POST", "/api/sessions/424242/undo".into(), b"".to_vec(), 404, ""),
-        ("GET", "/api/sessions/abc".into(), b"".to_vec(), 400, ""),
-        ("GET", "/api/plants/424242/plant.glb".into(), b"".to_vec(), 404, ""),
-        ("GET", format!("/api/plants/{}/plant.png?size=99999x2", p[0]), b"".to_vec(), 400, "size"),
-        ("GET", format!("/api/plants/{}/plant.png?view=under", p[0]), b"".to_vec(), 400, "view"),
-        ("GET", format!("/api/plants/{}/lineage?depth=0", p[0]), b"".to_vec(), 400, "depth"),
-        ("GET", "/api/plants?limit=100000".into(), b"".to_vec(), 400, "limit"),
-        ("GET", "/api/nothing".into(), b"".to_vec(), 404, ""),
-        ("GET", format!("/api/plants/{}/plant_tex99999.png", p[0]), b"".to_vec(), 404, ""),
-        ("GET", format!("/api/plants/{}/secrets.txt", p[0]), b"".to_vec(), 404, ""),
-        ("GET", "/vendor/three/../../../../etc/passwd".into(), b"".to_vec(), 404, ""),
-        ("GET", "/vendor/three/build/three.module.js".into(), b"".to_vec(), 200, ""),
+    let garden = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "garden", "settings": {"steps": 10, "children": 2}}),
+    );
+    let g = garden["id"].as_i64().unwrap();
+    let family = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "family", "config": {"run": {"population": 12}}}),
+    );
+    let f = family["id"].as_i64().unwrap();
+    let design = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "design", "design": {"population": 10, "generations": 1}}),
+    );
+    let d = design["id"].as_i64().unwrap();
+    let big = "x".repeat(2 << 20);
+    let s = "/api/sessions";
+    let cross = format!("/api/sessions/{id}/cross");
+    let two = |rest: &str| {
+        format!(
+            r#"{{"parents": [{{"plant": {}}}, {{"plant": {}}}]{rest}}}"#,
+            p[0], p[1]
+        )
+    };
+    let mutate = format!("/api/sessions/{id}/mutate");
+    let edit = format!("/api/sessions/{id}/edit");
+    let add = format!("/api/sessions/{id}/add");
+    let plant = |rest: &str| format!(r#"{{"plant": {}{rest}}}"#, p[0]);
+    #[rustfmt::skip]
+    let cases: Vec<Case> = vec![
+        // The body as a whole.
+        case("POST", s, "{", 400, ""),
+        case("POST", s, "[]", 400, ""),
+        case("POST", s, "{} {}", 400, ""),
+        case("POST", s, &big, 413, ""),
+        // Creating sessions: every mode's fields.
+        case("POST", s, "{}", 400, "mode"),
+        case("POST", s, r#"{"mode": 3}"#, 400, "mode"),
+        case("POST", s, r#"{"mode": "jungle"}"#, 400, "mode"),
+        case("POST", s, r#"{"mode": "breed", "model": "oak"}"#, 400, "model"),
+        case("POST", s, r#"{"mode": "breed", "model": 7}"#, 400, "model"),
+        case("POST", s, r#"{"mode": "breed", "seed": "abc"}"#, 400, "seed"),
+        case("POST", s, r#"{"mode": "breed", "seed": -1}"#, 400, "seed"),
+        case("POST", s, r#"{"mode": "breed", "seed": 1e30}"#, 400, "seed"),
+        case("POST", s, r#"{"mode": "breed", "colour": "red"}"#, 400, "colour"),
+        case("POST", s, r#"{"mode": "breed", "start": {"random": 0}}"#, 400, "start.random"),
+        case("POST", s, r#"{"mode": "breed", "start": {"random": 1e99}}"#, 400, "start.random"),
+        case("POST", s, r#"{"mode": "breed", "start": {"random": "x"}}"#, 400, "start.random"),
+        case("POST", s, r#"{"mode": "breed", "start": {"meadow": 1}}"#, 400, "start.meadow"),
+        case("POST", s, r#"{"mode": "breed", "start": {"examples": ["nope"]}}"#, 400, "start.examples[0]"),
+        case("POST", s, r#"{"mode": "breed", "start": {"examples": "plantmaker/fern"}}"#, 400, "start.examples"),
+        case("POST", s, r#"{"mode": "breed", "start": {"plants": [999999]}}"#, 400, "start.plants[0]"),
+        case("POST", s, r#"{"mode": "breed", "start": {"plants": [1, "a"]}}"#, 400, "start.plants[1]"),
+        case("POST", s, r#"{"mode": "breed", "start": {"genomes": [5]}}"#, 400, "start.genomes[0]"),
+        case("POST", s, r#"{"mode": "breed", "start": {"genomes": ["{\"model\": \"bintree\", \"format\": 1, \"depth\": -4}"]}}"#, 422, "start.genomes[0]"),
+        case("POST", s, r#"{"mode": "garden", "start": {"plant": 999999}}"#, 400, "start.plant"),
+        case("POST", s, r#"{"mode": "garden", "start": {"example": "nope"}}"#, 400, "start.example"),
+        case("POST", s, r#"{"mode": "garden", "start": {"genome": "{"}}"#, 422, "start.genome"),
+        case("POST", s, r#"{"mode": "garden", "start": {"empty": false}}"#, 400, "start.empty"),
+        case("POST", s, r#"{"mode": "garden", "settings": {"elevation": 91}}"#, 400, "settings.elevation"),
+        case("POST", s, r#"{"mode": "garden", "settings": {"steps": 5000}}"#, 400, "settings.steps"),
+        case("POST", s, r#"{"mode": "garden", "settings": {"azimuth": "x"}}"#, 400, "settings.azimuth"),
+        case("POST", s, r#"{"mode": "garden", "settings": {"colour": 1}}"#, 400, "settings.colour"),
+        case("POST", s, r#"{"mode": "garden", "seed": "abc"}"#, 400, "seed"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"population": -3}}}"#, 422, "config.run.population"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"population": 20000}}}"#, 400, "config.run.population"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"population": 1e9}}}"#, 422, "config.run.population"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"population": null}}}"#, 400, "config.run.population"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"seed": "abc"}}}"#, 422, "config.run.seed"),
+        case("POST", s, r#"{"mode": "family", "config": {"run": {"speed": 1}}}"#, 422, "config.run.speed"),
+        case("POST", s, r#"{"mode": "family", "config": {"bintree": {"mutation_rate": 7}}}"#, 422, "config.bintree.mutation_rate"),
+        case("POST", s, r#"{"mode": "family", "config": {"bintree": {"weights": {"height": "tall"}}}}"#, 422, "config.bintree.weights.height"),
+        case("POST", s, r#"{"mode": "family", "config": {"colour": 1}}"#, 400, "config.colour"),
+        case("POST", s, r#"{"mode": "design", "design": {"population": 5}}"#, 400, "design.population"),
+        case("POST", s, r#"{"mode": "design", "design": {"population": 1e9}}"#, 400, "design.population"),
+        case("POST", s, r#"{"mode": "design", "design": {"seed": "abc"}}"#, 400, "design.seed"),
+        case("POST", s, r#"{"mode": "design", "design": {"num_target": 0}}"#, 400, "design.num_target"),
+        case("POST", s, r#"{"mode": "design", "design": {"target": {"shape": "sphere", "radius": -1}}}"#, 422, "design.target.radius"),
+        case("POST", s, r#"{"mode": "design", "design": {"target": {"shape": "blob"}}}"#, 422, "design.target.shape"),
+        case("POST", s, r#"{"mode": "design", "design": {"target": {"shape": "sphere", "radius": null}}}"#, 400, "design.target.radius"),
+        case("POST", s, r#"{"mode": "design", "design": {"weights": {"pos": "high"}}}"#, 422, "design.weights.pos"),
+        case("POST", s, r#"{"mode": "design", "design": {"weights": 5}}"#, 400, "design.weights"),
+        case("POST", s, r#"{"mode": "design", "design": {"grid": {"min": [0,0,0], "max": [1,1,1], "divisions": [2,2,2], "cells": [{"cell": [9,0,0], "weight": 1}]}}}"#, 400, "design.grid.cells[0].cell[0]"),
+        case("POST", s, r#"{"mode": "design", "design": {"grid": {"min": [0,0,0], "max": [1,1,1], "divisions": [2,2], "cells": []}}}"#, 400, "design.grid.divisions"),
+        case("POST", s, r#"{"mode": "design", "design": {"grid": {"min": [0,0,0], "max": [1,1,1], "divisions": [2,2,2], "cells": [{"cell": [0,0,0], "weight": "x"}]}}}"#, 400, "design.grid.cells[0].weight"),
+        case("POST", s, r#"{"mode": "design", "design": {"colour": 1}}"#, 400, "design.colour"),
+        // Breeding steps.
+        case("POST", &cross, &format!(r#"{{"parents": [{{"plant": {}}}]}}"#, p[0]), 400, "parents"),
+        case("POST", &cross, r#"{"parents": "x"}"#, 400, "parents"),
+        case("POST", &cross, r#"{"parents": [{"plant": "a"}, {"plant": 1}]}"#, 400, "parents[0].plant"),
+        case("POST", &cross, &format!( r#"{{"parents": [{{"plant": {}}}, {{"plant": {}, "dominance": -1}}]}}"#, p[0], p[1]),
+            400,
+            "parents[1].dominance",
+        ),
+        case("POST", &cross, &format!( r#"{{"parents": [{{"plant": {}}}, {{"plant": {}, "dominance": "x"}}]}}"#, p[0], p[1]),
+            400,
+            "parents[1].dominance",
+        ),
+        case("POST", &cross, &format!( r#"{{"parents": [{{"plant": {}}}, {{"plant": 999999}}]}}"#, p[0]),
+            400,
+            "parents[1]",
+        ),
+        case("POST", &cross, &format!( r#"{{"parents": [{{"plant": {}}}, {{"plant": {}}}]}}"#, p[0], p[0]),
+            400,
+            "parents[1].plant",
+        ),
+        case("POST", &cross, &two(r#", "children": 10"#), 400, "children"),
+        case("POST", &cross, &two(r#", "children": -1"#), 400, "children"),
+        case("POST", &cross, &two(r#", "level": "max""#), 400, "level"),
+        case("POST", &cross, &two(r#", "level": 3"#), 400, "level"),
+        case("POST", &cross, &two(r#", "seed": 1.5"#), 400, "seed"),
+        case("POST", &cross, &two(r#", "colour": 1"#), 400, "colour"),
+        case("POST", &mutate, "{}", 400, "plant"),
+        case("POST", &mutate, r#"{"plant": 999999}"#, 400, "plant"),
+        case("POST", &mutate, &plant(r#", "depth": 11"#), 400, "depth"),
+        case("POST", &mutate, &plant(r#", "depth": "deep""#), 400, "depth"),
+        case("POST", &mutate, &plant(r#", "seed": -1"#), 400, "seed"),
+        case("POST", &mutate, &plant(r#", "children": 0"#), 400, "children"),
+        case("POST", &add, r#"{"random": 0}"#, 400, "random"),
+        case("POST", &add, r#"{"plants": [999999]}"#, 400, "plants[0]"),
+        case("POST", &add, r#"{"nope": 1}"#, 400, "nope"),
+        case("POST", &edit, &plant(r#", "genome": "{\"model\": \"bintree\"}""#), 422, "genome"),
+        case("POST", &edit, &plant(r#", "genome": 5"#), 422, "genome"),
+        case("POST", &edit, &plant(""), 400, "genome"),
+        case("POST", &edit, r#"{"plant": "x"}"#, 400, "plant"),
+        case("POST", &edit, &plant(r#", "fields": [{"path": "nope", "value": 1}]"#), 400, "fields[0].path"),
+        case("POST", &edit, &plant(r#", "fields": [{"path": 5, "value": 1}]"#), 400, "fields[0].path"),
+        case("POST", &edit, &plant(r#", "fields": [{"value": 1}]"#), 400, "fields[0].path"),
+        case("POST", &edit, &plant(r#", "seed": "x""#), 400, "seed"),
+        case("POST", format!("/api/sessions/{id}/grow"), "{}", 409, ""),
+        case("POST", format!("/api/sessions/{id}/redo"), "", 409, ""),
+        case("POST", "/api/sessions/424242/undo", "", 404, ""),
+        // Gardens, families and designs.
+        case("POST", format!("/api/sessions/{g}/grow"), r#"{"settings": {"steps": 5000}}"#, 400, "settings.steps"),
+        case("POST", format!("/api/sessions/{g}/grow"), r#"{"settings": "x"}"#, 400, "settings"),
+        case("POST", format!("/api/sessions/{g}/pick"), r#"{"plant": 999999}"#, 400, "plant"),
+        case("POST", format!("/api/sessions/{g}/pick"), r#"{"plant": "x"}"#, 400, "plant"),
+        case("POST", format!("/api/sessions/{f}/generations"), r#"{"count": "x"}"#, 400, "count"),
+        case("POST", format!("/api/sessions/{f}/generations"), r#"{"count": 99999}"#, 400, "count"),
+        case("POST", format!("/api/sessions/{f}/batch"), r#"{"batch": -1}"#, 400, "batch"),
+        case("POST", format!("/api/sessions/{f}/member"), r#"{"index": 99999}"#, 400, "index"),
+        case("POST", format!("/api/sessions/{f}/member"), "{}", 400, "index"),
+        case("POST", format!("/api/sessions/{d}/design"), r#"{"target": {"shape": "sphere", "radius": -1}}"#, 422, "target.radius"),
+        case("POST", format!("/api/sessions/{d}/design"), r#"{"population": 5}"#, 400, "population"),
+        case("POST", format!("/api/sessions/{d}/resume"), r#"{"generations": 0}"#, 400, "generations"),
+        case("POST", format!("/api/plants/{}/branch", p[0]), r#"{"mode": "jungle"}"#, 400, "mode"),
+        case("POST", format!("/api/plants/{}/branch", p[0]), r#"{"mode": 5}"#, 400, "mode"),
+        // Queries and paths.
+        case("GET", "/api/sessions/abc", "", 400, ""),
+        case("GET", "/api/plants/424242/plant.glb", "", 404, ""),
+        case("GET", format!("/api/plants/{}/plant.png?size=99999x2", p[0]), "", 400, "size"),
+        case("GET", format!("/api/plants/{}/plant.png?view=under", p[0]), "", 400, "view"),
+        case("GET", format!("/api/plants/{}/lineage?depth=0", p[0]), "", 400, "depth"),
+        case("GET", format!("/api/plants/{}/lineage?depth=x", p[0]), "", 400, "depth"),
+        case("GET", format!("/api/plants/{}/preview.glb?px=0", p[0]), "", 400, "px"),
+        case("GET", format!("/api/plants/{}/plant.glb?roots=maybe", p[0]), "", 400, "roots"),
+        case("GET", "/api/plants?limit=100000", "", 400, "limit"),
+        case("GET", "/api/plants?limit=x", "", 400, "limit"),
+        case("GET", "/api/nothing", "", 404, ""),
+        case("GET", format!("/api/plants/{}/secrets.txt", p[0]), "", 404, ""),
+        case("GET", "/vendor/three/../../../../etc/passwd", "", 404, ""),
+        case("GET", "/vendor/three/package.json", "", 404, ""),
+        case("GET", "/vendor/three/build/three.module.js", "", 200, ""),
     ];
     for (method, path, body, status, field) in &cases {
-        let (got, answer) = request(&server, method, path, body, true);
-        let text = String::from_utf8_lossy(&answer);
-        assert_eq!(got, *status, "{method} {path}: {text}");
-        if *status >= 400 && path.starts_with("/api") {
-            let answer: Value = serde_json::from_slice(&answer)
-                .unwrap_or_else(|_| panic!("{path}: JSON error, got {text}"));
-            assert!(!answer["error"].as_str().unwrap().is_empty());
-            assert_eq!(answer["field"], *field, "{method} {path}: {text}");
+        let answer = request(&server, method, path, body, true);
+        if *status == 200 {
+            assert_eq!(answer.0, 200, "{method} {path}");
+            continue;
         }
+        let what = format!(
+            "{method} {path} {}",
+            String::from_utf8_lossy(&body[..body.len().min(200)])
+        );
+        assert_refused(&what, answer, *status, field);
     }
     // The server is still up and the session untouched.
     assert_eq!(
         get(&server, &format!("/api/sessions/{id}"))["history"],
         json!([])
     );
+}
+
+/// A request a hostile page could send: method, path, headers, the status expected.
+type Refused<'a> = (&'a str, &'a str, Vec<(&'a str, &'a str)>, u16);
+
+#[test]
+fn pages_of_other_sites_and_foreign_host_names_are_refused() {
+    let dir = temp_dir("sites");
+    let server = start(&dir, "127.0.0.1");
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "breed", "model": "bintree", "start": {"random": 2}}),
+    );
+    let id = session["id"].as_i64().unwrap();
+    let p = grid(&session);
+    let mutate = format!("/api/sessions/{id}/mutate");
+    let body = format!(r#"{{"plant": {}, "children": 1}}"#, p[0]);
+    let own = format!("http://{}", server.address);
+    let port = server.address.rsplit(':').next().unwrap().to_owned();
+    let other_port = format!("http://127.0.0.1:{}", port.parse::<u16>().unwrap() ^ 1);
+    let evil_host = format!("evil.example:{port}");
+    let rebound = format!("127.0.0.1.nip.io:{port}");
+    // What a page on another site can send without a preflight, and what it cannot fake.
+    #[rustfmt::skip]
+    let refused: Vec<Refused> = vec![
+        ("POST", "/api/sessions", vec![("Content-Type", "text/plain")], 415),
+        ("POST", "/api/sessions", vec![("Content-Type", "application/x-www-form-urlencoded")], 415),
+        ("POST", "/api/sessions", vec![("Content-Type", "multipart/form-data; boundary=x")], 415),
+        ("POST", "/api/sessions", vec![("Content-Type", "")], 415),
+        ("POST", &mutate, vec![("Content-Type", "text/plain;charset=UTF-8"), ("Origin", "http://evil.example")], 403),
+        ("POST", &mutate, vec![("Origin", "http://evil.example")], 403),
+        ("POST", &mutate, vec![("Origin", "null")], 403),
+        ("POST", &mutate, vec![("Origin", &other_port)], 403),
+        ("POST", &mutate, vec![("Sec-Fetch-Site", "cross-site")], 403),
+        ("POST", &mutate, vec![("Sec-Fetch-Site", "same-site")], 403),
+        ("GET", "/api/sessions", vec![("Sec-Fetch-Site", "cross-site")], 403),
+        ("GET", "/api/plants/999999/plant_tex65535.png", vec![("Sec-Fetch-Site", "cross-site")], 403),
+        // DNS rebinding: the page's own requests, under another name.
+        ("GET", "/", vec![("Host", "evil.example")], 403),
+        ("GET", "/api/models", vec![("Host", &evil_host)], 403),
+        ("GET", "/api/models", vec![("Host", &rebound)], 403),
+        ("POST", &mutate, vec![("Host", &evil_host), ("Origin", "http://evil.example")], 403),
+        ("GET", "/api/models", vec![("Host", "")], 403),
+    ];
+    for (method, path, headers, status) in &refused {
+        let sent = if *method == "POST" {
+            body.as_bytes()
+        } else {
+            b""
+        };
+        let answer = request_with(&server, method, path, headers, sent);
+        assert_refused(&format!("{method} {path} {headers:?}"), answer, *status, "");
+    }
+    // A URL with a whole address names its host too; HTTP/1.0 without a Host is refused.
+    let absolute = format!(
+        "GET http://evil.example:{port}/api/models HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
+        server.address
+    );
+    assert_refused(
+        "absolute URL",
+        exchange(&server.address, absolute.as_bytes()),
+        403,
+        "",
+    );
+    assert_refused(
+        "HTTP/1.0",
+        exchange(&server.address, b"GET /api/models HTTP/1.0\r\n\r\n"),
+        403,
+        "",
+    );
+    // Nothing happened: no step, no new plant.
+    assert_eq!(
+        get(&server, &format!("/api/sessions/{id}"))["history"],
+        json!([])
+    );
+    assert_eq!(
+        get(&server, &format!("/api/plants?session={id}"))["total"],
+        2
+    );
+    // The studio's own page: its origin, loopback names, a link from another site to the
+    // page, and a token-free bearer of any case are all fine.
+    for (method, path, headers) in [
+        (
+            "POST",
+            mutate.as_str(),
+            vec![("Origin", own.as_str()), ("Sec-Fetch-Site", "same-origin")],
+        ),
+        (
+            "POST",
+            mutate.as_str(),
+            vec![("Content-Type", "application/json; charset=utf-8")],
+        ),
+        ("GET", "/api/models", vec![("Host", "localhost")]),
+        ("GET", "/api/models", vec![("Host", "[::1]")]),
+        (
+            "GET",
+            "/",
+            vec![
+                ("Sec-Fetch-Site", "cross-site"),
+                ("Sec-Fetch-Mode", "navigate"),
+            ],
+        ),
+    ] {
+        let sent = if method == "POST" {
+            body.as_bytes()
+        } else {
+            b""
+        };
+        let (status, answer) = request_with(&server, method, path, &headers, sent);
+        assert_eq!(
+            status,
+            200,
+            "{method} {path} {headers:?}: {}",
+            String::from_utf8_lossy(&answer)
+        );
+    }
+}
+
+#[test]
+fn a_reverse_proxy_name_is_allowed_only_when_given() {
+    let dir = temp_dir("proxy");
+    let server = start_with(&dir, &["--allow-host", "plants.example.org"]);
+    for (host, status) in [
+        ("plants.example.org", 200),
+        ("PLANTS.example.org:443", 200),
+        ("example.org", 403),
+    ] {
+        let (got, body) = request_with(&server, "GET", "/api/models", &[("Host", host)], b"");
+        assert_eq!(got, status, "{host}: {}", String::from_utf8_lossy(&body));
+    }
+    let (got, _) = request_with(
+        &server,
+        "POST",
+        "/api/sessions",
+        &[
+            ("Host", "plants.example.org"),
+            ("Origin", "https://plants.example.org"),
+        ],
+        br#"{"mode": "breed", "model": "bintree", "start": {"random": 1}}"#,
+    );
+    assert_eq!(got, 200, "a proxy serving https keeps the page's origin");
+}
+
+#[test]
+fn textures_are_served_only_for_what_a_real_plant_names() {
+    let dir = temp_dir("textures");
+    let server = start(&dir, "127.0.0.1");
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "breed", "start": {"examples": ["plantmaker/fern"]}}),
+    );
+    let fern = grid(&session)[0];
+    let mtl = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{fern}/plant.mtl"),
+        b"",
+        true,
+    );
+    assert_eq!(mtl.0, 200);
+    let mtl = String::from_utf8(mtl.1).unwrap();
+    let named: Vec<&str> = mtl
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("map_Kd "))
+        .filter_map(|options_and_file| options_and_file.split_whitespace().last())
+        .collect();
+    assert!(
+        !named.is_empty(),
+        "the fern's materials name textures: {mtl}"
+    );
+    for file in &named {
+        let (status, png) = request(
+            &server,
+            "GET",
+            &format!("/api/plants/{fern}/{file}"),
+            b"",
+            true,
+        );
+        assert_eq!(status, 200, "{file}");
+        assert!(png.starts_with(b"\x89PNG"), "{file}");
+    }
+    let unnamed = (0..128u16)
+        .map(|i| format!("plant_tex{i}.png"))
+        .find(|f| !named.contains(&f.as_str()))
+        .unwrap();
+    for path in [
+        format!("/api/plants/{fern}/{unnamed}"),
+        format!("/api/plants/{fern}/plant_tex65535.png"),
+        format!("/api/plants/{fern}/plant_tex99999.png"),
+        format!("/api/plants/{fern}/plant_tex+3.png"),
+        "/api/plants/999999/plant_tex3.png".to_owned(),
+        "/api/plants/999999/plant_tex65535.png".to_owned(),
+    ] {
+        assert_refused(&path, request(&server, "GET", &path, b"", true), 404, "");
+    }
+}
+
+#[test]
+fn over_long_and_malformed_requests_get_json_errors() {
+    let dir = temp_dir("heads");
+    let server = start(&dir, "127.0.0.1");
+    let host = &server.address;
+    let long = |n: usize| {
+        format!(
+            "GET /api/plants?session=1&x={} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n",
+            "a".repeat(n)
+        )
+    };
+    for n in [9_000, 70_000, 1 << 20] {
+        assert_refused(
+            &format!("a URL of {n} bytes"),
+            exchange(host, long(n).as_bytes()),
+            414,
+            "",
+        );
+    }
+    let path = format!("/api/{}", "a".repeat(9_000));
+    assert_refused(
+        "a long path",
+        request(&server, "GET", &path, b"", true),
+        414,
+        "",
+    );
+    let header = format!(
+        "GET /api/models HTTP/1.1\r\nHost: {host}\r\nX-Big: {}\r\nConnection: close\r\n\r\n",
+        "b".repeat(100_000)
+    );
+    assert_refused(
+        "a 100 kB header",
+        exchange(host, header.as_bytes()),
+        431,
+        "",
+    );
+    let huge = format!(
+        "GET /api/models HTTP/1.1\r\nHost: {host}\r\nX-Big: {}\r\n\r\n",
+        "b".repeat(1 << 20)
+    );
+    assert_refused("a 1 MB header", exchange(host, huge.as_bytes()), 431, "");
+    let mut many = format!("GET /api/models HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n");
+    for i in 0..200 {
+        many.push_str(&format!("X-{i}: 1\r\n"));
+    }
+    many.push_str("\r\n");
+    assert_refused("200 headers", exchange(host, many.as_bytes()), 431, "");
+    for bad in [
+        "GARBAGE\r\n\r\n".to_owned(),
+        format!("GET /api/models HTTP/9.9\r\nHost: {host}\r\n\r\n"),
+        format!(
+            "POST /api/sessions HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\nContent-Length: 2\r\nContent-Length: 3\r\n\r\n{{}}"
+        ),
+        format!(
+            "POST /api/sessions HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\nContent-Length: -1\r\n\r\n"
+        ),
+    ] {
+        assert_refused(&format!("{bad:?}"), exchange(host, bad.as_bytes()), 400, "");
+    }
+    // And the studio still answers.
+    assert_eq!(get(&server, "/api/models").as_array().unwrap().len(), 4);
+}
+
+#[test]
+fn design_runs_stream_valid_json_with_the_terms_named() {
+    let dir = temp_dir("events");
+    let server = start(&dir, "127.0.0.1");
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "design", "design": {"population": 10, "generations": 3}}),
+    );
+    let id = session["id"].as_i64().unwrap();
+    let mut stream = TcpStream::connect(&server.address).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(120)))
+        .unwrap();
+    let head = format!(
+        "GET /api/sessions/{id}/events HTTP/1.1\r\nHost: {}\r\nAccept: text/event-stream\r\n\r\n",
+        server.address
+    );
+    stream.write_all(head.as_bytes()).unwrap();
+    let mut events: Vec<(String, Value)> = Vec::new();
+    let mut reader = BufReader::new(stream);
+    let mut name = String::new();
+    let mut line = String::new();
+    while events.iter().filter(|(n, _)| n == "generation").count() < 2 {
+        line.clear();
+        if reader.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        let line = line.trim_end();
+        if let Some(n) = line
+            .strip_prefix("event: ")
+            .or_else(|| line.strip_prefix("event:"))
+        {
+            name = n.trim().to_owned();
+        } else if let Some(data) = line
+            .strip_prefix("data: ")
+            .or_else(|| line.strip_prefix("data:"))
+        {
+            let text = data.trim();
+            let value: Value = serde_json::from_str(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+            // Each key once: serde_json keeps the last of a repeated key, so count them.
+            assert_eq!(text.matches("\"generation\"").count(), 1, "{text}");
+            events.push((name.clone(), value));
+        }
+    }
+    let generations: Vec<&Value> = events
+        .iter()
+        .filter(|(n, _)| n == "generation")
+        .map(|(_, v)| v)
+        .collect();
+    assert!(generations.len() >= 2, "{events:?}");
+    for g in generations {
+        let terms = g["terms"].as_array().unwrap();
+        assert!(!terms.is_empty(), "{g}");
+        assert_eq!(
+            terms.len(),
+            g["best_terms"].as_array().unwrap().len(),
+            "{g}"
+        );
+        assert!(g["best"].is_number() && g["plant"].is_number(), "{g}");
+    }
 }
 
 #[test]
@@ -404,28 +904,57 @@ fn beyond_loopback_every_request_needs_the_printed_token() {
     let server = start(&dir, "0.0.0.0");
     let token = server.token.clone().expect("a token is printed");
     assert_eq!(token.len(), 32);
-    let local = Server {
-        child: Command::new("true").spawn().unwrap(),
-        address: server.address.replace("0.0.0.0", "127.0.0.1"),
-        token: Some(token.clone()),
-    };
+    // The printed address is one a browser on this machine can open.
+    assert!(
+        server.address.starts_with("127.0.0.1:"),
+        "{}",
+        server.address
+    );
     for path in ["/", "/api/models", "/vendor/three/build/three.module.js"] {
-        let (status, body) = request(&local, "GET", path, b"", false);
+        let (status, body) = request(&server, "GET", path, b"", false);
         assert_eq!(status, 401, "{path}");
         assert!(String::from_utf8_lossy(&body).contains("token"));
     }
-    let (status, _) = request(&local, "GET", "/api/models", b"", true);
+    let (status, _) = request(&server, "GET", "/api/models", b"", true);
     assert_eq!(status, 200);
+    for scheme in ["bearer", "BEARER", "Bearer "] {
+        let auth = format!("{scheme} {token}");
+        let (status, _) = request_with(
+            &server,
+            "GET",
+            "/api/models",
+            &[("Authorization", &auth)],
+            b"",
+        );
+        assert_eq!(status, 200, "{auth}");
+    }
     let (status, _) = request(
-        &local,
+        &server,
         "GET",
         &format!("/api/models?token={token}"),
         b"",
         false,
     );
     assert_eq!(status, 200);
-    let (status, _) = request(&local, "GET", "/api/models?token=0000", b"", false);
+    let (status, _) = request(&server, "GET", "/api/models?token=0000", b"", false);
     assert_eq!(status, 401);
+    // Bound to every interface, any address names the studio; a name that could be rebound
+    // to one does not.
+    let auth = format!("Bearer {token}");
+    for (host, status) in [
+        ("10.1.2.3:80", 200),
+        ("[fe80::1]", 200),
+        ("evil.example", 403),
+    ] {
+        let (got, _) = request_with(
+            &server,
+            "GET",
+            "/api/models",
+            &[("Host", host), ("Authorization", &auth)],
+            b"",
+        );
+        assert_eq!(got, status, "{host}");
+    }
 }
 
 #[test]

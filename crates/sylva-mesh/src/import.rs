@@ -103,6 +103,29 @@ fn u32_at(bytes: &[u8], at: usize) -> Result<u32, ImportError> {
 
 /// Reads a GLB.
 pub fn read_glb(bytes: &[u8]) -> Result<ImportedScene, ImportError> {
+    let (json, bin) = chunks(bytes)?;
+    let root: Value = serde_json::from_slice(json)?;
+    Reader { root: &root, bin }.scene()
+}
+
+/// The Sylva textures a GLB's materials name (ids, sorted, each once), read from its JSON
+/// alone: what a server may serve beside the GLB's OBJ.
+pub fn texture_ids(bytes: &[u8]) -> Result<Vec<u16>, ImportError> {
+    let (json, bin) = chunks(bytes)?;
+    let root: Value = serde_json::from_slice(json)?;
+    let reader = Reader { root: &root, bin };
+    let mut ids: Vec<u16> = reader
+        .list("materials")
+        .iter()
+        .filter_map(|m| reader.sylva_texture(&m["pbrMetallicRoughness"]["baseColorTexture"]))
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    Ok(ids)
+}
+
+/// A GLB's JSON and binary chunks.
+fn chunks(bytes: &[u8]) -> Result<(&[u8], &[u8]), ImportError> {
     if bytes.len() < 12 || u32_at(bytes, 0)? != 0x4654_6C67 {
         return Err(ImportError::NotGlb("it does not start with \"glTF\""));
     }
@@ -125,8 +148,7 @@ pub fn read_glb(bytes: &[u8]) -> Result<ImportedScene, ImportError> {
         }
         at += 8 + len.next_multiple_of(4);
     }
-    let root: Value = serde_json::from_slice(json.ok_or(ImportError::NotGlb("no JSON chunk"))?)?;
-    Reader { root: &root, bin }.scene()
+    Ok((json.ok_or(ImportError::NotGlb("no JSON chunk"))?, bin))
 }
 
 struct Reader<'a> {
@@ -748,6 +770,17 @@ mod tests {
                 "{name}: {error}"
             );
         }
+    }
+
+    #[test]
+    fn texture_ids_are_those_the_materials_name() {
+        let mut mesh = triangle_mesh();
+        mesh.materials[0].texture = Some(7);
+        let glb = to_glb(&Scene::single(SceneNode::new("a", &mesh))).unwrap();
+        assert_eq!(texture_ids(&glb).unwrap(), [7]);
+        let plain = to_glb(&Scene::single(SceneNode::new("a", &triangle_mesh()))).unwrap();
+        assert!(texture_ids(&plain).unwrap().is_empty());
+        assert!(texture_ids(b"not a glb at all").is_err());
     }
 
     #[test]

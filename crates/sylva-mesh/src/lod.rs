@@ -137,51 +137,12 @@ pub fn lod_levels(
         screen_coverage: 0.0,
     }];
     let mut scratch = Scratch::default();
-    let count = |q: f32, scratch: &mut Scratch| -> (f32, usize) {
-        skeleton.skeleton_at(q, scratch);
-        (q, skeleton.triangles(q, options, scratch))
-    };
-    let least = count(0.0, &mut scratch);
+    let least = (0.0, skeleton.count(0.0, options, &mut scratch));
     // What is known above the aim: level 0 (q = 1) at first, then each level found.
     let mut upper = (1.0f32, full);
     for k in 1..levels {
         let aim = full as f64 / f64::from(1u32 << k);
-        let found = if least.1 as f64 > aim {
-            least
-        } else if upper.1 as f64 <= aim {
-            upper // the level above already meets this aim
-        } else {
-            // Interpolate on log triangles between a q under the aim and one over it.
-            let ln = |t: usize| (t.max(1) as f64).ln();
-            let (mut lo, mut hi) = (least, upper);
-            let mut last_under = None;
-            for _ in 0..SEARCH_STEPS {
-                let t = (aim.ln() - ln(lo.1)) / (ln(hi.1) - ln(lo.1));
-                // Halve the bracket instead when two tries in a row fell on one side (the
-                // count is far from straight in log there).
-                let t = match last_under {
-                    Some((a, b)) if a == b => 0.5,
-                    _ => (t as f32).clamp(0.05, 0.95),
-                };
-                let tried = count(lo.0 + (hi.0 - lo.0) * t, &mut scratch);
-                let under = tried.1 as f64 <= aim;
-                last_under = Some((last_under.map_or(!under, |(_, b)| b), under));
-                if under {
-                    lo = tried;
-                    if tried.1 as f64 >= CLOSE_ENOUGH * aim {
-                        break;
-                    }
-                } else {
-                    hi = tried;
-                }
-                // A step in the count (many twigs losing a ring vertex at once) can leave
-                // no plant near the aim: stop once the bracket is this tight.
-                if hi.0 - lo.0 < MIN_BRACKET {
-                    break;
-                }
-            }
-            lo
-        };
+        let found = skeleton.search(aim, least, upper, options, &mut scratch);
         upper = found;
         let (q, triangles) = found;
         let plant = skeleton.simplify(q, &mut scratch)?;
@@ -206,6 +167,102 @@ pub fn lod_levels(
         };
     }
     Ok(chain)
+}
+
+impl Skeleton<'_> {
+    /// The triangles of the plant at detail `q`.
+    fn count(&self, q: f32, options: &MeshOptions, scratch: &mut Scratch) -> usize {
+        self.skeleton_at(q, scratch);
+        self.triangles(q, options, scratch)
+    }
+
+    /// The detail whose plant comes nearest `aim` triangles without going over, searched
+    /// between `least` (q = 0) and `upper` (a detail known to be over or at the aim), each
+    /// a detail and its count (see the module docs).
+    fn search(
+        &self,
+        aim: f64,
+        least: (f32, usize),
+        upper: (f32, usize),
+        options: &MeshOptions,
+        scratch: &mut Scratch,
+    ) -> (f32, usize) {
+        if least.1 as f64 > aim {
+            return least;
+        }
+        if upper.1 as f64 <= aim {
+            return upper; // the level above already meets this aim
+        }
+        // Interpolate on log triangles between a q under the aim and one over it.
+        let ln = |t: usize| (t.max(1) as f64).ln();
+        let (mut lo, mut hi) = (least, upper);
+        let mut last_under = None;
+        for _ in 0..SEARCH_STEPS {
+            let t = (aim.ln() - ln(lo.1)) / (ln(hi.1) - ln(lo.1));
+            // Halve the bracket instead when two tries in a row fell on one side (the
+            // count is far from straight in log there).
+            let t = match last_under {
+                Some((a, b)) if a == b => 0.5,
+                _ => (t as f32).clamp(0.05, 0.95),
+            };
+            let q = lo.0 + (hi.0 - lo.0) * t;
+            let tried = (q, self.count(q, options, scratch));
+            let under = tried.1 as f64 <= aim;
+            last_under = Some((last_under.map_or(!under, |(_, b)| b), under));
+            if under {
+                lo = tried;
+                if tried.1 as f64 >= CLOSE_ENOUGH * aim {
+                    break;
+                }
+            } else {
+                hi = tried;
+            }
+            // A step in the count (many twigs losing a ring vertex at once) can leave
+            // no plant near the aim: stop once the bracket is this tight.
+            if hi.0 - lo.0 < MIN_BRACKET {
+                break;
+            }
+        }
+        lo
+    }
+}
+
+/// A preview of `plant` of at most about `max_triangles` triangles: the level k of its chain
+/// whose aim, T₀ / 2ᵏ, is the first within `max_triangles` (k at most [`MAX_LEVELS`] − 1),
+/// found by the chain's own search from the plant as it is. Level 0 (the plant itself, its
+/// options and count) when it is within already. A view a few hundred pixels wide needs no
+/// more, whatever the plant.
+pub fn preview(
+    plant: &Plant,
+    options: &MeshOptions,
+    max_triangles: usize,
+) -> Result<LodLevel, LodError> {
+    let full = Mesher::new(options.clone())?.counts(plant)?.triangles;
+    let mut level = 0;
+    while level + 1 < MAX_LEVELS && full >> level > max_triangles {
+        level += 1;
+    }
+    if level == 0 {
+        return Ok(LodLevel {
+            plant: plant.clone(),
+            options: options.clone(),
+            detail: 1.0,
+            triangles: full,
+            screen_coverage: CULL_COVERAGE,
+        });
+    }
+    let skeleton = Skeleton::of(plant);
+    let mut scratch = Scratch::default();
+    let least = (0.0, skeleton.count(0.0, options, &mut scratch));
+    let aim = full as f64 / f64::from(1u32 << level);
+    let (q, triangles) = skeleton.search(aim, least, (1.0, full), options, &mut scratch);
+    Ok(LodLevel {
+        plant: skeleton.simplify(q, &mut scratch)?,
+        options: level_options(options, q),
+        detail: q,
+        triangles,
+        screen_coverage: CULL_COVERAGE,
+    })
 }
 
 /// The mesh options of detail `q`: fewer ring vertices by order, leaf stations and petals.
@@ -680,6 +737,38 @@ mod tests {
             assert!((a.max - b.max).length() < 0.1 * size && (a.min - b.min).length() < 0.1 * size);
         }
         assert_eq!(chain[3].screen_coverage, CULL_COVERAGE);
+    }
+
+    #[test]
+    fn previews_are_the_first_level_within_the_budget() {
+        let p = plant();
+        let options = MeshOptions::default();
+        let full = Mesher::new(options.clone())
+            .unwrap()
+            .counts(&p)
+            .unwrap()
+            .triangles;
+        let whole = preview(&p, &options, full).unwrap();
+        assert_eq!((whole.detail, whole.triangles), (1.0, full));
+        for budget in [full - 1, full / 3, full / 5] {
+            let level = preview(&p, &options, budget).unwrap();
+            let k = (0..MAX_LEVELS).find(|&k| full >> k <= budget).unwrap();
+            let aim = full as f64 / f64::from(1u32 << k);
+            assert!(level.triangles as f64 <= aim && level.triangles as f64 >= 0.6 * aim);
+            assert_eq!(
+                Mesher::new(level.options.clone())
+                    .unwrap()
+                    .mesh(&level.plant)
+                    .unwrap()
+                    .triangle_count(),
+                level.triangles,
+                "counts are exact"
+            );
+        }
+        // However small the budget, the chain's last level (or the plainest plant, q = 0).
+        let least = preview(&p, &options, 1).unwrap();
+        let last_aim = full as f64 / f64::from(1u32 << (MAX_LEVELS - 1));
+        assert!(least.triangles as f64 <= last_aim || least.detail == 0.0);
     }
 
     #[test]

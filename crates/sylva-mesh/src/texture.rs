@@ -184,27 +184,62 @@ impl Texture {
 
 /// Textures and PNGs made so far, by id: a texture is a pure function of its id, and making
 /// one (noise, then the best PNG compression) costs far more than meshing a small plant.
-/// At most [`KEPT_TEXTURES`] of each are kept; ids beyond are made again when asked.
-static MADE: LazyLock<Mutex<HashMap<u16, Arc<Texture>>>> = LazyLock::new(Mutex::default);
-static PNGS: LazyLock<Mutex<HashMap<u16, Arc<Vec<u8>>>>> = LazyLock::new(Mutex::default);
+/// The [`KEPT_TEXTURES`] used last of each are kept, so ids that come and go (a hostile
+/// upload's, say) cannot push out the ones in use.
+static MADE: LazyLock<Mutex<Kept<Texture>>> = LazyLock::new(Mutex::default);
+static PNGS: LazyLock<Mutex<Kept<Vec<u8>>>> = LazyLock::new(Mutex::default);
 
-/// Textures (and PNGs) kept in memory: the nine designs several times over (about 64 KiB
-/// each).
-const KEPT_TEXTURES: usize = 64;
+/// Textures (and PNGs) kept in memory, about 64 KiB each: every id a genome can name
+/// (PlantMaker's 0 to 127) with room to spare.
+const KEPT_TEXTURES: usize = 160;
 
-fn remember<T>(cache: &Mutex<HashMap<u16, Arc<T>>>, id: u16, value: Arc<T>) {
-    let mut cache = cache.lock().unwrap_or_else(|p| p.into_inner());
-    if cache.len() < KEPT_TEXTURES {
-        cache.insert(id, value);
+/// Values by id, each with the tick it was last used at.
+struct Kept<T> {
+    values: HashMap<u16, (Arc<T>, u64)>,
+    tick: u64,
+}
+
+impl<T> Default for Kept<T> {
+    fn default() -> Self {
+        Kept {
+            values: HashMap::new(),
+            tick: 0,
+        }
     }
 }
 
-fn recall<T>(cache: &Mutex<HashMap<u16, Arc<T>>>, id: u16) -> Option<Arc<T>> {
+impl<T> Kept<T> {
+    fn recall(&mut self, id: u16) -> Option<Arc<T>> {
+        self.tick += 1;
+        let tick = self.tick;
+        self.values.get_mut(&id).map(|(value, used)| {
+            *used = tick;
+            value.clone()
+        })
+    }
+
+    fn remember(&mut self, id: u16, value: Arc<T>) {
+        self.tick += 1;
+        if self.values.len() >= KEPT_TEXTURES
+            && !self.values.contains_key(&id)
+            && let Some(oldest) = self.values.iter().min_by_key(|(_, (_, used))| *used)
+        {
+            let oldest = *oldest.0;
+            self.values.remove(&oldest);
+        }
+        self.values.insert(id, (value, self.tick));
+    }
+}
+
+fn remember<T>(cache: &Mutex<Kept<T>>, id: u16, value: Arc<T>) {
     cache
         .lock()
         .unwrap_or_else(|p| p.into_inner())
-        .get(&id)
-        .cloned()
+        .remember(id, value);
+}
+
+fn recall<T>(cache: &Mutex<Kept<T>>, id: u16) -> Option<Arc<T>> {
+    cache.lock().unwrap_or_else(|p| p.into_inner()).recall(id)
 }
 
 /// Texture `id` (see the module docs for the designs), made once per process.
@@ -567,6 +602,19 @@ mod tests {
     }
 
     use super::*;
+
+    #[test]
+    fn ids_that_come_and_go_do_not_push_out_those_in_use() {
+        let mut kept: Kept<u16> = Kept::default();
+        kept.remember(3, Arc::new(3));
+        for id in 1000..1000 + 4 * KEPT_TEXTURES as u16 {
+            assert_eq!(kept.recall(3).as_deref(), Some(&3));
+            kept.remember(id, Arc::new(id));
+            assert!(kept.values.len() <= KEPT_TEXTURES);
+        }
+        assert_eq!(kept.recall(3).as_deref(), Some(&3));
+        assert!(kept.recall(1000).is_none());
+    }
 
     fn mean_abs_diff(a: &GrayImage, b: &GrayImage) -> f32 {
         let sum: u64 = a

@@ -10,12 +10,14 @@ use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use criterion::{Criterion, criterion_group, criterion_main};
 use serde_json::{Value, json};
+use sylva_studio::guard::Guard;
 use sylva_studio::{Archive, Studio, router};
 use tower::ServiceExt;
 
 fn call(runtime: &tokio::runtime::Runtime, studio: &Studio, path: &str, body: &Value) -> Value {
     runtime.block_on(async {
         let request = Request::post(path)
+            .header("host", "127.0.0.1")
             .header("content-type", "application/json")
             .body(Body::from(body.to_string()))
             .unwrap();
@@ -32,7 +34,7 @@ fn steps(c: &mut Criterion) {
     let dir = std::env::temp_dir().join(format!("sylva-studio-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let archive = Archive::open(&dir.join("bench.db")).unwrap();
-    let studio = Studio::new(archive, None, dir.clone());
+    let studio = Studio::new(archive, Guard::default());
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

@@ -17,7 +17,7 @@ use crate::Studio;
 use crate::archive::{self, NewPlant, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
-use crate::plants::{genome_of, grow_glb};
+use crate::plants::{Form, PreviewSize, genome_of, preview_glb};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// PlantMaker's name in files.
@@ -82,7 +82,7 @@ pub struct Made {
     pub settings: serde_json::Value,
     /// Its parents.
     pub parents: Vec<ParentRow>,
-    /// Its GLB, roots left out.
+    /// Its preview GLB for the grid's cells ([`PreviewSize::GRID`]).
     pub glb: Vec<u8>,
 }
 
@@ -105,7 +105,7 @@ impl Made {
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
-        let glb = grow_glb(&genome, seed, false, &parents, operator)?;
+        let glb = preview_glb(&genome, seed, &parents, operator, PreviewSize::GRID)?;
         Ok(Made {
             genome,
             seed,
@@ -139,10 +139,12 @@ pub fn store(c: &rusqlite::Connection, session: i64, made: &[Made]) -> Result<Ve
     Ok(ids)
 }
 
-/// Keeps the GLBs of stored plants in memory (after the transaction committed).
+/// Keeps the preview GLBs of stored plants in memory (after the transaction committed), so
+/// that the page's cells find them there.
 fn cache(studio: &Studio, ids: &[i64], made: Vec<Made>) {
     for (id, m) in ids.iter().zip(made) {
-        studio.meshes.put((*id, false), std::sync::Arc::new(m.glb));
+        let form = Form::Preview(PreviewSize::GRID);
+        studio.meshes.put((*id, form), std::sync::Arc::new(m.glb));
     }
 }
 
@@ -171,6 +173,16 @@ fn archived(
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// The one plant of `model` a request names in `field`.
+fn archived_one(studio: &Studio, id: i64, model: &str, field: &str) -> Result<PlantRow, ApiError> {
+    let mut rows = archived(studio, &[id], model, field).map_err(|mut e| {
+        e.field = field.to_owned();
+        e
+    })?;
+    rows.pop()
+        .ok_or_else(|| ApiError::internal("a plant read is missing"))
 }
 
 /// New plants for `start`/`add`, grown (on the blocking pool); and archived plants reused.
@@ -637,7 +649,7 @@ pub(crate) async fn mutate(
         ));
     }
     let count = children(request.children, GRID - 1)?;
-    let parent = archived(&studio, &[request.plant], &row.model, "plant")?.remove(0);
+    let parent = archived_one(&studio, request.plant, &row.model, "plant")?;
     let genome = genome_of(&parent)?;
     let settings = (row.model == PLANTMAKER).then(|| depth_settings(depth));
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
@@ -745,7 +757,7 @@ pub(crate) async fn edit(
     let lock = studio.session_lock(id);
     let _guard = lock.lock().await;
     let (row, state) = breed_state(&studio, id)?;
-    let old = archived(&studio, &[request.plant], &row.model, "plant")?.remove(0);
+    let old = archived_one(&studio, request.plant, &row.model, "plant")?;
     let original = genome_of(&old)?;
     let genome = match (&request.genome, request.fields.is_empty()) {
         (None, true) => original.clone(),

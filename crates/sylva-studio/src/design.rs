@@ -28,13 +28,13 @@ use crate::Studio;
 use crate::archive::{self, GenerationRow, RunRow};
 use crate::error::{ApiError, config_error};
 use crate::family::{archive_member, generation_row};
-use crate::http::Body;
+use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
 
 const AUTOMATA: &str = AutomataModel::NAME;
 
-/// What a run tells the pages watching it.
-#[derive(Serialize, Clone, Debug)]
+/// What a run tells the pages watching it: a generation's figures, or a change of status.
+#[derive(Clone, Debug)]
 pub struct RunEvent {
     /// The run.
     pub run: i64,
@@ -42,11 +42,37 @@ pub struct RunEvent {
     pub status: String,
     /// The generation just made (or the last one).
     pub generation: u32,
-    /// Its figures, for a generation event.
-    #[serde(flatten)]
-    pub row: Option<GenerationRow>,
+    /// Its figures and the names of its terms, for a generation event.
+    pub row: Option<(GenerationRow, Vec<String>)>,
     /// Why the run failed.
     pub error: Option<String>,
+}
+
+impl RunEvent {
+    /// The event's name and its data: one JSON object, each key once. A generation event
+    /// carries the terms' names, so a page that followed the run from its start can label
+    /// the first row.
+    fn to_sse(&self) -> (&'static str, serde_json::Value) {
+        let mut data = json!({
+            "run": self.run,
+            "status": self.status,
+            "generation": self.generation,
+        });
+        if let Some(error) = &self.error {
+            data["error"] = json!(error);
+        }
+        match &self.row {
+            Some((row, terms)) => {
+                data["best"] = json!(row.best);
+                data["mean"] = json!(row.mean);
+                data["best_terms"] = json!(row.best_terms);
+                data["plant"] = json!(row.plant);
+                data["terms"] = json!(terms);
+                ("generation", data)
+            }
+            None => ("status", data),
+        }
+    }
 }
 
 /// The runs going on, and the channels of the pages watching them.
@@ -144,12 +170,13 @@ pub struct DesignState {
     pub design: serde_json::Value,
 }
 
+/// Checks a count against its range, naming `field` (its JSON path in the request).
 fn range(value: u32, lo: u32, hi: u32, field: &str) -> Result<u32, ApiError> {
     if (lo..=hi).contains(&value) {
         Ok(value)
     } else {
         Err(ApiError::bad(
-            format!("design.{field}"),
+            field,
             format!("expected {lo} to {hi}, got {value}"),
         ))
     }
@@ -157,10 +184,28 @@ fn range(value: u32, lo: u32, hi: u32, field: &str) -> Result<u32, ApiError> {
 
 /// The config a design stands for: Poncin's typical run (`examples/automata/sphere.toml`)
 /// with the design's target, grid, weights and size.
-fn config_of(design: &Design) -> Result<(Config, u32), ApiError> {
-    let population = range(design.population.unwrap_or(1000), 10, 20_000, "population")?;
-    let generations = range(design.generations.unwrap_or(50), 1, 1000, "generations")?;
-    let num_target = range(design.num_target.unwrap_or(30), 1, 1000, "num_target")?;
+/// Errors name fields under `at`, the design's JSON path in the request (`design` when
+/// creating a session, "" when the body is the design).
+fn config_of(design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
+    let field = |name: &str| join(at, name);
+    let population = range(
+        design.population.unwrap_or(1000),
+        10,
+        20_000,
+        &field("population"),
+    )?;
+    let generations = range(
+        design.generations.unwrap_or(50),
+        1,
+        1000,
+        &field("generations"),
+    )?;
+    let num_target = range(
+        design.num_target.unwrap_or(30),
+        1,
+        1000,
+        &field("num_target"),
+    )?;
     let mut fitness = json!({
         "unit": 0.1,
         "num_target": num_target,
@@ -169,6 +214,17 @@ fn config_of(design: &Design) -> Result<(Config, u32), ApiError> {
                      "grid": if design.grid.is_some() { 10.0 } else { 0.0 } },
         "target": { "shape": "sphere", "center": [0.0, 200.0, 0.0], "radius": 150.0 },
     });
+    for (part, value) in [("target", &design.target), ("weights", &design.weights)] {
+        if let Some(null) = value.as_ref().and_then(|v| first_null(v, &field(part))) {
+            return Err(ApiError::bad(
+                null,
+                "null is not a value: leave the field out",
+            ));
+        }
+    }
+    if let Some(grid) = &design.grid {
+        check_cells(grid, &field("grid"))?;
+    }
     if let Some(target) = &design.target {
         fitness["target"] = target.clone();
     }
@@ -178,7 +234,7 @@ fn config_of(design: &Design) -> Result<(Config, u32), ApiError> {
         }
     } else if design.weights.is_some() {
         return Err(ApiError::bad(
-            "design.weights",
+            field("weights"),
             "expected an object of weights",
         ));
     }
@@ -206,17 +262,64 @@ fn config_of(design: &Design) -> Result<(Config, u32), ApiError> {
     });
     let value = toml::Value::try_from(&doc).map_err(|e| ApiError::bad("design", e))?;
     let text = toml::to_string(&value).map_err(|e| ApiError::bad("design", e))?;
-    let config = Config::parse(FilePath::new("design"), &text).map_err(|e| {
-        let mut e = config_error("", &text, &e);
-        e.field = format!("design.{}", e.field.trim_start_matches("automata.fitness."));
-        e
-    })?;
+    let config = Config::parse(FilePath::new("design"), &text)
+        .map_err(|e| config_error(&text, &e, |path| join(at, design_field(path))))?;
     Ok((config, generations))
+}
+
+/// The design's field behind a field of the config it becomes (`automata.fitness.target.radius`
+/// is `target.radius`).
+fn design_field(config: &str) -> &str {
+    match config {
+        "run.population" => "population",
+        "run.generations" => "generations",
+        "run.seed" => "seed",
+        "automata.fitness.num_target" => "num_target",
+        "automata.fitness.grid.at" => "grid.cells",
+        path => match path.strip_prefix("automata.fitness.") {
+            Some(rest)
+                if ["target", "weights", "grid"]
+                    .iter()
+                    .any(|part| rest == *part || rest.starts_with(&format!("{part}."))) =>
+            {
+                rest
+            }
+            _ => "",
+        },
+    }
+}
+
+/// Checks painted cells against the grid, naming the cell (the config would only know the
+/// grid's list of cells).
+fn check_cells(grid: &GridDesign, at: &str) -> Result<(), ApiError> {
+    for (i, c) in grid.cells.iter().enumerate() {
+        if let Some(axis) = (0..3).find(|&a| c.cell[a] >= grid.divisions[a]) {
+            return Err(ApiError::bad(
+                format!("{at}.cells[{i}].cell[{axis}]"),
+                format!(
+                    "expected 0 to {} (the grid has {} divisions along it), got {}",
+                    grid.divisions[axis].saturating_sub(1),
+                    grid.divisions[axis],
+                    c.cell[axis]
+                ),
+            ));
+        }
+        if !(c.weight.is_finite() && (-1e6..=1e6).contains(&c.weight)) {
+            return Err(ApiError::bad(
+                format!("{at}.cells[{i}].weight"),
+                format!(
+                    "expected a number from -1000000 to 1000000, got {}",
+                    c.weight
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Creates a design session and starts its run.
 pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let (config, generations) = config_of(&start.design)?;
+    let (config, generations) = config_of(&start.design, "design")?;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let id = archive::insert_session(c, "design", AUTOMATA, "Design", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -241,7 +344,7 @@ pub(crate) async fn redesign(
     let lock = studio.session_lock(id);
     let _guard = lock.lock().await;
     let before = design_state(&studio, id)?;
-    let (config, generations) = config_of(&design)?;
+    let (config, generations) = config_of(&design, "")?;
     stop_run(&studio, before.run)?;
     let run = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -403,7 +506,7 @@ fn save_generation(
         run: row.id,
         status,
         generation: evolution.generation(),
-        row: Some(figures),
+        row: Some((figures, evolution.term_names().to_vec())),
         error: None,
     });
     Ok(())
@@ -552,14 +655,8 @@ pub(crate) async fn events(
     let first = tokio_stream::once(first);
     let rest = BroadcastStream::new(receiver).filter_map(|e| e.ok());
     let stream = first.chain(rest).map(|e| {
-        let name = if e.row.is_some() {
-            "generation"
-        } else {
-            "status"
-        };
-        Ok(Event::default()
-            .event(name)
-            .data(serde_json::to_string(&e).unwrap_or_default()))
+        let (name, data) = e.to_sse();
+        Ok(Event::default().event(name).data(data.to_string()))
     });
     Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
 }

@@ -75,23 +75,49 @@ impl ApiError {
     }
 }
 
-/// The field of an error in a config the studio wrote from a request (`config.run.population`):
-/// the section above the error's line and the field the message names, under `prefix`.
-pub fn config_error(prefix: &str, text: &str, e: &sylva::InputError) -> ApiError {
-    let section = text
-        .lines()
-        .take(e.line)
+/// An error in a config the studio wrote (as TOML) from a request, as a 422 naming the
+/// config's field: the `[section]` above the error's line and the key on that line
+/// (`run.population`), never a word of the message (which may quote the request's values).
+/// `field` turns that config path into the request's own path.
+pub fn config_error(text: &str, e: &sylva::InputError, field: impl Fn(&str) -> String) -> ApiError {
+    let lines: Vec<&str> = text.lines().collect();
+    let upto = e.line.min(lines.len());
+    let section = lines[..upto]
+        .iter()
         .filter_map(|l| l.trim().strip_prefix('[')?.strip_suffix(']'))
-        .last()
-        .unwrap_or("");
-    let name = e.message.split('`').nth(1).unwrap_or("");
-    let field = [prefix, section, name]
+        .next_back()
+        .map_or("", |s| s.trim_matches(['[', ']']));
+    let key_of = |line: &str| -> Option<String> {
+        let line = line.trim_start();
+        if line.starts_with('[') {
+            return None;
+        }
+        let (key, _) = line.split_once('=')?;
+        Some(key.trim().trim_matches('"').to_owned())
+    };
+    let on_line = upto.checked_sub(1).and_then(|i| key_of(lines[i]));
+    // An error placed on a table's header (a tagged table, read whole) names the key in the
+    // message: taken only when the table has that key, never a value from the request.
+    let key = on_line.unwrap_or_else(|| {
+        let named = e.message.split('`').nth(1).unwrap_or("");
+        let table_end = lines[upto..]
+            .iter()
+            .position(|l| l.trim_start().starts_with('['))
+            .map_or(lines.len(), |i| upto + i);
+        lines[upto..table_end]
+            .iter()
+            .filter_map(|l| key_of(l))
+            .find(|k| k == named)
+            .unwrap_or_default()
+    });
+    let key = key.as_str();
+    let path = [section, key]
         .iter()
         .filter(|s| !s.is_empty())
         .copied()
         .collect::<Vec<_>>()
         .join(".");
-    ApiError::unprocessable(field, &e.message)
+    ApiError::unprocessable(field(&path), &e.message)
 }
 
 /// An input error's message with its line and column, when it has them.
@@ -118,6 +144,17 @@ impl From<rusqlite::Error> for ApiError {
 impl From<tokio::task::JoinError> for ApiError {
     fn from(e: tokio::task::JoinError) -> ApiError {
         ApiError::internal(format!("a worker failed: {e}"))
+    }
+}
+
+impl ApiError {
+    /// The answer's body: `{"error": "...", "field": "..."}`.
+    pub fn body(&self) -> String {
+        serde_json::to_string(&Body {
+            error: &self.error,
+            field: &self.field,
+        })
+        .unwrap_or_else(|_| r#"{"error":"","field":""}"#.to_owned())
     }
 }
 

@@ -21,7 +21,7 @@ use sylva_model::Model;
 use crate::Studio;
 use crate::archive::{self, GenerationRow, NewPlant};
 use crate::error::{ApiError, config_error};
-use crate::http::Body;
+use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
 
 const BINTREE: &str = BinTreeModel::NAME;
@@ -107,6 +107,26 @@ pub struct FamilyState {
 
 /// The config a family request asks for: the example's defaults under its sections.
 fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
+    if let Some(null) = request
+        .run
+        .as_ref()
+        .and_then(|r| first_null(&json!(r), "config.run"))
+    {
+        return Err(ApiError::bad(
+            null,
+            "null is not a value: leave the field out",
+        ));
+    }
+    if let Some(null) = request
+        .bintree
+        .as_ref()
+        .and_then(|b| first_null(b, "config.bintree"))
+    {
+        return Err(ApiError::bad(
+            null,
+            "null is not a value: leave the field out",
+        ));
+    }
     let mut run = request.run.clone().unwrap_or_default();
     let population = run.entry("population").or_insert(json!(100));
     // The page lists every member: a family is a browsable population, not a large search.
@@ -124,7 +144,8 @@ fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     }
     let value = toml::Value::try_from(&doc).map_err(|e| ApiError::bad("config", e))?;
     let text = toml::to_string(&value).map_err(|e| ApiError::bad("config", e))?;
-    Config::parse(FilePath::new("config"), &text).map_err(|e| config_error("config", &text, &e))
+    Config::parse(FilePath::new("config"), &text)
+        .map_err(|e| config_error(&text, &e, |path| join("config", path)))
 }
 
 fn members(run: &Evolution) -> Vec<MemberView> {

@@ -213,7 +213,11 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
             )
         }
         Mother::Plant(id) => {
-            let row = crate::plants::plant_row(studio, id)?;
+            let row = crate::plants::plant_row(studio, id).map_err(|mut e| {
+                e.status = axum::http::StatusCode::BAD_REQUEST;
+                e.field = "start.plant".into();
+                e
+            })?;
             let genome = genome_of(&row)?;
             (
                 lsystem_genome(&genome, "start.plant")?,
@@ -222,7 +226,13 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
                 Some(id),
             )
         }
-        Mother::Empty(_) => (LSystemGenome::empty(), "empty", json!({}), None),
+        Mother::Empty(true) => (LSystemGenome::empty(), "empty", json!({}), None),
+        Mother::Empty(false) => {
+            return Err(ApiError::bad(
+                "start.empty",
+                "expected true (a garden from empty rules), or another start",
+            ));
+        }
     };
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let id = archive::insert_session(c, "garden", LSYSTEM, "Garden", &json!({}))?;

@@ -1,16 +1,12 @@
-//! The HTTP plumbing: typed JSON bodies with limits, the access token, and the page's files.
-
-use std::path::{Component, Path, PathBuf};
+//! The HTTP plumbing: typed JSON bodies with limits, JSON errors, and the page's files.
 
 use axum::body::Body as AxumBody;
-use axum::extract::{FromRequest, Request, State};
-use axum::http::{HeaderMap, HeaderValue, StatusCode, Uri, header};
+use axum::extract::{FromRequest, Request};
+use axum::http::{StatusCode, Uri, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
-use rust_embed::RustEmbed;
 use serde::de::DeserializeOwned;
 
-use crate::Studio;
 use crate::error::ApiError;
 
 /// The largest request body, 1 MiB: genome files are a few kilobytes.
@@ -46,45 +42,93 @@ pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
     };
     let mut de = serde_json::Deserializer::from_slice(bytes);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let field = e.path().to_string();
-        let field = if field == "." || field == "?" {
-            String::new()
-        } else {
-            field
-        };
-        ApiError::bad(field, e.inner())
+        let sent = serde_json::from_slice(bytes).unwrap_or(serde_json::Value::Null);
+        body_error(&e, &sent)
     })?;
     de.end()
         .map_err(|e| ApiError::bad("", format!("after the JSON value: {e}")))?;
     Ok(value)
 }
 
-/// The access token check, for a studio bound beyond loopback. A page opened with
-/// `?token=T` gets it as a cookie, so that its scripts and models carry it.
-pub async fn require_token(State(studio): State<Studio>, req: Request, next: Next) -> Response {
-    let Some(token) = studio.token.as_deref() else {
-        return next.run(req).await;
+/// Reads a part of a request already parsed as JSON, naming fields under `at` (a JSON path
+/// of the request, or "" for the whole of it).
+pub fn from_value<T: DeserializeOwned>(value: serde_json::Value, at: &str) -> Result<T, ApiError> {
+    let sent = value.clone();
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let mut error = body_error(&e, &sent);
+        error.field = join(at, &error.field);
+        error
+    })
+}
+
+/// A serde error as a 400 naming the field by its JSON path in the request as sent (`sent`):
+/// the path where it was found; for a missing field, that field; for an unknown field or
+/// variant that is a key of the object there, that key.
+fn body_error<E: std::fmt::Display>(
+    e: &serde_path_to_error::Error<E>,
+    sent: &serde_json::Value,
+) -> ApiError {
+    let path = e.path().to_string();
+    let path = if path == "." || path == "?" {
+        ""
+    } else {
+        &path
     };
-    let from_query = query_token(req.uri()).is_some_and(|t| same(&t, token));
-    let ok = from_query || header_token(req.headers(), token);
-    if !ok {
-        return ApiError::new(
-            StatusCode::UNAUTHORIZED,
-            "token",
-            "this studio needs its access token: open the address it printed at start \
-             (with ?token=...), or send `Authorization: Bearer TOKEN`",
-        )
-        .into_response();
-    }
-    let mut response = next.run(req).await;
-    if from_query
-        && let Ok(cookie) = HeaderValue::from_str(&format!(
-            "sylva_token={token}; Path=/; HttpOnly; SameSite=Strict"
-        ))
+    let message = e.inner().to_string();
+    let quoted = |prefix: &str| {
+        message
+            .strip_prefix(prefix)
+            .and_then(|rest| rest.split('`').next())
+    };
+    let field = if let Some(name) = quoted("missing field `") {
+        join(path, name)
+    } else if let Some(name) = quoted("unknown field `").or_else(|| quoted("unknown variant `"))
+        && at_path(sent, path).is_some_and(|v| v.get(name).is_some())
     {
-        response.headers_mut().append(header::SET_COOKIE, cookie);
+        join(path, name)
+    } else {
+        path.to_owned()
+    };
+    ApiError::bad(field, message)
+}
+
+/// The value at a JSON path (`a.b[1].c`) of `value`.
+fn at_path<'v>(value: &'v serde_json::Value, path: &str) -> Option<&'v serde_json::Value> {
+    let mut at = value;
+    for part in path.split('.').filter(|p| !p.is_empty()) {
+        let (name, indices) = part.split_at(part.find('[').unwrap_or(part.len()));
+        if !name.is_empty() {
+            at = at.get(name)?;
+        }
+        for index in indices.split(['[', ']']).filter(|s| !s.is_empty()) {
+            at = at.get(index.parse::<usize>().ok()?)?;
+        }
     }
-    response
+    Some(at)
+}
+
+/// The JSON path (under `at`) of the first `null` in `value`: configs have no null, so a
+/// request's null would otherwise fail without a field when its TOML is written.
+pub fn first_null(value: &serde_json::Value, at: &str) -> Option<String> {
+    match value {
+        serde_json::Value::Null => Some(at.to_owned()),
+        serde_json::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| first_null(v, &format!("{at}[{i}]"))),
+        serde_json::Value::Object(map) => map.iter().find_map(|(k, v)| first_null(v, &join(at, k))),
+        _ => None,
+    }
+}
+
+/// `name` under the JSON path `path` (`a.b` and `c` give `a.b.c`).
+pub fn join(path: &str, name: &str) -> String {
+    match (path.is_empty(), name.is_empty()) {
+        (true, _) => name.to_owned(),
+        (false, true) => path.to_owned(),
+        (false, false) if name.starts_with('[') => format!("{path}{name}"),
+        (false, false) => format!("{path}.{name}"),
+    }
 }
 
 /// Makes every 4xx the API answers a JSON error, including the plain-text rejections of
@@ -122,44 +166,16 @@ pub async fn json_errors(req: Request, next: Next) -> Response {
     ApiError::new(status, field, error).into_response()
 }
 
-fn query_token(uri: &Uri) -> Option<String> {
-    uri.query()?
-        .split('&')
-        .find_map(|pair| pair.strip_prefix("token="))
-        .map(str::to_owned)
-}
+// The page's files and three.js's, built in by build.rs: `PAGE`, `THREE`, `THREE_VERSION`.
+include!(concat!(env!("OUT_DIR"), "/assets.rs"));
 
-fn header_token(headers: &HeaderMap, token: &str) -> bool {
-    let bearer = headers
-        .get(header::AUTHORIZATION)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.strip_prefix("Bearer "))
-        .is_some_and(|t| same(t.trim(), token));
-    let cookie = headers
-        .get_all(header::COOKIE)
+/// A built-in file by its path.
+fn built_in(files: &'static [(&'static str, &'static [u8])], path: &str) -> Option<&'static [u8]> {
+    files
         .iter()
-        .filter_map(|v| v.to_str().ok())
-        .flat_map(|v| v.split(';'))
-        .filter_map(|kv| kv.trim().strip_prefix("sylva_token="))
-        .any(|t| same(t, token));
-    bearer || cookie
+        .find(|(p, _)| *p == path)
+        .map(|(_, bytes)| *bytes)
 }
-
-/// Compares in time independent of where the strings differ.
-fn same(a: &str, b: &str) -> bool {
-    a.len() == b.len()
-        && a.bytes()
-            .zip(b.bytes())
-            .fold(0u8, |acc, (x, y)| acc | (x ^ y))
-            == 0
-}
-
-/// The page's own files, built into the binary (read from the folder in debug builds).
-#[derive(RustEmbed)]
-#[folder = "web/"]
-#[include = "index.html"]
-#[include = "app/*"]
-struct Page;
 
 fn content_type(path: &str) -> &'static str {
     match path.rsplit('.').next() {
@@ -175,52 +191,52 @@ fn content_type(path: &str) -> &'static str {
     }
 }
 
-fn file_response(path: &str, bytes: Vec<u8>) -> Response {
+fn file_response(path: &str, bytes: impl Into<AxumBody>) -> Response {
     (
         [
             (header::CONTENT_TYPE, content_type(path)),
             (header::CACHE_CONTROL, "no-cache"),
         ],
-        bytes,
+        bytes.into(),
     )
         .into_response()
 }
+
+/// A folder to serve the page's own files from instead of the built-in copies
+/// (`SYLVA_STUDIO_WEB`, for working on the page: edit, reload, no rebuild).
+static PAGE_FOLDER: std::sync::LazyLock<Option<std::path::PathBuf>> =
+    std::sync::LazyLock::new(|| std::env::var_os("SYLVA_STUDIO_WEB").map(Into::into));
 
 /// `GET /` and `GET /app/...`: the page.
 pub async fn page(uri: Uri) -> Response {
     let path = uri.path().trim_start_matches('/');
     let path = if path.is_empty() { "index.html" } else { path };
-    match Page::get(path) {
-        Some(file) => file_response(path, file.data.into_owned()),
+    if let Some(folder) = PAGE_FOLDER.as_ref() {
+        let plain = std::path::Path::new(path)
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)));
+        let page_file = path == "index.html" || path.starts_with("app/");
+        if plain
+            && page_file
+            && let Ok(bytes) = std::fs::read(folder.join(path))
+        {
+            return file_response(path, bytes);
+        }
+        return ApiError::not_found(format!("`/{path}`")).into_response();
+    }
+    match built_in(PAGE, path) {
+        Some(bytes) => file_response(path, bytes.to_vec()),
         None => ApiError::not_found(format!("`/{path}`")).into_response(),
     }
 }
 
-/// `GET /vendor/three/...`: three.js from the installed npm folder.
-pub async fn vendor(State(studio): State<Studio>, uri: Uri) -> Response {
+/// `GET /vendor/three/...`: the files of three.js the page imports, and its licence.
+pub async fn vendor(uri: Uri) -> Response {
     let rest = uri.path().trim_start_matches("/vendor/three/");
-    match vendor_path(&studio.three, rest) {
-        Some(path) => match tokio::fs::read(&path).await {
-            Ok(bytes) => file_response(rest, bytes),
-            Err(_) => ApiError::not_found(format!("`/vendor/three/{rest}`")).into_response(),
-        },
+    match built_in(THREE, rest) {
+        Some(bytes) => file_response(rest, bytes),
         None => ApiError::not_found(format!("`/vendor/three/{rest}`")).into_response(),
     }
-}
-
-/// A file of three.js's `build/` or `examples/jsm/` folders; nothing else (no `..`).
-fn vendor_path(root: &Path, rest: &str) -> Option<PathBuf> {
-    let relative = Path::new(rest);
-    let plain = relative
-        .components()
-        .all(|c| matches!(c, Component::Normal(_)));
-    let allowed = rest.starts_with("build/") || rest.starts_with("examples/jsm/");
-    (plain && allowed && rest.ends_with(".js")).then(|| root.join(relative))
-}
-
-/// Where three.js is installed by default: the studio crate's `web/node_modules/three`.
-pub fn default_three() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("web/node_modules/three")
 }
 
 /// An empty 204.
@@ -233,20 +249,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn vendor_paths_stay_in_three() {
-        let root = Path::new("/t");
-        assert!(vendor_path(root, "build/three.module.js").is_some());
-        assert!(vendor_path(root, "examples/jsm/controls/OrbitControls.js").is_some());
-        assert!(vendor_path(root, "build/../../../etc/passwd.js").is_none());
-        assert!(vendor_path(root, "package.json").is_none());
-        assert!(vendor_path(root, "/etc/x.js").is_none());
-    }
-
-    #[test]
-    fn tokens_compare_exactly() {
-        assert!(same("abc", "abc"));
-        assert!(!same("abc", "abd"));
-        assert!(!same("abc", "abcd"));
+    fn the_page_and_three_are_built_in() {
+        assert!(built_in(PAGE, "index.html").is_some());
+        assert!(built_in(PAGE, "app/main.js").is_some());
+        assert!(built_in(PAGE, "../Cargo.toml").is_none());
+        if !THREE.is_empty() {
+            assert!(built_in(THREE, "build/three.module.js").is_some());
+            assert!(built_in(THREE, "build/three.core.js").is_some());
+            assert!(built_in(THREE, "examples/jsm/loaders/GLTFLoader.js").is_some());
+            assert!(built_in(THREE, "LICENSE").is_some());
+            assert!(built_in(THREE, "build/../../../etc/passwd").is_none());
+            assert!(!THREE_VERSION.is_empty());
+        }
     }
 
     #[test]

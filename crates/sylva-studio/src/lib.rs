@@ -8,7 +8,10 @@
 //! - [`family`]: the deciduous-evolution viewer's binary-tree population.
 //! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
 //! - [`plants`]: plants as GLB, OBJ, PNG and genome files, and their lineage.
-//! - [`http`]: typed JSON bodies, the access token, the page's files.
+//! - [`guard`]: who may talk to the studio: Host names, other sites' pages, content types,
+//!   the access token.
+//! - [`listen`]: connections, with request heads bounded before hyper parses them.
+//! - [`http`]: typed JSON bodies and the page's files, built into the binary.
 //!
 //! The server is a client of the library layer (the `sylva` crate), never of the command
 //! line. Heavy work (growing, meshing, evolving) runs on the blocking pool or a run's own
@@ -27,7 +30,9 @@ pub mod design;
 pub mod error;
 pub mod family;
 pub mod garden;
+pub mod guard;
 pub mod http;
+pub mod listen;
 pub mod plants;
 pub mod sessions;
 
@@ -53,9 +58,9 @@ pub struct Options {
     pub port: u16,
     /// The archive file.
     pub db: PathBuf,
-    /// Where three.js is installed (`web/node_modules/three` of the studio crate by
-    /// default).
-    pub three: PathBuf,
+    /// Host names the studio answers to besides its loopback names and bound address (a
+    /// reverse proxy's name).
+    pub allow_hosts: Vec<String>,
 }
 
 impl Default for Options {
@@ -64,7 +69,7 @@ impl Default for Options {
             host: "127.0.0.1".into(),
             port: 8417,
             db: PathBuf::from("sylva-studio.db"),
-            three: http::default_three(),
+            allow_hosts: Vec::new(),
         }
     }
 }
@@ -81,11 +86,12 @@ pub enum StartError {
         #[source]
         source: ArchiveError,
     },
-    /// three.js is not installed.
+    /// The binary was built without three.js, so the page cannot run.
     #[error(
-        "three.js is not installed in {0}: run `npm ci --prefix crates/sylva-studio/web` (the page needs it)"
+        "this sylva was built without three.js, which the studio's page needs: in the source \
+         checkout, run `npm ci --prefix crates/sylva-studio/web`, then build (or install) again"
     )]
-    NoThree(PathBuf),
+    NoThree,
     /// The address could not be bound.
     #[error("binding {address}")]
     Bind {
@@ -108,10 +114,8 @@ pub struct Studio(Arc<Inner>);
 pub struct Inner {
     /// The archive.
     pub archive: Archive,
-    /// The access token, when bound beyond loopback.
-    pub token: Option<String>,
-    /// Where three.js is installed.
-    pub three: PathBuf,
+    /// Who may talk to the studio.
+    pub guard: guard::Guard,
     /// Recently served meshes.
     pub meshes: plants::MeshCache,
     /// Threads for growing many plants at once.
@@ -132,12 +136,11 @@ impl Deref for Studio {
 }
 
 impl Studio {
-    /// A studio on an archive, with an access token or none.
-    pub fn new(archive: Archive, token: Option<String>, three: PathBuf) -> Studio {
+    /// A studio on an archive, guarded by `guard`.
+    pub fn new(archive: Archive, guard: guard::Guard) -> Studio {
         Studio(Arc::new(Inner {
             archive,
-            token,
-            three,
+            guard,
             meshes: plants::MeshCache::default(),
             pool: sylva_core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
@@ -181,6 +184,7 @@ pub fn router(studio: Studio) -> Router {
         .route("/plants", get(plants::list))
         .route("/plants/{id}", get(plants::get))
         .route("/plants/{id}/plant.glb", get(plants::glb))
+        .route("/plants/{id}/preview.glb", get(plants::preview))
         .route("/plants/{id}/plant.obj", get(plants::obj))
         .route("/plants/{id}/plant.mtl", get(plants::mtl))
         .route("/plants/{id}/plant.png", get(plants::png))
@@ -196,7 +200,7 @@ pub fn router(studio: Studio) -> Router {
         .route("/app/{*path}", get(http::page))
         .layer(axum::middleware::from_fn_with_state(
             studio.clone(),
-            http::require_token,
+            guard::check,
         ))
         .layer(axum::middleware::from_fn(http::json_errors))
         .layer(axum::extract::DefaultBodyLimit::max(http::MAX_BODY))
@@ -223,15 +227,16 @@ fn new_token() -> String {
 /// Opens the archive, resumes the runs that were running, binds, prints the address and
 /// serves until Ctrl+C.
 pub fn serve(options: Options) -> Result<(), StartError> {
-    if !options.three.join("build/three.module.js").is_file() {
-        return Err(StartError::NoThree(options.three));
+    if http::THREE.is_empty() {
+        return Err(StartError::NoThree);
     }
     let archive = Archive::open(&options.db).map_err(|source| StartError::Archive {
         path: options.db.clone(),
         source,
     })?;
     let token = (!is_loopback(&options.host)).then(new_token);
-    let studio = Studio::new(archive, token.clone(), options.three.clone());
+    let guard = guard::Guard::new(&options.host, &options.allow_hosts, token.clone());
+    let studio = Studio::new(archive, guard);
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -246,26 +251,39 @@ pub fn serve(options: Options) -> Result<(), StartError> {
             })?;
         let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
         design::resume_all(&studio);
-        let shown = match bound {
-            SocketAddr::V6(a) => format!("[{}]:{}", a.ip(), a.port()),
-            SocketAddr::V4(a) => a.to_string(),
-        };
+        let query = token.map(|t| format!("?token={t}")).unwrap_or_default();
         // Written, not printed: a closed stdout must not stop the server.
         use std::io::Write;
         let mut out = std::io::stdout();
-        let _ = match &token {
-            Some(t) => writeln!(out, "Sylva studio: http://{shown}/?token={t}"),
-            None => writeln!(out, "Sylva studio: http://{shown}/"),
-        };
+        let _ = writeln!(out, "Sylva studio: http://{}/{query}", openable(bound));
+        if bound.ip().is_unspecified()
+            && let Some(name) = guard::machine_name()
+        {
+            let _ = writeln!(
+                out,
+                "from other machines: http://{name}:{}/{query}",
+                bound.port()
+            );
+        }
         let _ = writeln!(out, "archive: {}", options.db.display());
         let _ = out.flush();
-        axum::serve(listener, router(studio.clone()))
-            .with_graceful_shutdown(async {
-                let _ = tokio::signal::ctrl_c().await;
-            })
-            .await
-            .map_err(StartError::Runtime)?;
+        listen::serve(listener, router(studio.clone()), async {
+            let _ = tokio::signal::ctrl_c().await;
+        })
+        .await
+        .map_err(StartError::Runtime)?;
         studio.runs.stop_all();
         Ok(())
     })
+}
+
+/// An address a browser on this machine can open for `bound`: loopback for a studio bound
+/// to every interface (`0.0.0.0` is not an address to open), brackets for IPv6.
+fn openable(bound: SocketAddr) -> String {
+    match bound {
+        SocketAddr::V4(a) if a.ip().is_unspecified() => format!("127.0.0.1:{}", a.port()),
+        SocketAddr::V6(a) if a.ip().is_unspecified() => format!("[::1]:{}", a.port()),
+        SocketAddr::V6(a) => format!("[{}]:{}", a.ip(), a.port()),
+        SocketAddr::V4(a) => a.to_string(),
+    }
 }

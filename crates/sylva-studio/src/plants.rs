@@ -15,7 +15,7 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::assets::Origin;
-use sylva::{Genome, Grown, Registry};
+use sylva::{Genome, Grown, Preview, Registry};
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::View;
 
@@ -25,8 +25,10 @@ use crate::error::ApiError;
 use crate::http::Body;
 use crate::sessions::SessionView;
 
-/// Recently served GLBs, by plant and whether roots are shown; the oldest go first when
-/// there are more than [`CACHED_MESHES`] or their bytes pass [`CACHED_BYTES`].
+/// Recently served GLBs, by plant and form; the oldest go first when there are more than
+/// [`CACHED_MESHES`] or their bytes pass [`CACHED_BYTES`]. Keys are real plants' (a plant is
+/// read from the archive before its GLB is made) and each has a handful of forms, so
+/// nothing a request makes up enters it.
 #[derive(Default)]
 pub struct MeshCache {
     inner: Mutex<CachedMeshes>,
@@ -35,8 +37,20 @@ pub struct MeshCache {
 /// The most bytes of GLBs kept in memory (a random PlantMaker plant's GLB can be 40 MB).
 const CACHED_BYTES: usize = 512 << 20;
 
-/// A plant and whether its roots are shown.
-type MeshKey = (i64, bool);
+/// Which GLB of a plant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Form {
+    /// The plant in full, its roots left out or kept.
+    Full {
+        /// Whether the roots are kept.
+        roots: bool,
+    },
+    /// A preview for views of up to this many pixels a side ([`PreviewSize`]).
+    Preview(PreviewSize),
+}
+
+/// A plant and which of its GLBs.
+type MeshKey = (i64, Form);
 
 /// The GLBs, the order they came in, and their bytes.
 type CachedMeshes = (HashMap<MeshKey, Arc<Vec<u8>>>, VecDeque<MeshKey>, usize);
@@ -67,6 +81,29 @@ impl MeshCache {
                 *bytes -= glb.len();
             }
         }
+    }
+}
+
+/// The size class of a preview: the longest side of the view it is for, in device pixels,
+/// rounded up to a power of two from 128 to 2048. A class allows `side² / 8` triangles (at
+/// most 400,000): one triangle for every eight pixels of a square view is more than the eye
+/// can tell from the plant in full.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PreviewSize(u16);
+
+impl PreviewSize {
+    /// The class the breeding grid's cells are (up to 512 pixels a side), made with each
+    /// plant a step breeds.
+    pub const GRID: PreviewSize = PreviewSize(512);
+
+    /// The class of a view `pixels` wide at most.
+    pub fn of(pixels: u32) -> PreviewSize {
+        PreviewSize(pixels.clamp(128, 2048).next_power_of_two() as u16)
+    }
+
+    /// The triangles a preview of this class may have.
+    pub fn triangles(self) -> usize {
+        (usize::from(self.0).pow(2) / 8).min(400_000)
     }
 }
 
@@ -102,6 +139,25 @@ pub fn grow_glb(
     sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
 }
 
+/// Grows a genome into a preview GLB of `size` (roots left out), its node's extras as
+/// [`grow_glb`]'s with the preview's detail.
+pub fn preview_glb(
+    genome: &Genome,
+    seed: u64,
+    parents: &[ParentRow],
+    operator: &str,
+    size: PreviewSize,
+) -> Result<Vec<u8>, ApiError> {
+    let preview = Preview::grow(genome, seed, false, size.triangles())
+        .map_err(|e| ApiError::library("genome", e))?;
+    let mut node = SceneNode::new(genome.model(), &preview.mesh);
+    let mut extras = extras(genome, seed, parents, operator);
+    extras["preview"] = preview.extras()["preview"].clone();
+    node.extras = Some(extras);
+    let scene = sylva_mesh::Scene::single(node);
+    sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
+}
+
 /// What an exported node's extras hold in the studio.
 pub fn extras(
     genome: &Genome,
@@ -117,7 +173,13 @@ pub fn extras(
 
 /// A plant's GLB: from memory, the stored mesh, or grown again.
 pub fn plant_glb(studio: &Studio, id: i64, roots: bool) -> Result<Arc<Vec<u8>>, ApiError> {
-    if let Some(glb) = studio.meshes.get((id, roots)) {
+    plant_form(studio, id, Form::Full { roots })
+}
+
+/// A plant's GLB in `form`: from memory, the stored mesh (a garden specimen's, whatever
+/// the form: it is small, and cannot be grown alone), or grown again.
+pub fn plant_form(studio: &Studio, id: i64, form: Form) -> Result<Arc<Vec<u8>>, ApiError> {
+    if let Some(glb) = studio.meshes.get((id, form)) {
         return Ok(glb);
     }
     let (row, parents, stored) = studio.archive.read(|c| {
@@ -128,12 +190,17 @@ pub fn plant_glb(studio: &Studio, id: i64, roots: bool) -> Result<Arc<Vec<u8>>, 
         ))
     })?;
     let row = row.ok_or_else(|| ApiError::not_found(format!("plant {id}")))?;
-    let glb = match stored {
-        Some(glb) => glb,
-        None => grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?,
+    let glb = match (stored, form) {
+        (Some(glb), _) => glb,
+        (None, Form::Full { roots }) => {
+            grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?
+        }
+        (None, Form::Preview(size)) => {
+            preview_glb(&genome_of(&row)?, row.seed, &parents, &row.operator, size)?
+        }
     };
     let glb = Arc::new(glb);
-    studio.meshes.put((id, roots), glb.clone());
+    studio.meshes.put((id, form), glb.clone());
     Ok(glb)
 }
 
@@ -155,6 +222,32 @@ pub(crate) async fn glb(
     Query(q): Query<GlbQuery>,
 ) -> Result<Response, ApiError> {
     let glb = tokio::task::spawn_blocking(move || plant_glb(&studio, id, q.roots)).await??;
+    Ok(glb_response(&glb))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PreviewQuery {
+    px: Option<u32>,
+}
+
+/// `GET /api/plants/{id}/preview.glb?px=N`: the plant at the detail a view of `N` device
+/// pixels a side needs (320 by default), for the grid's cells; `plant.glb` is the plant in
+/// full, for exports.
+pub(crate) async fn preview(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<PreviewQuery>,
+) -> Result<Response, ApiError> {
+    let px = q.px.unwrap_or(320);
+    if !(16..=16384).contains(&px) {
+        return Err(ApiError::bad(
+            "px",
+            format!("expected 16 to 16384 pixels, got {px}"),
+        ));
+    }
+    let form = Form::Preview(PreviewSize::of(px));
+    let glb = tokio::task::spawn_blocking(move || plant_form(&studio, id, form)).await??;
     Ok(glb_response(&glb))
 }
 
@@ -242,14 +335,30 @@ fn parse_size(s: &str) -> Result<(u32, u32), ApiError> {
     }
 }
 
-/// `GET /api/plants/{id}/plant_tex{N}.png`: a texture the OBJ's materials name (the same
-/// for every plant; the path only puts it beside the `.mtl`).
-pub(crate) async fn texture(Path((id, file)): Path<(i64, String)>) -> Result<Response, ApiError> {
+/// `GET /api/plants/{id}/plant_tex{N}.png`: a texture the plant's materials name, beside
+/// its `.mtl`. Anything else is 404, and nothing is made or kept for it: a request (an
+/// `<img>` on any page) cannot fill a cache with made-up ids.
+pub(crate) async fn texture(
+    State(studio): State<Studio>,
+    Path((id, file)): Path<(i64, String)>,
+) -> Result<Response, ApiError> {
+    let not_found = || ApiError::not_found(format!("`/api/plants/{id}/{file}`"));
     let texture = file
         .strip_prefix("plant_tex")
         .and_then(|f| f.strip_suffix(".png"))
+        .filter(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
         .and_then(|n| n.parse::<u16>().ok())
-        .ok_or_else(|| ApiError::not_found(format!("`/api/plants/{id}/{file}`")))?;
+        .ok_or_else(not_found)?;
+    let named = tokio::task::spawn_blocking(move || -> Result<bool, ApiError> {
+        let glb = plant_glb(&studio, id, false)?;
+        let ids = sylva_mesh::import::texture_ids(&glb)
+            .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))?;
+        Ok(ids.contains(&texture))
+    })
+    .await??;
+    if !named {
+        return Err(not_found());
+    }
     let png = tokio::task::spawn_blocking(move || sylva_mesh::texture::texture_png(texture))
         .await?
         .map_err(ApiError::internal)?;
@@ -528,14 +637,27 @@ mod tests {
     use super::*;
 
     #[test]
+    fn preview_sizes_are_few_and_bounded() {
+        assert_eq!(PreviewSize::of(0), PreviewSize(128));
+        assert_eq!(PreviewSize::of(300), PreviewSize(512));
+        assert_eq!(PreviewSize::of(512), PreviewSize::GRID);
+        assert_eq!(PreviewSize::of(u32::MAX), PreviewSize(2048));
+        let classes: HashSet<PreviewSize> = (0..20_000).map(PreviewSize::of).collect();
+        assert_eq!(classes.len(), 5);
+        assert_eq!(PreviewSize::GRID.triangles(), 32_768);
+        assert_eq!(PreviewSize(2048).triangles(), 400_000);
+    }
+
+    #[test]
     fn the_cache_keeps_its_bytes_bounded() {
         let cache = MeshCache::default();
         let big = Arc::new(vec![0u8; CACHED_BYTES / 3]);
+        let full = Form::Full { roots: false };
         for id in 0..5 {
-            cache.put((id, false), big.clone());
+            cache.put((id, full), big.clone());
         }
-        assert!(cache.get((0, false)).is_none() && cache.get((1, false)).is_none());
-        assert!(cache.get((4, false)).is_some());
+        assert!(cache.get((0, full)).is_none() && cache.get((1, full)).is_none());
+        assert!(cache.get((4, full)).is_some());
         let inner = cache.inner.lock().unwrap_or_else(|p| p.into_inner());
         assert!(inner.2 <= CACHED_BYTES);
         assert_eq!(inner.2, inner.0.values().map(|g| g.len()).sum::<usize>());

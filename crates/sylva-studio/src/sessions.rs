@@ -6,13 +6,13 @@
 use axum::Json;
 use axum::extract::{Path, State};
 use rust_embed::RustEmbed;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use sylva::{Genome, Registry};
 
 use crate::Studio;
 use crate::archive::{self, StepRow};
 use crate::error::ApiError;
-use crate::http::Body;
+use crate::http::{Body, from_value};
 use crate::{breed, design, family, garden};
 
 /// A session as the page sees it.
@@ -166,8 +166,6 @@ pub(crate) async fn list(
 }
 
 /// What `POST /api/sessions` takes: the mode and how it starts.
-#[derive(Deserialize)]
-#[serde(tag = "mode", rename_all = "lowercase")]
 pub enum NewSession {
     /// PlantMaker's main window.
     Breed(breed::Start),
@@ -179,12 +177,46 @@ pub enum NewSession {
     Design(design::Start),
 }
 
+impl NewSession {
+    /// Reads a request: `mode` says which mode's fields the rest are. (Read by hand rather
+    /// than as a serde tagged enum, which would lose the path of an error in the rest.)
+    pub fn from_json(request: serde_json::Value) -> Result<NewSession, ApiError> {
+        let serde_json::Value::Object(mut fields) = request else {
+            return Err(ApiError::bad("", "expected a JSON object with a `mode`"));
+        };
+        let modes = "breed, garden, family or design";
+        let mode = match fields.remove("mode") {
+            Some(serde_json::Value::String(mode)) => mode,
+            Some(other) => {
+                return Err(ApiError::bad(
+                    "mode",
+                    format!("expected {modes}, got {other}"),
+                ));
+            }
+            None => return Err(ApiError::bad("mode", format!("missing: expected {modes}"))),
+        };
+        let rest = serde_json::Value::Object(fields);
+        Ok(match mode.as_str() {
+            "breed" => NewSession::Breed(from_value(rest, "")?),
+            "garden" => NewSession::Garden(from_value(rest, "")?),
+            "family" => NewSession::Family(from_value(rest, "")?),
+            "design" => NewSession::Design(from_value(rest, "")?),
+            other => {
+                return Err(ApiError::bad(
+                    "mode",
+                    format!("expected {modes}, got {other:?}"),
+                ));
+            }
+        })
+    }
+}
+
 /// `POST /api/sessions`.
 pub(crate) async fn create(
     State(studio): State<Studio>,
-    Body(request): Body<NewSession>,
+    Body(request): Body<serde_json::Value>,
 ) -> Result<Json<SessionView>, ApiError> {
-    let id = match request {
+    let id = match NewSession::from_json(request)? {
         NewSession::Breed(start) => breed::create(&studio, start).await?,
         NewSession::Garden(start) => garden::create(&studio, start).await?,
         NewSession::Family(start) => family::create(&studio, start).await?,

@@ -49,6 +49,6 @@ pub use assets::{Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
 pub use genome::{Genome, load_genome, parse_genome};
-pub use lod::LodAssets;
+pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;

@@ -1,7 +1,8 @@
 //! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_mesh::lod`]),
 //! each alone in its own scene, or all of them as sibling nodes named `NAME_LOD0`,
 //! `NAME_LOD1`, … (the Unity naming convention) with each level's screen coverage in its
-//! node's extras.
+//! node's extras. And a [`Preview`]: the one level a view of a given size needs, meshed
+//! without meshing the plant in full.
 
 use serde_json::json;
 use sylva_mesh::lod::{LodError, LodLevel, lod_levels};
@@ -9,8 +10,9 @@ use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 
-use crate::assets::{Grown, mesh_options};
+use crate::assets::{Grown, Origin, grow_plant, mesh_options};
 use crate::error::{Error, InputError};
+use crate::genome::Genome;
 
 /// One level, meshed.
 pub struct LodAsset {
@@ -99,5 +101,67 @@ impl LodAssets {
         Scene {
             nodes: (0..self.levels.len()).map(|k| self.node(k, name)).collect(),
         }
+    }
+}
+
+/// A plant grown and meshed at the first level of its chain within a triangle budget
+/// ([`sylva_mesh::lod::preview`]): what a view a few hundred pixels wide needs, however
+/// large the plant. Only the preview is meshed; the plant in full is counted, not meshed.
+pub struct Preview {
+    /// The preview's mesh.
+    pub mesh: Mesh,
+    /// Its detail number (1: the plant as it is).
+    pub detail: f32,
+    /// The triangles of the plant in full.
+    pub full_triangles: usize,
+    /// The node's extras: the plant's origin, and `preview` (detail and both counts).
+    extras: serde_json::Value,
+    /// The model's name, for the node.
+    model: &'static str,
+}
+
+impl Preview {
+    /// Grows `genome` with `seed` (roots left out unless `roots`) and meshes the level of at
+    /// most about `max_triangles` triangles.
+    pub fn grow(
+        genome: &Genome,
+        seed: u64,
+        roots: bool,
+        max_triangles: usize,
+    ) -> Result<Preview, Error> {
+        let plant = grow_plant(genome, seed, roots, None)?;
+        let options = mesh_options(genome.mesh_hint());
+        let full_triangles = Mesher::new(options.clone())?.counts(&plant)?.triangles;
+        let level =
+            sylva_mesh::lod::preview(&plant, &options, max_triangles).map_err(|e| match e {
+                LodError::Mesh(e) => Error::Mesh(e),
+                other => Error::Input(InputError::new("preview", other.to_string())),
+            })?;
+        let mesh = Mesher::new(level.options.clone())?.mesh(&level.plant)?;
+        let mut extras = Origin::of(genome, seed).extras();
+        extras["preview"] = json!({
+            "detail": level.detail,
+            "triangles": mesh.triangle_count(),
+            "full_triangles": full_triangles,
+        });
+        Ok(Preview {
+            mesh,
+            detail: level.detail,
+            full_triangles,
+            extras,
+            model: genome.model(),
+        })
+    }
+
+    /// The extras its node carries.
+    pub fn extras(&self) -> &serde_json::Value {
+        &self.extras
+    }
+
+    /// A scene of the preview at the origin, its node carrying its origin.
+    pub fn scene(&self) -> Scene<'_> {
+        let mut node = SceneNode::new(self.model, &self.mesh);
+        node.extras = Some(self.extras.clone());
+        Scene::single(node)
     }
 }

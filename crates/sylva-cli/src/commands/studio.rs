@@ -16,19 +16,19 @@ pub struct StudioArgs {
     /// The archive: every plant, step and run, in SQLite.
     #[arg(long, default_value = "sylva-studio.db")]
     db: PathBuf,
-    /// Where three.js is installed [default: the studio crate's web/node_modules/three].
-    #[arg(long)]
-    three: Option<PathBuf>,
+    /// A host name the studio answers to besides loopback and the bound address, such as a
+    /// reverse proxy's (repeatable). Requests naming any other host get 403.
+    #[arg(long = "allow-host", value_name = "NAME")]
+    allow_hosts: Vec<String>,
 }
 
 /// `sylva studio`.
 pub fn run(args: &StudioArgs) -> anyhow::Result<()> {
-    let defaults = sylva_studio::Options::default();
     sylva_studio::serve(sylva_studio::Options {
         host: args.host.clone(),
         port: args.port,
         db: args.db.clone(),
-        three: args.three.clone().unwrap_or(defaults.three),
+        allow_hosts: args.allow_hosts.clone(),
     })?;
     Ok(())
 }
