@@ -306,6 +306,9 @@ fn same(a: &str, b: &str) -> bool {
 mod tests {
     use super::*;
 
+    /// Headers by name and value.
+    type Pairs<'a> = &'a [(&'static str, &'a str)];
+
     fn headers(pairs: &[(&'static str, &str)]) -> HeaderMap {
         let mut h = HeaderMap::new();
         for (k, v) in pairs {
@@ -367,7 +370,7 @@ mod tests {
         let g = Guard::new("127.0.0.1", &[], None);
         let host = ("host", "127.0.0.1:8417");
         let json = ("content-type", "application/json");
-        let cases: &[(Method, &str, &[(&'static str, &str)], u16)] = &[
+        let cases: &[(Method, &str, Pairs, u16)] = &[
             (Method::POST, "/api/sessions", &[host, json], 200),
             (Method::POST, "/api/sessions", &[host, ("content-type", "Application/JSON; charset=utf-8")], 200),
             (Method::POST, "/api/sessions", &[host, json, ("origin", "http://127.0.0.1:8417")], 200),
@@ -400,7 +403,7 @@ mod tests {
     fn tokens_come_as_bearer_of_any_case_cookie_or_query() {
         let g = Guard::new("0.0.0.0", &[], Some("abc123".into()));
         let host = ("host", "10.0.0.2:8417");
-        let cases: &[(&str, &[(&'static str, &str)], u16)] = &[
+        let cases: &[(&str, Pairs, u16)] = &[
             ("/api/models", &[host], 401),
             ("/api/models", &[host, ("authorization", "Bearer abc123")], 200),
             ("/api/models", &[host, ("authorization", "bearer abc123")], 200),
