@@ -200,7 +200,17 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
     let session = post(&server, "/api/sessions", json!({"mode": "breed"}));
     let id = session["id"].as_i64().unwrap();
     let first = grid(&session);
-    assert_eq!(first.len(), 5, "the five PlantMaker examples: {session}");
+    // The five PlantMaker examples, and four of their mutants to fill the grid.
+    assert_eq!(first.len(), 9, "{session}");
+    for (i, plant) in first.iter().enumerate() {
+        let p = get(&server, &format!("/api/plants/{plant}"));
+        if i < 5 {
+            assert_eq!(p["operator"], "example", "{p}");
+        } else {
+            assert_eq!(p["operator"], "mutate", "{p}");
+            assert_eq!(p["parents"][0]["plant"], first[i - 5], "{p}");
+        }
+    }
 
     // Cross two at a high level with dominance: the parents lead, seven children follow.
     let crossed = post(
@@ -266,6 +276,26 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
         get(&server, &format!("/api/plants/{}", g3[1]))["operator"],
         "regrow"
     );
+
+    // Branch from the grandchild: a new session whose population lists it (a plant of the
+    // new session with its genome and seed, whose parent it is), and a full grid.
+    let branched = post(
+        &server,
+        &format!("/api/plants/{grandchild}/branch"),
+        json!({}),
+    );
+    let b = branched["id"].as_i64().unwrap();
+    assert_eq!(grid(&branched).len(), 9);
+    let listed = get(&server, &format!("/api/plants?session={b}"));
+    let first_of_branch = grid(&branched)[0];
+    let copy = get(&server, &format!("/api/plants/{first_of_branch}"));
+    assert_eq!(copy["operator"], "branch");
+    assert_eq!(copy["parents"][0]["plant"], grandchild);
+    assert_eq!(
+        copy["genome"],
+        get(&server, &format!("/api/plants/{grandchild}"))["genome"]
+    );
+    assert_eq!(listed["total"], 9);
 
     // Undo twice, redo once.
     let undone = post(&server, &format!("/api/sessions/{id}/undo"), json!({}));
@@ -614,7 +644,7 @@ fn pages_of_other_sites_and_foreign_host_names_are_refused() {
     );
     assert_eq!(
         get(&server, &format!("/api/plants?session={id}"))["total"],
-        2
+        9
     );
     // The studio's own page: its origin, loopback names, a link from another site to the
     // page, and a token-free bearer of any case are all fine.
@@ -981,7 +1011,20 @@ fn gardens_and_families_step_and_undo() {
         &format!("/api/sessions/{id}/pick"),
         json!({"plant": pick}),
     );
-    assert_eq!(next["state"]["mother"], pick);
+    // The picked plant's body in her new garden is archived as her own plant.
+    let mother = next["state"]["mother"].as_i64().unwrap();
+    assert_ne!(mother, pick);
+    let row = get(&server, &format!("/api/plants/{mother}"));
+    assert_eq!(
+        (row["operator"].as_str(), &row["parents"][0]["plant"]),
+        (Some("mother"), &json!(pick))
+    );
+    assert_eq!(next["state"]["specimens"][0]["plant"], mother);
+    let child = next["state"]["specimens"][1]["plant"].as_i64().unwrap();
+    assert_eq!(
+        get(&server, &format!("/api/plants/{child}"))["parents"][0]["plant"],
+        mother
+    );
     let lateral = post(
         &server,
         &format!("/api/sessions/{id}/grow"),

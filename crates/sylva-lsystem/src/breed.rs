@@ -39,7 +39,24 @@ pub struct BreedSettings {
     pub children: usize,
     /// Mutation probabilities. Default [`MutationRates::default`].
     pub rates: MutationRates,
+    /// When the mother's shoot draws nothing (empty rules), mutate each child again, up to
+    /// [`MAX_REDRAWS`] times, until its shoot draws a module ([`LSystem::draws_within`]), so
+    /// that a person breeding by eye has something to choose from. Default false: the paper's
+    /// loop, where most first steps from empty rules change nothing visible.
+    ///
+    /// [`LSystem::draws_within`]: crate::genome::LSystem::draws_within
+    pub visible_children: bool,
 }
+
+/// Most extra mutations a child of a mother that draws nothing gets with
+/// [`BreedSettings::visible_children`].
+pub const MAX_REDRAWS: usize = 1000;
+
+/// Derivations of a shoot looked at for a module (the mutations add a rule and a symbol at a
+/// time, so a drawn module shows within a few).
+const DRAW_STEPS: usize = 8;
+/// The longest string looked at.
+const DRAW_LIMIT: usize = 4096;
 
 sylva_core::ranged!(spacing: f32, "spacing", 0.01, 1000.0, " m");
 sylva_core::ranged!(children: usize, "children", 0, MAX_SPECIMENS - 1);
@@ -51,6 +68,7 @@ impl Default for BreedSettings {
             spacing: 2.5,
             children: 8,
             rates: MutationRates::default(),
+            visible_children: false,
         }
     }
 }
@@ -180,11 +198,19 @@ pub fn breed_garden<R: Rng + ?Sized>(
         parameter_scale: 0.0,
     };
     let children = settings.children.min(MAX_SPECIMENS - 1);
+    let draws = |g: &LSystemGenome| g.shoot.draws_within(DRAW_STEPS, DRAW_LIMIT);
+    let redraw = settings.visible_children && !draws(mother);
     let mut genomes = Vec::with_capacity(children + 1);
     genomes.push(mother.clone());
     for _ in 0..children {
         let mut child = mother.clone();
         mutation.mutate(&mut child, rng);
+        for _ in 0..MAX_REDRAWS {
+            if !redraw || draws(&child) {
+                break;
+            }
+            mutation.mutate(&mut child, rng);
+        }
         genomes.push(child);
     }
     grow_together(genomes, settings, pool)

@@ -73,6 +73,24 @@ impl LSystem {
         }
     }
 
+    /// Whether the system writes a module within `steps` derivations of its axiom (or before
+    /// its string passes `limit` symbols), the environment aside: one that does not draws
+    /// nothing, however long it grows (growth also needs light, minerals and reserves).
+    pub fn draws_within(&self, steps: usize, limit: usize) -> bool {
+        let drawn = |word: &[Symbol]| word.iter().any(|s| matches!(s, Symbol::Module(_)));
+        let mut word = self.axiom.clone();
+        for _ in 0..steps {
+            if drawn(&word) {
+                return true;
+            }
+            match crate::grammar::derive(&word, &self.rules, limit) {
+                Ok(next) if next != word => word = next,
+                _ => break,
+            }
+        }
+        drawn(&word)
+    }
+
     /// Parses an axiom and rules written in the paper's notation.
     pub fn parse(axiom: &str, rules: &[&str], compartment: Compartment) -> Result<LSystem, String> {
         let axiom = parse_word(axiom, compartment).map_err(|e| {

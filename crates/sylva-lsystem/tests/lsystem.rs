@@ -254,6 +254,56 @@ fn the_breeding_garden_follows_the_paper() {
 }
 
 #[test]
+fn children_of_empty_rules_can_be_bred_until_they_draw() {
+    let blank = BreedSettings {
+        grow: small(),
+        spacing: 0.6,
+        ..BreedSettings::default()
+    };
+    let visible = BreedSettings {
+        visible_children: true,
+        ..blank
+    };
+    let grown = |settings: &BreedSettings| {
+        let mut rng = sylva_core::rng::seeded(4);
+        breed_garden(&LSystemGenome::empty(), settings, &mut rng, &Pool::Serial).unwrap()
+    };
+    let (paper, shown) = (grown(&blank), grown(&visible));
+    let draws = |g: &LSystemGenome| g.shoot.draws_within(8, 4096);
+    let germinated = |garden: &sylva_lsystem::breed::BredGarden| {
+        garden.specimens[1..]
+            .iter()
+            .filter(|s| s.stats.germinated())
+            .count()
+    };
+    // The paper's loop: most first steps from empty rules change nothing visible.
+    assert!(
+        paper.specimens[1..]
+            .iter()
+            .filter(|s| draws(&s.genome))
+            .count()
+            <= 2
+    );
+    // Bred until they draw: every child's shoot writes a module, and they grow.
+    assert!(shown.specimens[1..].iter().all(|s| draws(&s.genome)));
+    assert!(
+        germinated(&shown) >= 6,
+        "{} of 8 children germinated (the paper's loop: {})",
+        germinated(&shown),
+        germinated(&paper)
+    );
+    // The mother stays as she is, and a mother that draws is bred as in the paper.
+    assert_eq!(shown.specimens[0].genome, LSystemGenome::empty());
+    let mut a = sylva_core::rng::seeded(9);
+    let mut b = sylva_core::rng::seeded(9);
+    let bush = LSystemGenome::bush();
+    assert_eq!(
+        breed_garden(&bush, &blank, &mut a, &Pool::Serial).unwrap(),
+        breed_garden(&bush, &visible, &mut b, &Pool::Serial).unwrap()
+    );
+}
+
+#[test]
 fn the_problem_scores_biomass() {
     let problem = LSystemProblem {
         grow: small(),

@@ -105,7 +105,7 @@ impl Made {
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
-        let glb = preview_glb(&genome, seed, &parents, operator, PreviewSize::GRID)?;
+        let glb = preview_glb(&genome, seed, PreviewSize::GRID)?;
         Ok(Made {
             genome,
             seed,
@@ -185,7 +185,41 @@ fn archived_one(studio: &Studio, id: i64, model: &str, field: &str) -> Result<Pl
         .ok_or_else(|| ApiError::internal("a plant read is missing"))
 }
 
-/// New plants for `start`/`add`, grown (on the blocking pool); and archived plants reused.
+/// A plant to grow for `start`/`add`.
+#[derive(Clone)]
+struct Sprout {
+    genome: Genome,
+    /// Its seed; the genome's default when `None`.
+    seed: Option<u64>,
+    operator: &'static str,
+    settings: serde_json::Value,
+    parents: Vec<ParentRow>,
+    /// Where the request named it (`start.genomes[2]`), for an error growing it.
+    field: String,
+}
+
+impl Sprout {
+    fn new(
+        genome: Genome,
+        operator: &'static str,
+        settings: serde_json::Value,
+        field: String,
+    ) -> Sprout {
+        Sprout {
+            genome,
+            seed: None,
+            operator,
+            settings,
+            parents: Vec::new(),
+            field,
+        }
+    }
+}
+
+/// New plants for `start`/`add` of `session` (none yet when starting), grown on the
+/// blocking pool; and archived plants of the session reused. An archived plant of another
+/// session enters as a branch: a plant of this session with its genome and seed, whose
+/// parent it is, so the session's population lists it and its lineage leads back.
 async fn make_plants(
     studio: &Studio,
     model: &'static str,
@@ -193,8 +227,9 @@ async fn make_plants(
     seed: u64,
     seq: i64,
     field: &str,
+    session: Option<i64>,
 ) -> Result<(Vec<Made>, Vec<i64>), ApiError> {
-    let mut genomes: Vec<(Genome, &'static str, serde_json::Value)> = Vec::new();
+    let mut genomes: Vec<Sprout> = Vec::new();
     let mut reused = Vec::new();
     match plants {
         Plants::Random(n) => {
@@ -212,7 +247,8 @@ async fn make_plants(
                 let genome = entry
                     .random(None, s)
                     .map_err(|e| ApiError::unprocessable(field, input_message(&e)))?;
-                genomes.push((genome, "random", json!({ "seed": s })));
+                let at = sub(field, "random");
+                genomes.push(Sprout::new(genome, "random", json!({ "seed": s }), at));
             }
         }
         Plants::Examples(names) => {
@@ -233,7 +269,13 @@ async fn make_plants(
                         ),
                     ));
                 }
-                genomes.push((genome, "example", json!({ "example": name })));
+                let at = sub(field, &format!("examples[{i}]"));
+                genomes.push(Sprout::new(
+                    genome,
+                    "example",
+                    json!({ "example": name }),
+                    at,
+                ));
             }
         }
         Plants::Genomes(texts) => {
@@ -247,16 +289,30 @@ async fn make_plants(
                         format!("a {} genome; this session breeds {model}", genome.model()),
                     ));
                 }
-                genomes.push((genome, "upload", json!({})));
+                genomes.push(Sprout::new(genome, "upload", json!({}), f));
             }
         }
         Plants::Plants(ids) => {
             check_count(ids.len(), &sub(field, "plants"))?;
-            archived(studio, &ids, model, &sub(field, "plants"))?;
-            reused = ids;
+            let rows = archived(studio, &ids, model, &sub(field, "plants"))?;
+            for (i, row) in rows.into_iter().enumerate() {
+                if session.is_some() && row.session == session {
+                    reused.push(row.id);
+                } else {
+                    let at = sub(field, &format!("plants[{i}]"));
+                    genomes.push(Sprout {
+                        seed: Some(row.seed),
+                        parents: vec![ParentRow {
+                            plant: row.id,
+                            dominance: 1.0,
+                        }],
+                        ..Sprout::new(genome_of(&row)?, "branch", json!({}), at)
+                    });
+                }
+            }
         }
     }
-    let made = blocking_grow(studio, genomes, field).await?;
+    let made = blocking_grow(studio, genomes).await?;
     Ok((made, reused))
 }
 
@@ -290,22 +346,25 @@ pub fn parse_genome(text: &str, field: &str) -> Result<Genome, ApiError> {
     })
 }
 
-/// Grows genomes side by side on the blocking pool.
-async fn blocking_grow(
-    studio: &Studio,
-    genomes: Vec<(Genome, &'static str, serde_json::Value)>,
-    field: &str,
-) -> Result<Vec<Made>, ApiError> {
+/// Grows sprouts side by side on the blocking pool.
+async fn blocking_grow(studio: &Studio, sprouts: Vec<Sprout>) -> Result<Vec<Made>, ApiError> {
     let studio = studio.clone();
-    let field = field.to_owned();
     tokio::task::spawn_blocking(move || {
-        let jobs = genomes.len();
+        let jobs = sprouts.len();
         studio
             .pool
             .map(jobs, |i| {
-                let (genome, operator, settings) = genomes[i].clone();
-                Made::grow(genome, operator, settings, Vec::new()).map_err(|mut e| {
-                    e.field = format!("{field}[{i}]");
+                let Sprout {
+                    genome,
+                    seed,
+                    operator,
+                    settings,
+                    parents,
+                    field,
+                } = sprouts[i].clone();
+                let seed = seed.unwrap_or_else(|| genome.default_seed());
+                Made::grow_with(genome, seed, operator, settings, parents).map_err(|mut e| {
+                    e.field = field;
                     e
                 })
             })
@@ -371,7 +430,11 @@ fn default_start(model: &str) -> Plants {
     }
 }
 
-/// Creates a breed session.
+/// The Depth that fills a new session's grid, as the page's default.
+const FILL_DEPTH: u32 = 2;
+
+/// Creates a breed session: its first plants, then, when they are fewer than the grid holds,
+/// mutants of them in turn (Depth 2) until all nine cells are filled.
 pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let model = model_name(start.model.as_deref())?;
     let seed = start.seed.unwrap_or(1);
@@ -379,19 +442,56 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
         Some(plants) => plants,
         None => default_start(model),
     };
-    let (made, reused) = make_plants(studio, model, plants, seed, 0, "start").await?;
+    let (made, reused) = make_plants(studio, model, plants, seed, 0, "start", None).await?;
+    // A new session reuses no plant: archived plants enter it as branches (above).
+    debug_assert!(reused.is_empty());
+    let parents: Vec<Genome> = made.iter().map(|m| m.genome.clone()).collect();
+    let fill = GRID.saturating_sub(parents.len());
+    let settings = (model == PLANTMAKER).then(|| depth_settings(FILL_DEPTH));
+    let mutants = if fill == 0 {
+        Vec::new()
+    } else {
+        let parents = parents.clone();
+        // Drawn as step −1, apart from the start's own streams (step 0).
+        breed_children(
+            studio,
+            fill,
+            seed,
+            -1,
+            move |i, s| {
+                let child = parents[i % parents.len()]
+                    .mutate(settings.as_ref(), s)
+                    .map_err(|e| ApiError::library("start", e))?;
+                Ok((child, Vec::new()))
+            },
+            "mutate",
+            json!({ "depth": FILL_DEPTH }),
+        )
+        .await?
+    };
     let (id, ids) = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let title = format!("Breed {model}");
         let id = archive::insert_session(c, "breed", model, &title, &json!({}))?;
         let mut ids = store(c, id, &made)?;
-        ids.extend(reused);
+        let mut mutants = mutants;
+        for (i, m) in mutants.iter_mut().enumerate() {
+            m.parents = vec![ParentRow {
+                plant: ids[i % ids.len()],
+                dominance: 1.0,
+            }];
+        }
+        ids.extend(store(c, id, &mutants)?);
         let state = BreedState {
             grid: promote(&[], &ids, 0),
             seed,
         };
         archive::set_state(c, id, &json!(state))?;
-        Ok((id, ids))
+        Ok((
+            id,
+            (ids, made.into_iter().chain(mutants).collect::<Vec<_>>()),
+        ))
     })?;
+    let (ids, made) = ids;
     cache(studio, &ids, made);
     Ok(id)
 }
@@ -507,7 +607,7 @@ async fn breed_children(
     count: usize,
     seed: u64,
     seq: i64,
-    breed: impl Fn(u64) -> Result<(Genome, Vec<ParentRow>), ApiError> + Send + Sync + 'static,
+    breed: impl Fn(usize, u64) -> Result<(Genome, Vec<ParentRow>), ApiError> + Send + Sync + 'static,
     operator: &'static str,
     settings: serde_json::Value,
 ) -> Result<Vec<Made>, ApiError> {
@@ -519,7 +619,7 @@ async fn breed_children(
                 let mut last = None;
                 for attempt in 0..4u64 {
                     let s = step_seed(seed, seq, i as u64 + 16 * attempt);
-                    let (genome, parents) = breed(s)?;
+                    let (genome, parents) = breed(i, s)?;
                     let mut settings = settings.clone();
                     settings["seed"] = json!(s);
                     match Made::grow(genome, operator, settings, parents) {
@@ -590,7 +690,7 @@ pub(crate) async fn cross(
         count,
         seed,
         seq,
-        move |s| {
+        move |_, s| {
             let pairs: Vec<(&Genome, f64)> = genomes.iter().zip(weights.iter().copied()).collect();
             let (child, used) = Genome::cross(&pairs, settings.as_ref(), s)
                 .map_err(|e| ApiError::library("parents", e))?;
@@ -660,7 +760,7 @@ pub(crate) async fn mutate(
         count,
         seed,
         seq,
-        move |s| {
+        move |_, s| {
             let child = genome
                 .mutate(settings.as_ref(), s)
                 .map_err(|e| ApiError::library("plant", e))?;
@@ -699,7 +799,7 @@ pub(crate) async fn add(
     let (row, state) = breed_state(&studio, id)?;
     let model = model_name(Some(&row.model))?;
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
-    let (made, reused) = make_plants(&studio, model, plants, state.seed, seq, "").await?;
+    let (made, reused) = make_plants(&studio, model, plants, state.seed, seq, "", Some(id)).await?;
     let action = json!({ "op": "add", "plants": reused });
     Ok(Json(record(
         &studio, id, &state, action, &reused, made, None,

@@ -31,8 +31,12 @@ use crate::sessions::{SessionView, example, session_of, step_seed, view};
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct GardenSettings {
-    /// Steps to grow, 0 to 1000. Default 100.
+    /// Steps to grow, 0 to 1000. Default [`DEFAULT_STEPS`].
     pub steps: u32,
+    /// Metres between neighbouring seeds, 0.25 to 2.5. Default [`DEFAULT_SPACING`]. (Sessions
+    /// archived before it was a control grew 2.5 m apart.)
+    #[serde(default = "paper_spacing")]
+    pub spacing: f64,
     /// The light's height above the horizon, 0 to 90 degrees. Default 90 (straight down).
     pub elevation: f64,
     /// The compass direction the light comes from, 0 to 360 degrees. Default 0.
@@ -41,10 +45,20 @@ pub struct GardenSettings {
     pub children: u32,
 }
 
+/// Steps a new garden grows: long enough that neighbours meet and shade each other.
+pub const DEFAULT_STEPS: u32 = 150;
+/// Metres between seeds in a new garden: close enough to compete by the end of its steps.
+pub const DEFAULT_SPACING: f64 = 1.0;
+
+fn paper_spacing() -> f64 {
+    2.5
+}
+
 impl Default for GardenSettings {
     fn default() -> Self {
         GardenSettings {
-            steps: 100,
+            steps: DEFAULT_STEPS,
+            spacing: DEFAULT_SPACING,
             elevation: 90.0,
             azimuth: 0.0,
             children: 8,
@@ -57,6 +71,7 @@ impl Default for GardenSettings {
 #[serde(deny_unknown_fields)]
 pub struct SettingsChange {
     steps: Option<u32>,
+    spacing: Option<f64>,
     elevation: Option<f64>,
     azimuth: Option<f64>,
     children: Option<u32>,
@@ -66,6 +81,7 @@ impl GardenSettings {
     fn with(self, change: &SettingsChange) -> Result<GardenSettings, ApiError> {
         let s = GardenSettings {
             steps: change.steps.unwrap_or(self.steps),
+            spacing: change.spacing.unwrap_or(self.spacing),
             elevation: change.elevation.unwrap_or(self.elevation),
             azimuth: change.azimuth.unwrap_or(self.azimuth),
             children: change.children.unwrap_or(self.children),
@@ -81,6 +97,12 @@ impl GardenSettings {
             }
         };
         range(s.steps <= 1000, "steps", "0 to 1000", s.steps.to_string())?;
+        range(
+            s.spacing.is_finite() && (0.25..=2.5).contains(&s.spacing),
+            "spacing",
+            "0.25 to 2.5 metres",
+            s.spacing.to_string(),
+        )?;
         range(
             s.elevation.is_finite() && (0.0..=90.0).contains(&s.elevation),
             "elevation",
@@ -105,6 +127,9 @@ impl GardenSettings {
     fn breed_settings(&self) -> BreedSettings {
         let mut b = BreedSettings {
             children: self.children as usize,
+            spacing: self.spacing as f32,
+            // a person breeding by eye needs something to see, from empty rules too
+            visible_children: true,
             ..BreedSettings::default()
         };
         b.grow.steps = self.steps;
@@ -382,46 +407,56 @@ async fn grow_garden(
     .await?
 }
 
-/// Archives a grown garden: the children as plants with their meshes, the mother's mesh
-/// if she has none yet, the scene. Returns the view after.
+/// Archives a grown garden, every specimen with its mesh as it stands in this garden: the
+/// children as new plants; the mother as herself the first time she grows (a plant of this
+/// session without a mesh yet), else as a new plant of her genome (operator `mother`) whose
+/// parent she is, so that her card, picture and export show her as she stands here (and a
+/// plant branched from another session keeps its own mesh). Returns the view after,
+/// whose mother is that plant.
 fn store_garden(
     c: &rusqlite::Connection,
     session: i64,
     state: &GardenState,
     grown: Grown,
 ) -> Result<GardenState, ApiError> {
-    let mut specimens = Vec::with_capacity(grown.specimens.len());
     let settings = json!(state.settings);
+    let new_plant = |genome: &LSystemGenome, operator: &str, parent: i64| {
+        archive::insert_plant(
+            c,
+            &NewPlant {
+                session: Some(session),
+                model: LSYSTEM,
+                genome: &LSystemModel.write(genome),
+                seed: 0,
+                operator,
+                settings: &settings,
+                parents: &[ParentRow {
+                    plant: parent,
+                    dominance: 1.0,
+                }],
+            },
+        )
+    };
+    let mut mother = state.mother;
+    let mut specimens = Vec::with_capacity(grown.specimens.len());
+    // The mother comes first: her children are hers as she stands here.
     for (genome, is_mother, mut view, glb) in grown.specimens {
         let id = if is_mother {
-            if archive::mesh(c, state.mother)?.is_none() {
-                archive::insert_mesh(c, state.mother, &glb)?;
+            let ours = archive::plant(c, state.mother)?.is_some_and(|r| r.session == Some(session));
+            if !ours || archive::mesh(c, state.mother)?.is_some() {
+                mother = new_plant(&genome, "mother", state.mother)?;
             }
-            state.mother
+            mother
         } else {
-            let id = archive::insert_plant(
-                c,
-                &NewPlant {
-                    session: Some(session),
-                    model: LSYSTEM,
-                    genome: &LSystemModel.write(&genome),
-                    seed: 0,
-                    operator: "mutate",
-                    settings: &settings,
-                    parents: &[ParentRow {
-                        plant: state.mother,
-                        dominance: 1.0,
-                    }],
-                },
-            )?;
-            archive::insert_mesh(c, id, &glb)?;
-            id
+            new_plant(&genome, "mutate", mother)?
         };
+        archive::insert_mesh(c, id, &glb)?;
         view.plant = id;
         specimens.push(view);
     }
     let scene = archive::insert_scene(c, &grown.scene)?;
     Ok(GardenState {
+        mother,
         specimens,
         scene: Some(scene),
         ..state.clone()

@@ -251,6 +251,7 @@ pub fn serve(options: Options) -> Result<(), StartError> {
             })?;
         let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
         design::resume_all(&studio);
+        warm_textures();
         let query = token.map(|t| format!("?token={t}")).unwrap_or_default();
         // Written, not printed: a closed stdout must not stop the server.
         use std::io::Write;
@@ -275,6 +276,24 @@ pub fn serve(options: Options) -> Result<(), StartError> {
         studio.runs.stop_all();
         Ok(())
     })
+}
+
+/// Sylva's textures a genome can name: PlantMaker's genome texture 1 to 127 is Sylva texture
+/// 0 to 126 (the other models name none).
+const GENOME_TEXTURES: std::ops::Range<u16> = 0..127;
+
+/// Makes every texture a genome can name, and its PNG, on a thread of its own while the
+/// studio waits for its first page. A texture is a pure function of its id, kept once made,
+/// and the first of each costs tens of milliseconds (noise, then the best PNG compression):
+/// made here, no breeding step pays for them.
+fn warm_textures() {
+    let _ = std::thread::Builder::new()
+        .name("sylva-textures".into())
+        .spawn(|| {
+            for id in GENOME_TEXTURES {
+                let _ = sylva_mesh::texture::texture_png(id);
+            }
+        });
 }
 
 /// An address a browser on this machine can open for `bound`: loopback for a studio bound

@@ -139,23 +139,13 @@ pub fn grow_glb(
     sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
 }
 
-/// Grows a genome into a preview GLB of `size` (roots left out), its node's extras as
-/// [`grow_glb`]'s with the preview's detail.
-pub fn preview_glb(
-    genome: &Genome,
-    seed: u64,
-    parents: &[ParentRow],
-    operator: &str,
-    size: PreviewSize,
-) -> Result<Vec<u8>, ApiError> {
+/// Grows a genome into a preview GLB of `size` (roots left out), for the views. Its node's
+/// extras hold the plant's genome and seed and the preview's detail; exports
+/// (`plant.glb`) carry the whole origin (parents, operator).
+pub fn preview_glb(genome: &Genome, seed: u64, size: PreviewSize) -> Result<Vec<u8>, ApiError> {
     let preview = Preview::grow(genome, seed, false, size.triangles())
         .map_err(|e| ApiError::library("genome", e))?;
-    let mut node = SceneNode::new(genome.model(), &preview.mesh);
-    let mut extras = extras(genome, seed, parents, operator);
-    extras["preview"] = preview.extras()["preview"].clone();
-    node.extras = Some(extras);
-    let scene = sylva_mesh::Scene::single(node);
-    sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
+    sylva_mesh::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
 }
 
 /// What an exported node's extras hold in the studio.
@@ -195,9 +185,7 @@ pub fn plant_form(studio: &Studio, id: i64, form: Form) -> Result<Arc<Vec<u8>>, 
         (None, Form::Full { roots }) => {
             grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?
         }
-        (None, Form::Preview(size)) => {
-            preview_glb(&genome_of(&row)?, row.seed, &parents, &row.operator, size)?
-        }
+        (None, Form::Preview(size)) => preview_glb(&genome_of(&row)?, row.seed, size)?,
     };
     let glb = Arc::new(glb);
     studio.meshes.put((id, form), glb.clone());
