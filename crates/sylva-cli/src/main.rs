@@ -33,7 +33,7 @@ enum Command {
     /// Evolve plants; writes stats.csv, best.json, best.glb, best.png, fitness.svg,
     /// population.png and a checkpoint into the run directory.
     Evolve(commands::evolve::EvolveArgs),
-    /// Grow one genome into a 3D asset (format from the extension: .glb, .obj, .wrl), or
+    /// Grow one genome into a 3D asset (format from the extension: .glb, .obj, .wrl, .stl), or
     /// write its skeleton as data (.skeleton.json).
     Grow(commands::grow::GrowArgs),
     /// Plant a garden: many plants of one or more genomes (each with its own seed) placed on

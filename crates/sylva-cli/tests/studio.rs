@@ -711,6 +711,76 @@ fn a_reverse_proxy_name_is_allowed_only_when_given() {
 }
 
 #[test]
+fn obj_comes_as_one_zip_and_stl_for_printing() {
+    let dir = temp_dir("exports");
+    let server = start(&dir, "127.0.0.1");
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "breed", "start": {"examples": ["plantmaker/fern"]}}),
+    );
+    let fern = grid(&session)[0];
+    let (status, zip) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{fern}/plant.zip"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 200);
+    let mut archive = zip::ZipArchive::new(std::io::Cursor::new(zip)).unwrap();
+    let mut files = std::collections::BTreeMap::new();
+    for i in 0..archive.len() {
+        let mut file = archive.by_index(i).unwrap();
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).unwrap();
+        files.insert(file.name().unwrap().into_owned(), bytes);
+    }
+    let obj = String::from_utf8(files[&format!("plant-{fern}.obj")].clone()).unwrap();
+    let mtl_name = obj.lines().find_map(|l| l.strip_prefix("mtllib ")).unwrap();
+    let mtl = String::from_utf8(files[mtl_name].clone()).unwrap();
+    let textures: std::collections::BTreeSet<&str> = mtl
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("map_Kd "))
+        .filter_map(|l| l.split_whitespace().last())
+        .collect();
+    assert!(!textures.is_empty());
+    for t in &textures {
+        assert!(files[*t].starts_with(b"\x89PNG"), "{t}");
+    }
+    assert_eq!(files.len(), 2 + textures.len(), "{:?}", files.keys());
+    // The same plant, the same bytes.
+    let (_, again) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{fern}/plant.zip"),
+        b"",
+        true,
+    );
+    let (_, first) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{fern}/plant.zip"),
+        b"",
+        true,
+    );
+    assert_eq!(again, first);
+
+    let (status, stl) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{fern}/plant.stl"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 200);
+    let triangles = u32::from_le_bytes([stl[80], stl[81], stl[82], stl[83]]) as usize;
+    let faces = obj.lines().filter(|l| l.starts_with("f ")).count();
+    assert_eq!(triangles, faces);
+    assert_eq!(stl.len(), 84 + 50 * triangles);
+}
+
+#[test]
 fn textures_are_served_only_for_what_a_real_plant_names() {
     let dir = temp_dir("textures");
     let server = start(&dir, "127.0.0.1");

@@ -246,14 +246,14 @@ async function main() {
     const p = await checkPainted("breed", 0.004, "breed grid");
     const views = p.views.filter((v) => v.plant);
     const blank = views.filter((v) => v.fraction < 0.001);
-    check(views.length === 5, `breed grid: ${views.length} plants shown, not the five examples`);
+    check(views.length === 9, `breed grid: ${views.length} plants shown, not the five examples and four of their mutants`);
     check(blank.length === 0, `breed grid: ${blank.length} of the views are blank (${blank.map((v) => "#" + v.plant).join(" ")})`);
     await shot("breed");
   });
 
   await step("breed: pick two and cross", async () => {
     const before = await gridIds();
-    check(before.length === 5, `the grid holds ${before.length} plants, not the five examples`);
+    check(before.length === 9, `the grid holds ${before.length} plants, not nine`);
     const h0 = await byTestId("history-item").count();
     await byTestId("grid-cell-0").click();
     const selectMs = await page.evaluate(() => window.sylvaStudio.lastSelectMs);
@@ -388,7 +388,7 @@ async function main() {
     check(extras.length > 0, "no node of the GLB has extras (origin: genome, seed, parents, operator)");
     const origin = JSON.stringify(extras);
     check(/seed/.test(origin), `the GLB's extras do not carry the seed: ${origin.slice(0, 200)}`);
-    for (const link of ["export-obj", "export-mtl", "export-png", "export-genome"]) {
+    for (const link of ["export-obj", "export-stl", "export-png", "export-genome"]) {
       const u = await byTestId(link).getAttribute("href");
       const r = await fetch(new URL(u, base));
       check(r.ok, `${link}: GET ${u}: ${r.status}`);
@@ -435,6 +435,69 @@ async function main() {
     const r = await api(`/api/plants/${(await gridIds())[index]}`);
     check(r.operator === "regrow" && Number(r.seed) === 4242, `the regrown plant is ${r.operator} with seed ${r.seed}`);
     await waitGridLoaded();
+  });
+
+  await step("breed: heavy plants paint within a second (Depth-10 mutants, their cross, a random start)", async () => {
+    const paint = async (click, what) => {
+      const n0 = await page.evaluate(() => window.sylvaStudio.paintCount);
+      await click();
+      await page.waitForFunction((n) => window.sylvaStudio.paintCount > n ||
+        document.querySelector('[data-testid="message"]').dataset.kind === "error", n0, { timeout: 120_000 });
+      await noError(what);
+      await waitGridLoaded();
+      const ms = await page.evaluate(() => window.sylvaStudio.lastPaintMs);
+      const p = await checkPainted("breed", 0.004, what);
+      const blank = p.views.filter((v) => v.plant && v.fraction < 0.0005);
+      check(blank.length === 0, `${what}: ${blank.length} views are blank`);
+      return ms;
+    };
+    const setDepth = (d) => byTestId("depth").evaluate((e, v) => {
+      e.value = String(v);
+      e.dispatchEvent(new Event("input", { bubbles: true }));
+    }, d);
+    const heavy = { mutate: [], cross: [], random: null, bytes: {} };
+    // Depth 10 on two of the examples
+    for (let k = 0; k < 2; k++) {
+      const ids = await gridIds();
+      let cell = -1;
+      for (let i = ids.length - 1; i >= 0 && cell < 0; i--) {
+        if ((await api(`/api/plants/${ids[i]}`)).operator === "example") cell = i;
+      }
+      check(cell >= 0, `no example left in the grid (${ids})`);
+      await byTestId(`grid-cell-${cell}`).click();
+      await setDepth(10);
+      heavy.mutate.push(await paint(() => byTestId("mutate").click(), "a Depth-10 mutation"));
+    }
+    // the cross of two Depth-10 mutants (the last step's first children)
+    await byTestId("grid-cell-1").click();
+    await byTestId("grid-cell-2").click();
+    heavy.cross.push(await paint(() => byTestId("cross").click(), "a cross of Depth-10 mutants"));
+    // a random start: nine random PlantMaker plants, up to a million triangles each
+    await byTestId("new-session").click();
+    await inMode("breed", "new-session-form").waitFor();
+    await byTestId("new-model").selectOption("plantmaker");
+    await byTestId("new-start-random").check();
+    const c0 = await page.evaluate(() => window.sylvaStudio.createCount);
+    await inMode("breed", "new-create").click();
+    await page.waitForFunction((n) => window.sylvaStudio.createCount > n ||
+      document.querySelector('[data-testid="message"]').dataset.kind === "error", c0, { timeout: 120_000 });
+    await noError("a random start");
+    await waitGridLoaded();
+    heavy.random = await page.evaluate(() => window.sylvaStudio.lastCreatePaintMs);
+    const p = await checkPainted("breed", 0.004, "a random start");
+    check(p.views.filter((v) => v.plant).length === 9, "a random start shows fewer than nine plants");
+    // what the views loaded, against the plants in full
+    const loaded = await page.evaluate(() => window.sylvaStudio.timings.slice(-9));
+    heavy.bytes.views = loaded.reduce((a, t) => a + t.bytes, 0);
+    const ids = await gridIds();
+    let full = 0;
+    for (const id of ids) {
+      const r = await fetch(`${base}/api/plants/${id}/plant.glb`);
+      full += (await r.arrayBuffer()).byteLength;
+    }
+    heavy.bytes.full = full;
+    results.heavy = heavy;
+    await shot("breed-random");
   });
 
   // ---- Garden ----
@@ -601,6 +664,12 @@ async function main() {
   console.log(`click to paint, Cross:  ${results.crossPaintMs?.toFixed(0)} ms in the page${split(results.crossStep)} (${results.crossOutsideMs} ms seen by the test)`);
   console.log(`click to paint, Mutate: ${results.mutatePaintMs?.toFixed(0)} ms in the page${split(results.mutateStep)} (${results.mutateOutsideMs} ms seen by the test)`);
   console.log(`click to highlight:     ${results.selectMs?.toFixed(1)} ms`);
+  const hv = results.heavy;
+  if (hv) {
+    const list = (a) => a.map((x) => x.toFixed(0)).join(", ");
+    console.log(`click to paint, heavy:  Depth-10 mutations ${list(hv.mutate)} ms; their cross ${list(hv.cross)} ms; a random start ${hv.random?.toFixed(0)} ms (views ${(hv.bytes.views / 1e6).toFixed(1)} MB of GLB, the plants in full ${(hv.bytes.full / 1e6).toFixed(1)} MB)`);
+  }
+  fs.writeFileSync(path.join(out, "timings.json"), JSON.stringify(results, null, 2));
   console.log(`screenshots in ${path.relative(repo, out)}/`);
   console.log(`studio e2e: all passed in ${((Date.now() - T0) / 1000).toFixed(1)} s`);
 }

@@ -187,6 +187,8 @@ pub fn router(studio: Studio) -> Router {
         .route("/plants/{id}/preview.glb", get(plants::preview))
         .route("/plants/{id}/plant.obj", get(plants::obj))
         .route("/plants/{id}/plant.mtl", get(plants::mtl))
+        .route("/plants/{id}/plant.zip", get(plants::obj_zip))
+        .route("/plants/{id}/plant.stl", get(plants::stl))
         .route("/plants/{id}/plant.png", get(plants::png))
         .route("/plants/{id}/genome.json", get(plants::genome))
         .route("/plants/{id}/{file}", get(plants::texture))

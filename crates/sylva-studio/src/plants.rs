@@ -268,6 +268,72 @@ fn obj_files(studio: &Studio, id: i64) -> Result<(String, String), ApiError> {
     Ok(sylva_mesh::export::to_obj(&scene.scene(), "plant.mtl"))
 }
 
+/// `GET /api/plants/{id}/plant.zip`: the OBJ export in one download: `plant-ID.obj`, the
+/// `plant-ID.mtl` it names and the `plant-ID_texN.png` textures the MTL names, so the folder
+/// it unpacks to opens in any OBJ viewer.
+pub(crate) async fn obj_zip(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let zip = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
+        let glb = plant_glb(&studio, id, false)?;
+        let scene = imported(&glb)?;
+        let obj = format!("plant-{id}.obj");
+        let files = sylva_mesh::export::scene_files(std::path::Path::new(&obj), &scene.scene())
+            .map_err(|e| ApiError::internal(format!("exporting OBJ: {e}")))?;
+        zip_files(&files).map_err(|e| ApiError::internal(format!("writing the zip: {e}")))
+    })
+    .await??;
+    Ok(download(zip, "application/zip", &format!("plant-{id}.zip")))
+}
+
+/// A zip of `(name, bytes)` files, in order: text deflated, PNGs stored (they are
+/// compressed already), every date 1980-01-01 so the same files give the same bytes.
+fn zip_files(files: &[(std::path::PathBuf, Vec<u8>)]) -> zip::result::ZipResult<Vec<u8>> {
+    use std::io::Write;
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (path, bytes) in files {
+        let name = path.to_string_lossy();
+        let method = if name.ends_with(".png") {
+            zip::CompressionMethod::Stored
+        } else {
+            zip::CompressionMethod::Deflated
+        };
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(method)
+            .last_modified_time(zip::DateTime::default());
+        zip.start_file(name, options)?;
+        zip.write_all(bytes)?;
+    }
+    Ok(zip.finish()?.into_inner())
+}
+
+/// `GET /api/plants/{id}/plant.stl`: the plant for 3D printing, binary STL in millimetres.
+pub(crate) async fn stl(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Response, ApiError> {
+    let stl = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
+        let glb = plant_glb(&studio, id, false)?;
+        Ok(sylva_mesh::export::to_stl(&imported(&glb)?.scene()))
+    })
+    .await??;
+    Ok(download(stl, "model/stl", &format!("plant-{id}.stl")))
+}
+
+/// A file to save, under `name`.
+fn download(bytes: Vec<u8>, content_type: &'static str, name: &str) -> Response {
+    let disposition = format!("attachment; filename=\"{name}\"");
+    (
+        [
+            (header::CONTENT_TYPE, content_type.to_owned()),
+            (header::CONTENT_DISPOSITION, disposition),
+        ],
+        bytes,
+    )
+        .into_response()
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct PngQuery {

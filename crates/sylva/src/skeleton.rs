@@ -309,7 +309,7 @@ impl GrowOutput {
             InputError::file(
                 path,
                 format!(
-                    "unknown output format ({found}); expected .glb, .obj or .wrl for a mesh, \
+                    "unknown output format ({found}); expected .glb, .obj, .wrl or .stl for a mesh, \
                      or {SUFFIX} for the skeleton as data"
                 ),
             )

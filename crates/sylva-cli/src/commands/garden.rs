@@ -32,7 +32,7 @@ pub struct GardenArgs {
     /// Seed of the plants' seeds, positions and turns.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output scene (.glb, .obj or .wrl).
+    /// Output scene (.glb, .obj, .wrl or .stl).
     #[arg(short, long)]
     output: PathBuf,
     /// Also render a picture.

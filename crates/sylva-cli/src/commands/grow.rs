@@ -15,7 +15,7 @@ use super::InFile;
 pub struct GrowArgs {
     /// Genome JSON.
     genome: PathBuf,
-    /// Output: a 3D asset (.glb, .obj, .wrl), or the skeleton as data (.skeleton.json).
+    /// Output: a 3D asset (.glb, .obj, .wrl, .stl), or the skeleton as data (.skeleton.json).
     #[arg(short, long)]
     output: PathBuf,
     /// Also render a picture.

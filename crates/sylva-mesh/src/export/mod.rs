@@ -1,4 +1,4 @@
-//! Writing a [`Scene`] to files: GLB (glTF 2.0 binary), OBJ with MTL, and VRML97.
+//! Writing a [`Scene`] to files: GLB (glTF 2.0 binary), OBJ with MTL, VRML97 and STL.
 //!
 //! - [`to_glb`]: one glTF node per [`SceneNode`](crate::SceneNode), one glTF mesh per distinct
 //!   [`Mesh`] (nodes borrowing the same mesh share it), the node's extras kept as glTF
@@ -9,6 +9,7 @@
 //! - [`to_obj`]: world-space vertices, one object per node, one `usemtl` per primitive.
 //! - [`to_vrml`] / [`to_vrml_with_textures`]: one `Transform` per node, one `Shape` per
 //!   primitive.
+//! - [`to_stl`]: binary STL in millimetres, for 3D printing: triangles only.
 //! - [`write_scene`]: picks the format from the file extension ([`Format::from_path`]) and
 //!   writes atomically, so a reader never sees half a file.
 //!
@@ -34,6 +35,7 @@
 mod glb;
 mod lean;
 mod obj;
+mod stl;
 mod vrml;
 
 use std::fmt::Write as _;
@@ -48,6 +50,7 @@ pub use glb::{
     to_glb, to_glb_with,
 };
 pub use obj::to_obj;
+pub use stl::to_stl;
 pub use vrml::{DEFAULT_TEXTURE_STEM, to_vrml, to_vrml_with_textures};
 
 use crate::mesh::Mesh;
@@ -57,13 +60,13 @@ use crate::scene::Scene;
 #[derive(Debug, Error)]
 pub enum ExportError {
     /// The file extension names no format this crate writes.
-    #[error("unknown export format \".{extension}\" (expected .glb, .obj or .wrl)")]
+    #[error("unknown export format \".{extension}\" (expected .glb, .obj, .wrl or .stl)")]
     UnknownExtension {
         /// The extension found.
         extension: String,
     },
     /// The path has no extension to pick a format by.
-    #[error("{path:?} has no file extension (expected .glb, .obj or .wrl)")]
+    #[error("{path:?} has no file extension (expected .glb, .obj, .wrl or .stl)")]
     NoExtension {
         /// The path given.
         path: PathBuf,
@@ -195,10 +198,12 @@ pub enum Format {
     Obj,
     /// VRML97, `.wrl`.
     Vrml,
+    /// Binary STL in millimetres, `.stl`.
+    Stl,
 }
 
 impl Format {
-    /// The format named by a path's extension (`glb`, `obj` or `wrl`, in any case).
+    /// The format named by a path's extension (`glb`, `obj`, `wrl` or `stl`, in any case).
     pub fn from_path(path: &Path) -> Result<Format, ExportError> {
         let Some(extension) = path.extension() else {
             return Err(ExportError::NoExtension {
@@ -210,6 +215,7 @@ impl Format {
             "glb" => Ok(Format::Glb),
             "obj" => Ok(Format::Obj),
             "wrl" => Ok(Format::Vrml),
+            "stl" => Ok(Format::Stl),
             _ => Err(ExportError::UnknownExtension {
                 extension: extension.into_owned(),
             }),
@@ -222,6 +228,7 @@ impl Format {
             Format::Glb => "glb",
             Format::Obj => "obj",
             Format::Vrml => "wrl",
+            Format::Stl => "stl",
         }
     }
 }
@@ -270,6 +277,7 @@ pub fn scene_files(path: &Path, scene: &Scene) -> Result<Vec<(PathBuf, Vec<u8>)>
     };
     Ok(match format {
         Format::Glb => vec![(path.to_owned(), to_glb(scene)?)],
+        Format::Stl => vec![(path.to_owned(), to_stl(scene))],
         Format::Vrml => {
             let mut files = textures()?;
             files.push((

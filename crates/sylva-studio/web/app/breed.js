@@ -324,6 +324,7 @@ export function createBreedMode(ctx, root) {
       class: "primary",
       testid: "new-create",
       onclick: async () => {
+        const t0 = performance.now();
         const made = await ctx.act(async () => {
           const body = { mode: "breed", model: model.value, seed: seedValue(seed.value) };
           if (startRandom.checked) body.start = { random: readNumber(randomN, "random") };
@@ -333,7 +334,10 @@ export function createBreedMode(ctx, root) {
           } else body.start = { genomes: await readFiles([...files.files]) };
           return api.createSession(body);
         });
-        if (made) await ctx.sessionCreated(made);
+        if (made && (await ctx.sessionCreated(made)) !== false) {
+          stats.lastCreatePaintMs = performance.now() - t0;
+          stats.createCount += 1;
+        }
       },
     }, "Create session");
     return h(

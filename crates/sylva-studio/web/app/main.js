@@ -240,6 +240,28 @@ async function loadPopulation() {
     ui.populationMore.hidden = true;
     return;
   }
+  const own = modes[s.mode] && modes[s.mode].population;
+  if (own) {
+    // a mode whose population is not (only) archived plants lists it itself
+    const list = own(populationLimit);
+    clear(ui.population);
+    ui.populationTotal.textContent = `(${list.total})`;
+    for (const item of list.items) {
+      ui.population.append(
+        h("li", {},
+          h("button", {
+            class: "pop-item" + (item.shown ? " shown" : ""),
+            testid: "population-item",
+            dataset: item.dataset,
+            title: item.title || "",
+            onclick: item.open,
+          },
+          h("span", { class: "pop-text" }, h("b", {}, item.label), " ", h("span", { class: "dim" }, item.sub || "")))),
+      );
+    }
+    ui.populationMore.hidden = !(list.total > list.items.length);
+    return;
+  }
   const list = await ctx.act(() => api.plants(s.id, 0, Math.min(populationLimit, 1000)));
   if (!list || !ctx.session || ctx.session.id !== s.id) return;
   const inGrid = new Set(((s.state && s.state.grid) || []).map((g) => g.plant));
@@ -267,7 +289,7 @@ async function loadPopulation() {
   ui.populationMore.hidden = !(list.total > (list.plants || []).length && populationLimit < 1000);
 }
 ui.populationMore.addEventListener("click", () => {
-  populationLimit = Math.min(populationLimit + 100, 1000);
+  populationLimit = Math.min(populationLimit + 100, 10000);
   refreshPopulation();
 });
 

@@ -2,6 +2,8 @@
 //
 // paintCount / lastPaintMs: after a Breed step (Cross, Mutate, Add), the time from the click to
 // the frame that has all nine plants drawn, and how many such steps were painted.
+// createCount / lastCreatePaintMs: the same for a new breeding session, from the click on
+// Create to its grid drawn.
 // lastSelectMs: from a click on a grid cell to its highlight being applied.
 // probe(name): draws stage `name` ("breed", "garden", "family", "design") and counts the
 // pixels that differ from the background (gl.readPixels, same task as the draw).
@@ -12,6 +14,8 @@ export const stats = {
   timings,
   paintCount: 0,
   lastPaintMs: null,
+  createCount: 0,
+  lastCreatePaintMs: null,
   lastSelectMs: null,
   history: [],
   stages: {},
