@@ -7,17 +7,20 @@
 //! parent), so a step's parents and offspring lead the grid and the plants left alone
 //! longest are replaced (`docs/studio.md`).
 
+use std::sync::Arc;
+
 use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::{Genome, Registry};
+use sylva_core::Plant;
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
-use crate::plants::{Form, PreviewSize, genome_of, preview_glb};
+use crate::plants::{Form, PreviewSize, genome_of, grow_shown, plant_bytes, preview_glb};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// PlantMaker's name in files.
@@ -82,6 +85,8 @@ pub struct Made {
     pub settings: serde_json::Value,
     /// Its parents.
     pub parents: Vec<ParentRow>,
+    /// The plant as the views show it (roots left out).
+    pub plant: Plant,
     /// Its preview GLB for the grid's cells ([`PreviewSize::GRID`]).
     pub glb: Vec<u8>,
 }
@@ -105,13 +110,15 @@ impl Made {
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
-        let glb = preview_glb(&genome, seed, PreviewSize::GRID)?;
+        let plant = grow_shown(&genome, seed)?;
+        let glb = preview_glb(&genome, seed, &plant, PreviewSize::GRID)?;
         Ok(Made {
             genome,
             seed,
             operator,
             settings,
             parents,
+            plant,
             glb,
         })
     }
@@ -139,12 +146,16 @@ pub fn store(c: &rusqlite::Connection, session: i64, made: &[Made]) -> Result<Ve
     Ok(ids)
 }
 
-/// Keeps the preview GLBs of stored plants in memory (after the transaction committed), so
-/// that the page's cells find them there.
+/// Keeps stored plants and their preview GLBs in memory (after the transaction committed),
+/// so that the page's views find them there, or make a preview of their size without
+/// growing the plant again.
 fn cache(studio: &Studio, ids: &[i64], made: Vec<Made>) {
-    for (id, m) in ids.iter().zip(made) {
+    for (&id, m) in ids.iter().zip(made) {
         let form = Form::Preview(PreviewSize::GRID);
-        studio.meshes.put((*id, form), std::sync::Arc::new(m.glb));
+        let bytes = m.glb.len();
+        studio.meshes.put((id, form), Arc::new(m.glb), bytes);
+        let bytes = plant_bytes(&m.plant);
+        studio.plants.put(id, Arc::new(m.plant), bytes);
     }
 }
 

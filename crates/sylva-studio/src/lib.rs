@@ -7,7 +7,8 @@
 //! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
 //! - [`family`]: the deciduous-evolution viewer's binary-tree population.
 //! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
-//! - [`plants`]: plants as GLB, OBJ, PNG and genome files, and their lineage.
+//! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
+//! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
 //! - [`guard`]: who may talk to the studio: Host names, other sites' pages, content types,
 //!   the access token.
 //! - [`listen`]: connections, with request heads bounded before hyper parses them.
@@ -26,6 +27,7 @@
 
 pub mod archive;
 pub mod breed;
+pub mod cache;
 pub mod design;
 pub mod error;
 pub mod family;
@@ -118,6 +120,8 @@ pub struct Inner {
     pub guard: guard::Guard,
     /// Recently served meshes.
     pub meshes: plants::MeshCache,
+    /// Recently grown plants.
+    pub plants: plants::PlantCache,
     /// Threads for growing many plants at once.
     pub pool: sylva_core::par::Pool,
     /// One lock per session, so that two tabs' steps on one session queue up.
@@ -141,7 +145,8 @@ impl Studio {
         Studio(Arc::new(Inner {
             archive,
             guard,
-            meshes: plants::MeshCache::default(),
+            meshes: plants::mesh_cache(),
+            plants: plants::plant_cache(),
             pool: sylva_core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
             families: family::Families::default(),

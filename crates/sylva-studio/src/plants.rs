@@ -5,8 +5,8 @@
 //! (growth is deterministic), or, for a garden specimen (whose shape depends on its
 //! neighbours), read from the mesh stored when the garden grew. Recent GLBs stay in memory.
 
-use std::collections::{HashMap, HashSet, VecDeque};
-use std::sync::{Arc, Mutex};
+use std::collections::{HashSet, VecDeque};
+use std::sync::Arc;
 
 use axum::Json;
 use axum::extract::{Path, Query, State};
@@ -16,26 +16,41 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::assets::Origin;
 use sylva::{Genome, Grown, Preview, Registry};
+use sylva_core::Plant;
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::View;
 
 use crate::Studio;
 use crate::archive::{self, ParentRow, PlantRow};
+use crate::cache::Bounded;
 use crate::error::ApiError;
 use crate::http::Body;
 use crate::sessions::SessionView;
 
-/// Recently served GLBs, by plant and form; the oldest go first when there are more than
-/// [`CACHED_MESHES`] or their bytes pass [`CACHED_BYTES`]. Keys are real plants' (a plant is
-/// read from the archive before its GLB is made) and each has a handful of forms, so
-/// nothing a request makes up enters it.
-#[derive(Default)]
-pub struct MeshCache {
-    inner: Mutex<CachedMeshes>,
+/// GLBs kept in memory, by plant and form: at most 256, and 512 MB (a random PlantMaker
+/// plant's GLB in full can be 40 MB).
+pub type MeshCache = Bounded<(i64, Form), Vec<u8>>;
+
+/// A mesh cache of the studio's size.
+pub fn mesh_cache() -> MeshCache {
+    Bounded::new(256, 512 << 20)
 }
 
-/// The most bytes of GLBs kept in memory (a random PlantMaker plant's GLB can be 40 MB).
-const CACHED_BYTES: usize = 512 << 20;
+/// Grown plants kept in memory, by plant (roots left out), so that a preview of any size is
+/// simplified and meshed without growing the plant again: at most 256, and 256 MB.
+pub type PlantCache = Bounded<i64, Plant>;
+
+/// A plant cache of the studio's size.
+pub fn plant_cache() -> PlantCache {
+    Bounded::new(256, 256 << 20)
+}
+
+/// Roughly the bytes a plant holds.
+pub fn plant_bytes(plant: &Plant) -> usize {
+    std::mem::size_of_val(plant.segments())
+        + std::mem::size_of_val(plant.organs())
+        + std::mem::size_of_val(plant.materials())
+}
 
 /// Which GLB of a plant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -47,41 +62,6 @@ pub enum Form {
     },
     /// A preview for views of up to this many pixels a side ([`PreviewSize`]).
     Preview(PreviewSize),
-}
-
-/// A plant and which of its GLBs.
-type MeshKey = (i64, Form);
-
-/// The GLBs, the order they came in, and their bytes.
-type CachedMeshes = (HashMap<MeshKey, Arc<Vec<u8>>>, VecDeque<MeshKey>, usize);
-
-/// GLBs kept in memory.
-const CACHED_MESHES: usize = 256;
-
-impl MeshCache {
-    /// A cached GLB.
-    pub fn get(&self, key: MeshKey) -> Option<Arc<Vec<u8>>> {
-        let inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        inner.0.get(&key).cloned()
-    }
-
-    /// Keeps a GLB.
-    pub fn put(&self, key: MeshKey, glb: Arc<Vec<u8>>) {
-        let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        let (map, order, bytes) = &mut *inner;
-        *bytes += glb.len();
-        match map.insert(key, glb) {
-            Some(old) => *bytes -= old.len(),
-            None => order.push_back(key),
-        }
-        while order.len() > CACHED_MESHES || (*bytes > CACHED_BYTES && order.len() > 1) {
-            if let Some(old) = order.pop_front()
-                && let Some(glb) = map.remove(&old)
-            {
-                *bytes -= glb.len();
-            }
-        }
-    }
 }
 
 /// The size class of a preview: the longest side of the view it is for, in device pixels,
@@ -139,13 +119,35 @@ pub fn grow_glb(
     sylva_mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
 }
 
-/// Grows a genome into a preview GLB of `size` (roots left out), for the views. Its node's
-/// extras hold the plant's genome and seed and the preview's detail; exports
-/// (`plant.glb`) carry the whole origin (parents, operator).
-pub fn preview_glb(genome: &Genome, seed: u64, size: PreviewSize) -> Result<Vec<u8>, ApiError> {
-    let preview = Preview::grow(genome, seed, false, size.triangles())
+/// A preview GLB of `size` of `plant` (grown from `genome` with `seed`, roots left out), for
+/// the views. Its node's extras hold the plant's genome and seed and the preview's detail;
+/// exports (`plant.glb`) carry the whole origin (parents, operator).
+pub fn preview_glb(
+    genome: &Genome,
+    seed: u64,
+    plant: &Plant,
+    size: PreviewSize,
+) -> Result<Vec<u8>, ApiError> {
+    let preview = Preview::of(genome, seed, plant, size.triangles())
         .map_err(|e| ApiError::library("genome", e))?;
     sylva_mesh::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
+}
+
+/// Grows a genome as the views show it: roots left out.
+pub fn grow_shown(genome: &Genome, seed: u64) -> Result<Plant, ApiError> {
+    sylva::assets::grow_plant(genome, seed, false, None).map_err(|e| ApiError::library("genome", e))
+}
+
+/// A plant grown as the views show it: from memory, or grown again (and kept).
+fn shown_plant(studio: &Studio, row: &PlantRow) -> Result<Arc<Plant>, ApiError> {
+    if let Some(plant) = studio.plants.get(row.id) {
+        return Ok(plant);
+    }
+    let plant = Arc::new(grow_shown(&genome_of(row)?, row.seed)?);
+    studio
+        .plants
+        .put(row.id, plant.clone(), plant_bytes(&plant));
+    Ok(plant)
 }
 
 /// What an exported node's extras hold in the studio.
@@ -185,10 +187,13 @@ pub fn plant_form(studio: &Studio, id: i64, form: Form) -> Result<Arc<Vec<u8>>, 
         (None, Form::Full { roots }) => {
             grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?
         }
-        (None, Form::Preview(size)) => preview_glb(&genome_of(&row)?, row.seed, size)?,
+        (None, Form::Preview(size)) => {
+            let plant = shown_plant(studio, &row)?;
+            preview_glb(&genome_of(&row)?, row.seed, &plant, size)?
+        }
     };
     let glb = Arc::new(glb);
-    studio.meshes.put((id, form), glb.clone());
+    studio.meshes.put((id, form), glb.clone(), glb.len());
     Ok(glb)
 }
 
@@ -700,20 +705,5 @@ mod tests {
         assert_eq!(classes.len(), 5);
         assert_eq!(PreviewSize::GRID.triangles(), 32_768);
         assert_eq!(PreviewSize(2048).triangles(), 400_000);
-    }
-
-    #[test]
-    fn the_cache_keeps_its_bytes_bounded() {
-        let cache = MeshCache::default();
-        let big = Arc::new(vec![0u8; CACHED_BYTES / 3]);
-        let full = Form::Full { roots: false };
-        for id in 0..5 {
-            cache.put((id, full), big.clone());
-        }
-        assert!(cache.get((0, full)).is_none() && cache.get((1, full)).is_none());
-        assert!(cache.get((4, full)).is_some());
-        let inner = cache.inner.lock().unwrap_or_else(|p| p.into_inner());
-        assert!(inner.2 <= CACHED_BYTES);
-        assert_eq!(inner.2, inner.0.values().map(|g| g.len()).sum::<usize>());
     }
 }

@@ -13,6 +13,7 @@ use sylva_mesh::{Mesh, Scene, SceneNode};
 use crate::assets::{Grown, Origin, grow_plant, mesh_options};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
+use sylva_core::Plant;
 
 /// One level, meshed.
 pub struct LodAsset {
@@ -130,10 +131,21 @@ impl Preview {
         max_triangles: usize,
     ) -> Result<Preview, Error> {
         let plant = grow_plant(genome, seed, roots, None)?;
+        Preview::of(genome, seed, &plant, max_triangles)
+    }
+
+    /// The preview of `plant`, grown already from `genome` with `seed` (as [`grow_plant`]
+    /// grows it), of at most about `max_triangles` triangles.
+    pub fn of(
+        genome: &Genome,
+        seed: u64,
+        plant: &Plant,
+        max_triangles: usize,
+    ) -> Result<Preview, Error> {
         let options = mesh_options(genome.mesh_hint());
-        let full_triangles = Mesher::new(options.clone())?.counts(&plant)?.triangles;
+        let full_triangles = Mesher::new(options.clone())?.counts(plant)?.triangles;
         let level =
-            sylva_mesh::lod::preview(&plant, &options, max_triangles).map_err(|e| match e {
+            sylva_mesh::lod::preview(plant, &options, max_triangles).map_err(|e| match e {
                 LodError::Mesh(e) => Error::Mesh(e),
                 other => Error::Input(InputError::new("preview", other.to_string())),
             })?;

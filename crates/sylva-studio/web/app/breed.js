@@ -160,7 +160,12 @@ export function createBreedMode(ctx, root) {
     exampleSelect.disabled = addExamplesBtn.disabled = list.length === 0;
   }
 
-  /** Shows the session's grid; resolves once all of its plants are drawn. */
+  /**
+   * Shows the session's grid; resolves once all of its plants are drawn. New plants are
+   * loaded side by side and put in their cells together, so that the stage draws once rather
+   * than once per arrival while the others are still being parsed (software WebGL draws on
+   * the page's own thread).
+   */
   async function render(s) {
     session = s;
     ensureStage();
@@ -182,22 +187,11 @@ export function createBreedMode(ctx, root) {
         cell.view.setContent(null);
         return;
       }
-      cell.label.textContent = `#${id} · dominance ${entry.dominance}`;
       cell.el.classList.add("loading");
-      cell.view.setContent(null, { frame: false });
       loads.push(
-        loadPlant(id).then(
-          (object) => {
-            if (cell.plant !== id) return;
-            cell.view.setContent(object, { plantId: id });
-            cell.el.classList.remove("loading");
-          },
-          (err) => {
-            if (cell.plant !== id) return;
-            cell.el.classList.remove("loading");
-            cell.el.classList.add("failed");
-            ctx.showError(err, `plant #${id}`);
-          },
+        loadPlant(id, cell.el).then(
+          (object) => ({ cell, id, object }),
+          (error) => ({ cell, id, error }),
         ),
       );
     });
@@ -206,7 +200,19 @@ export function createBreedMode(ctx, root) {
       if (entry) cell.label.textContent = `#${entry.plant} · dominance ${entry.dominance}`;
     });
     applySelection();
-    await Promise.all(loads);
+    const arrived = await Promise.all(loads);
+    for (const { cell, id, object, error } of arrived) {
+      if (cell.plant !== id) continue; // a later render took the cell
+      cell.el.classList.remove("loading");
+      if (error) {
+        cell.view.setContent(null);
+        cell.el.classList.add("failed");
+        ctx.showError(error, `plant #${id}`);
+      } else {
+        cell.el.classList.remove("failed");
+        cell.view.setContent(object, { plantId: id });
+      }
+    }
     const loaded = performance.now();
     await stage.nextPaint();
     if (token === renderToken) stats.lastRender = { loadedAt: loaded, paintedAt: performance.now(), plants: loads.length };
@@ -334,8 +340,17 @@ export function createBreedMode(ctx, root) {
           } else body.start = { genomes: await readFiles([...files.files]) };
           return api.createSession(body);
         });
+        const answered = performance.now();
         if (made && (await ctx.sessionCreated(made)) !== false) {
-          stats.lastCreatePaintMs = performance.now() - t0;
+          const now = performance.now();
+          const r = stats.lastRender || {};
+          stats.lastCreatePaintMs = now - t0;
+          stats.lastCreate = {
+            answerMs: answered - t0,
+            loadMs: (r.loadedAt ?? now) - answered,
+            drawMs: now - (r.loadedAt ?? now),
+            newPlants: r.plants ?? 0,
+          };
           stats.createCount += 1;
         }
       },

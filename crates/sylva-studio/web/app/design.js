@@ -63,6 +63,10 @@ export function createDesignMode(ctx, root) {
   const stopBtn = h("button", { testid: "design-stop", onclick: () => stop() }, "Stop");
   const resumeBtn = h("button", { testid: "design-resume", onclick: () => resume() }, "Resume");
   const frameBtn = h("button", { testid: "design-frame", onclick: () => view && view.frame() }, "Frame");
+  // The move gizmo sits at the target's centre, where the trees grow: shown only while the
+  // person moves the target (and before a run shows a tree).
+  const moveBtn = h("button", { testid: "design-move", "aria-pressed": "false", title: "Show the arrows that move the target", onclick: () => setMoving(!moving) }, "Move target");
+  let moving = true;
 
   const form = h(
     "div",
@@ -70,7 +74,7 @@ export function createDesignMode(ctx, root) {
     h("h3", {}, "Target surface"),
     field("Shape", shape),
     shapeFields,
-    h("p", { class: "hint" }, "Paper units (0.1 m). Drag the arrows in the view to move the target."),
+    h("p", { class: "hint" }, "Paper units (0.1 m). Move target shows arrows in the view to drag it by."),
     h("h3", {}, "Weights"),
     h("div", { class: "weights" }, WEIGHTS.map(([k, , t]) => field(k, weightInputs[k], t))),
     h("h3", {}, "Run"),
@@ -102,7 +106,7 @@ export function createDesignMode(ctx, root) {
   const chart = h("canvas", { class: "chart", testid: "design-chart" });
   const termsChart = h("canvas", { class: "chart", testid: "design-terms-chart" });
   const right = h("div", { class: "design-right" },
-    h("div", { class: "toolbar" }, statusEl, frameBtn), wrap,
+    h("div", { class: "toolbar" }, statusEl, frameBtn, moveBtn), wrap,
     h("div", { class: "charts" }, chart, termsChart), tableBox);
   const workspace = h("div", { class: "workspace design" }, form, right);
   const formHolder = h("div", { class: "form-holder" });
@@ -300,7 +304,7 @@ export function createDesignMode(ctx, root) {
   function ensureStage() {
     if (stage) return;
     stage = new Stage(canvas);
-    view = stage.addView(viewEl);
+    view = stage.addView(viewEl, { detail: true });
     probes.stages.design = stage;
     targetGroup = new THREE.Group();
     gridGroup = new THREE.Group();
@@ -323,8 +327,19 @@ export function createDesignMode(ctx, root) {
       }
     });
     new ResizeObserver(() => drawCharts()).observe(chart);
+    setMoving(moving);
     drawTarget();
     view.frame();
+  }
+
+  function setMoving(on) {
+    moving = on;
+    moveBtn.setAttribute("aria-pressed", String(on));
+    moveBtn.classList.toggle("on", on);
+    if (!tc) return;
+    tc.enabled = on;
+    tc.getHelper().visible = on;
+    stage.requestRender();
   }
 
   function drawTarget() {
@@ -475,6 +490,7 @@ export function createDesignMode(ctx, root) {
         return;
       }
       if (!session || session.id !== id) return;
+      if (Array.isArray(g.terms) && g.terms.length) terms = g.terms;
       rows.set(g.generation, g);
       setStatus(g.status || RUNNING, g.generation, run?.generations, null);
       drawTable();
@@ -528,7 +544,7 @@ export function createDesignMode(ctx, root) {
         const pid = wantPlant;
         let object;
         try {
-          object = await loadPlant(pid);
+          object = await loadPlant(pid, viewEl);
         } catch (err) {
           ctx.showError(err, `plant #${pid}`);
           shownPlant = pid;
@@ -538,6 +554,8 @@ export function createDesignMode(ctx, root) {
         // frame again when the new best outgrows what is in view (runs grow their trees)
         const box = new THREE.Box3().setFromObject(object);
         const outgrows = framedBox && !box.isEmpty() && !framedBox.containsBox(box);
+        // the first tree of a run: out of its way
+        if (shownPlant === null && moving) setMoving(false);
         view.setContent(object, { frame: !framed || outgrows, plantId: pid });
         if (!framed || outgrows) {
           framedBox = new THREE.Box3().setFromObject(view.content);

@@ -67,7 +67,7 @@ export function createFamilyMode(ctx, root) {
   function ensureStage() {
     if (stage) return;
     stage = new Stage(canvas);
-    view = stage.addView(viewEl);
+    view = stage.addView(viewEl, { detail: true });
     probes.stages.family = stage;
     new ResizeObserver(() => drawStats()).observe(chart);
   }
@@ -123,7 +123,7 @@ export function createFamilyMode(ctx, root) {
     memberPlant = answer.plant;
     memberLabel.dataset.plant = String(answer.plant);
     try {
-      const object = await loadPlant(answer.plant);
+      const object = await loadPlant(answer.plant, viewEl);
       if (mine !== memberToken) return false;
       view.setContent(object, { plantId: answer.plant });
       await stage.nextPaint();
@@ -253,6 +253,26 @@ export function createFamilyMode(ctx, root) {
     );
   }
 
+  /**
+   * The population panel's list: every member of the generation shown, fittest first (a
+   * member is archived as a plant when it is browsed, so the archive alone lists fewer).
+   */
+  function population(limit) {
+    const members = session?.state?.members || [];
+    const items = members.slice(0, limit).map((m, i) => ({
+      label: `${i + 1}.`,
+      sub: `fitness ${fmtNum(m.fitness)}`,
+      shown: i === index,
+      title: i === index ? "on screen now" : "show this tree",
+      dataset: { member: String(i) },
+      open: () => {
+        index = i;
+        showMember();
+      },
+    }));
+    return { total: members.length, items };
+  }
+
   return {
     name: "family",
     formHolder,
@@ -260,6 +280,7 @@ export function createFamilyMode(ctx, root) {
     render,
     newSessionForm,
     onKey,
+    population,
     show() {
       ensureStage();
       stage.requestRender();

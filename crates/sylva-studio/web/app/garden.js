@@ -8,7 +8,11 @@ import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { stats } from "./stats.js";
 
 export function createGardenMode(ctx, root) {
-  const steps = num("garden-steps", 40, { min: 0, max: 1000, step: 1, width: "5em" });
+  // the server's defaults for a new garden: neighbours meet and shade each other
+  const STEPS = 150;
+  const SPACING = 1.0;
+  const steps = num("garden-steps", STEPS, { min: 0, max: 1000, step: 1, width: "5em" });
+  const spacing = num("garden-spacing", SPACING, { min: 0.25, max: 2.5, step: 0.05, width: "4.5em" });
   const elevation = num("garden-elevation", 90, { min: 0, max: 90, width: "4.5em" });
   const azimuth = num("garden-azimuth", 0, { min: 0, max: 360, width: "4.5em" });
   const children = num("garden-children", 8, { min: 0, max: 8, step: 1, width: "3.5em" });
@@ -18,6 +22,7 @@ export function createGardenMode(ctx, root) {
     "div",
     { class: "toolbar" },
     field("Steps", steps, "growing time of the garden, 0 to 1000"),
+    field("Spacing m", spacing, "metres between neighbouring seeds, 0.25 to 2.5"),
     field("Light elevation °", elevation, "0 to 90 (90: from straight above)"),
     field("Azimuth °", azimuth, "0 to 360"),
     field("Children", children, "mutated children grown beside the mother, 0 to 8"),
@@ -42,7 +47,7 @@ export function createGardenMode(ctx, root) {
   function ensureStage() {
     if (stage) return;
     stage = new Stage(canvas);
-    view = stage.addView(viewEl);
+    view = stage.addView(viewEl, { detail: true });
     stats.stages.garden = stage;
     let down = null;
     viewEl.addEventListener("pointerdown", (e) => (down = { x: e.clientX, y: e.clientY, b: e.button }));
@@ -89,6 +94,7 @@ export function createGardenMode(ctx, root) {
     const st = s.state || {};
     const set = st.settings || {};
     if (set.steps !== undefined) steps.value = set.steps;
+    if (set.spacing !== undefined) spacing.value = set.spacing;
     if (set.elevation !== undefined) elevation.value = set.elevation;
     if (set.azimuth !== undefined) azimuth.value = set.azimuth;
     if (set.children !== undefined) children.value = set.children;
@@ -124,7 +130,8 @@ export function createGardenMode(ctx, root) {
     for (const s of specimens) {
       const ring = new THREE.Mesh(
         new THREE.RingGeometry(r * 0.88, r, 48),
-        new THREE.MeshBasicMaterial({ color: s.is_mother ? 0xf0c75e : 0x6b7380, side: THREE.DoubleSide }),
+        // light rings on the light ground: where each seed is, without weighing on the plants
+        new THREE.MeshBasicMaterial({ color: s.is_mother ? 0xe8b440 : 0x9aa392, transparent: true, opacity: s.is_mother ? 0.9 : 0.55, side: THREE.DoubleSide, depthWrite: false }),
       );
       ring.rotation.x = -Math.PI / 2;
       ring.position.set(s.x, r * 0.004, s.z);
@@ -165,6 +172,7 @@ export function createGardenMode(ctx, root) {
   function settings() {
     return {
       steps: readNumber(steps, "steps"),
+      spacing: readNumber(spacing, "spacing"),
       elevation: readNumber(elevation, "elevation"),
       azimuth: readNumber(azimuth, "azimuth"),
       children: readNumber(children, "children"),
@@ -193,7 +201,8 @@ export function createGardenMode(ctx, root) {
     if (examples.some((e) => e.name === "lsystem/herb")) example.value = "lsystem/herb";
     const plant = num("garden-new-plant", "", { min: 1, step: 1, width: "6em" });
     plant.addEventListener("input", () => (fromPlant.checked = true));
-    const nSteps = num("garden-new-steps", 40, { min: 0, max: 1000, step: 1, width: "5em" });
+    const nSteps = num("garden-new-steps", STEPS, { min: 0, max: 1000, step: 1, width: "5em" });
+    const nSpacing = num("garden-new-spacing", SPACING, { min: 0.25, max: 2.5, step: 0.05, width: "4.5em" });
     const nElevation = num("garden-new-elevation", 90, { min: 0, max: 90, width: "4.5em" });
     const nAzimuth = num("garden-new-azimuth", 0, { min: 0, max: 360, width: "4.5em" });
     const nChildren = num("garden-new-children", 8, { min: 0, max: 8, step: 1, width: "3.5em" });
@@ -211,6 +220,7 @@ export function createGardenMode(ctx, root) {
             start,
             settings: {
               steps: readNumber(nSteps, "steps"),
+              spacing: readNumber(nSpacing, "spacing"),
               elevation: readNumber(nElevation, "elevation"),
               azimuth: readNumber(nAzimuth, "azimuth"),
               children: readNumber(nChildren, "children"),
@@ -231,7 +241,7 @@ export function createGardenMode(ctx, root) {
         h("label", { class: "row" }, fromEmpty, " start from empty rules"),
         h("label", { class: "row" }, fromPlant, " archived plant #", plant),
       ),
-      h("div", { class: "row" }, field("Steps", nSteps), field("Elevation °", nElevation), field("Azimuth °", nAzimuth), field("Children", nChildren)),
+      h("div", { class: "row" }, field("Steps", nSteps), field("Spacing m", nSpacing), field("Elevation °", nElevation), field("Azimuth °", nAzimuth), field("Children", nChildren)),
       h("div", { class: "buttons" }, create, cancel ? h("button", { testid: "new-cancel", onclick: cancel }, "Cancel") : null),
     );
   }
