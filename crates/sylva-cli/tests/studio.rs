@@ -781,6 +781,71 @@ fn obj_comes_as_one_zip_and_stl_for_printing() {
 }
 
 #[test]
+fn a_copied_binary_serves_the_page_from_any_folder() {
+    let dir = temp_dir("installed");
+    // As `cargo install` leaves it: the binary alone, run from a folder of its own.
+    let bin = dir.join("bin/sylva");
+    std::fs::create_dir_all(bin.parent().unwrap()).unwrap();
+    std::fs::copy(env!("CARGO_BIN_EXE_sylva"), &bin).unwrap();
+    let work = dir.join("elsewhere");
+    std::fs::create_dir_all(&work).unwrap();
+    let mut child = Command::new(&bin)
+        .args(["studio", "--port", "0", "--db", "studio.db"])
+        .current_dir(&work)
+        .env_remove("SYLVA_STUDIO_WEB")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let address = line
+        .trim()
+        .strip_prefix("Sylva studio: http://")
+        .and_then(|u| u.strip_suffix('/'))
+        .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
+        .to_owned();
+    let server = Server {
+        child,
+        address,
+        token: None,
+    };
+    let web = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sylva-studio/web");
+    for (path, file) in [
+        ("/", web.join("index.html")),
+        ("/app/main.js", web.join("app/main.js")),
+        ("/app/viewer.js", web.join("app/viewer.js")),
+        (
+            "/vendor/three/build/three.module.js",
+            web.join("node_modules/three/build/three.module.js"),
+        ),
+        (
+            "/vendor/three/examples/jsm/loaders/GLTFLoader.js",
+            web.join("node_modules/three/examples/jsm/loaders/GLTFLoader.js"),
+        ),
+        (
+            "/vendor/three/LICENSE",
+            web.join("node_modules/three/LICENSE"),
+        ),
+    ] {
+        let (status, body) = request(&server, "GET", path, b"", true);
+        assert_eq!(status, 200, "{path}");
+        assert_eq!(
+            body,
+            std::fs::read(&file).unwrap(),
+            "{path} is {}",
+            file.display()
+        );
+    }
+    assert!(
+        work.join("studio.db").is_file(),
+        "the archive is made where it runs"
+    );
+}
+
+#[test]
 fn textures_are_served_only_for_what_a_real_plant_names() {
     let dir = temp_dir("textures");
     let server = start(&dir, "127.0.0.1");
