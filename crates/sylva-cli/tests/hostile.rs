@@ -4,6 +4,7 @@
 
 use std::fs;
 use std::path::Path;
+use std::process::{Command, Output};
 
 mod support;
 use support::{example, s, sylva, temp_dir};
@@ -365,5 +366,119 @@ fn a_glb_whose_nodes_share_children_is_refused_at_once() {
         "more than one parent",
     );
     assert!(start.elapsed().as_secs() < 10);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs sylva under an rlimit (`"as"`: the address space, `"data"`: the data segment) of
+/// `bytes`, set by util-linux's `prlimit`, or by the shell's `ulimit` where it is missing.
+fn sylva_limited(resource: &str, bytes: u64, args: &[&str]) -> Output {
+    let sylva = env!("CARGO_BIN_EXE_sylva");
+    let has_prlimit = Command::new("prlimit")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    let mut command = if has_prlimit {
+        let mut c = Command::new("prlimit");
+        c.arg(format!("--{resource}={bytes}")).arg("--").arg(sylva);
+        c
+    } else {
+        let flag = if resource == "as" { "-v" } else { "-d" };
+        let mut c = Command::new("sh");
+        c.arg("-c")
+            .arg(format!(
+                "ulimit {flag} {} && exec \"$0\" \"$@\"",
+                bytes / 1024
+            ))
+            .arg(sylva);
+        c
+    };
+    command
+        .args(args)
+        .output()
+        .expect("sylva runs under a limit")
+}
+
+#[test]
+fn the_memory_budget_knows_the_process_limits() {
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    let dir = temp_dir("rlimits");
+    let glb = dir.join("g.glb");
+    let conifer = example("plantmaker/conifer.json");
+    // 5000 conifers of 8 variants hold about 300 MiB of nodes (each carries its genome).
+    let garden = [
+        "garden",
+        &conifer,
+        "--count",
+        "5000",
+        "--variants",
+        "8",
+        "--area",
+        "100000x100000",
+        "-o",
+        s(&glb),
+    ];
+    for (resource, limit) in [
+        ("as", "RLIMIT_AS 256.0 MiB"),
+        ("data", "RLIMIT_DATA 256.0 MiB"),
+    ] {
+        let out = sylva_limited(resource, 256 << 20, &garden);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{resource}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        for part in [
+            "conifer.json",
+            "a garden of 5000 plants",
+            "would need about",
+            limit,
+        ] {
+            assert!(
+                stderr.contains(part),
+                "{resource}: expected {part:?} in {stderr}"
+            );
+        }
+        assert!(!glb.exists());
+        // A budget that ignores the limit (as the default did, half the machine's memory)
+        // lets the same garden start, and the allocator kills it.
+        let mut ignoring = garden.to_vec();
+        ignoring.extend(["--max-memory", "64G"]);
+        let out = sylva_limited(resource, 256 << 20, &ignoring);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.code().is_none() && stderr.contains("memory allocation of"),
+            "{resource}: {:?} {stderr}",
+            out.status
+        );
+        assert!(!glb.exists());
+    }
+    // The documented maximum under a 4 GiB address space: refused before a plant grows
+    // but the first, for the GLB it would write and, as a forest of variants, for memory.
+    let max = [
+        "garden",
+        &conifer,
+        "--count",
+        "100000",
+        "--area",
+        "100000x100000",
+        "-o",
+        s(&glb),
+    ];
+    let out = sylva_limited("as", 4 << 30, &max);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("more than the 4 GiB a GLB can hold"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("`--variants K`"), "{stderr}");
+    let mut variants = max.to_vec();
+    variants.extend(["--variants", "8"]);
+    let out = sylva_limited("as", 4 << 30, &variants);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("a garden of 100000 plants"), "{stderr}");
+    assert!(stderr.contains("RLIMIT_AS 4.0 GiB"), "{stderr}");
+    assert!(!glb.exists());
     fs::remove_dir_all(&dir).unwrap();
 }

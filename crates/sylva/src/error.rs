@@ -170,6 +170,10 @@ impl Error {
     pub fn is_limit(&self) -> bool {
         use sylva_mesh::export::ExportError;
         use sylva_mesh::mesher::MeshError;
+        // `Export` is transparent: its source is the export error's source, not itself.
+        if matches!(self, Error::Export(ExportError::TooLarge { .. })) {
+            return true;
+        }
         let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(self);
         while let Some(e) = cause {
             let limit = e.is::<sylva_core::budget::OverBudget>()

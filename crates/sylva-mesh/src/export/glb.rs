@@ -207,6 +207,19 @@ pub fn to_glb_with(scene: &Scene, options: &GlbOptions) -> Result<Vec<u8>, Expor
     Ok(out)
 }
 
+/// Bytes `mesh` adds to the binary chunk of a GLB laid out with `options` (the mesh
+/// without a rig): `(each, once)`, what each copy of the mesh adds and what the first adds
+/// besides (its embedded textures). Estimates of large scenes multiply them before the
+/// other meshes are made.
+pub fn mesh_binary_bytes(mesh: &Mesh, options: &GlbOptions) -> Result<(u64, u64), ExportError> {
+    let mut w = Writer::new(Counter(0), options.quantize);
+    w.mesh(mesh, "", None)?;
+    let first = w.bin.len() as u64;
+    w.mesh(mesh, "", None)?;
+    let each = w.bin.len() as u64 - first;
+    Ok((each, first.saturating_sub(each)))
+}
+
 /// A GLB laid out and ready to stream: its JSON is built and its length known; its binary
 /// data is made only while [`Glb::write_to`] writes it. Every check is done when it is made,
 /// so writing fails only on I/O.
