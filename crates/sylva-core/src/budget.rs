@@ -24,11 +24,18 @@
 //! them needs no system call of our own; [`Limits`] holds what was read and
 //! [`Limits::budget`] chooses, so the choice is tested on text. Estimates are of the large
 //! buffers a step allocates (plants, meshes, files, voxels, populations), not of every byte.
+//!
+//! Time has a budget too, for work whose length a legal input can make absurd (L-system
+//! plants at their bounds in a large world): work estimated to take longer than
+//! [`max_time`] before its results are written (one hour unless [`set_max_time`], the
+//! command line's `--max-time`, says otherwise) is refused by [`check_time`] with its
+//! estimate and what to change.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
 
 const GIB: u64 = 1 << 30;
 
@@ -425,6 +432,119 @@ pub fn check(
     }
 }
 
+/// The time budget by default: an hour.
+pub const DEFAULT_MAX_TIME: Duration = Duration::from_secs(3600);
+
+/// The time budget set by [`set_max_time`], in milliseconds; 0 means the default.
+static MAX_TIME_MS: AtomicU64 = AtomicU64::new(0);
+
+/// The time budget in force.
+pub fn max_time() -> Duration {
+    match MAX_TIME_MS.load(Ordering::Relaxed) {
+        0 => DEFAULT_MAX_TIME,
+        ms => Duration::from_millis(ms),
+    }
+}
+
+/// Sets the time budget for the rest of the process (zero goes back to the default).
+pub fn set_max_time(budget: Duration) {
+    let ms = u64::try_from(budget.as_millis()).unwrap_or(u64::MAX);
+    MAX_TIME_MS.store(ms, Ordering::Relaxed);
+}
+
+/// A length of time, shown in seconds, minutes, hours or days.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+pub struct Seconds(pub f64);
+
+impl fmt::Display for Seconds {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = self.0;
+        if !s.is_finite() {
+            write!(f, "forever")
+        } else if s < 10.0 {
+            write!(f, "{s:.1} s")
+        } else if s < 120.0 {
+            write!(f, "{s:.0} s")
+        } else if s < 3600.0 {
+            write!(f, "{:.1} min", s / 60.0)
+        } else if s < 172_800.0 {
+            write!(f, "{:.1} h", s / 3600.0)
+        } else if s < 3.156e8 {
+            write!(f, "{:.0} days", s / 86_400.0)
+        } else if s < 3.156e11 {
+            write!(f, "{:.0} years", s / 3.156e7)
+        } else {
+            write!(f, "{:.1e} years", s / 3.156e7)
+        }
+    }
+}
+
+/// Work that would take longer than the time budget.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "{what} would take up to about {estimate}, more than the time budget of {budget} \
+     ({set_by}); {advice}"
+)]
+pub struct OverTime {
+    /// What was asked for, and of which fields or flags it follows.
+    pub what: String,
+    /// The estimate.
+    pub estimate: Seconds,
+    /// The budget.
+    pub budget: Seconds,
+    /// `"set with `--max-time`"`, or the default and how to change it.
+    pub set_by: &'static str,
+    /// What to change.
+    pub advice: String,
+}
+
+/// Refuses work estimated to take `seconds`, more than the time budget. `what` names the
+/// work and the fields or flags it follows; `advice` says what to change.
+pub fn check_time(
+    seconds: f64,
+    what: impl fmt::Display,
+    advice: impl fmt::Display,
+) -> Result<(), OverTime> {
+    let budget = max_time().as_secs_f64();
+    if seconds <= budget {
+        return Ok(());
+    }
+    Err(OverTime {
+        what: what.to_string(),
+        estimate: Seconds(seconds),
+        budget: Seconds(budget),
+        set_by: match MAX_TIME_MS.load(Ordering::Relaxed) {
+            0 => "the default; set another with `--max-time`",
+            _ => "set with `--max-time`",
+        },
+        advice: advice.to_string(),
+    })
+}
+
+/// Parses a length of time: seconds, or a number with `s`, `m` (minutes), `h` or `d`.
+pub fn parse_duration(text: &str) -> Result<Duration, String> {
+    let bad = || format!("expected a time like 90s, 10m, 2h or 1d; got {text:?}");
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let value: f64 = number.parse().map_err(|_| bad())?;
+    let scale = match unit.trim() {
+        "" | "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        "d" => 86_400.0,
+        _ => return Err(bad()),
+    };
+    let seconds = value * scale;
+    if seconds.is_finite() && (0.001..=1e12).contains(&seconds) {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(bad())
+    }
+}
+
 /// Parses a size: a whole number of bytes, or a number with `K`, `M`, `G` or `T` (powers of
 /// 1024; `KiB`, `MB` and the like are read the same way).
 pub fn parse_bytes(text: &str) -> Result<u64, String> {
@@ -471,6 +591,46 @@ mod tests {
         }
         assert_eq!(Bytes(512).to_string(), "512 bytes");
         assert_eq!(Bytes(3 << 29).to_string(), "1.5 GiB");
+    }
+
+    #[test]
+    fn times_read_and_show() {
+        assert_eq!(parse_duration("90s"), Ok(Duration::from_secs(90)));
+        assert_eq!(parse_duration("10m"), Ok(Duration::from_secs(600)));
+        assert_eq!(parse_duration("1.5h"), Ok(Duration::from_secs(5400)));
+        assert_eq!(parse_duration("2d"), Ok(Duration::from_secs(172_800)));
+        assert_eq!(parse_duration("45"), Ok(Duration::from_secs(45)));
+        for bad in ["", "h", "-1h", "5w", "0", "1e400"] {
+            assert!(parse_duration(bad).is_err(), "{bad}");
+        }
+        let shown = |s: f64| Seconds(s).to_string();
+        assert_eq!(shown(2.25), "2.2 s");
+        assert_eq!(shown(95.0), "95 s");
+        assert_eq!(shown(330.0), "5.5 min");
+        assert_eq!(shown(9000.0), "2.5 h");
+        assert_eq!(shown(864_000.0), "10 days");
+        assert_eq!(shown(1.767e10), "560 years");
+        assert_eq!(shown(3.156e11), "1.0e4 years");
+        assert_eq!(shown(f64::INFINITY), "forever");
+    }
+
+    #[test]
+    fn work_over_the_time_budget_is_refused() {
+        // The default budget (no test in this crate sets another).
+        assert_eq!(max_time(), DEFAULT_MAX_TIME);
+        assert!(check_time(3599.0, "x", "y").is_ok());
+        let e = check_time(
+            7200.0,
+            "a breeding round of 9 plants",
+            "lower `max_symbols`",
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a breeding round of 9 plants would take up to about 2.0 h, more than the time \
+             budget of 1.0 h (the default; set another with `--max-time`); lower \
+             `max_symbols`"
+        );
     }
 
     #[test]
