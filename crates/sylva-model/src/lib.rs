@@ -305,6 +305,30 @@ pub trait Evolve: Model {
     fn genome_bytes(&self, _settings: &Self::Settings) -> u64 {
         4096
     }
+
+    /// How long one evaluation may take at the settings' bounds, for a model whose genomes
+    /// can take long to grow (an L-system plant grows step by step in a voxel world);
+    /// `None`, the default, for models whose genomes grow in milliseconds. `start` is the
+    /// run's first start genome, if any. A run whose generation would take longer than the
+    /// time budget is refused before it starts.
+    fn evaluation_time(
+        &self,
+        _settings: &Self::Settings,
+        _start: Option<&Self::Genome>,
+    ) -> Option<EvaluationTime> {
+        None
+    }
+}
+
+/// How long one evaluation may take ([`Evolve::evaluation_time`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EvaluationTime {
+    /// Seconds on one core, at the settings' bounds.
+    pub seconds: f64,
+    /// What an evaluation does, naming the settings it follows.
+    pub what: String,
+    /// What to change to make it shorter.
+    pub advice: String,
 }
 
 /// What [`Evolve::setup`] makes.
