@@ -25,6 +25,11 @@ struct Cli {
     /// is least]. Work that would need more is refused before it starts, with its estimate.
     #[arg(long, global = true, value_parser = sylva_core::budget::parse_bytes)]
     max_memory: Option<u64>,
+    /// Longest Sylva may work before it writes results, like 90s, 10m or 2h [default: 1h]:
+    /// L-system growth (a breeding round, an experiment, a generation of a run) estimated to
+    /// take longer is refused before it starts, with its estimate.
+    #[arg(long, global = true, value_parser = sylva_core::budget::parse_duration)]
+    max_time: Option<std::time::Duration>,
     #[command(subcommand)]
     command: Command,
 }
@@ -65,6 +70,9 @@ fn main() -> ExitCode {
         None => {
             sylva_core::budget::default_budget();
         }
+    }
+    if let Some(time) = cli.max_time {
+        sylva_core::budget::set_max_time(time);
     }
     let command = cli.command;
     // A panic would be a bug in Sylva: it is reported as one, in one line, with exit code 1.

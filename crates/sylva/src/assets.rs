@@ -331,6 +331,48 @@ impl SceneAssets {
     }
 }
 
+/// Refuses, before any mesh is made, a scene of `placed` plants whose GLB would pass the
+/// 4 GiB a GLB can hold even at the fewest bytes its meshes can take
+/// ([`export::mesh_binary_floor`] of their exact counts; plants placed more than once are
+/// counted once). Errors name `source`; `advice` says what to change.
+pub fn check_scene_glb(
+    placed: &[Placed<'_>],
+    quantize: bool,
+    source: &Path,
+    advice: &str,
+) -> Result<(), Error> {
+    let mut seen = std::collections::HashSet::new();
+    let mut meshers: Vec<(MeshHint, Mesher)> = Vec::new();
+    let mut floor = 0u64;
+    for p in placed {
+        if !seen.insert(p.plant as *const Plant) {
+            continue;
+        }
+        let mesher = mesher_for(&mut meshers, p.hint)?;
+        let counts = mesher
+            .counts(p.plant)
+            .map_err(|e| Error::from(e).in_file(source))?;
+        floor = floor.saturating_add(export::mesh_binary_floor(
+            counts.vertices as u64,
+            counts.triangles as u64,
+            quantize,
+        ));
+    }
+    if floor > u64::from(u32::MAX) {
+        return Err(InputError::file(
+            source,
+            format!(
+                "a scene of {} plants would make a GLB of at least {}, more than the 4 GiB a \
+                 GLB can hold; {advice}",
+                placed.len(),
+                sylva_core::budget::Bytes(floor)
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
 /// Grows a PlantMaker garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...),
 /// each standing at its placement and carrying its genome and seed. Errors name `source`,
 /// the garden's file (or whatever a front end calls it).
