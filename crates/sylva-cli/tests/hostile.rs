@@ -616,6 +616,29 @@ fn maximal_lsystem_work_is_estimated_before_it_starts() {
     );
     assert_eq!(estimate_in(&stderr), estimate);
     assert!(out.join("specimens.csv").exists());
+    // Grown alone, with leaves and fine roots of 2 m (32 voxel samples each): announced
+    // likewise, and refused under a budget below its estimate.
+    let mut long = maximal_lsystem(false);
+    for module in ["leaf", "fine_root"] {
+        long["modules"][module]["length"] = 2.0.into();
+    }
+    let long_file = dir.join("long.json");
+    fs::write(&long_file, long.to_string()).unwrap();
+    let glb = dir.join("one.glb");
+    let done = sylva(&["grow", s(&long_file), "-o", s(&glb)]);
+    let stderr = String::from_utf8_lossy(&done.stderr);
+    assert!(done.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("note: growing the plant may take up to about"),
+        "{stderr}"
+    );
+    assert!(estimate_in(&stderr) > 60.0, "{stderr}");
+    let stderr = refused(
+        &["grow", s(&genome), "-o", s(&glb), "--max-time", "20s"],
+        2,
+        "growing a plant 150 steps, up to 1000000 symbols a compartment",
+    );
+    assert!(stderr.contains("time budget of 20 s"), "{stderr}");
     fs::remove_dir_all(&dir).unwrap();
 }
 

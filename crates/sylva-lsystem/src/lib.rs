@@ -110,6 +110,13 @@ impl Model for LSystemModel {
     fn mesh_hint(&self) -> MeshHint {
         MeshHint { round_caps: true }
     }
+
+    /// The work of growing it alone in the default world ([`work`]).
+    fn growth_seconds(&self, genome: &LSystemGenome) -> Option<f64> {
+        let grow = garden::GrowSettings::default();
+        let sowing = garden::Sowing::new(genome.clone(), sylva_core::glam::Vec2::ZERO);
+        Some(work::garden(&grow.world, &[sowing], grow.steps, work::Rules::Known).seconds(1))
+    }
 }
 
 impl Evolve for LSystemModel {

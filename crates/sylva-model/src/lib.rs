@@ -149,6 +149,13 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn mesh_hint(&self) -> MeshHint {
         MeshHint::default()
     }
+
+    /// Seconds growing `genome` may take on one core, estimated before it grows, for a
+    /// model whose growth can take long (L-system plants grow step by step in a voxel
+    /// world); `None`, the default, for models whose plants grow in milliseconds.
+    fn growth_seconds(&self, _genome: &Self::Genome) -> Option<f64> {
+        None
+    }
 }
 
 /// How a model's plants are best meshed: facts about the model's shapes, which the library

@@ -30,6 +30,43 @@ pub fn announce(seconds: f64, what: impl Display, advice: &str) {
     }
 }
 
+/// A spinner shown while a genome grows, taken off the screen when dropped.
+pub struct Growing(Option<ProgressBar>);
+
+impl Drop for Growing {
+    fn drop(&mut self) {
+        if let Some(spinner) = &self.0 {
+            spinner.finish_and_clear();
+        }
+    }
+}
+
+/// Before a genome grows alone (`grow`, `render`): announces growth that may take a minute
+/// or more, with a spinner showing the time spent until the result is dropped.
+pub fn growing(genome: &sylva::Genome) -> Growing {
+    Growing(growing_spinner(genome))
+}
+
+fn growing_spinner(genome: &sylva::Genome) -> Option<ProgressBar> {
+    let seconds = genome.growth_seconds()?;
+    announce(
+        seconds,
+        "growing the plant",
+        "lower `max_symbols` and `max_modules` in its `physiology`",
+    );
+    if seconds < ANNOUNCE_SECONDS {
+        return None;
+    }
+    let spinner = ProgressBar::new_spinner()
+        .with_style(
+            ProgressStyle::with_template("{spinner} growing ({elapsed}, up to about {msg})")
+                .expect("the template is valid"),
+        )
+        .with_message(Seconds(seconds).to_string());
+    spinner.enable_steady_tick(std::time::Duration::from_millis(250));
+    Some(spinner)
+}
+
 /// A progress bar over `len` units on stderr, named by `prefix` (drawn only on a
 /// terminal).
 pub fn progress_bar(len: u64, prefix: &'static str) -> ProgressBar {
