@@ -10,7 +10,8 @@
 //!   [`TreeMeasures`].
 //! - [`hull`]: the volume of a cloud of points' convex hull (a crown's envelope).
 //! - [`taper`]: the pipe model's radii for any grown plant.
-//! - [`budget`]: the memory a job may use, checked before the work starts.
+//! - [`budget`]: the memory a job may use (from the limits the process runs under) and the
+//!   time it may take, checked before the work starts.
 //! - [`hash`]: a stable hash for genome fingerprints.
 //! - [`io`]: atomic file writes.
 //! - [`par`]: the one seam where work goes parallel ([`par::Pool`]).

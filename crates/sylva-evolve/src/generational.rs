@@ -366,7 +366,7 @@ where
         let copy = |parent: usize, operator: Operator| {
             let genome = old[parent].genome.clone();
             let (fitness, evaluated) = if s.reevaluate || old[parent].fitness.is_none() {
-                (Some(problem.evaluate(&genome)), true)
+                (Some(crate::problem::evaluate(problem, &genome)), true)
             } else {
                 (old[parent].fitness, false)
             };
@@ -392,7 +392,7 @@ where
                     .crossover
                     .crossover(&old[a].genome, &old[b].genome, &mut rng);
                 Offspring {
-                    fitness: Some(problem.evaluate(&genome)),
+                    fitness: Some(crate::problem::evaluate(problem, &genome)),
                     genome,
                     operator: Operator::Crossover,
                     parents: [Some(a), Some(b)],
@@ -408,7 +408,7 @@ where
                 let mut genome = old[parent].genome.clone();
                 self.mutation.mutate(&mut genome, &mut rng);
                 Offspring {
-                    fitness: Some(problem.evaluate(&genome)),
+                    fitness: Some(crate::problem::evaluate(problem, &genome)),
                     genome,
                     operator: Operator::Mutation,
                     parents: [Some(parent), None],

@@ -1,7 +1,8 @@
 //! Sylva's generic evolution engine. It knows genomes and fitness, never plants.
 //!
 //! - [`Problem`]: a genome type, random genomes, and a fitness ([`Fitness`]: a total and
-//!   named terms; higher is better).
+//!   named terms; higher is better). Runs count their evaluations
+//!   ([`problem::evaluations`]), for progress bars.
 //! - [`Mutate`] and [`Crossover`]: variation operators, one method each, randomness passed in.
 //! - [`Strategy`]: how one generation becomes the next; [`MeanReplacement`] is Susinno's.
 //! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,

@@ -1,5 +1,7 @@
 //! What to evolve and how to score it.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use rand::Rng;
 
 use crate::fitness::Fitness;
@@ -20,4 +22,22 @@ pub trait Problem: Sync {
 
     /// A random genome.
     fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> Self::Genome;
+}
+
+/// Evaluations made by this process's runs so far.
+static EVALUATIONS: AtomicU64 = AtomicU64::new(0);
+
+/// Scores `genome` with `problem`, counting the evaluation ([`evaluations`]). The engine
+/// evaluates through it.
+pub fn evaluate<P: Problem>(problem: &P, genome: &P::Genome) -> Fitness {
+    let fitness = problem.evaluate(genome);
+    EVALUATIONS.fetch_add(1, Ordering::Relaxed);
+    fitness
+}
+
+/// Evaluations made so far by every run of this process, counted as each ends: what a
+/// progress bar reads from another thread while a generation is bred (runs in parallel add
+/// to the same count; it decides nothing).
+pub fn evaluations() -> u64 {
+    EVALUATIONS.load(Ordering::Relaxed)
 }

@@ -176,8 +176,8 @@ where
             let mut child = self.crossover.crossover(&a.genome, &b.genome, &mut rng);
             self.mutation.mutate(&mut child, &mut rng);
             let random = problem.random_genome(&mut rng);
-            let child_fitness = problem.evaluate(&child);
-            let random_fitness = problem.evaluate(&random);
+            let child_fitness = crate::problem::evaluate(problem, &child);
+            let random_fitness = crate::problem::evaluate(problem, &random);
             if random_fitness.cmp_total(&child_fitness).is_gt() {
                 (random, random_fitness, false)
             } else {
@@ -215,7 +215,9 @@ pub fn evaluate_missing<P: Problem>(
         .collect();
     let scores: Vec<Fitness> = {
         let pop = &*population;
-        evaluator.map(todo.len(), |k| problem.evaluate(&pop[todo[k]].genome))
+        evaluator.map(todo.len(), |k| {
+            crate::problem::evaluate(problem, &pop[todo[k]].genome)
+        })
     };
     for (i, f) in todo.iter().zip(scores) {
         population[*i].fitness = Some(f);

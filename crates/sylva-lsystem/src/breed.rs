@@ -20,6 +20,7 @@ use crate::genome::{LSystemGenome, LSystemMutation};
 use crate::grammar::Module;
 use crate::growth::{BoundsHit, GrowingPlant};
 use crate::mutate::MutationRates;
+use crate::work::{self, Rules, Work};
 
 /// Most specimens in a breeding garden, as in the paper.
 pub const MAX_SPECIMENS: usize = 9;
@@ -153,22 +154,49 @@ pub fn grid_position(i: usize, spacing: f32) -> Vec2 {
 }
 
 /// Grows the given genomes together on the breeding grid (the first in the corner); each
-/// plant's share of a step runs on `pool`.
+/// plant's share of a step runs on `pool`. Refused before the first step when it would take
+/// longer than the time budget ([`breeding_work`]).
 pub fn grow_together(
     genomes: Vec<LSystemGenome>,
     settings: &BreedSettings,
     pool: &Pool,
 ) -> Result<BredGarden, GardenError> {
+    grow_together_with(genomes, settings, pool, &mut |_| {})
+}
+
+/// As [`grow_together`], calling `on_step` with the steps done after each (a progress bar).
+pub fn grow_together_with(
+    genomes: Vec<LSystemGenome>,
+    settings: &BreedSettings,
+    pool: &Pool,
+    on_step: &mut dyn FnMut(u32),
+) -> Result<BredGarden, GardenError> {
     if genomes.len() > MAX_SPECIMENS {
         return Err(GardenError::TooManyPlants(genomes.len()));
     }
-    let sowings = genomes
+    let sowings: Vec<Sowing> = genomes
         .into_iter()
         .enumerate()
         .map(|(i, g)| Sowing::new(g, grid_position(i, settings.spacing)))
         .collect();
+    if let Some(first) = sowings.first() {
+        work::garden(
+            &settings.grow.world,
+            &sowings,
+            settings.grow.steps,
+            Rules::Known,
+        )
+        .check(
+            pool.threads(),
+            format_args!(
+                "a breeding round of {}",
+                breeding_what(sowings.len(), settings, &first.genome)
+            ),
+            BREEDING_ADVICE,
+        )?;
+    }
     let mut garden = Garden::new(settings.grow.world, sowings)?;
-    garden.run(settings.grow.steps, pool)?;
+    garden.run_with(settings.grow.steps, pool, on_step)?;
     let records = garden.records().to_vec();
     let specimens = garden
         .plants()
@@ -185,14 +213,41 @@ pub fn grow_together(
     Ok(BredGarden { specimens, records })
 }
 
-/// The paper's design-loop garden: the mother in a corner and `settings.children` mutated
-/// children, grown together.
-pub fn breed_garden<R: Rng + ?Sized>(
+/// What to change when breeding would take too long.
+const BREEDING_ADVICE: &str = "lower `max_symbols` and `max_modules` in the mother's \
+     `physiology` (her children keep it), or her module lengths";
+
+/// "9 plants growing 150 steps, each up to ...".
+fn breeding_what(plants: usize, settings: &BreedSettings, mother: &LSystemGenome) -> String {
+    format!(
+        "{plants} plants growing {} steps, each up to {}",
+        settings.grow.steps,
+        work::bounds(&mother.physiology)
+    )
+}
+
+/// The work of growing `genomes` on the breeding grid ([`grow_together`]), at their bounds
+/// ([`crate::work`]).
+pub fn breeding_work(genomes: &[LSystemGenome], settings: &BreedSettings) -> Work {
+    let sowings: Vec<Sowing> = genomes
+        .iter()
+        .enumerate()
+        .map(|(i, g)| Sowing::new(g.clone(), grid_position(i, settings.spacing)))
+        .collect();
+    work::garden(
+        &settings.grow.world,
+        &sowings,
+        settings.grow.steps,
+        Rules::Known,
+    )
+}
+
+/// The mother and `settings.children` mutated children, as [`breed_garden`] sows them.
+pub fn breeding_genomes<R: Rng + ?Sized>(
     mother: &LSystemGenome,
     settings: &BreedSettings,
     rng: &mut R,
-    pool: &Pool,
-) -> Result<BredGarden, GardenError> {
+) -> Vec<LSystemGenome> {
     let mutation = LSystemMutation {
         rates: settings.rates,
         parameter_scale: 0.0,
@@ -213,7 +268,18 @@ pub fn breed_garden<R: Rng + ?Sized>(
         }
         genomes.push(child);
     }
-    grow_together(genomes, settings, pool)
+    genomes
+}
+
+/// The paper's design-loop garden: the mother in a corner and `settings.children` mutated
+/// children ([`breeding_genomes`]), grown together.
+pub fn breed_garden<R: Rng + ?Sized>(
+    mother: &LSystemGenome,
+    settings: &BreedSettings,
+    rng: &mut R,
+    pool: &Pool,
+) -> Result<BredGarden, GardenError> {
+    grow_together(breeding_genomes(mother, settings, rng), settings, pool)
 }
 
 /// The chooser of runs without a person: the specimen with the largest biomass. On a tie
@@ -271,15 +337,74 @@ pub fn evolve_biomorphs(
     settings: &BreedSettings,
     generations: u32,
     seed: u64,
-    mut choose: impl FnMut(&BredGarden) -> usize,
+    choose: impl FnMut(&BredGarden) -> usize,
     pool: &Pool,
 ) -> Result<BiomorphRun, GardenError> {
+    evolve_biomorphs_with(
+        start,
+        settings,
+        generations,
+        seed,
+        choose,
+        pool,
+        &mut |_| {},
+    )
+}
+
+/// The work of [`evolve_biomorphs`] for `generations` rounds from `start`: each round
+/// `settings.children + 1` plants at their bounds, with any rules and sizes mutation may
+/// give them ([`Rules::Any`]).
+pub fn biomorphs_work(start: &LSystemGenome, settings: &BreedSettings, generations: u32) -> Work {
+    let plants = settings.children.min(MAX_SPECIMENS - 1) + 1;
+    let sowings: Vec<Sowing> = (0..plants)
+        .map(|i| Sowing::new(start.clone(), grid_position(i, settings.spacing)))
+        .collect();
+    work::garden(
+        &settings.grow.world,
+        &sowings,
+        settings.grow.steps,
+        Rules::Any,
+    )
+    .times(u64::from(generations.max(1)))
+}
+
+/// As [`evolve_biomorphs`], calling `on_step` with the garden steps done so far, over all
+/// generations (a progress bar). Refused before the first round when the rounds would take
+/// longer than the time budget ([`biomorphs_work`]).
+pub fn evolve_biomorphs_with(
+    start: &LSystemGenome,
+    settings: &BreedSettings,
+    generations: u32,
+    seed: u64,
+    mut choose: impl FnMut(&BredGarden) -> usize,
+    pool: &Pool,
+    on_step: &mut dyn FnMut(u64),
+) -> Result<BiomorphRun, GardenError> {
+    biomorphs_work(start, settings, generations).check(
+        pool.threads(),
+        format_args!(
+            "{generations} breeding rounds (`generations`) of {}",
+            breeding_what(
+                settings.children.min(MAX_SPECIMENS - 1) + 1,
+                settings,
+                start
+            )
+        ),
+        format_args!("breed fewer generations or for fewer steps, or {BREEDING_ADVICE}"),
+    )?;
+    let steps = u64::from(settings.grow.steps);
     let mut mother = start.clone();
     let mut record = Vec::new();
     let mut last = None;
     for generation in 1..=generations {
         let mut rng = sylva_core::rng::stream(seed, generation, 0);
-        let garden = breed_garden(&mother, settings, &mut rng, pool)?;
+        let before = u64::from(generation - 1) * steps;
+        let garden = grow_together_with(
+            breeding_genomes(&mother, settings, &mut rng),
+            settings,
+            pool,
+            &mut |done| on_step(before + u64::from(done)),
+        )?;
         let chosen = choose(&garden).min(garden.specimens.len().saturating_sub(1));
         let specimen = &garden.specimens[chosen];
         record.push(BiomorphGeneration {

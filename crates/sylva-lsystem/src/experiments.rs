@@ -16,7 +16,9 @@
 //! itself ([`Simulation::genome_files`]). The model reads no files: the caller loads those
 //! genomes and passes them to [`Simulation::run`]. Each outcome holds its measured figures,
 //! the grown plants placed in the world with their genomes ([`SimulationOutcome::plants`])
-//! and the per-step records ([`SimulationOutcome::records`]).
+//! and the per-step records ([`SimulationOutcome::records`]). [`Simulation::work`] estimates
+//! an experiment before it starts, and it is refused when that is over the time budget
+//! ([`crate::work`]).
 
 use std::path::PathBuf;
 
@@ -27,9 +29,12 @@ use sylva_core::hull::convex_hull_volume;
 use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant, Segment};
 
-use crate::breed::{BiomorphRun, BreedSettings, evolve_biomorphs, largest_biomass};
+use crate::breed::{
+    BiomorphRun, BreedSettings, biomorphs_work, evolve_biomorphs_with, largest_biomass,
+};
 use crate::garden::{Garden, GardenError, MAX_STEPS, Sowing, StepRecord};
 use crate::genome::LSystemGenome;
+use crate::work::{self, Rules, Work};
 
 /// Why a simulation could not run.
 #[derive(Debug, thiserror::Error)]
@@ -49,6 +54,10 @@ pub enum ExperimentError {
     #[error(transparent)]
     Garden(#[from] GardenError),
 }
+
+/// What to change when an experiment would take too long.
+const EXPERIMENT_ADVICE: &str = "lower `max_symbols` and `max_modules` in the genomes' \
+     `physiology`, the steps, or the world's voxels";
 
 /// A world with its light set to `light`, everything else from `world`.
 fn with_light(world: &EnvironmentSettings, light: LightSettings) -> EnvironmentSettings {
@@ -286,6 +295,15 @@ impl HerbsUnderTree {
         herb: &LSystemGenome,
         pool: &Pool,
     ) -> Result<HerbsUnderTreeOutcome, ExperimentError> {
+        self.run_with(tree, herb, pool, &mut |_| {})
+    }
+
+    /// The tree and the herbs, as sown, with their labels.
+    fn sowings(
+        &self,
+        tree: &LSystemGenome,
+        herb: &LSystemGenome,
+    ) -> Result<(Vec<Sowing>, Vec<String>), ExperimentError> {
         if !(1..=64).contains(&self.herbs_per_ring) {
             return Err(ExperimentError::Config(format!(
                 "`herbs_per_ring` must be 1 to 64, got {}",
@@ -307,9 +325,49 @@ impl HerbsUnderTree {
                 labels.push(format!("herb {}", labels.len()));
             }
         }
+        Ok((sowings, labels))
+    }
+
+    /// The work of [`HerbsUnderTree::run`], at the plants' bounds.
+    pub fn work(
+        &self,
+        tree: &LSystemGenome,
+        herb: &LSystemGenome,
+    ) -> Result<Work, ExperimentError> {
+        let (sowings, _) = self.sowings(tree, herb)?;
+        let steps = self.head_start.saturating_add(self.steps);
+        Ok(work::garden(&self.world, &sowings, steps, Rules::Known))
+    }
+
+    /// As [`HerbsUnderTree::run`], calling `on_step` with the steps done after each.
+    pub fn run_with(
+        &self,
+        tree: &LSystemGenome,
+        herb: &LSystemGenome,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u64),
+    ) -> Result<HerbsUnderTreeOutcome, ExperimentError> {
+        let (sowings, labels) = self.sowings(tree, herb)?;
+        let n = self.herbs_per_ring;
+        self.work(tree, herb)?
+            .check(
+                pool.threads(),
+                format_args!(
+                    "a tree and {} herbs growing {} steps (`head_start` and `steps`), the tree up \
+                 to {} and each herb up to {}",
+                    2 * n,
+                    self.head_start.saturating_add(self.steps),
+                    work::bounds(&tree.physiology),
+                    work::bounds(&herb.physiology)
+                ),
+                EXPERIMENT_ADVICE,
+            )
+            .map_err(GardenError::from)?;
         let world = with_light(&self.world, vertical());
         let mut garden = Garden::new(world, sowings)?;
-        garden.run(self.head_start + self.steps, pool)?;
+        garden.run_with(self.head_start + self.steps, pool, &mut |done| {
+            on_step(u64::from(done))
+        })?;
         let herbs: Vec<HerbOutcome> = garden.plants()[1..]
             .iter()
             .enumerate()
@@ -436,6 +494,26 @@ impl LateralLight {
         tree: &LSystemGenome,
         pool: &Pool,
     ) -> Result<LateralLightOutcome, ExperimentError> {
+        self.run_with(tree, pool, &mut |_| {})
+    }
+
+    /// The work of [`LateralLight::run`] (two gardens of two trees), at the trees' bounds.
+    pub fn work(&self, tree: &LSystemGenome) -> Work {
+        let pair = [
+            Sowing::new(tree.clone(), Vec2::ZERO),
+            Sowing::new(tree.clone(), Vec2::ZERO),
+        ];
+        work::garden(&self.world, &pair, self.steps, Rules::Known).times(2)
+    }
+
+    /// As [`LateralLight::run`], calling `on_step` with the steps done after each, over both
+    /// gardens.
+    pub fn run_with(
+        &self,
+        tree: &LSystemGenome,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u64),
+    ) -> Result<LateralLightOutcome, ExperimentError> {
         let source = self.world.light.towards_source();
         let towards = Vec2::new(source.x, source.z);
         if towards.length() < 1e-3 {
@@ -443,19 +521,32 @@ impl LateralLight {
                 "lateral-light needs a light below 90 degrees of elevation".into(),
             ));
         }
+        self.work(tree)
+            .check(
+                pool.threads(),
+                format_args!(
+                    "two pairs of trees growing {} steps (`steps`), each up to {}",
+                    self.steps,
+                    work::bounds(&tree.physiology)
+                ),
+                EXPERIMENT_ADVICE,
+            )
+            .map_err(GardenError::from)?;
         // Side by side across the light.
         let across = Vec2::new(-towards.y, towards.x).normalize() * (0.5 * self.spacing);
-        let grow = |world: EnvironmentSettings| -> Result<Garden, ExperimentError> {
+        let mut grow = |world: EnvironmentSettings, before: u64| {
             let sowings = vec![
                 Sowing::new(tree.clone(), -across),
                 Sowing::new(tree.clone(), across),
             ];
             let mut garden = Garden::new(world, sowings)?;
-            garden.run(self.steps, pool)?;
-            Ok(garden)
+            garden.run_with(self.steps, pool, &mut |done| {
+                on_step(before + u64::from(done))
+            })?;
+            Ok::<Garden, ExperimentError>(garden)
         };
-        let lateral = grow(self.world)?;
-        let control = grow(with_light(&self.world, vertical()))?;
+        let lateral = grow(self.world, 0)?;
+        let control = grow(with_light(&self.world, vertical()), u64::from(self.steps))?;
         let shapes = |g: &Garden| [0, 1].map(|i| CrownShape::of(g.plants()[i].plant(), towards));
         let labels = ["tree 1".to_owned(), "tree 2".to_owned()];
         Ok(LateralLightOutcome {
@@ -526,19 +617,31 @@ impl EmptyRules {
         start: &LSystemGenome,
         pool: &Pool,
     ) -> Result<EmptyRulesOutcome, ExperimentError> {
+        self.run_with(start, pool, &mut |_| {})
+    }
+
+    /// As [`EmptyRules::run`], calling `on_step` with the garden steps done after each, over
+    /// all generations.
+    pub fn run_with(
+        &self,
+        start: &LSystemGenome,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u64),
+    ) -> Result<EmptyRulesOutcome, ExperimentError> {
         if !(1..=10_000).contains(&self.generations) {
             return Err(ExperimentError::Config(format!(
                 "`generations` must be 1 to 10000, got {}",
                 self.generations
             )));
         }
-        let run = evolve_biomorphs(
+        let run = evolve_biomorphs_with(
             start,
             &self.breed,
             self.generations,
             self.seed,
             largest_biomass,
             pool,
+            on_step,
         )?;
         let plants = run
             .last
@@ -611,6 +714,11 @@ impl Simulation {
         genomes: &[LSystemGenome],
         pool: &Pool,
     ) -> Result<SimulationOutcome, ExperimentError> {
+        self.run_with(genomes, pool, &mut |_| {})
+    }
+
+    /// The genomes, checked against the files the experiment names.
+    fn check_genomes(&self, genomes: &[LSystemGenome]) -> Result<(), ExperimentError> {
         let expected = self.genome_files().len();
         if genomes.len() != expected {
             return Err(ExperimentError::Genomes {
@@ -618,16 +726,51 @@ impl Simulation {
                 given: genomes.len(),
             });
         }
+        Ok(())
+    }
+
+    /// The work of the experiment with these genomes, at the plants' bounds
+    /// ([`crate::work`]); its `steps` are the garden steps that
+    /// [`run_with`](Simulation::run_with) counts.
+    pub fn work(&self, genomes: &[LSystemGenome]) -> Result<Work, ExperimentError> {
+        self.check_genomes(genomes)?;
         Ok(match self {
-            Simulation::HerbsUnderTree(c) => {
-                SimulationOutcome::HerbsUnderTree(c.run(&genomes[0], &genomes[1], pool)?)
+            Simulation::HerbsUnderTree(c) => c.work(&genomes[0], &genomes[1])?,
+            Simulation::LateralLight(c) => c.work(&genomes[0]),
+            Simulation::EmptyRules(c) => {
+                let empty = LSystemGenome::empty();
+                biomorphs_work(genomes.first().unwrap_or(&empty), &c.breed, c.generations)
             }
+        })
+    }
+
+    /// As [`Simulation::run`], calling `on_step` with the garden steps done after each (a
+    /// progress bar; [`Simulation::work`] says how many there are). Refused before the
+    /// first step when the experiment would take longer than the time budget.
+    pub fn run_with(
+        &self,
+        genomes: &[LSystemGenome],
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u64),
+    ) -> Result<SimulationOutcome, ExperimentError> {
+        self.check_genomes(genomes)?;
+        Ok(match self {
+            Simulation::HerbsUnderTree(c) => SimulationOutcome::HerbsUnderTree(c.run_with(
+                &genomes[0],
+                &genomes[1],
+                pool,
+                on_step,
+            )?),
             Simulation::LateralLight(c) => {
-                SimulationOutcome::LateralLight(c.run(&genomes[0], pool)?)
+                SimulationOutcome::LateralLight(c.run_with(&genomes[0], pool, on_step)?)
             }
             Simulation::EmptyRules(c) => {
                 let empty = LSystemGenome::empty();
-                SimulationOutcome::EmptyRules(c.run(genomes.first().unwrap_or(&empty), pool)?)
+                SimulationOutcome::EmptyRules(c.run_with(
+                    genomes.first().unwrap_or(&empty),
+                    pool,
+                    on_step,
+                )?)
             }
         })
     }

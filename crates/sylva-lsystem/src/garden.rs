@@ -88,6 +88,9 @@ pub enum GardenError {
     /// The plants at their bounds and the world would not fit in the memory budget.
     #[error("the garden does not fit in memory")]
     OverBudget(#[from] sylva_core::budget::OverBudget),
+    /// Growing would take longer than the time budget ([`crate::work`]).
+    #[error("growing would take too long")]
+    OverTime(#[from] sylva_core::budget::OverTime),
 }
 
 impl From<GardenError> for sylva_model::DevelopError {
@@ -263,13 +266,25 @@ impl Garden {
 
     /// Runs `steps` steps; each plant's share of a step runs on `pool`.
     pub fn run(&mut self, steps: u32, pool: &Pool) -> Result<(), GardenError> {
+        self.run_with(steps, pool, &mut |_| {})
+    }
+
+    /// As [`Garden::run`], calling `on_step` with the steps done after each (a progress
+    /// bar).
+    pub fn run_with(
+        &mut self,
+        steps: u32,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u32),
+    ) -> Result<(), GardenError> {
         if u64::from(self.step) + u64::from(steps) > u64::from(MAX_STEPS) {
             return Err(GardenError::TooManySteps(
                 u64::from(self.step) + u64::from(steps),
             ));
         }
-        for _ in 0..steps {
+        for done in 1..=steps {
             self.step(pool)?;
+            on_step(done);
         }
         Ok(())
     }

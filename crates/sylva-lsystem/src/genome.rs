@@ -411,12 +411,27 @@ impl LSystemGenome {
         self.develop_with(&GrowSettings::default(), seed)
     }
 
-    /// Grows the plant alone with the given world and time.
+    /// Grows the plant alone with the given world and time; refused before the first step
+    /// when that would take longer than the time budget ([`crate::work`]).
     pub fn develop_with(&self, settings: &GrowSettings, seed: u64) -> Result<Plant, DevelopError> {
-        let mut garden = Garden::new(
-            settings.world,
-            vec![Sowing::new(self.clone(), sylva_core::glam::Vec2::ZERO)],
-        )?;
+        let sowings = vec![Sowing::new(self.clone(), sylva_core::glam::Vec2::ZERO)];
+        crate::work::garden(
+            &settings.world,
+            &sowings,
+            settings.steps,
+            crate::work::Rules::Known,
+        )
+        .check(
+            1,
+            format_args!(
+                "growing a plant {} steps, up to {}",
+                settings.steps,
+                crate::work::bounds(&self.physiology)
+            ),
+            "lower `max_symbols` and `max_modules` in its `physiology`",
+        )
+        .map_err(crate::garden::GardenError::from)?;
+        let mut garden = Garden::new(settings.world, sowings)?;
         garden.run(settings.steps, &Pool::Serial)?;
         let mut plant = garden.into_plants().swap_remove(0);
         plant.meta_mut().seed = seed;

@@ -15,6 +15,8 @@
 //! - [`problem`]: runs without a person: the model's settings (the `[lsystem]` config) and
 //!   an [`sylva_evolve::Problem`] that grows each genome alone and scores it.
 //! - [`experiments`]: the paper's two simulations and the run from empty rules.
+//! - [`work`]: what growing costs, estimated at the bounds before it starts and held to the
+//!   time budget.
 //!
 //! ```
 //! use sylva_lsystem::{LSystemGenome, garden::GrowSettings};
@@ -41,6 +43,7 @@ pub mod interpret;
 pub mod mutate;
 pub mod physiology;
 pub mod problem;
+pub mod work;
 
 pub use genome::{CompartmentCrossover, LSystemGenome, LSystemMutation};
 pub use problem::{LSystemProblem, LSystemSettings, LSystemStrategy, Score};
@@ -49,8 +52,8 @@ use rand::Rng;
 use sylva_core::Plant;
 use sylva_evolve::{Crossover, Mutate};
 use sylva_model::{
-    Bred, ConfigError, DevelopError, Evolve, MeshHint, Model, Parent, Setup, VariationError,
-    two_most_dominant,
+    Bred, ConfigError, DevelopError, EvaluationTime, Evolve, MeshHint, Model, Parent, Setup,
+    VariationError, two_most_dominant,
 };
 
 /// Bornhofen and Lattaud's virtual plants as a Sylva model. A genome grows alone in the
@@ -107,6 +110,13 @@ impl Model for LSystemModel {
     fn mesh_hint(&self) -> MeshHint {
         MeshHint { round_caps: true }
     }
+
+    /// The work of growing it alone in the default world ([`work`]).
+    fn growth_seconds(&self, genome: &LSystemGenome) -> Option<f64> {
+        let grow = garden::GrowSettings::default();
+        let sowing = garden::Sowing::new(genome.clone(), sylva_core::glam::Vec2::ZERO);
+        Some(work::garden(&grow.world, &[sowing], grow.steps, work::Rules::Known).seconds(1))
+    }
 }
 
 impl Evolve for LSystemModel {
@@ -150,5 +160,31 @@ impl Evolve for LSystemModel {
 
     fn genome_file(&self, _problem: &LSystemProblem, genome: &LSystemGenome) -> LSystemGenome {
         genome.clone()
+    }
+
+    /// One genome grown alone for the settings' steps, at the start genome's bounds (its
+    /// physiology stays over the run) with any rules and module sizes mutation may give it.
+    fn evaluation_time(
+        &self,
+        settings: &LSystemSettings,
+        start: Option<&LSystemGenome>,
+    ) -> Option<EvaluationTime> {
+        let empty = LSystemGenome::empty();
+        let start = start.unwrap_or(&empty);
+        let grow = &settings.grow;
+        let sowing = garden::Sowing::new(start.clone(), sylva_core::glam::Vec2::ZERO);
+        let work = work::garden(&grow.world, &[sowing], grow.steps, work::Rules::Any);
+        Some(EvaluationTime {
+            seconds: work.seconds(1),
+            what: format!(
+                "growing {} steps (`[lsystem.grow] steps`) in a world of {:?} voxels, up to {}",
+                grow.steps,
+                grow.world.size,
+                work::bounds(&start.physiology)
+            ),
+            advice: "lower `max_symbols` and `max_modules` in the start genome's `physiology`, \
+                     the steps or the world, or breed a smaller `population`"
+                .into(),
+        })
     }
 }

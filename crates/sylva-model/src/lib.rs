@@ -149,6 +149,13 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn mesh_hint(&self) -> MeshHint {
         MeshHint::default()
     }
+
+    /// Seconds growing `genome` may take on one core, estimated before it grows, for a
+    /// model whose growth can take long (L-system plants grow step by step in a voxel
+    /// world); `None`, the default, for models whose plants grow in milliseconds.
+    fn growth_seconds(&self, _genome: &Self::Genome) -> Option<f64> {
+        None
+    }
 }
 
 /// How a model's plants are best meshed: facts about the model's shapes, which the library
@@ -305,6 +312,30 @@ pub trait Evolve: Model {
     fn genome_bytes(&self, _settings: &Self::Settings) -> u64 {
         4096
     }
+
+    /// How long one evaluation may take at the settings' bounds, for a model whose genomes
+    /// can take long to grow (an L-system plant grows step by step in a voxel world);
+    /// `None`, the default, for models whose genomes grow in milliseconds. `start` is the
+    /// run's first start genome, if any. A run whose generation would take longer than the
+    /// time budget is refused before it starts.
+    fn evaluation_time(
+        &self,
+        _settings: &Self::Settings,
+        _start: Option<&Self::Genome>,
+    ) -> Option<EvaluationTime> {
+        None
+    }
+}
+
+/// How long one evaluation may take ([`Evolve::evaluation_time`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EvaluationTime {
+    /// Seconds on one core, at the settings' bounds.
+    pub seconds: f64,
+    /// What an evaluation does, naming the settings it follows.
+    pub what: String,
+    /// What to change to make it shorter.
+    pub advice: String,
 }
 
 /// What [`Evolve::setup`] makes.

@@ -229,9 +229,14 @@ pub fn place(
     let mut order: Vec<usize> = (0..radii.len()).collect();
     order.sort_by(|&a, &b| radii[b].total_cmp(&radii[a]));
     let largest = radii.iter().copied().fold(0.0f32, f32::max);
-    // A grid of cells two largest radii wide: a circle can only touch circles whose centres
-    // lie in its own cell or the eight around it.
-    let cell = (2.0 * largest).max(1e-3);
+    // A grid of cells at least two largest radii wide: a circle can only touch circles whose
+    // centres lie in its own cell or the eight around it. Cells are widened so there are
+    // about four per plant at most: a huge plot of few plants needs no grid of millions of
+    // empty cells (which cells hold a plant changes only how many are looked at, not where
+    // the plants go).
+    let spread =
+        ((f64::from(width) * f64::from(depth)) / (4.0 * radii.len().max(1) as f64)).sqrt() as f32;
+    let cell = (2.0 * largest).max(spread).max(1e-3);
     let (cols, rows) = (
         ((width / cell).ceil() as usize).clamp(1, 4096),
         ((depth / cell).ceil() as usize).clamp(1, 4096),

@@ -165,14 +165,20 @@ impl Error {
         matches!(self, Error::Input(_))
     }
 
-    /// A refusal of legal input that asks for more than a limit or the memory budget allows
-    /// (a plant, mesh or file too large): the user's to change, like bad input.
+    /// A refusal of legal input that asks for more than a limit or the memory or time budget
+    /// allows (a plant, mesh or file too large, growth too long): the user's to change, like
+    /// bad input.
     pub fn is_limit(&self) -> bool {
         use sylva_mesh::export::ExportError;
         use sylva_mesh::mesher::MeshError;
+        // `Export` is transparent: its source is the export error's source, not itself.
+        if matches!(self, Error::Export(ExportError::TooLarge { .. })) {
+            return true;
+        }
         let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(self);
         while let Some(e) = cause {
             let limit = e.is::<sylva_core::budget::OverBudget>()
+                || e.is::<sylva_core::budget::OverTime>()
                 || matches!(e.downcast_ref(), Some(DevelopError::TooLarge { .. }))
                 || matches!(
                     e.downcast_ref(),

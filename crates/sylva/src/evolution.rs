@@ -332,6 +332,23 @@ pub struct Config {
     source: Option<PathBuf>,
 }
 
+/// Evaluations made so far by every run of this process, for a progress bar to read from
+/// another thread while a generation is bred ([`sylva_evolve::problem::evaluations`]).
+pub fn evaluations_done() -> u64 {
+    sylva_evolve::problem::evaluations()
+}
+
+/// How long a generation of a run may take ([`Config::generation_time`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenerationTime {
+    /// Seconds, at the settings' bounds.
+    pub seconds: f64,
+    /// What a generation does, naming the settings it follows.
+    pub what: String,
+    /// What to change to make it shorter.
+    pub advice: String,
+}
+
 /// What every typed config can do, object-safe. Implemented once, for [`EvolveConfig`].
 trait AnyConfig: Send + Sync {
     fn model(&self) -> &'static str;
@@ -345,6 +362,7 @@ trait AnyConfig: Send + Sync {
     fn start(&self, source: &str, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error>;
     fn resume(&self, source: &str, path: &Path, text: &str, pool: Pool)
     -> Result<Evolution, Error>;
+    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime>;
 }
 
 impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
@@ -404,6 +422,11 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
         )
         .map_err(|e| InputError::new(source, e))?;
         let setup = setup(&self.model, &self.settings, typed, seed, population, source)?;
+        // The settings are valid; generation 0 grows as the run is made.
+        if let Some(t) = self.generation_time(&start, pool.threads()) {
+            sylva_core::budget::check_time(t.seconds, t.what, t.advice)
+                .map_err(|e| InputError::new(source, e))?;
+        }
         let settings = RunSettings {
             seed,
             population,
@@ -414,6 +437,27 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
         let evolution = Evolution::typed(self.clone(), run);
         evolution.check_finite(source)?;
         Ok(evolution)
+    }
+
+    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
+        let first = start.first().and_then(|g| g.get::<M>());
+        let t = self.model.evaluation_time(&self.settings, first)?;
+        let population = self.run.population as usize;
+        // A generation evaluates up to `population` genomes, side by side on the threads.
+        let threads = threads.clamp(1, population.max(1));
+        let rounds = population.div_ceil(threads);
+        let on = match threads {
+            1 => "1 thread".to_owned(),
+            n => format!("{n} threads"),
+        };
+        Some(GenerationTime {
+            seconds: t.seconds * rounds as f64,
+            what: format!(
+                "a generation of {population} genomes (`population`) on {on}, each {}",
+                t.what
+            ),
+            advice: t.advice,
+        })
     }
 
     fn resume(
@@ -544,6 +588,14 @@ impl Config {
     /// to the config file.
     pub fn start_files(&self) -> Vec<PathBuf> {
         self.inner.start_files()
+    }
+
+    /// How long a generation of this run may take on `threads` threads, for models whose
+    /// genomes can take long to grow (L-system plants); `None` for the others. `start` holds
+    /// the start genomes ([`Config::load_start`]). [`Evolution::start`] refuses a run whose
+    /// generation is over the time budget.
+    pub fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
+        self.inner.generation_time(start, threads)
     }
 
     /// Reads the genome files of [`Config::start_files`] from `base` (the config file's

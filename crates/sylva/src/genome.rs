@@ -33,6 +33,7 @@ trait AnyGenome: Send + Sync {
     fn develop(&self, seed: u64) -> Result<Plant, DevelopError>;
     fn default_seed(&self) -> u64;
     fn mesh_hint(&self) -> MeshHint;
+    fn growth_seconds(&self) -> Option<f64>;
     fn same(&self, other: &dyn AnyGenome) -> bool;
     fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError>;
     fn cross(
@@ -94,6 +95,10 @@ impl<M: Model> AnyGenome for Typed<M> {
 
     fn mesh_hint(&self) -> MeshHint {
         self.model.mesh_hint()
+    }
+
+    fn growth_seconds(&self) -> Option<f64> {
+        self.model.growth_seconds(&self.genome)
     }
 
     fn same(&self, other: &dyn AnyGenome) -> bool {
@@ -194,6 +199,12 @@ impl Genome {
     /// How the model's plants are best meshed.
     pub fn mesh_hint(&self) -> MeshHint {
         self.inner.mesh_hint()
+    }
+
+    /// Seconds growing it may take on one core, for models whose growth can take long
+    /// (L-system plants); `None` for the others.
+    pub fn growth_seconds(&self) -> Option<f64> {
+        self.inner.growth_seconds()
     }
 
     /// A mutated copy, made by the model's own mutation with `settings` (the model's

@@ -5,14 +5,14 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, picture};
+use sylva::assets::{Origin, Placed, SceneAssets, check_scene_glb, picture};
 use sylva::files::Outputs;
 use sylva::genome::load_genome_of;
 use sylva::{Genome, InputError};
 use sylva_core::glam::Vec3;
 use sylva_core::{MaterialKind, Plant};
 use sylva_lsystem::LSystemModel;
-use sylva_lsystem::breed::{BreedSettings, breed_garden};
+use sylva_lsystem::breed::{BreedSettings, breeding_genomes, breeding_work, grow_together_with};
 use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva_mesh::{Scene, SceneNode};
 use sylva_model::Model;
@@ -50,8 +50,22 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
     };
     let pool = super::pool(args.threads)?;
     let mut rng = sylva_core::rng::seeded(args.seed);
-    let garden = breed_garden(&mother, &settings, &mut rng, &pool)
-        .map_err(|e| InputError::file_error(&args.mother, &e))?;
+    let genomes = breeding_genomes(&mother, &settings, &mut rng);
+    super::announce(
+        breeding_work(&genomes, &settings).seconds(pool.threads()),
+        format_args!(
+            "growing {} plants for {} steps",
+            genomes.len(),
+            settings.grow.steps
+        ),
+        "lower `max_symbols` and `max_modules` in the mother's `physiology`",
+    );
+    let bar = super::progress_bar(u64::from(settings.grow.steps), "growing: step");
+    let garden = grow_together_with(genomes, &settings, &pool, &mut |step| {
+        bar.set_position(u64::from(step))
+    })
+    .map_err(|e| InputError::file_error(&args.mother, &e))?;
+    bar.finish_and_clear();
     let mut out = Outputs::new();
     out.create_dir(&args.out)?;
     let shown: Vec<Plant> = garden
@@ -86,6 +100,12 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
+    check_scene_glb(
+        &placed,
+        false,
+        &args.mother,
+        "grow smaller plants (lower `max_modules` in the mother's `physiology`)",
+    )?;
     let assets = SceneAssets::mesh(&placed).in_file(&args.mother)?;
 
     let mut table =
@@ -123,7 +143,8 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
         }
     }
     let scene = assets.scene();
-    out.add_scene(&args.out.join("garden.glb"), &scene)?;
+    out.add_scene(&args.out.join("garden.glb"), &scene)
+        .in_file(&args.mother)?;
     out.add(
         &args.out.join("garden.png"),
         &picture(&scene, View::Iso, SCENE_PICTURE)?,

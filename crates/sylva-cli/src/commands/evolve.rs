@@ -2,12 +2,16 @@
 //! it runs, and every result file when it ends.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, Grown, InputError};
+use sylva_core::budget::Seconds;
 use sylva_core::taper::PipeTaper;
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::{self, SheetCell, SheetOptions};
@@ -69,6 +73,8 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     });
     let pool = super::pool(config.run().threads)?;
     let checkpoint = out.join(CHECKPOINT);
+    let target = config.run().generations;
+    let population = u64::from(config.run().population);
     let mut evolution = if args.resume {
         let text = sylva::files::read_text(&checkpoint)?;
         Evolution::resume(&config, &checkpoint, &text, pool.clone())?
@@ -79,7 +85,22 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
             .and_then(|p| p.parent())
             .unwrap_or(Path::new("."));
         let start = config.load_start(base)?;
-        Evolution::start(&config, start, pool.clone())?
+        if let Some(t) = config.generation_time(&start, pool.threads()) {
+            super::announce(
+                t.seconds * (f64::from(target) + 1.0),
+                format_args!(
+                    "this run of {} generations (each up to about {})",
+                    u64::from(target) + 1,
+                    Seconds(t.seconds)
+                ),
+                &t.advice,
+            );
+        }
+        // Generation 0 is grown as the run starts.
+        let ticker = Ticker::start(bar(population, 1, 0, target), population);
+        let evolution = Evolution::start(&config, start, pool.clone())?;
+        ticker.finish();
+        evolution
     };
     sylva::files::create_dir(&out)?;
     // A run killed while writing left temporary files: they go.
@@ -88,16 +109,99 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     write_results(&evolution, &config, &out, &pool)
 }
 
+/// A bar over the genomes of `generations` generations of `population`, showing generation
+/// `first` (the one being bred) of a run of `target`.
+fn bar(population: u64, generations: u32, first: u32, target: u32) -> ProgressBar {
+    ProgressBar::new(population.saturating_mul(u64::from(generations.max(1))))
+        .with_style(
+            ProgressStyle::with_template(
+                "{spinner} generation {prefix}/{len_generations} {bar:30} {pos}/{len} genomes, \
+                 best {msg} ({elapsed}, eta {eta})",
+            )
+            .expect("the template is valid")
+            .with_key(
+                "len_generations",
+                move |_: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{target}");
+                },
+            ),
+        )
+        .with_prefix(first.to_string())
+        .with_message("-")
+}
+
+/// Moves a bar counted in genomes evaluated, reading the engine's count four times a second
+/// while a generation is bred on the calling thread.
+struct Ticker {
+    bar: ProgressBar,
+    population: u64,
+    /// Generations finished since the bar started.
+    finished: Arc<AtomicU64>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Ticker {
+    fn start(bar: ProgressBar, population: u64) -> Ticker {
+        let finished = Arc::new(AtomicU64::new(0));
+        let stop = Arc::new(AtomicBool::new(false));
+        let base = sylva::evolution::evaluations_done();
+        let thread = {
+            let (bar, finished, stop) = (bar.clone(), finished.clone(), stop.clone());
+            std::thread::spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    // Within the current generation's share of the bar, whatever the
+                    // strategy evaluates (copies are not evaluated again).
+                    let done = finished.load(Ordering::Relaxed) * population;
+                    let evaluated = sylva::evolution::evaluations_done() - base;
+                    bar.set_position(evaluated.clamp(done, done + population));
+                    std::thread::sleep(Duration::from_millis(250));
+                }
+            })
+        };
+        Ticker {
+            bar,
+            population,
+            finished,
+            stop,
+            thread: Some(thread),
+        }
+    }
+
+    /// Generation `generation` is done, with best fitness `best`.
+    fn generation(&self, generation: u32, best: f64) {
+        let finished = self.finished.fetch_add(1, Ordering::Relaxed) + 1;
+        self.bar.set_position(finished * self.population);
+        self.bar.set_prefix((generation + 1).to_string());
+        self.bar.set_message(format!("{best:.4}"));
+    }
+
+    /// Stops the ticking and takes the bar off the screen.
+    fn finish(mut self) {
+        self.stop_thread();
+        self.bar.finish_and_clear();
+    }
+
+    fn stop_thread(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+impl Drop for Ticker {
+    fn drop(&mut self) {
+        self.stop_thread();
+    }
+}
+
 /// Breeds up to the config's generation, showing progress and checkpointing as it goes.
 fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyhow::Result<()> {
     let target = config.run().generations;
-    let bar = ProgressBar::new(u64::from(target)).with_style(
-        ProgressStyle::with_template(
-            "{spinner} generation {pos}/{len} {bar:30} best {msg} ({per_sec}, eta {eta})",
-        )
-        .expect("the template is valid"),
-    );
-    bar.set_position(u64::from(evolution.generation().min(target)));
+    let population = u64::from(config.run().population);
+    let done = evolution.generation().min(target);
+    let ticker = Ticker::start(bar(population, target - done, done + 1, target), population);
     let save = |evolution: &Evolution| -> anyhow::Result<()> {
         sylva::files::write(checkpoint, evolution.checkpoint()?.as_bytes())?;
         Ok(())
@@ -106,15 +210,14 @@ fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyho
     let mut last_save = Instant::now();
     while evolution.generation() < target {
         let best = evolution.step()?.best;
-        bar.set_message(format!("{best:.4}"));
-        bar.set_position(u64::from(evolution.generation()));
+        ticker.generation(evolution.generation(), best);
         if last_save.elapsed() >= every {
             save(evolution)?;
             last_save = Instant::now();
         }
     }
     save(evolution)?;
-    bar.finish_and_clear();
+    ticker.finish();
     Ok(())
 }
 

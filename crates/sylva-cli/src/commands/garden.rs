@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use sylva::assets::{
-    GardenNodes, SceneAssets, asset_format, check_png, garden_glb, garden_glb_options,
-    garden_placed, garden_placements, grow_garden, picture,
+    GardenLayout, GardenNodes, SceneAssets, asset_format, check_garden, check_png, garden_glb,
+    garden_glb_options, garden_placed, garden_placements, grow_garden, picture,
 };
 use sylva::files::{Outputs, read_text};
 use sylva::genome::{expect_model, load_genome_of, parse_genome};
@@ -131,39 +131,45 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
     let options = garden_glb_options(&garden);
     let mut out = Outputs::new();
     // (plants, distinct plants meshed, triangles, picture)
-    let (plants, meshes, triangles, png) =
-        if format == Format::Glb && wind.is_none() && args.png.is_none() {
-            // Grown, meshed and dropped one plant at a time as the GLB streams out: memory
-            // holds the placements, the JSON and one plant with its mesh, not the scene.
-            let placements = garden_placements(&garden, first)?;
-            let nodes = GardenNodes::of(&garden, &placements);
-            let mut glb = garden_glb(&garden, &placements, &nodes, options).in_file(first)?;
-            out.add_glb(&args.output, &mut glb)?;
-            let meshes = placements.iter().map(|p| p.plant + 1).max().unwrap_or(0);
-            (
-                placements.len(),
-                meshes,
-                glb.stats().triangles as usize,
-                None,
-            )
-        } else {
-            let grown = grow_garden(&garden, first)?;
-            let placed = garden_placed(&garden, &grown);
-            let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
-            let scene = assets.scene();
-            out.add_scene_with(&args.output, &scene, &options)
-                .in_file(first)?;
-            let png = match &args.png {
-                Some(path) => Some((path, picture(&scene, View::Iso, SCENE_PICTURE)?)),
-                None => None,
-            };
-            (
-                placed.len(),
-                grown.plants.len(),
-                scene.triangle_count(),
-                png,
-            )
+    let streamed = format == Format::Glb && wind.is_none() && args.png.is_none();
+    // Estimated from the first plant of each genome, before the others grow.
+    let layout = match streamed {
+        true => GardenLayout::Streamed,
+        false => GardenLayout::Held,
+    };
+    check_garden(&garden, first, layout, format == Format::Glb, &options)?;
+    let (plants, meshes, triangles, png) = if streamed {
+        // Grown, meshed and dropped one plant at a time as the GLB streams out: memory
+        // holds the placements, the JSON and one plant with its mesh, not the scene.
+        let placements = garden_placements(&garden, first)?;
+        let nodes = GardenNodes::of(&garden, &placements);
+        let mut glb = garden_glb(&garden, &placements, &nodes, options).in_file(first)?;
+        out.add_glb(&args.output, &mut glb)?;
+        let meshes = placements.iter().map(|p| p.plant + 1).max().unwrap_or(0);
+        (
+            placements.len(),
+            meshes,
+            glb.stats().triangles as usize,
+            None,
+        )
+    } else {
+        let grown = grow_garden(&garden, first)?;
+        let placed = garden_placed(&garden, &grown);
+        let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
+        let scene = assets.scene();
+        out.add_scene_with(&args.output, &scene, &options)
+            .in_file(first)?;
+        let png = match &args.png {
+            Some(path) => Some((path, picture(&scene, View::Iso, SCENE_PICTURE)?)),
+            None => None,
         };
+        (
+            placed.len(),
+            grown.plants.len(),
+            scene.triangle_count(),
+            png,
+        )
+    };
     let garden_path = args.output.with_extension("garden.json");
     if !is_garden {
         out.add(&garden_path, garden.to_json().as_bytes())?;

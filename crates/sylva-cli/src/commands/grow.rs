@@ -66,8 +66,10 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     if output == GrowOutput::Skeleton {
         return skeleton(args, &genome, seed);
     }
+    let growing = super::growing(&genome);
     let grown =
         Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind).in_file(&args.genome)?;
+    drop(growing);
     if let Some(levels) = args.lod {
         return lod(args, grown, levels as usize, wind.as_ref(), &glb);
     }
@@ -159,6 +161,7 @@ fn lod(
 /// asked for too.
 fn skeleton(args: &GrowArgs, genome: &Genome, seed: u64) -> anyhow::Result<()> {
     let roots = !args.hide_roots;
+    let growing = super::growing(genome);
     let (skeleton, png) = match &args.png {
         None => {
             let skeleton = grow_skeleton(genome, seed, roots, args.taper).in_file(&args.genome)?;
@@ -172,6 +175,7 @@ fn skeleton(args: &GrowArgs, genome: &Genome, seed: u64) -> anyhow::Result<()> {
             (Skeleton::of_grown(&grown), Some((png, picture)))
         }
     };
+    drop(growing);
     let mut out = Outputs::new();
     out.add(&args.output, skeleton.to_json().as_bytes())?;
     if let Some((path, bytes)) = png {

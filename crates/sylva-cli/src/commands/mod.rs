@@ -9,7 +9,76 @@ pub mod render;
 pub mod simulate;
 pub mod studio;
 
+use std::fmt::Display;
 use std::path::Path;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sylva_core::budget::Seconds;
+
+/// Work estimated to take this long or longer is announced before it starts, seconds.
+const ANNOUNCE_SECONDS: f64 = 60.0;
+
+/// Says on stderr, before it starts, how long work may take when that is a minute or more
+/// (and within the time budget: beyond it the work is refused, with the estimate).
+pub fn announce(seconds: f64, what: impl Display, advice: &str) {
+    if seconds >= ANNOUNCE_SECONDS && seconds <= sylva_core::budget::max_time().as_secs_f64() {
+        eprintln!(
+            "note: {what} may take up to about {} (estimated at the plants' bounds); {advice} \
+             to make it shorter",
+            Seconds(seconds)
+        );
+    }
+}
+
+/// A spinner shown while a genome grows, taken off the screen when dropped.
+pub struct Growing(Option<ProgressBar>);
+
+impl Drop for Growing {
+    fn drop(&mut self) {
+        if let Some(spinner) = &self.0 {
+            spinner.finish_and_clear();
+        }
+    }
+}
+
+/// Before a genome grows alone (`grow`, `render`): announces growth that may take a minute
+/// or more, with a spinner showing the time spent until the result is dropped.
+pub fn growing(genome: &sylva::Genome) -> Growing {
+    Growing(growing_spinner(genome))
+}
+
+fn growing_spinner(genome: &sylva::Genome) -> Option<ProgressBar> {
+    let seconds = genome.growth_seconds()?;
+    announce(
+        seconds,
+        "growing the plant",
+        "lower `max_symbols` and `max_modules` in its `physiology`",
+    );
+    if seconds < ANNOUNCE_SECONDS {
+        return None;
+    }
+    let spinner = ProgressBar::new_spinner()
+        .with_style(
+            ProgressStyle::with_template("{spinner} growing ({elapsed}, up to about {msg})")
+                .expect("the template is valid"),
+        )
+        .with_message(Seconds(seconds).to_string());
+    spinner.enable_steady_tick(std::time::Duration::from_millis(250));
+    Some(spinner)
+}
+
+/// A progress bar over `len` units on stderr, named by `prefix` (drawn only on a
+/// terminal).
+pub fn progress_bar(len: u64, prefix: &'static str) -> ProgressBar {
+    ProgressBar::new(len)
+        .with_style(
+            ProgressStyle::with_template(
+                "{spinner} {prefix} {pos}/{len} {bar:30} ({elapsed}, eta {eta})",
+            )
+            .expect("the template is valid"),
+        )
+        .with_prefix(prefix)
+}
 
 /// A result whose limit refusals name the input file they follow from.
 pub trait InFile<T> {

@@ -67,8 +67,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let growing = super::growing(&genome);
         let grown =
             Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
+        drop(growing);
         let chain = sylva::LodAssets::new(grown, levels as usize, None).in_file(&args.file)?;
         let png = lod_strip(&chain, args.view, args.size)?;
         sylva::files::write(&args.output, &png)?;
@@ -83,8 +85,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         let wind = args.wind.options(&args.output)?;
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let growing = super::growing(&genome);
         let grown = Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind)
             .in_file(&args.file)?;
+        drop(growing);
         let png = wind_strip(&grown, frames as usize, args.view, args.size)?;
         sylva::files::write(&args.output, &png)?;
     } else if is_glb {
@@ -95,8 +99,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     } else {
         let genome = load_genome(&args.file)?;
         let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let growing = super::growing(&genome);
         let grown =
             Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
+        drop(growing);
         write_picture(&grown.scene(), &args.output, args.view, args.size)?;
     }
     println!("wrote {}", args.output.display());

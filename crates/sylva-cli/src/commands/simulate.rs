@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use sylva::assets::{Origin, Placed, SceneAssets, picture};
+use sylva::assets::{Origin, Placed, SceneAssets, check_scene_glb, picture};
 use sylva::files::{Outputs, read_text};
 use sylva::genome::load_genome_of;
 use sylva::report::simulation_report;
@@ -45,9 +45,20 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         .map(|file| load_genome_of::<LSystemModel>(&base.join(file), "experiments grow"))
         .collect::<Result<Vec<_>, _>>()?;
     let pool = super::pool(args.threads)?;
-    let outcome = simulation
-        .run(&genomes, &pool)
+    let work = simulation
+        .work(&genomes)
         .map_err(|e| InputError::file_error(path, &e))?;
+    super::announce(
+        work.seconds(pool.threads()),
+        format_args!("the experiment's {} garden steps", work.steps),
+        "lower `max_symbols` and `max_modules` in the genomes' `physiology`, the steps or the \
+         world",
+    );
+    let bar = super::progress_bar(work.steps, "growing: step");
+    let outcome = simulation
+        .run_with(&genomes, &pool, &mut |step| bar.set_position(step))
+        .map_err(|e| InputError::file_error(path, &e))?;
+    bar.finish_and_clear();
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = path
             .file_stem()
@@ -77,9 +88,17 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
+    check_scene_glb(
+        &placed,
+        false,
+        path,
+        "grow smaller plants (lower `max_modules` in the genomes' `physiology`)",
+    )?;
     let assets = SceneAssets::mesh(&placed).in_file(path)?;
     let scene = assets.scene();
-    files.add_scene(&out.join("scene.glb"), &scene)?;
+    files
+        .add_scene(&out.join("scene.glb"), &scene)
+        .in_file(path)?;
     files.add(
         &out.join("scene.png"),
         &picture(&scene, View::Iso, SCENE_PICTURE)?,

@@ -207,6 +207,31 @@ pub fn to_glb_with(scene: &Scene, options: &GlbOptions) -> Result<Vec<u8>, Expor
     Ok(out)
 }
 
+/// The fewest bytes a mesh of `vertices` and `triangles` adds to a GLB's binary chunk:
+/// positions and normals (quantised when `quantize`) and indices, without texture
+/// coordinates, colours or a skin. What is over 4 GiB by this count can be refused before
+/// any mesh is made.
+pub fn mesh_binary_floor(vertices: u64, triangles: u64, quantize: bool) -> u64 {
+    let vertex = if quantize { 8 + 4 } else { 12 + 12 };
+    let index = if vertices > U16_VERTICES as u64 { 4 } else { 2 };
+    vertices
+        .saturating_mul(vertex)
+        .saturating_add(triangles.saturating_mul(3 * index))
+}
+
+/// Bytes `mesh` adds to the binary chunk of a GLB laid out with `options` (the mesh
+/// without a rig): `(each, once)`, what each copy of the mesh adds and what the first adds
+/// besides (its embedded textures). Estimates of large scenes multiply them before the
+/// other meshes are made.
+pub fn mesh_binary_bytes(mesh: &Mesh, options: &GlbOptions) -> Result<(u64, u64), ExportError> {
+    let mut w = Writer::new(Counter(0), options.quantize);
+    w.mesh(mesh, "", None)?;
+    let first = w.bin.len() as u64;
+    w.mesh(mesh, "", None)?;
+    let each = w.bin.len() as u64 - first;
+    Ok((each, first.saturating_sub(each)))
+}
+
 /// A GLB laid out and ready to stream: its JSON is built and its length known; its binary
 /// data is made only while [`Glb::write_to`] writes it. Every check is done when it is made,
 /// so writing fails only on I/O.
@@ -1303,6 +1328,46 @@ mod tests {
         rig: Rig,
         wide: Mesh,
         empty: Mesh,
+    }
+
+    #[test]
+    fn a_mesh_is_weighed_as_the_writer_writes_it() {
+        let s = samples();
+        for mesh in [&s.plain, &s.lean, &s.textured, &s.wide] {
+            for quantize in [false, true] {
+                let options = GlbOptions {
+                    quantize,
+                    ..GlbOptions::default()
+                };
+                let (each, once) = mesh_binary_bytes(mesh, &options).unwrap();
+                // Beside another mesh in one file, the mesh adds `each` (and `once`).
+                let two = to_glb_with(
+                    &Scene {
+                        nodes: vec![SceneNode::new("a", mesh), SceneNode::new("b", &s.other)],
+                    },
+                    &options,
+                )
+                .unwrap();
+                let (_, bin) = chunks(&two);
+                let alone =
+                    to_glb_with(&Scene::single(SceneNode::new("b", &s.other)), &options).unwrap();
+                let (_, plain) = chunks(&alone);
+                let added = bin.unwrap().len() as u64 - plain.unwrap().len() as u64;
+                // The textured mesh embeds its pictures once, the others nothing (padding
+                // aside).
+                assert!(
+                    added >= each && added <= each + once + 4,
+                    "{added} {each} {once}"
+                );
+                let floor = mesh_binary_floor(
+                    mesh.positions.len() as u64,
+                    mesh.triangle_count() as u64,
+                    quantize,
+                );
+                assert!(floor <= each, "{floor} > {each}");
+                assert!(floor > 0);
+            }
+        }
     }
 
     /// The small mesh with half of its first primitive's triangles in a darker shade of

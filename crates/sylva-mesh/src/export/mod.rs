@@ -47,7 +47,7 @@ use thiserror::Error;
 pub(crate) use glb::IMAGE_NAME_PREFIX;
 pub use glb::{
     EXT_MESH_GPU_INSTANCING, Glb, GlbNode, GlbOptions, GlbStats, KHR_MESH_QUANTIZATION, MeshSource,
-    to_glb, to_glb_with,
+    mesh_binary_bytes, mesh_binary_floor, to_glb, to_glb_with,
 };
 pub use obj::to_obj;
 pub use stl::to_stl;
