@@ -963,6 +963,85 @@ fn over_long_and_malformed_requests_get_json_errors() {
     assert_eq!(get(&server, "/api/models").as_array().unwrap().len(), 4);
 }
 
+/// Reads server-sent events from `reader` until `enough` says so: (name, data) pairs.
+fn read_events(
+    reader: &mut impl BufRead,
+    enough: impl Fn(&[(String, Value)]) -> bool,
+) -> Vec<(String, Value)> {
+    let mut events: Vec<(String, Value)> = Vec::new();
+    let mut name = String::new();
+    let mut line = String::new();
+    while !enough(&events) {
+        line.clear();
+        if reader.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        let line = line.trim_end();
+        if let Some(n) = line.strip_prefix("event:") {
+            name = n.trim().to_owned();
+        } else if let Some(data) = line.strip_prefix("data:") {
+            let text = data.trim();
+            let value: Value = serde_json::from_str(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+            events.push((name.clone(), value));
+        }
+    }
+    events
+}
+
+/// Opens a session's event stream.
+fn event_stream(server: &Server, session: i64) -> BufReader<TcpStream> {
+    let mut stream = TcpStream::connect(&server.address).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(120)))
+        .unwrap();
+    let head = format!(
+        "GET /api/sessions/{session}/events HTTP/1.1\r\nHost: {}\r\nAccept: text/event-stream\r\n\r\n",
+        server.address
+    );
+    stream.write_all(head.as_bytes()).unwrap();
+    BufReader::new(stream)
+}
+
+#[test]
+fn gardens_report_their_progress_while_they_grow() {
+    let dir = temp_dir("progress");
+    let server = start(&dir, "127.0.0.1");
+    let garden = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "garden", "settings": {"steps": 40, "children": 2}}),
+    );
+    let id = garden["id"].as_i64().unwrap();
+    let mut events = event_stream(&server, id);
+    // The stream is open once its head has come.
+    let mut line = String::new();
+    while events.read_line(&mut line).unwrap() > 0 && line != "\r\n" {
+        line.clear();
+    }
+    let grown = std::thread::scope(|scope| {
+        let grow = scope.spawn(|| {
+            post(
+                &server,
+                &format!("/api/sessions/{id}/grow"),
+                json!({"settings": {"steps": 60}}),
+            )
+        });
+        let seen = read_events(&mut events, |e| {
+            e.last().is_some_and(|(_, v)| v["step"] == v["steps"])
+        });
+        grow.join().unwrap();
+        seen
+    });
+    let steps: Vec<u64> = grown
+        .iter()
+        .filter(|(name, v)| name == "progress" && v["what"] == "garden" && v["steps"] == 60)
+        .map(|(_, v)| v["step"].as_u64().unwrap())
+        .collect();
+    assert!(steps.len() >= 10, "{grown:?}");
+    assert!(steps.windows(2).all(|w| w[0] < w[1]), "{steps:?}");
+    assert_eq!(steps.last(), Some(&60));
+}
+
 #[test]
 fn design_runs_stream_valid_json_with_the_terms_named() {
     let dir = temp_dir("events");

@@ -528,6 +528,9 @@ async function main() {
       return m && Number(m.dataset.plant) !== old;
     }, mother.plant, { timeout: 90_000 });
     const s = await page.evaluate(() => window.sylvaStudio.session());
+    const seen = await page.evaluate(() => window.sylvaStudio.gardenProgress);
+    check(seen.length >= 2 && seen.includes(s.state.settings.steps),
+      `the page saw no progress while the garden grew (steps ${JSON.stringify(seen.slice(-10))})`);
     const row = await api(`/api/plants/${s.state.mother}`);
     check(row.operator === "mother" && row.parents[0].plant === next.plant,
       `the new mother #${s.state.mother} is not the picked #${next.plant} (${row.operator} of ${JSON.stringify(row.parents)})`);

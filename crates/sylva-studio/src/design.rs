@@ -7,26 +7,22 @@
 //! checkpoint when it starts again ([`resume_all`]), to the bytes of a run never stopped.
 
 use std::collections::HashMap;
-use std::convert::Infallible;
 use std::path::Path as FilePath;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use axum::Json;
 use axum::extract::{Path, State};
-use axum::response::sse::{Event, KeepAlive, Sse};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::{Config, Evolution};
 use sylva_automata::AutomataModel;
 use sylva_model::Model;
-use tokio::sync::broadcast;
-use tokio_stream::StreamExt;
-use tokio_stream::wrappers::BroadcastStream;
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, RunRow};
 use crate::error::{ApiError, config_error};
+use crate::events::SessionEvent;
 use crate::family::{archive_member, generation_row};
 use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
@@ -75,24 +71,34 @@ impl RunEvent {
     }
 }
 
-/// The runs going on, and the channels of the pages watching them.
+/// Tells the pages watching `session` of a run.
+fn tell(studio: &Studio, session: i64, event: RunEvent) {
+    let (name, data) = event.to_sse();
+    studio.events.send(session, name, data);
+}
+
+/// Where a design session's run stands, as the first event a page watching it gets.
+pub fn status_event(studio: &Studio, session: i64) -> Result<SessionEvent, ApiError> {
+    let state = design_state(studio, session)?;
+    let row = run_row(studio, state.run)?;
+    let (name, data) = RunEvent {
+        run: row.id,
+        status: row.status,
+        generation: row.generation,
+        row: None,
+        error: row.error,
+    }
+    .to_sse();
+    Ok(SessionEvent { name, data })
+}
+
+/// The runs going on.
 #[derive(Default)]
 pub struct Runs {
     stops: Mutex<HashMap<i64, Arc<AtomicBool>>>,
-    channels: Mutex<HashMap<i64, broadcast::Sender<RunEvent>>>,
 }
 
 impl Runs {
-    /// The channel of a session's events.
-    fn channel(&self, session: i64) -> broadcast::Sender<RunEvent> {
-        self.channels
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .entry(session)
-            .or_insert_with(|| broadcast::channel(256).0)
-            .clone()
-    }
-
     /// Asks every run to stop (at its next generation), leaving their status as it is, so
     /// that they resume when the studio starts again.
     pub fn stop_all(&self) {
@@ -401,13 +407,14 @@ fn spawn(studio: &Studio, run: i64) -> Result<(), ApiError> {
                     Ok(())
                 });
                 if let Ok(row) = run_row(&worker, run) {
-                    let _ = worker.runs.channel(row.session).send(RunEvent {
+                    let event = RunEvent {
                         run,
                         status: "failed".into(),
                         generation: row.generation,
                         row: None,
                         error: Some(e.error),
-                    });
+                    };
+                    tell(&worker, row.session, event);
                 }
             }
         });
@@ -428,7 +435,6 @@ fn drive(studio: &Studio, run: i64, stop: &AtomicBool) -> Result<(), ApiError> {
     let row = run_row(studio, run)?;
     let path = FilePath::new("design");
     let config = Config::parse(path, &row.config).map_err(|e| ApiError::internal(e.message))?;
-    let channel = studio.runs.channel(row.session);
     let mut evolution = match &row.checkpoint {
         Some(text) => Evolution::resume(&config, path, text, studio.pool.clone())
             .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?,
@@ -438,7 +444,7 @@ fn drive(studio: &Studio, run: i64, stop: &AtomicBool) -> Result<(), ApiError> {
             studio.archive.transaction(|c| -> Result<_, ApiError> {
                 Ok(archive::set_run_terms(c, run, evolution.term_names())?)
             })?;
-            save_generation(studio, &row, &evolution, stop, &channel)?;
+            save_generation(studio, &row, &evolution, stop)?;
             evolution
         }
     };
@@ -452,19 +458,20 @@ fn drive(studio: &Studio, run: i64, stop: &AtomicBool) -> Result<(), ApiError> {
                 archive::save_run(c, run, None, evolution.generation(), "done", None)
                     .map_err(ApiError::from)
             })?;
-            let _ = channel.send(RunEvent {
+            let done = RunEvent {
                 run,
                 status: "done".into(),
                 generation: evolution.generation(),
                 row: None,
                 error: None,
-            });
+            };
+            tell(studio, row.session, done);
             return Ok(());
         }
         evolution
             .step()
             .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?;
-        save_generation(studio, &row, &evolution, stop, &channel)?;
+        save_generation(studio, &row, &evolution, stop)?;
     }
 }
 
@@ -475,7 +482,6 @@ fn save_generation(
     row: &RunRow,
     evolution: &Evolution,
     stop: &AtomicBool,
-    channel: &broadcast::Sender<RunEvent>,
 ) -> Result<(), ApiError> {
     let best = evolution.best();
     let plant = archive_member(studio, row.session, row.id, evolution.generation(), &best)?;
@@ -502,13 +508,14 @@ fn save_generation(
         )?;
         Ok(status)
     })?;
-    let _ = channel.send(RunEvent {
+    let event = RunEvent {
         run: row.id,
         status,
         generation: evolution.generation(),
         row: Some((figures, evolution.term_names().to_vec())),
         error: None,
-    });
+    };
+    tell(studio, row.session, event);
     Ok(())
 }
 
@@ -541,13 +548,14 @@ pub(crate) async fn stop(
     let state = design_state(&studio, id)?;
     stop_run(&studio, state.run)?;
     let row = run_row(&studio, state.run)?;
-    let _ = studio.runs.channel(id).send(RunEvent {
+    let event = RunEvent {
         run: row.id,
         status: row.status,
         generation: row.generation,
         row: None,
         error: None,
-    });
+    };
+    tell(&studio, id, event);
     Ok(Json(view(&studio, id)?))
 }
 
@@ -634,31 +642,6 @@ pub(crate) async fn run(
         rows,
         error: row.error,
     }))
-}
-
-/// `GET /api/sessions/{id}/events`: server-sent events, one per generation and one per
-/// change of status.
-pub(crate) async fn events(
-    State(studio): State<Studio>,
-    Path(id): Path<i64>,
-) -> Result<Sse<impl tokio_stream::Stream<Item = Result<Event, Infallible>>>, ApiError> {
-    let state = design_state(&studio, id)?;
-    let receiver = studio.runs.channel(id).subscribe();
-    let row = run_row(&studio, state.run)?;
-    let first = RunEvent {
-        run: row.id,
-        status: row.status,
-        generation: row.generation,
-        row: None,
-        error: row.error,
-    };
-    let first = tokio_stream::once(first);
-    let rest = BroadcastStream::new(receiver).filter_map(|e| e.ok());
-    let stream = first.chain(rest).map(|e| {
-        let (name, data) = e.to_sse();
-        Ok(Event::default().event(name).data(data.to_string()))
-    });
-    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
 }
 
 /// Resumes every run that was running when the studio stopped (or was killed).

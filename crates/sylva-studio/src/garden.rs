@@ -15,7 +15,7 @@ use sylva::Genome;
 use sylva::assets::{Placed, SceneAssets};
 use sylva_core::MaterialKind;
 use sylva_core::glam::Vec3;
-use sylva_lsystem::breed::{BreedSettings, breed_garden};
+use sylva_lsystem::breed::{BreedSettings, breeding_genomes, grow_together_with};
 use sylva_lsystem::{LSystemGenome, LSystemModel};
 use sylva_mesh::{Scene, SceneNode};
 use sylva_model::Model;
@@ -287,7 +287,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
         Ok(id)
     })?;
     let state = garden_state(studio, id)?.1;
-    let grown = grow_garden(studio, &state, &mother, 0).await?;
+    let grown = grow_garden(studio, id, &state, &mother, 0).await?;
     studio.archive.transaction(|c| -> Result<_, ApiError> {
         let after = store_garden(c, id, &state, grown)?;
         archive::set_state(c, id, &json!(after))?;
@@ -331,9 +331,11 @@ struct Grown {
     scene: Vec<u8>,
 }
 
-/// Grows the mother's garden on the blocking pool.
+/// Grows the mother's garden of `session` on the blocking pool, telling the pages watching
+/// the session how far it has grown.
 async fn grow_garden(
     studio: &Studio,
+    session: i64,
     state: &GardenState,
     mother: &LSystemGenome,
     seq: i64,
@@ -345,7 +347,10 @@ async fn grow_garden(
     let mother_id = state.mother;
     tokio::task::spawn_blocking(move || -> Result<Grown, ApiError> {
         let mut rng = sylva_core::rng::seeded(seed);
-        let garden = breed_garden(&mother, &settings.breed_settings(), &mut rng, &studio.pool)
+        let breed = settings.breed_settings();
+        let genomes = breeding_genomes(&mother, &breed, &mut rng);
+        let mut progress = crate::events::progress(&studio, session, "garden", settings.steps);
+        let garden = grow_together_with(genomes, &breed, &studio.pool, &mut progress)
             .map_err(|e| ApiError::unprocessable("settings", sylva::error::chain(&e)))?;
         let shown: Vec<_> = garden
             .specimens
@@ -488,7 +493,7 @@ async fn step(
         ..before.clone()
     };
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
-    let grown = grow_garden(studio, &state, &genome, seq).await?;
+    let grown = grow_garden(studio, id, &state, &genome, seq).await?;
     studio.archive.transaction(|c| -> Result<_, ApiError> {
         let after = store_garden(c, id, &state, grown)?;
         archive::record_step(c, id, &action, &json!(before), &json!(after))?;

@@ -7,6 +7,7 @@
 //! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
 //! - [`family`]: the deciduous-evolution viewer's binary-tree population.
 //! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
+//! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
 //! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
 //! - [`guard`]: who may talk to the studio: Host names, other sites' pages, content types,
@@ -30,6 +31,7 @@ pub mod breed;
 pub mod cache;
 pub mod design;
 pub mod error;
+pub mod events;
 pub mod family;
 pub mod garden;
 pub mod guard;
@@ -130,6 +132,8 @@ pub struct Inner {
     pub families: family::Families,
     /// Design runs going on.
     pub runs: design::Runs,
+    /// The channels of the pages watching sessions.
+    pub events: events::Events,
 }
 
 impl Deref for Studio {
@@ -151,6 +155,7 @@ impl Studio {
             locks: Mutex::default(),
             families: family::Families::default(),
             runs: design::Runs::default(),
+            events: events::Events::default(),
         }))
     }
 
@@ -185,7 +190,7 @@ pub fn router(studio: Studio) -> Router {
         .route("/sessions/{id}/stop", post(design::stop))
         .route("/sessions/{id}/resume", post(design::resume))
         .route("/sessions/{id}/run", get(design::run))
-        .route("/sessions/{id}/events", get(design::events))
+        .route("/sessions/{id}/events", get(events::stream))
         .route("/plants", get(plants::list))
         .route("/plants/{id}", get(plants::get))
         .route("/plants/{id}/plant.glb", get(plants::glb))

@@ -57,6 +57,14 @@ pub fn view(studio: &Studio, id: i64) -> Result<SessionView, ApiError> {
     })
 }
 
+/// A session, or 404.
+pub fn session_row(studio: &Studio, id: i64) -> Result<archive::SessionRow, ApiError> {
+    studio
+        .archive
+        .read(|c| archive::session(c, id))?
+        .ok_or_else(|| ApiError::not_found(format!("session {id}")))
+}
+
 /// A session that must be of `mode`.
 pub fn session_of(studio: &Studio, id: i64, mode: &str) -> Result<archive::SessionRow, ApiError> {
     let row = studio

@@ -543,10 +543,11 @@ pub(crate) mod tests {
         );
         assert_eq!(Format::from_path(Path::new("b.obj")).unwrap(), Format::Obj);
         assert_eq!(Format::from_path(Path::new("b.Wrl")).unwrap(), Format::Vrml);
-        let e = Format::from_path(Path::new("b.stl")).unwrap_err();
+        assert_eq!(Format::from_path(Path::new("b.STL")).unwrap(), Format::Stl);
+        let e = Format::from_path(Path::new("b.fbx")).unwrap_err();
         let msg = e.to_string();
         assert!(
-            msg.contains(".stl") && msg.contains(".glb") && msg.contains(".wrl"),
+            msg.contains(".fbx") && msg.contains(".glb") && msg.contains(".stl"),
             "{msg}"
         );
         assert!(matches!(
@@ -655,8 +656,8 @@ pub(crate) mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mesh = small_mesh();
         let scene = Scene::single(SceneNode::new("plant", &mesh));
-        let e = write_scene(&dir.path().join("p.stl"), &scene).unwrap_err();
-        assert!(matches!(e, ExportError::UnknownExtension { ref extension } if extension == "stl"));
+        let e = write_scene(&dir.path().join("p.fbx"), &scene).unwrap_err();
+        assert!(matches!(e, ExportError::UnknownExtension { ref extension } if extension == "fbx"));
 
         let mut broken = small_mesh();
         broken.primitives[0].indices[0] = 1_000_000;

@@ -18,6 +18,8 @@ export function createGardenMode(ctx, root) {
   const children = num("garden-children", 8, { min: 0, max: 8, step: 1, width: "3.5em" });
   const growBtn = h("button", { class: "primary", testid: "garden-grow", onclick: () => grow() }, "Grow again");
   const info = h("span", { class: "hint", testid: "garden-status" });
+  // how far a garden has grown, while it grows (the session's `progress` events)
+  const progressBar = h("progress", { testid: "garden-progress", max: 1, value: 0, hidden: true });
   const toolbar = h(
     "div",
     { class: "toolbar" },
@@ -27,6 +29,7 @@ export function createGardenMode(ctx, root) {
     field("Azimuth °", azimuth, "0 to 360"),
     field("Children", children, "mutated children grown beside the mother, 0 to 8"),
     growBtn,
+    progressBar,
     info,
   );
   const canvas = h("canvas", { class: "stage-canvas", testid: "garden-canvas" });
@@ -91,6 +94,7 @@ export function createGardenMode(ctx, root) {
   async function render(s) {
     session = s;
     ensureStage();
+    follow(s.id);
     const st = s.state || {};
     const set = st.settings || {};
     if (set.steps !== undefined) steps.value = set.steps;
@@ -182,13 +186,47 @@ export function createGardenMode(ctx, root) {
   async function grow() {
     if (!session) return;
     const s = await ctx.act(() => api.grow(session.id, { settings: settings() }));
+    doneGrowing();
     if (s) await ctx.setSession(s);
   }
 
   async function pick(plant) {
     if (!session) return;
     const s = await ctx.act(() => api.pick(session.id, plant));
+    doneGrowing();
     if (s) await ctx.setSession(s);
+  }
+
+  // ---- progress while a garden grows ----------------------------------------------------------
+  let events = null;
+  let eventsSession = null;
+  function follow(id) {
+    if (events && eventsSession === id && events.readyState !== EventSource.CLOSED) return;
+    unfollow();
+    eventsSession = id;
+    events = new EventSource(api.eventsUrl(id));
+    events.addEventListener("progress", (e) => {
+      let p;
+      try {
+        p = JSON.parse(e.data);
+      } catch {
+        return;
+      }
+      if (!session || session.id !== id) return;
+      stats.gardenProgress.push(p.step);
+      progressBar.max = Math.max(p.steps, 1);
+      progressBar.value = p.step;
+      progressBar.hidden = p.step >= p.steps;
+      info.textContent = p.step >= p.steps ? "meshing…" : `growing: step ${p.step} of ${p.steps}`;
+    });
+  }
+  function unfollow() {
+    if (events) events.close();
+    events = null;
+    eventsSession = null;
+  }
+  function doneGrowing() {
+    progressBar.hidden = true;
   }
 
   function newSessionForm({ cancel }) {
@@ -254,10 +292,15 @@ export function createGardenMode(ctx, root) {
     newSessionForm,
     show() {
       ensureStage();
+      if (session) follow(session.id);
       stage.requestRender();
     },
-    hide() {},
+    hide() {
+      unfollow();
+    },
     reset() {
+      unfollow();
+      doneGrowing();
       session = null;
       gardenKey = "";
       if (view) view.setContent(null);

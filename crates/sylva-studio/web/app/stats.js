@@ -5,6 +5,7 @@
 // createCount / lastCreatePaintMs: the same for a new breeding session, from the click on
 // Create to its grid drawn.
 // lastSelectMs: from a click on a grid cell to its highlight being applied.
+// gardenProgress: the steps of every garden progress event the page received.
 // probe(name): draws stage `name` ("breed", "garden", "family", "design") and counts the
 // pixels that differ from the background (gl.readPixels, same task as the draw).
 
@@ -18,6 +19,7 @@ export const stats = {
   lastCreatePaintMs: null,
   lastSelectMs: null,
   history: [],
+  gardenProgress: [],
   stages: {},
   ready: false,
   probe(name) {
