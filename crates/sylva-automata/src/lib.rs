@@ -121,8 +121,8 @@ use rand::Rng;
 use sylva_core::Plant;
 use sylva_evolve::{Crossover, Mutate};
 use sylva_model::{
-    Bred, ConfigError, DevelopError, Evolve, Model, Parent, Setup, VariationError,
-    two_most_dominant,
+    Bred, ConfigError, CrossLevel, DevelopError, Evolve, Knobs, Model, Parent, Setup,
+    VariationError, two_most_dominant,
 };
 
 /// Poncin's automata as a Sylva model.
@@ -154,6 +154,26 @@ impl Model for AutomataModel {
         let mut child = genome.clone();
         SubtreeMutation { config: s.gp() }.mutate(&mut child.program, rng);
         child
+    }
+
+    /// Depth 1 nudges one constant of the program by 0.1 or 0.2 (the finest change a
+    /// program can take); Depth 2 is the default subtree mutation (subtrees up to 4 deep);
+    /// each Depth above grows its new subtree one level deeper (up to 12 at Depth 10).
+    /// The level sets where crossover cuts: low at operators only (the largest subtrees),
+    /// medium at operators nine times in ten (Koza's, the default), high at operators half
+    /// the time (more single values).
+    fn hand_settings(&self, knobs: Knobs) -> AutomataSettings {
+        let depth = u32::from(knobs.depth.get());
+        AutomataSettings {
+            nudge: if depth == 1 { 1.0 } else { 0.0 },
+            mutation_depth: if depth <= 2 { 4 } else { depth + 2 },
+            function_points: match knobs.level {
+                CrossLevel::Low => 1.0,
+                CrossLevel::Medium => 0.9,
+                CrossLevel::High => 0.5,
+            },
+            ..AutomataSettings::default()
+        }
     }
 
     /// Typed subtree crossover of the two most dominant parents' programs; the child grows

@@ -12,6 +12,8 @@
 //! max_size = 500          # most nodes of a tree, 20 to 5000
 //! detail = "chords"       # how evaluation grows a program: "chords" or "full" (below)
 //! nudge = 0.0             # share of mutations that move one constant by 0.1 or 0.2
+//! mutation_depth = 4      # deepest subtree a mutation grows, 1 to 16
+//! function_points = 0.9   # share of crossover and mutation points at operators, 0 to 1
 //!
 //! [automata.breeding]     # tournament 7; crossover 0.88, reproduction 0.10, mutation 0.02
 //! [automata.growth]       # how programs grow (every field of an automata genome file)
@@ -71,6 +73,13 @@ pub struct AutomataSettings {
     /// of replacing a subtree, 0 to 1. Default 0 (Sylva's: the paper only replaces).
     #[serde(deserialize_with = "nudge", skip_serializing_if = "is_zero")]
     pub nudge: f64,
+    /// Deepest subtree a mutation grows, 1 to 16. Default 4.
+    #[serde(deserialize_with = "mutation_depth", skip_serializing_if = "is_four")]
+    pub mutation_depth: u32,
+    /// Share of crossover and mutation points that are operators (with the subtree below)
+    /// rather than values, 0 to 1. Default 0.9 (Koza's).
+    #[serde(deserialize_with = "function_points", skip_serializing_if = "is_koza")]
+    pub function_points: f64,
     /// Tournament selection and the 88 / 10 / 2 operator rates.
     pub breeding: GenerationalSettings,
     /// How programs grow (written into every evolved genome).
@@ -95,6 +104,14 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+fn is_four(depth: &u32) -> bool {
+    *depth == 4
+}
+
+fn is_koza(rate: &f64) -> bool {
+    *rate == 0.9
+}
+
 fn is_chords(detail: &EvaluationDetail) -> bool {
     *detail == EvaluationDetail::Chords
 }
@@ -115,6 +132,8 @@ impl Default for AutomataSettings {
             max_size: 500,
             detail: EvaluationDetail::Chords,
             nudge: 0.0,
+            mutation_depth: 4,
+            function_points: 0.9,
             breeding: GenerationalSettings::default(),
             growth: Growth::default(),
             fitness: PoncinFitness::default(),
@@ -127,6 +146,8 @@ sylva_core::ranged!(init_depth: u32, "init depth", 1, 16);
 sylva_core::ranged!(max_depth: u32, "max_depth", 2, 64);
 sylva_core::ranged!(max_size: u32, "max_size", 20, 5000);
 sylva_core::ranged!(nudge: f64, "nudge", 0.0, 1.0);
+sylva_core::ranged!(mutation_depth: u32, "mutation_depth", 1, 16);
+sylva_core::ranged!(function_points: f64, "function_points", 0.0, 1.0);
 
 impl AutomataSettings {
     /// The GP operators' limits.
@@ -139,6 +160,8 @@ impl AutomataSettings {
             max_depth: self.max_depth,
             max_size: self.max_size,
             nudge: self.nudge,
+            mutation_depth: self.mutation_depth,
+            function_point_rate: self.function_points,
             ..GpConfig::default()
         }
     }

@@ -40,8 +40,8 @@ use sylva_core::Plant;
 use sylva_evolve::bits::BitFlip;
 use sylva_evolve::{Crossover, Mutate};
 use sylva_model::{
-    Bred, ConfigError, DevelopError, Evolve, Model, Parent, Setup, VariationError,
-    two_most_dominant,
+    Bred, ConfigError, CrossLevel, DevelopError, Evolve, Knobs, Model, Parent, Setup,
+    VariationError, two_most_dominant,
 };
 
 /// Susinno's binary tree as a Sylva model.
@@ -71,6 +71,21 @@ impl Model for BinTreeModel {
         }
         .mutate(&mut bits, rng);
         BinTree::decode_as(&bits, g.min_radius, g.geometry)
+    }
+
+    /// Depth d flips each of the 65 bits with probability 0.01·d (Depth 2 is the default
+    /// 0.02; Depth 10 flips about six bits). The level: low and medium cut the bit string
+    /// once (a tree's two halves are its largest parts), high takes each bit from either
+    /// parent.
+    fn hand_settings(&self, knobs: Knobs) -> BinTreeSettings {
+        BinTreeSettings {
+            mutation_rate: 0.01 * f64::from(knobs.depth.get()),
+            crossover: match knobs.level {
+                CrossLevel::Low | CrossLevel::Medium => CrossoverKind::OnePoint,
+                CrossLevel::High => CrossoverKind::Uniform,
+            },
+            ..BinTreeSettings::default()
+        }
     }
 
     /// Crosses the encodings of the two most dominant parents (values round to the

@@ -845,6 +845,77 @@ fn a_copied_binary_serves_the_page_from_any_folder() {
     );
 }
 
+/// How far apart two genomes' JSON are: each number by its relative difference, each
+/// string by the share of its characters that differ (by position, and its length), each
+/// value one side lacks as 1.
+fn genome_distance(a: &Value, b: &Value) -> f64 {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            (x - y).abs() / (x.abs() + y.abs()).max(1e-9)
+        }
+        (Value::String(x), Value::String(y)) => {
+            let (x, y): (Vec<char>, Vec<char>) = (x.chars().collect(), y.chars().collect());
+            let n = x.len().max(y.len()).max(1);
+            let same = x.iter().zip(&y).filter(|(p, q)| p == q).count();
+            (n - same) as f64 / n as f64
+        }
+        (Value::Array(x), Value::Array(y)) => (0..x.len().max(y.len()))
+            .map(|i| match (x.get(i), y.get(i)) {
+                (Some(p), Some(q)) => genome_distance(p, q),
+                _ => 1.0,
+            })
+            .sum(),
+        (Value::Object(x), Value::Object(y)) => x
+            .keys()
+            .chain(y.keys().filter(|k| !x.contains_key(*k)))
+            .map(|k| match (x.get(k), y.get(k)) {
+                (Some(p), Some(q)) => genome_distance(p, q),
+                _ => 1.0,
+            })
+            .sum(),
+        (x, y) => f64::from(u8::from(x != y)),
+    }
+}
+
+#[test]
+fn depth_means_the_same_in_every_model() {
+    let dir = temp_dir("knobs");
+    let server = start(&dir, "127.0.0.1");
+    for model in ["plantmaker", "bintree", "automata", "lsystem"] {
+        let session = post(
+            &server,
+            "/api/sessions",
+            json!({"mode": "breed", "model": model, "seed": 5}),
+        );
+        let id = session["id"].as_i64().unwrap();
+        let parent = grid(&session)[0];
+        let genome = get(&server, &format!("/api/plants/{parent}"))["genome"].clone();
+        let mean_distance = |depth: u32| {
+            let mut distances = Vec::new();
+            for seed in 1..=3u64 {
+                let bred = post(
+                    &server,
+                    &format!("/api/sessions/{id}/mutate"),
+                    json!({"plant": parent, "depth": depth, "children": 8, "seed": seed}),
+                );
+                let children: Vec<i64> = grid(&bred)[1..].to_vec();
+                for child in children {
+                    let row = get(&server, &format!("/api/plants/{child}"));
+                    assert_eq!(row["parents"][0]["plant"], parent);
+                    distances.push(genome_distance(&genome, &row["genome"]));
+                }
+            }
+            distances.iter().sum::<f64>() / distances.len() as f64
+        };
+        let (gentle, strong) = (mean_distance(1), mean_distance(10));
+        assert!(
+            strong > 2.0 * gentle && strong > 0.0,
+            "{model}: Depth 1 moves its children {gentle:.3} on average, Depth 10 {strong:.3}"
+        );
+    }
+}
+
 #[test]
 fn textures_are_served_only_for_what_a_real_plant_names() {
     let dir = temp_dir("textures");

@@ -525,6 +525,92 @@ mod tests {
     }
 }
 
+/// How a crossover of two L-system plants mixes them (Sylva's addition; the paper breeds by
+/// mutation alone), from the largest parts to the smallest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LSystemCrossover {
+    /// Both L-systems from one parent, the angles and module shapes from the other.
+    Halves,
+    /// Each compartment's L-system, the angles and the module shapes, each from either
+    /// parent ([`CompartmentCrossover`]). The default.
+    #[default]
+    Compartments,
+    /// Each axiom and rule of each compartment, each angle and each module's shape from
+    /// either parent. Rules are matched by position (rule `i` rewrites the `i`-th letter), so
+    /// any mix is a legal genome; a rule one parent lacks comes from the other.
+    Rules,
+}
+
+impl sylva_evolve::Crossover<LSystemGenome> for LSystemCrossover {
+    fn crossover<R: Rng + ?Sized>(
+        &self,
+        a: &LSystemGenome,
+        b: &LSystemGenome,
+        rng: &mut R,
+    ) -> LSystemGenome {
+        match self {
+            LSystemCrossover::Halves => {
+                let (systems, shapes) = if rng.random_bool(0.5) { (a, b) } else { (b, a) };
+                LSystemGenome {
+                    shoot: systems.shoot.clone(),
+                    root: systems.root.clone(),
+                    angles: shapes.angles,
+                    modules: shapes.modules,
+                    ..a.clone()
+                }
+            }
+            LSystemCrossover::Compartments => CompartmentCrossover.crossover(a, b, rng),
+            LSystemCrossover::Rules => {
+                let mut coin = || rng.random_bool(0.5);
+                let mut child = a.clone();
+                child.shoot = mix_rules(&a.shoot, &b.shoot, &mut coin);
+                child.root = mix_rules(&a.root, &b.root, &mut coin);
+                let angles = [
+                    &mut child.angles.turn,
+                    &mut child.angles.pitch,
+                    &mut child.angles.roll,
+                ];
+                let theirs = [b.angles.turn, b.angles.pitch, b.angles.roll];
+                for (mine, other) in angles.into_iter().zip(theirs) {
+                    if coin() {
+                        *mine = other;
+                    }
+                }
+                let shapes = [
+                    (&mut child.modules.leaf, b.modules.leaf),
+                    (&mut child.modules.branch, b.modules.branch),
+                    (&mut child.modules.fine_root, b.modules.fine_root),
+                    (&mut child.modules.root_branch, b.modules.root_branch),
+                ];
+                for (mine, other) in shapes {
+                    if coin() {
+                        *mine = other;
+                    }
+                }
+                child
+            }
+        }
+    }
+}
+
+/// An L-system whose axiom and each rule come from `a` or `b`, each as `coin` says (true:
+/// `b`); a rule only one of them has comes from that one.
+fn mix_rules(a: &LSystem, b: &LSystem, coin: &mut impl FnMut() -> bool) -> LSystem {
+    let axiom = if coin() { &b.axiom } else { &a.axiom };
+    let n = a.rules.rules.len().max(b.rules.rules.len());
+    let rules = (0..n)
+        .filter_map(|i| {
+            let (x, y) = (a.rules.rules.get(i), b.rules.rules.get(i));
+            if coin() { y.or(x) } else { x.or(y) }.cloned()
+        })
+        .collect();
+    LSystem {
+        axiom: axiom.clone(),
+        rules: RuleSet { rules },
+    }
+}
+
 /// Crossover of two L-system plants (Sylva's addition; the paper breeds by mutation alone):
 /// the child takes each compartment's L-system, the angles and the module shapes, each from
 /// either parent with equal odds, and the first parent's physiology. Whole L-systems travel

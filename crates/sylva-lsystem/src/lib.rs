@@ -45,15 +45,15 @@ pub mod physiology;
 pub mod problem;
 pub mod work;
 
-pub use genome::{CompartmentCrossover, LSystemGenome, LSystemMutation};
+pub use genome::{CompartmentCrossover, LSystemCrossover, LSystemGenome, LSystemMutation};
 pub use problem::{LSystemProblem, LSystemSettings, LSystemStrategy, Score};
 
 use rand::Rng;
 use sylva_core::Plant;
 use sylva_evolve::{Crossover, Mutate};
 use sylva_model::{
-    Bred, ConfigError, DevelopError, EvaluationTime, Evolve, MeshHint, Model, Parent, Setup,
-    VariationError, two_most_dominant,
+    Bred, ConfigError, CrossLevel, DevelopError, EvaluationTime, Evolve, Knobs, MeshHint, Model,
+    Parent, Setup, VariationError, two_most_dominant,
 };
 
 /// Bornhofen and Lattaud's virtual plants as a Sylva model. A genome grows alone in the
@@ -93,18 +93,38 @@ impl Model for LSystemModel {
         child
     }
 
-    /// Compartment crossover of the two most dominant parents.
+    /// The settings' crossover of the two most dominant parents.
     fn cross<R: Rng + ?Sized>(
         &self,
         parents: &[Parent<'_, LSystemGenome>],
-        _s: &LSystemSettings,
+        s: &LSystemSettings,
         rng: &mut R,
     ) -> Result<Bred<LSystemGenome>, VariationError> {
         let (a, b) = two_most_dominant(parents)?;
         Ok(Bred {
-            genome: CompartmentCrossover.crossover(parents[a].genome, parents[b].genome, rng),
+            genome: s
+                .crossover
+                .crossover(parents[a].genome, parents[b].genome, rng),
             parents: vec![a, b],
         })
+    }
+
+    /// Depth d multiplies every mutation probability by d/2 (at most 1: Depth 2 is the
+    /// paper's rates; Depth 10, five times as many changes). The level: low takes both
+    /// L-systems from one parent and the angles and module shapes from the other, medium
+    /// each compartment whole from either (the default), high each rule, axiom, angle and
+    /// module shape from either.
+    fn hand_settings(&self, knobs: Knobs) -> LSystemSettings {
+        let defaults = LSystemSettings::default();
+        LSystemSettings {
+            rates: defaults.rates.scaled(knobs.depth.scale()),
+            crossover: match knobs.level {
+                CrossLevel::Low => LSystemCrossover::Halves,
+                CrossLevel::Medium => LSystemCrossover::Compartments,
+                CrossLevel::High => LSystemCrossover::Rules,
+            },
+            ..defaults
+        }
     }
 
     fn mesh_hint(&self) -> MeshHint {

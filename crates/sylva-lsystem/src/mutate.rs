@@ -63,6 +63,24 @@ sylva_core::ranged!(insert_rule: f64, "insert_rule", 0.0, 1.0);
 sylva_core::ranged!(duplicate_rule: f64, "duplicate_rule", 0.0, 1.0);
 sylva_core::ranged!(mutate_parameter: f64, "mutate_parameter", 0.0, 1.0);
 
+impl MutationRates {
+    /// Every probability multiplied by `factor` (at most 1).
+    pub fn scaled(self, factor: f64) -> MutationRates {
+        let f = |p: f64| (p * factor).clamp(0.0, 1.0);
+        MutationRates {
+            delete_char: f(self.delete_char),
+            insert_char: f(self.insert_char),
+            permute_char: f(self.permute_char),
+            duplicate_char: f(self.duplicate_char),
+            mutate_char: f(self.mutate_char),
+            delete_rule: f(self.delete_rule),
+            insert_rule: f(self.insert_rule),
+            duplicate_rule: f(self.duplicate_rule),
+            mutate_parameter: f(self.mutate_parameter),
+        }
+    }
+}
+
 impl Default for MutationRates {
     fn default() -> Self {
         MutationRates {

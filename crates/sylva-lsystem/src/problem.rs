@@ -15,7 +15,7 @@ use sylva_evolve::{
 
 use crate::breed::SpecimenStats;
 use crate::garden::{Garden, GrowSettings, Sowing};
-use crate::genome::{CompartmentCrossover, LSystemGenome, LSystemMutation};
+use crate::genome::{LSystemCrossover, LSystemGenome, LSystemMutation};
 use crate::grammar::Module;
 use crate::mutate::MutationRates;
 
@@ -36,6 +36,10 @@ pub struct LSystemSettings {
     pub random_rounds: u32,
     /// Mutation probabilities (section 3.3).
     pub rates: MutationRates,
+    /// How crossover mixes two plants: `"halves"`, `"compartments"` or `"rules"`. Default
+    /// compartments.
+    #[serde(skip_serializing_if = "is_compartments")]
+    pub crossover: LSystemCrossover,
     /// World and time each genome grows in.
     pub grow: GrowSettings,
     /// Tournament selection and operator rates. Default: no crossover, 20% reproduction,
@@ -45,6 +49,11 @@ pub struct LSystemSettings {
 
 sylva_core::ranged!(random_rounds: u32, "random_rounds", 0, 1000);
 
+/// The default crossover stays out of written configs, which keep their bytes.
+fn is_compartments(crossover: &LSystemCrossover) -> bool {
+    *crossover == LSystemCrossover::Compartments
+}
+
 impl Default for LSystemSettings {
     fn default() -> Self {
         LSystemSettings {
@@ -52,6 +61,7 @@ impl Default for LSystemSettings {
             score: Score::Biomass,
             random_rounds: 10,
             rates: MutationRates::default(),
+            crossover: LSystemCrossover::Compartments,
             grow: GrowSettings::default(),
             breeding: GenerationalSettings {
                 crossover: 0.0,
@@ -87,13 +97,13 @@ impl LSystemSettings {
             random_rounds: self.random_rounds,
             mutation,
         };
-        let strategy = Generational::new(CompartmentCrossover, mutation, self.breeding.clone())?;
+        let strategy = Generational::new(self.crossover, mutation, self.breeding.clone())?;
         Ok((problem, strategy))
     }
 }
 
 /// L-system breeding: mutation (and, if asked, compartment crossover).
-pub type LSystemStrategy = Generational<CompartmentCrossover, LSystemMutation>;
+pub type LSystemStrategy = Generational<LSystemCrossover, LSystemMutation>;
 
 /// What [`LSystemProblem`] selects for.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -2,7 +2,8 @@
 //!
 //! A model is a type that implements [`Model`]: its name, its genome type, how a genome
 //! grows into a [`Plant`], its settings, and its own variation operators (random genomes,
-//! mutation, crossover of two or more parents with dominance weights). A model that can
+//! mutation, crossover of two or more parents with dominance weights, and what a person's
+//! [`Knobs`] mean for them). A model that can
 //! also be evolved without a person implements [`Evolve`]: the engine's [`Problem`] and
 //! [`Strategy`] its settings describe, and how an evolved genome becomes a genome file. A
 //! model's settings are one type, the `[name]` section of an evolution config, so a run and
@@ -15,7 +16,7 @@
 //! ```
 //! use rand::{Rng, RngExt};
 //! use sylva_core::{Plant, glam::Vec3};
-//! use sylva_model::{Bred, DevelopError, Model, Parent, VariationError, plant_meta};
+//! use sylva_model::{Bred, DevelopError, Knobs, Model, Parent, VariationError, plant_meta};
 //!
 //! /// A plant of one cylinder, `height` metres tall.
 //! #[derive(Clone, Copy, Debug, Default)]
@@ -45,6 +46,8 @@
 //!     fn mutate<R: Rng + ?Sized>(&self, g: &StickGenome, _: &(), rng: &mut R) -> StickGenome {
 //!         StickGenome { height: (g.height * rng.random_range(0.8..1.25)).clamp(0.1, 10.0) }
 //!     }
+//!
+//!     fn hand_settings(&self, _: Knobs) {}
 //!
 //!     fn cross<R: Rng + ?Sized>(
 //!         &self,
@@ -128,6 +131,12 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
         rng: &mut R,
     ) -> Result<Bred<Self::Genome>, VariationError>;
 
+    /// The settings a person breeding by hand means with `knobs` (PlantMaker's crossover
+    /// level and mutation Depth, §2): each model gives them its own operators' meaning, so
+    /// the studio's controls act on every model. Depth 2 and the medium level are what a
+    /// person starts with: a model's default mutation and crossover.
+    fn hand_settings(&self, knobs: Knobs) -> Self::Settings;
+
     /// Reads a genome file's text. The default is serde's reader, which refuses unknown
     /// fields and reports the line and column of any error.
     fn parse(&self, text: &str) -> Result<Self::Genome, GenomeError> {
@@ -156,6 +165,80 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn growth_seconds(&self, _genome: &Self::Genome) -> Option<f64> {
         None
     }
+}
+
+/// How much of the parents a crossover mixes, as PlantMaker's levels name it (Figure 9):
+/// low keeps large parts of each parent together, high mixes the smallest parts. Each model
+/// says what its parts are ([`Model::hand_settings`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CrossLevel {
+    /// Large parts of each parent together.
+    Low,
+    /// The model's default crossover.
+    #[default]
+    Medium,
+    /// The smallest parts mixed.
+    High,
+}
+
+/// How strongly a mutation changes a genome, 1 (the least) to 10, as PlantMaker's Depth
+/// control. 2 is a model's default mutation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(try_from = "u8", into = "u8")]
+pub struct Depth(u8);
+
+impl Depth {
+    /// The least Depth.
+    pub const MIN: u8 = 1;
+    /// The greatest Depth.
+    pub const MAX: u8 = 10;
+
+    /// A Depth of 1 to 10.
+    pub fn new(depth: u8) -> Option<Depth> {
+        (Self::MIN..=Self::MAX)
+            .contains(&depth)
+            .then_some(Depth(depth))
+    }
+
+    /// Its value, 1 to 10.
+    pub fn get(self) -> u8 {
+        self.0
+    }
+
+    /// Its value as a share of the range above the default: 1 at Depth 2, 5 at Depth 10,
+    /// 0.5 at Depth 1 (what most models multiply their rates by).
+    pub fn scale(self) -> f64 {
+        f64::from(self.0) / 2.0
+    }
+}
+
+impl Default for Depth {
+    fn default() -> Self {
+        Depth(2)
+    }
+}
+
+impl TryFrom<u8> for Depth {
+    type Error = String;
+    fn try_from(depth: u8) -> Result<Depth, String> {
+        Depth::new(depth).ok_or_else(|| format!("expected a Depth of 1 to 10, got {depth}"))
+    }
+}
+
+impl From<Depth> for u8 {
+    fn from(depth: Depth) -> u8 {
+        depth.0
+    }
+}
+
+/// A person's controls when breeding by hand: the crossover level and the mutation Depth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+pub struct Knobs {
+    /// How much a crossover mixes.
+    pub level: CrossLevel,
+    /// How strongly a mutation changes.
+    pub depth: Depth,
 }
 
 /// How a model's plants are best meshed: facts about the model's shapes, which the library

@@ -447,6 +447,23 @@ impl sylva_model::Model for PlantMakerModel {
         child
     }
 
+    /// The paper's own controls: the level is the crossover's (Figure 9), and Depth d
+    /// mutates each variable with probability 0.05·d by noise of 0.05 + 0.02·d of its range
+    /// (Depth 2: 0.1 and 0.09).
+    fn hand_settings(&self, knobs: sylva_model::Knobs) -> PlantMakerSettings {
+        let d = f64::from(knobs.depth.get());
+        PlantMakerSettings {
+            crossover: match knobs.level {
+                sylva_model::CrossLevel::Low => Level::Low,
+                sylva_model::CrossLevel::Medium => Level::Medium,
+                sylva_model::CrossLevel::High => Level::High,
+            },
+            mutation_rate: 0.05 * d,
+            mutation_spread: 0.05 + 0.02 * d,
+            ..PlantMakerSettings::default()
+        }
+    }
+
     /// The paper's crossover of every parent, by dominance, at the settings' level.
     fn cross<R: Rng + ?Sized>(
         &self,

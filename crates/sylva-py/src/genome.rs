@@ -74,7 +74,7 @@ impl Genome {
             )
         })?;
         let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
-        let inner = entry.random(settings.as_ref(), seed).py()?;
+        let inner = entry.random(settings.as_ref().into(), seed).py()?;
         Ok(Genome { inner })
     }
 
@@ -187,7 +187,7 @@ impl Genome {
     #[pyo3(signature = (seed, settings = None))]
     fn mutate(&self, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
         let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
-        let inner = self.inner.mutate(settings.as_ref(), seed).py()?;
+        let inner = self.inner.mutate(settings.as_ref().into(), seed).py()?;
         Ok(Genome { inner })
     }
 
@@ -249,7 +249,7 @@ pub fn cross(
     let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
     let pairs: Vec<(&sylva::Genome, f64)> =
         parents.iter().map(|g| &g.inner).zip(dominance).collect();
-    let (child, used) = sylva::Genome::cross(&pairs, settings.as_ref(), seed).py()?;
+    let (child, used) = sylva::Genome::cross(&pairs, settings.as_ref().into(), seed).py()?;
     Ok((Genome { inner: child }, used))
 }
 

@@ -13,7 +13,7 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::{Genome, Registry};
+use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 use sylva_core::Plant;
 
 use crate::Studio;
@@ -256,7 +256,7 @@ async fn make_plants(
             for i in 0..n {
                 let s = step_seed(seed, seq, u64::from(i));
                 let genome = entry
-                    .random(None, s)
+                    .random(Settings::Default, s)
                     .map_err(|e| ApiError::unprocessable(field, input_message(&e)))?;
                 let at = sub(field, "random");
                 genomes.push(Sprout::new(genome, "random", json!({ "seed": s }), at));
@@ -442,7 +442,7 @@ fn default_start(model: &str) -> Plants {
 }
 
 /// The Depth that fills a new session's grid, as the page's default.
-const FILL_DEPTH: u32 = 2;
+const FILL_DEPTH: u8 = 2;
 
 /// Creates a breed session: its first plants, then, when they are fewer than the grid holds,
 /// mutants of them in turn (Depth 2) until all nine cells are filled.
@@ -458,7 +458,10 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
     debug_assert!(reused.is_empty());
     let parents: Vec<Genome> = made.iter().map(|m| m.genome.clone()).collect();
     let fill = GRID.saturating_sub(parents.len());
-    let settings = (model == PLANTMAKER).then(|| depth_settings(FILL_DEPTH));
+    let settings = Knobs {
+        level: CrossLevel::Medium,
+        depth: Depth::new(FILL_DEPTH).unwrap_or_default(),
+    };
     let mutants = if fill == 0 {
         Vec::new()
     } else {
@@ -471,7 +474,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
             -1,
             move |i, s| {
                 let child = parents[i % parents.len()]
-                    .mutate(settings.as_ref(), s)
+                    .mutate(Settings::Knobs(settings), s)
                     .map_err(|e| ApiError::library("start", e))?;
                 Ok((child, Vec::new()))
             },
@@ -593,7 +596,7 @@ fn one() -> f64 {
 #[serde(deny_unknown_fields)]
 pub struct CrossRequest {
     parents: Vec<CrossParent>,
-    level: Option<String>,
+    level: Option<CrossLevel>,
     children: Option<u32>,
     seed: Option<u64>,
 }
@@ -683,15 +686,12 @@ pub(crate) async fn cross(
     }
     let rows = archived(&studio, &ids, &row.model, "parents")?;
     let genomes = rows.iter().map(genome_of).collect::<Result<Vec<_>, _>>()?;
-    let level = request.level.as_deref().unwrap_or("medium");
-    if !matches!(level, "low" | "medium" | "high") {
-        return Err(ApiError::bad(
-            "level",
-            format!("expected low, medium or high, got {level:?}"),
-        ));
-    }
+    let level = request.level.unwrap_or_default();
     let count = children(request.children, GRID.saturating_sub(ids.len()).max(1))?;
-    let settings = (row.model == PLANTMAKER).then(|| json!({ "crossover": level }));
+    let knobs = Knobs {
+        level,
+        ..Knobs::default()
+    };
     let weights: Vec<f64> = request.parents.iter().map(|p| p.dominance).collect();
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
@@ -703,7 +703,7 @@ pub(crate) async fn cross(
         seq,
         move |_, s| {
             let pairs: Vec<(&Genome, f64)> = genomes.iter().zip(weights.iter().copied()).collect();
-            let (child, used) = Genome::cross(&pairs, settings.as_ref(), s)
+            let (child, used) = Genome::cross(&pairs, Settings::Knobs(knobs), s)
                 .map_err(|e| ApiError::library("parents", e))?;
             let parents = used
                 .iter()
@@ -737,12 +737,6 @@ pub struct MutateRequest {
     seed: Option<u64>,
 }
 
-/// PlantMaker's mutation settings for a Depth of 1 to 10 (`docs/studio.md`).
-pub fn depth_settings(depth: u32) -> serde_json::Value {
-    let d = f64::from(depth);
-    json!({ "mutation_rate": 0.05 * d, "mutation_spread": 0.05 + 0.02 * d })
-}
-
 /// `POST /api/sessions/{id}/mutate`.
 pub(crate) async fn mutate(
     State(studio): State<Studio>,
@@ -753,16 +747,16 @@ pub(crate) async fn mutate(
     let _guard = lock.lock().await;
     let (row, state) = breed_state(&studio, id)?;
     let depth = request.depth.unwrap_or(2);
-    if !(1..=10).contains(&depth) {
-        return Err(ApiError::bad(
-            "depth",
-            format!("expected 1 to 10, got {depth}"),
-        ));
-    }
+    let knobs = Knobs {
+        depth: u8::try_from(depth)
+            .ok()
+            .and_then(Depth::new)
+            .ok_or_else(|| ApiError::bad("depth", format!("expected 1 to 10, got {depth}")))?,
+        ..Knobs::default()
+    };
     let count = children(request.children, GRID - 1)?;
     let parent = archived_one(&studio, request.plant, &row.model, "plant")?;
     let genome = genome_of(&parent)?;
-    let settings = (row.model == PLANTMAKER).then(|| depth_settings(depth));
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
     let parent_id = parent.id;
@@ -773,7 +767,7 @@ pub(crate) async fn mutate(
         seq,
         move |_, s| {
             let child = genome
-                .mutate(settings.as_ref(), s)
+                .mutate(Settings::Knobs(knobs), s)
                 .map_err(|e| ApiError::library("plant", e))?;
             Ok((
                 child,

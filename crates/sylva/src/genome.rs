@@ -11,7 +11,9 @@ use std::sync::Arc;
 
 use sylva_core::Plant;
 use sylva_core::rng::ChaCha8Rng;
-use sylva_model::{Bred, DevelopError, GenomeError, MeshHint, Model, Parent, VariationError};
+use sylva_model::{
+    Bred, DevelopError, GenomeError, Knobs, MeshHint, Model, Parent, VariationError,
+};
 
 use crate::error::{Error, InputError};
 use crate::files::read_text;
@@ -44,9 +46,25 @@ trait AnyGenome: Send + Sync {
     ) -> Result<(Genome, Vec<usize>), Error>;
 }
 
-/// A model's settings for breeding by hand, as JSON (a front end's form), or the model's
-/// defaults.
-pub type Settings<'a> = Option<&'a serde_json::Value>;
+/// What breeding by hand follows.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum Settings<'a> {
+    /// The model's defaults.
+    #[default]
+    Default,
+    /// A person's controls, which each model turns into its own settings
+    /// ([`sylva_model::Model::hand_settings`]).
+    Knobs(Knobs),
+    /// The model's settings as JSON (its config section; a Python dict), read as a config
+    /// section is: unknown fields refused, numbers checked.
+    Json(&'a serde_json::Value),
+}
+
+impl<'a> From<Option<&'a serde_json::Value>> for Settings<'a> {
+    fn from(json: Option<&'a serde_json::Value>) -> Settings<'a> {
+        json.map_or(Settings::Default, Settings::Json)
+    }
+}
 
 /// A model's genome with the model it belongs to.
 struct Typed<M: Model> {
@@ -56,11 +74,20 @@ struct Typed<M: Model> {
 
 impl<M: Model> Typed<M> {
     fn settings(&self, settings: Settings<'_>) -> Result<M::Settings, InputError> {
-        match settings {
-            None => Ok(M::Settings::default()),
-            Some(v) => serde_json::from_value(v.clone())
-                .map_err(|e| InputError::new(format!("{} settings", M::NAME), e.to_string())),
-        }
+        settings_of(&self.model, settings)
+    }
+}
+
+/// Model `M`'s settings for `settings`.
+pub(crate) fn settings_of<M: Model>(
+    model: &M,
+    settings: Settings<'_>,
+) -> Result<M::Settings, InputError> {
+    match settings {
+        Settings::Default => Ok(M::Settings::default()),
+        Settings::Knobs(knobs) => Ok(model.hand_settings(knobs)),
+        Settings::Json(v) => serde_json::from_value(v.clone())
+            .map_err(|e| InputError::new(format!("{} settings", M::NAME), e.to_string())),
     }
 }
 

@@ -19,7 +19,7 @@
 //!   expected.
 //!
 //! ```
-//! use sylva::{Genome, Grown, Registry};
+//! use sylva::{Genome, Grown, Registry, Settings};
 //!
 //! // A genome file of any model, grown into a meshed plant.
 //! let text = r#"{"model": "bintree", "format": 1, "depth": 5, "lower_radius": 0.2,
@@ -30,7 +30,7 @@
 //! let grown = Grown::new(genome.clone(), genome.default_seed(), true)?;
 //! assert_eq!(grown.plant.segments().len(), 31);
 //! // Bred by hand with the model's own operators.
-//! let child = genome.mutate(None, 7)?;
+//! let child = genome.mutate(Settings::Default, 7)?;
 //! assert_eq!(child.model(), "bintree");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -48,7 +48,8 @@ pub mod skeleton;
 pub use assets::{Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
-pub use genome::{Genome, load_genome, parse_genome};
+pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;
+pub use sylva_model::{CrossLevel, Depth, Knobs};

@@ -90,12 +90,8 @@ fn parse<M: Model + Default>(text: &str) -> Result<Genome, GenomeError> {
 }
 
 fn random<M: Model + Default>(settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
-    let settings: M::Settings = match settings {
-        None => M::Settings::default(),
-        Some(v) => serde_json::from_value(v.clone())
-            .map_err(|e| InputError::new(format!("{} settings", M::NAME), e))?,
-    };
     let model = M::default();
+    let settings = crate::genome::settings_of(&model, settings)?;
     let genome = model.random(&settings, &mut sylva_core::rng::seeded(seed));
     Ok(Genome::new(model, genome))
 }

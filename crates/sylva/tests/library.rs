@@ -6,7 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use sylva::assets::export;
-use sylva::{Config, Evolution, Genome, Grown, InputError, ModelEntry, Registry, load_genome};
+use sylva::{
+    Config, Evolution, Genome, Grown, InputError, ModelEntry, Registry, Settings, load_genome,
+};
 use sylva_core::par::Pool;
 
 mod common;
@@ -216,18 +218,19 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
         let a = load_genome(&example(name)).unwrap();
         let model = a.model();
         let entry = Registry::standard().get(model).unwrap();
-        let b = entry.random(None, 3).unwrap();
+        let b = entry.random(Settings::Default, 3).unwrap();
         assert_eq!(b.model(), model);
         // Mutation and crossover are the model's, deterministic in the seed.
-        let m = a.mutate(None, 9).unwrap();
-        assert_eq!(m, a.mutate(None, 9).unwrap(), "{name}");
-        let (child, parents) = Genome::cross(&[(&a, 1.0), (&b, 2.0)], None, 4).unwrap();
+        let m = a.mutate(Settings::Default, 9).unwrap();
+        assert_eq!(m, a.mutate(Settings::Default, 9).unwrap(), "{name}");
+        let (child, parents) =
+            Genome::cross(&[(&a, 1.0), (&b, 2.0)], Settings::Default, 4).unwrap();
         assert_eq!(child.model(), model);
         assert!(
             !parents.is_empty() && parents.iter().all(|&p| p < 2),
             "{name}"
         );
-        let (again, _) = Genome::cross(&[(&a, 1.0), (&b, 2.0)], None, 4).unwrap();
+        let (again, _) = Genome::cross(&[(&a, 1.0), (&b, 2.0)], Settings::Default, 4).unwrap();
         assert_eq!(child, again, "{name}");
         // What breeding makes is a genome file of the model that reads back the same.
         let text = child.to_json();
@@ -235,27 +238,31 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
     }
     let oak = load_genome(&example("bintree/oak.json")).unwrap();
     let fern = load_genome(&example("plantmaker/fern.json")).unwrap();
-    let e = Genome::cross(&[(&oak, 1.0), (&fern, 1.0)], None, 1).unwrap_err();
+    let e = Genome::cross(&[(&oak, 1.0), (&fern, 1.0)], Settings::Default, 1).unwrap_err();
     assert!(
         e.is_input() && e.to_string().contains("cannot be crossed"),
         "{e}"
     );
-    let e = Genome::cross(&[(&oak, 1.0)], None, 1).unwrap_err();
+    let e = Genome::cross(&[(&oak, 1.0)], Settings::Default, 1).unwrap_err();
     assert!(e.to_string().contains("two or more parents"), "{e}");
-    let e = Genome::cross(&[(&oak, 1.0), (&oak, f64::NAN)], None, 1).unwrap_err();
+    let e = Genome::cross(&[(&oak, 1.0), (&oak, f64::NAN)], Settings::Default, 1).unwrap_err();
     assert!(e.to_string().contains("dominance"), "{e}");
     let settings = serde_json::json!({ "mutation_rat": 0.5 });
-    let e = oak.mutate(Some(&settings), 1).unwrap_err();
+    let e = oak.mutate(Settings::Json(&settings), 1).unwrap_err();
     assert!(e.to_string().contains("mutation_rat"), "{e}");
     let settings = serde_json::json!({ "mutation_rate": 1.5 });
-    let e = oak.mutate(Some(&settings), 1).unwrap_err();
+    let e = oak.mutate(Settings::Json(&settings), 1).unwrap_err();
     assert!(e.to_string().contains("mutation_rate"), "{e}");
     // PlantMaker crosses every parent by dominance, at the settings' level.
     let bush = load_genome(&example("plantmaker/flowering-bush.json")).unwrap();
     let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
     let high = serde_json::json!({ "crossover": "high" });
-    let (_, parents) =
-        Genome::cross(&[(&fern, 1.0), (&bush, 1.0), (&tulip, 1.0)], Some(&high), 2).unwrap();
+    let (_, parents) = Genome::cross(
+        &[(&fern, 1.0), (&bush, 1.0), (&tulip, 1.0)],
+        Settings::Json(&high),
+        2,
+    )
+    .unwrap();
     assert!(parents.len() >= 2, "{parents:?}");
 }
 
@@ -312,6 +319,8 @@ mod cylinder {
             )?;
             Ok(plant)
         }
+
+        fn hand_settings(&self, _: sylva_model::Knobs) {}
 
         fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> CylinderGenome {
             CylinderGenome {
@@ -387,10 +396,14 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     let bytes = std::fs::read(&glb).unwrap();
     assert!(String::from_utf8_lossy(&bytes).contains(r#""model":"cylinder""#));
     // Bred by hand like the four.
-    let child = genome.mutate(None, 1).unwrap();
+    let child = genome.mutate(Settings::Default, 1).unwrap();
     assert_eq!(child.model(), cylinder::Cylinder::NAME);
-    let random = registry.get("cylinder").unwrap().random(None, 2).unwrap();
-    let (bred, _) = Genome::cross(&[(&genome, 2.0), (&random, 1.0)], None, 3).unwrap();
+    let random = registry
+        .get("cylinder")
+        .unwrap()
+        .random(Settings::Default, 2)
+        .unwrap();
+    let (bred, _) = Genome::cross(&[(&genome, 2.0), (&random, 1.0)], Settings::Default, 3).unwrap();
     assert_eq!(bred.get::<cylinder::Cylinder>().unwrap().height, 2.5);
     // It does not evolve: the registry says so when a config names it.
     assert!(!registry.get("cylinder").unwrap().evolves());
@@ -455,6 +468,7 @@ mod void {
         fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> u32 {
             rng.random()
         }
+        fn hand_settings(&self, _: sylva_model::Knobs) {}
         fn mutate<R: Rng + ?Sized>(&self, g: &u32, _: &(), _: &mut R) -> u32 {
             *g
         }
