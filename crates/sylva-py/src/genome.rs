@@ -171,14 +171,17 @@ impl Genome {
         taper: Option<f64>,
     ) -> PyResult<Plant> {
         let genome = self.inner.clone();
-        let seed = seed.unwrap_or_else(|| genome.default_seed());
         let taper = taper
             .map(sylva_core::taper::PipeTaper::new)
             .transpose()
             .map_err(|e| bad_value("taper", e))?;
-        let grown = py
-            .detach(|| sylva::Grown::with_taper(genome, seed, roots, taper))
-            .py()?;
+        let options = sylva::GrowOptions {
+            seed,
+            roots,
+            taper,
+            ..sylva::GrowOptions::default()
+        };
+        let grown = py.detach(|| sylva::Grown::grow(genome, &options)).py()?;
         Ok(Plant::new(grown))
     }
 
@@ -253,7 +256,7 @@ pub fn cross(
     Ok((Genome { inner: child }, used))
 }
 
-/// Seconds per call of the library's grow-and-mesh (`sylva::Grown::new`) of `genome`,
+/// Seconds per call of the library's grow-and-mesh (`sylva::Grown::grow`) of `genome`,
 /// timed in Rust over `repeats` calls: the baseline `benches/overhead.py` compares
 /// `Genome.grow` with.
 #[pyfunction]
@@ -267,7 +270,11 @@ pub fn _rust_grow_seconds(
     py.detach(|| {
         let start = std::time::Instant::now();
         for _ in 0..repeats.max(1) {
-            std::hint::black_box(sylva::Grown::new(genome.clone(), seed, true)?);
+            let options = sylva::GrowOptions {
+                seed: Some(seed),
+                ..sylva::GrowOptions::default()
+            };
+            std::hint::black_box(sylva::Grown::grow(genome.clone(), &options)?);
         }
         Ok::<_, sylva::Error>(start.elapsed().as_secs_f64() / f64::from(repeats.max(1)))
     })

@@ -473,7 +473,7 @@ pub fn garden(
         }
     };
     let assets = py
-        .detach(|| sylva::assets::garden_assets(&garden, &source))
+        .detach(|| sylva::assets::garden_assets(&garden, &source, None))
         .py()?;
     Ok(Scene::new(assets, Some(garden.to_json())))
 }
@@ -524,6 +524,6 @@ pub fn scene(
             ..Placed::new(format!("plant-{i}"), &g.plant, g.genome.mesh_hint())
         })
         .collect();
-    let assets = py.detach(|| SceneAssets::mesh(&placed)).py()?;
+    let assets = py.detach(|| SceneAssets::mesh(&placed, None)).py()?;
     Ok(Scene::new(assets, None))
 }

@@ -386,7 +386,8 @@ async fn grow_garden(
                 ..Placed::new(format!("specimen-{i}"), plant, hint)
             })
             .collect();
-        let assets = SceneAssets::mesh(&placed).map_err(|e| ApiError::library("settings", e))?;
+        let assets =
+            SceneAssets::mesh(&placed, None).map_err(|e| ApiError::library("settings", e))?;
         let scene = sylva_mesh::export::to_glb(&assets.scene())
             .map_err(|e| ApiError::library("settings", e.into()))?;
         let mut specimens = Vec::with_capacity(garden.specimens.len());

@@ -15,7 +15,7 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::assets::Origin;
-use sylva::{Genome, Grown, Preview, Registry};
+use sylva::{Genome, GrowOptions, Grown, Preview, Registry};
 use sylva_core::Plant;
 use sylva_mesh::SceneNode;
 use sylva_mesh::render::View;
@@ -111,8 +111,13 @@ pub fn grow_glb(
     parents: &[ParentRow],
     operator: &str,
 ) -> Result<Vec<u8>, ApiError> {
+    let options = GrowOptions {
+        seed: Some(seed),
+        roots,
+        ..GrowOptions::default()
+    };
     let grown =
-        Grown::new(genome.clone(), seed, roots).map_err(|e| ApiError::library("genome", e))?;
+        Grown::grow(genome.clone(), &options).map_err(|e| ApiError::library("genome", e))?;
     let mut node = SceneNode::new(genome.model(), &grown.mesh);
     node.extras = Some(extras(genome, seed, parents, operator));
     let scene = sylva_mesh::Scene::single(node);

@@ -72,6 +72,57 @@ impl Origin {
     }
 }
 
+/// How a genome grows into an asset. `GrowOptions::default()` grows it as the genome says:
+/// its own seed, roots kept, the model's own radii, no wind, the plant in full, positions as
+/// floats. Set the fields that differ:
+///
+/// ```no_run
+/// # use sylva::assets::{GrowOptions, Grown};
+/// # let genome = sylva::load_genome("examples/plantmaker/fern.json".as_ref())?;
+/// let grown = Grown::grow(genome, &GrowOptions { seed: Some(7), roots: false, ..Default::default() })?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct GrowOptions {
+    /// The seed; the genome's own ([`Genome::default_seed`]) when `None`. Default `None`.
+    pub seed: Option<u64>,
+    /// Keep the roots in the plant, its mesh, exports and pictures. Default true.
+    pub roots: bool,
+    /// The pipe model's radii before meshing (`--taper`). Default none: the model's own.
+    pub taper: Option<PipeTaper>,
+    /// A wind skin and clip (`--wind`). Default none.
+    pub wind: Option<WindOptions>,
+    /// Levels of detail, 2 to 8, for [`LodAssets`](crate::LodAssets) (`--lod`). Default
+    /// none: the plant in full alone.
+    pub lod: Option<usize>,
+    /// Positions and normals stored as integers in GLB files (`--quantize`,
+    /// `KHR_mesh_quantization`). Default false.
+    pub quantize: bool,
+}
+
+impl Default for GrowOptions {
+    fn default() -> Self {
+        GrowOptions {
+            seed: None,
+            roots: true,
+            taper: None,
+            wind: None,
+            lod: None,
+            quantize: false,
+        }
+    }
+}
+
+impl GrowOptions {
+    /// How GLB files of the grown asset are written.
+    pub fn glb_options(&self) -> GlbOptions {
+        GlbOptions {
+            quantize: self.quantize,
+            ..GlbOptions::default()
+        }
+    }
+}
+
 /// A grown genome: its plant and mesh.
 pub struct Grown {
     /// What was grown.
@@ -86,53 +137,27 @@ pub struct Grown {
     pub taper: Option<PipeTaper>,
     /// Whether the roots were kept (`false`: left out of the plant, its mesh and exports).
     pub roots: bool,
-    /// The wind skin and clip, if asked for ([`Grown::with_wind`]).
+    /// The wind skin and clip, if asked for ([`GrowOptions::wind`]).
     pub rig: Option<Rig>,
 }
 
 impl Grown {
-    /// Grows and meshes a genome, leaving out the roots when `roots` is false (they stay
-    /// out of the exported asset and the pictures).
-    pub fn new(genome: Genome, seed: u64, roots: bool) -> Result<Grown, Error> {
-        Grown::with_taper(genome, seed, roots, None)
-    }
-
-    /// As [`Grown::new`], then, with a `taper`, the pipe model's radii before meshing.
-    pub fn with_taper(
-        genome: Genome,
-        seed: u64,
-        roots: bool,
-        taper: Option<PipeTaper>,
-    ) -> Result<Grown, Error> {
+    /// Grows and meshes a genome as `options` say: with their seed (or the genome's own),
+    /// without the roots unless kept, the pipe model's radii with a taper, and a wind skin
+    /// and clip with wind (meshed once, recording where each vertex came from).
+    pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
+        let seed = options.seed.unwrap_or_else(|| genome.default_seed());
+        let (roots, taper) = (options.roots, options.taper);
         let plant = grow_plant(&genome, seed, roots, taper)?;
-        let mesh = Mesher::new(mesh_options(genome.mesh_hint()))?.mesh(&plant)?;
-        Ok(Grown {
-            genome,
-            seed,
-            plant,
-            mesh,
-            taper,
-            roots,
-            rig: None,
-        })
-    }
-
-    /// As [`Grown::with_taper`], with a wind skin and clip when `wind` is given (meshed once,
-    /// recording where each vertex came from).
-    pub fn with_wind(
-        genome: Genome,
-        seed: u64,
-        roots: bool,
-        taper: Option<PipeTaper>,
-        wind: Option<WindOptions>,
-    ) -> Result<Grown, Error> {
-        let Some(wind) = wind else {
-            return Grown::with_taper(genome, seed, roots, taper);
+        let mut mesher = Mesher::new(mesh_options(genome.mesh_hint()))?;
+        let (mesh, rig) = match &options.wind {
+            None => (mesher.mesh(&plant)?, None),
+            Some(wind) => {
+                let (mesh, sources) = mesher.mesh_with_sources(&plant)?;
+                let rig = sylva_mesh::wind::rig(&plant, &mesh, sources, wind);
+                (mesh, Some(rig))
+            }
         };
-        let plant = grow_plant(&genome, seed, roots, taper)?;
-        let (mesh, sources) =
-            Mesher::new(mesh_options(genome.mesh_hint()))?.mesh_with_sources(&plant)?;
-        let rig = sylva_mesh::wind::rig(&plant, &mesh, sources, &wind);
         Ok(Grown {
             genome,
             seed,
@@ -140,7 +165,7 @@ impl Grown {
             mesh,
             taper,
             roots,
-            rig: Some(rig),
+            rig,
         })
     }
 
@@ -161,7 +186,7 @@ impl Grown {
     }
 }
 
-/// Grows a genome into its plant, unmeshed, as [`Grown::with_taper`] does: the roots left
+/// Grows a genome into its plant, unmeshed, as [`Grown::grow`] does: the roots left
 /// out when `roots` is false, then the pipe model's radii with a `taper`. For the work that
 /// needs the skeleton only (such as [`crate::skeleton`]).
 pub fn grow_plant(
@@ -233,17 +258,9 @@ pub struct SceneAssets {
 
 impl SceneAssets {
     /// Meshes every plant (one mesher per set of options, its buffers reused), after
-    /// checking that all the meshes together fit the memory budget.
-    pub fn mesh(placed: &[Placed<'_>]) -> Result<SceneAssets, Error> {
-        SceneAssets::mesh_with_wind(placed, None)
-    }
-
-    /// As [`SceneAssets::mesh`], each plant with a wind skin and clip when `wind` is given
-    /// (one clip, `wind`, moves them all).
-    pub fn mesh_with_wind(
-        placed: &[Placed<'_>],
-        wind: Option<WindOptions>,
-    ) -> Result<SceneAssets, Error> {
+    /// checking that all the meshes together fit the memory budget; each plant with a wind
+    /// skin and clip when `wind` is given (one clip, `wind`, moves them all).
+    pub fn mesh(placed: &[Placed<'_>], wind: Option<WindOptions>) -> Result<SceneAssets, Error> {
         // Each distinct plant (by address) once, in order of first appearance.
         let mut index_of: std::collections::HashMap<*const Plant, usize> =
             std::collections::HashMap::new();
@@ -374,20 +391,16 @@ pub fn check_scene_glb(
 }
 
 /// Grows a PlantMaker garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...),
-/// each standing at its placement and carrying its genome and seed. Errors name `source`,
-/// the garden's file (or whatever a front end calls it).
-pub fn garden_assets(garden: &Garden, source: &Path) -> Result<SceneAssets, Error> {
-    garden_assets_with_wind(garden, source, None)
-}
-
-/// As [`garden_assets`], each plant with a wind skin when `wind` is given.
-pub fn garden_assets_with_wind(
+/// each standing at its placement and carrying its genome and seed, with a wind skin when
+/// `wind` is given. Errors name `source`, the garden's file (or whatever a front end calls
+/// it).
+pub fn garden_assets(
     garden: &Garden,
     source: &Path,
     wind: Option<WindOptions>,
 ) -> Result<SceneAssets, Error> {
     let grown = grow_garden(garden, source)?;
-    SceneAssets::mesh_with_wind(&garden_placed(garden, &grown), wind).map_err(|e| e.in_file(source))
+    SceneAssets::mesh(&garden_placed(garden, &grown), wind).map_err(|e| e.in_file(source))
 }
 
 /// Grows every plant of a PlantMaker garden and places it, unmeshed. Errors name `source`.

@@ -19,7 +19,7 @@
 //!   expected.
 //!
 //! ```
-//! use sylva::{Genome, Grown, Registry, Settings};
+//! use sylva::{Genome, GrowOptions, Grown, Registry, Settings};
 //!
 //! // A genome file of any model, grown into a meshed plant.
 //! let text = r#"{"model": "bintree", "format": 1, "depth": 5, "lower_radius": 0.2,
@@ -27,7 +27,7 @@
 //!   "rotation1": {"angle": 30, "axis": [1, 0, 0]},
 //!   "rotation2": {"angle": -30, "axis": [0, 0, 1]}, "min_radius": 0.02}"#;
 //! let genome: Genome = Registry::standard().parse_genome(text)?;
-//! let grown = Grown::new(genome.clone(), genome.default_seed(), true)?;
+//! let grown = Grown::grow(genome.clone(), &GrowOptions::default())?;
 //! assert_eq!(grown.plant.segments().len(), 31);
 //! // Bred by hand with the model's own operators.
 //! let child = genome.mutate(Settings::Default, 7)?;
@@ -45,7 +45,7 @@ pub mod registry;
 pub mod report;
 pub mod skeleton;
 
-pub use assets::{Grown, Origin, Placed, SceneAssets};
+pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
 pub use genome::{Genome, Settings, load_genome, parse_genome};

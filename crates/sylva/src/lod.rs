@@ -7,10 +7,10 @@
 use serde_json::json;
 use sylva_mesh::lod::{LodError, LodLevel, lod_levels};
 use sylva_mesh::mesher::Mesher;
-use sylva_mesh::wind::{Rig, WindOptions};
+use sylva_mesh::wind::Rig;
 use sylva_mesh::{Mesh, Scene, SceneNode};
 
-use crate::assets::{Grown, Origin, grow_plant, mesh_options};
+use crate::assets::{GrowOptions, Grown, Origin, grow_plant, mesh_options};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
 use sylva_core::Plant;
@@ -34,9 +34,11 @@ pub struct LodAssets {
 }
 
 impl LodAssets {
-    /// The chain of `levels` levels of `grown` (level 0 is its own mesh and rig), each
-    /// further level rigged for `wind` when `grown` has wind.
-    pub fn new(grown: Grown, levels: usize, wind: Option<&WindOptions>) -> Result<Self, Error> {
+    /// The chain of `options.lod` levels of `grown` (level 0 is its own mesh and rig; one
+    /// level when `lod` is none), each further level rigged for `options.wind` when `grown`
+    /// has wind. `options` are those `grown` grew with.
+    pub fn new(grown: Grown, options: &GrowOptions) -> Result<Self, Error> {
+        let (levels, wind) = (options.lod.unwrap_or(1), options.wind.as_ref());
         let options = mesh_options(grown.genome.mesh_hint());
         let extras = grown.scene().nodes[0].extras.clone().unwrap_or(json!({}));
         let chain = lod_levels(&grown.plant, &options, levels).map_err(|e| match e {

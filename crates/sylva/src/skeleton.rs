@@ -12,14 +12,14 @@
 //!
 //! ```
 //! use sylva::skeleton::Skeleton;
-//! use sylva::{Grown, Registry};
+//! use sylva::{GrowOptions, Grown, Registry};
 //!
 //! let text = r#"{"model": "bintree", "format": 1, "depth": 3, "lower_radius": 0.2,
 //!   "upper_radius": 0.15, "length": 1.5, "length_ratio": 0.8,
 //!   "rotation1": {"angle": 30, "axis": [1, 0, 0]},
 //!   "rotation2": {"angle": -30, "axis": [0, 0, 1]}, "min_radius": 0.02}"#;
 //! let genome = Registry::standard().parse_genome(text)?;
-//! let grown = Grown::new(genome, 0, true)?;
+//! let grown = Grown::grow(genome, &GrowOptions::default())?;
 //! let skeleton = Skeleton::of_grown(&grown);
 //! assert_eq!(skeleton.segments.len(), 7);
 //! assert!(skeleton.to_json().starts_with("{\n  \"format\": 1,\n  \"kind\": \"sylva-skeleton\""));

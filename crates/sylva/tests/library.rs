@@ -7,8 +7,17 @@ use std::path::{Path, PathBuf};
 
 use sylva::assets::export;
 use sylva::{
-    Config, Evolution, Genome, Grown, InputError, ModelEntry, Registry, Settings, load_genome,
+    Config, Evolution, Genome, GrowOptions, Grown, InputError, ModelEntry, Registry, Settings,
+    load_genome,
 };
+
+/// Growing with `seed`, everything else at its default.
+fn seeded(seed: u64) -> GrowOptions {
+    GrowOptions {
+        seed: Some(seed),
+        ..GrowOptions::default()
+    }
+}
 use sylva_core::par::Pool;
 
 mod common;
@@ -383,7 +392,7 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
         "not in the standard list"
     );
     // Grown, meshed and exported as any plant, carrying its origin.
-    let grown = Grown::new(genome.clone(), 0, true).unwrap();
+    let grown = Grown::grow(genome.clone(), &seeded(0)).unwrap();
     assert_eq!(grown.plant.segments().len(), 1);
     assert!(grown.mesh.triangle_count() > 0);
     let dir = std::env::temp_dir().join(format!("sylva-cylinder-{}", std::process::id()));
@@ -520,8 +529,19 @@ fn the_pipe_taper_keeps_the_pipes_and_travels_with_the_asset() {
     let taper = sylva_core::taper::PipeTaper::new(e).unwrap();
     for file in ["lsystem/tree.json", "automata/helix.json"] {
         let genome = load_genome(&example(file)).unwrap();
-        let plain = Grown::new(genome.clone(), 0, false).unwrap();
-        let tapered = Grown::with_taper(genome, 0, false, Some(taper)).unwrap();
+        let options = GrowOptions {
+            roots: false,
+            ..seeded(0)
+        };
+        let plain = Grown::grow(genome.clone(), &options).unwrap();
+        let tapered = Grown::grow(
+            genome,
+            &GrowOptions {
+                taper: Some(taper),
+                ..options
+            },
+        )
+        .unwrap();
         let s = tapered.plant.segments();
         assert_eq!(
             s.len(),

@@ -4,9 +4,19 @@
 use std::path::{Path, PathBuf};
 
 use sylva::assets::{Placed, SceneAssets};
-use sylva::{Grown, load_genome};
+use sylva::{GrowOptions, Grown, load_genome};
 use sylva_core::glam::Vec3;
 use sylva_mesh::wind::WindOptions;
+
+/// Growing with `seed`, roots kept or not, and `wind`.
+fn windy(seed: u64, roots: bool, wind: Option<WindOptions>) -> GrowOptions {
+    GrowOptions {
+        seed: Some(seed),
+        roots,
+        wind,
+        ..GrowOptions::default()
+    }
+}
 
 mod common;
 
@@ -36,8 +46,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
     ] {
         let genome = load_genome(&example(name)).unwrap();
         let seed = genome.default_seed();
-        let grown =
-            Grown::with_wind(genome, seed, false, None, Some(WindOptions::default())).unwrap();
+        let grown = Grown::grow(genome, &windy(seed, false, Some(WindOptions::default()))).unwrap();
         let rig = grown.rig.as_ref().unwrap();
         assert!(rig.joints.len() >= 2, "{name}: {} joints", rig.joints.len());
         let glb = sylva_mesh::export::to_glb(&grown.scene()).unwrap();
@@ -72,7 +81,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
             ..Placed::new(format!("oak-{i}"), &plant, genome.mesh_hint())
         })
         .collect();
-    let assets = SceneAssets::mesh_with_wind(&placed, Some(WindOptions::default())).unwrap();
+    let assets = SceneAssets::mesh(&placed, Some(WindOptions::default())).unwrap();
     let glb = sylva_mesh::export::to_glb(&assets.scene()).unwrap();
     let json = gltf(&glb);
     assert_eq!(json["skins"].as_array().unwrap().len(), 3);
@@ -107,8 +116,8 @@ fn wind_glbs_of_every_model_are_validator_clean() {
 #[test]
 fn without_wind_the_bytes_are_unchanged() {
     let genome = load_genome(&example("bintree/oak.json")).unwrap();
-    let plain = Grown::with_taper(genome.clone(), 0, true, None).unwrap();
-    let none = Grown::with_wind(genome, 0, true, None, None).unwrap();
+    let plain = Grown::grow(genome.clone(), &windy(0, true, None)).unwrap();
+    let none = Grown::grow(genome, &windy(0, true, None)).unwrap();
     assert_eq!(
         sylva_mesh::export::to_glb(&plain.scene()).unwrap(),
         sylva_mesh::export::to_glb(&none.scene()).unwrap()
@@ -128,7 +137,7 @@ fn wind_strips() {
         let genome = load_genome(&example(name)).unwrap();
         let seed = genome.default_seed();
         let wind = WindOptions::new(strength, 4.0).unwrap();
-        let grown = Grown::with_wind(genome, seed, false, None, Some(wind)).unwrap();
+        let grown = Grown::grow(genome, &windy(seed, false, Some(wind))).unwrap();
         let rig = grown.rig.as_ref().unwrap();
         let b = sylva_mesh::Scene::single(sylva_mesh::SceneNode::new("p", &grown.mesh)).bounds();
         let step = 1.1 * (b.max.x - b.min.x);

@@ -106,7 +106,7 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
         &args.mother,
         "grow smaller plants (lower `max_modules` in the mother's `physiology`)",
     )?;
-    let assets = SceneAssets::mesh(&placed).in_file(&args.mother)?;
+    let assets = SceneAssets::mesh(&placed, None).in_file(&args.mother)?;
 
     let mut table =
         String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");

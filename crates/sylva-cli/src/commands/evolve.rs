@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
 use sylva::report::{fitness_svg, stats_csv};
-use sylva::{Config, Evolution, Grown, InputError};
+use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
 use sylva_core::budget::Seconds;
 use sylva_core::taper::PipeTaper;
 use sylva_mesh::SceneNode;
@@ -243,10 +243,13 @@ fn write_results(
     )?;
     let best = evolution.best();
     files.add(&out.join("best.json"), best.genome.to_json().as_bytes())?;
-    let seed = best.genome.default_seed();
     let taper = config.output().pipe_taper();
-    let wind = config.output().wind_options();
-    let grown = Grown::with_wind(best.genome.clone(), seed, true, taper, wind)?;
+    let options = GrowOptions {
+        taper,
+        wind: config.output().wind_options(),
+        ..GrowOptions::default()
+    };
+    let grown = Grown::grow(best.genome.clone(), &options)?;
     files.add_scene(&out.join("best.glb"), &grown.scene())?;
     let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
     let mut scene = grown.scene();
@@ -297,7 +300,13 @@ fn population_sheet(
     let chosen = evolution.fittest(count);
     let grown = chosen
         .iter()
-        .map(|m| Grown::with_taper(m.genome.clone(), m.genome.default_seed(), true, taper))
+        .map(|m| {
+            let options = GrowOptions {
+                taper,
+                ..GrowOptions::default()
+            };
+            Grown::grow(m.genome.clone(), &options)
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let cells: Vec<SheetCell> = chosen
         .iter()

@@ -155,7 +155,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
     } else {
         let grown = grow_garden(&garden, first)?;
         let placed = garden_placed(&garden, &grown);
-        let assets = SceneAssets::mesh_with_wind(&placed, wind).in_file(first)?;
+        let assets = SceneAssets::mesh(&placed, wind).in_file(first)?;
         let scene = assets.scene();
         out.add_scene_with(&args.output, &scene, &options)
             .in_file(first)?;

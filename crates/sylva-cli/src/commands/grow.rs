@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use sylva::assets::{check_png, picture};
 use sylva::files::Outputs;
 use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
-use sylva::{Genome, Grown, InputError, LodAssets, load_genome};
+use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets, load_genome};
 use sylva_mesh::render::View;
 
 use super::InFile;
@@ -47,10 +47,15 @@ pub struct GrowArgs {
 pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let output = GrowOutput::of(&args.output)?;
     let wind = args.wind.options(&args.output)?;
-    let glb = sylva_mesh::export::GlbOptions {
+    let options = GrowOptions {
+        seed: args.seed,
+        roots: !args.hide_roots,
+        taper: args.taper,
         quantize: args.quantize.check(&args.output, wind.is_some())?,
-        ..Default::default()
+        lod: args.lod.map(|n| n as usize),
+        wind,
     };
+    let glb = options.glb_options();
     if args.lod.is_some() && output != GrowOutput::Asset(sylva_mesh::export::Format::Glb) {
         return Err(InputError::new(
             "--lod",
@@ -62,16 +67,14 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         check_png(png)?;
     }
     let genome = load_genome(&args.genome)?;
-    let seed = args.seed.unwrap_or_else(|| genome.default_seed());
     if output == GrowOutput::Skeleton {
-        return skeleton(args, &genome, seed);
+        return skeleton(args, &genome, &options);
     }
     let growing = super::growing(&genome);
-    let grown =
-        Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind).in_file(&args.genome)?;
+    let grown = Grown::grow(genome, &options).in_file(&args.genome)?;
     drop(growing);
-    if let Some(levels) = args.lod {
-        return lod(args, grown, levels as usize, wind.as_ref(), &glb);
+    if options.lod.is_some() {
+        return lod(args, grown, &options);
     }
     let mut out = Outputs::new();
     out.add_scene_with(&args.output, &grown.scene(), &glb)
@@ -109,15 +112,10 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
 
 /// `sylva grow --lod N`: NAME_LOD0.glb … beside the output, and the output as one scene of
 /// every level.
-fn lod(
-    args: &GrowArgs,
-    grown: Grown,
-    levels: usize,
-    wind: Option<&sylva_mesh::wind::WindOptions>,
-    glb: &sylva_mesh::export::GlbOptions,
-) -> anyhow::Result<()> {
+fn lod(args: &GrowArgs, grown: Grown, options: &GrowOptions) -> anyhow::Result<()> {
+    let glb = &options.glb_options();
     let (segments, organs) = (grown.plant.segments().len(), grown.plant.organs().len());
-    let chain = LodAssets::new(grown, levels, wind).in_file(&args.genome)?;
+    let chain = LodAssets::new(grown, options).in_file(&args.genome)?;
     let name = args
         .output
         .file_stem()
@@ -159,8 +157,9 @@ fn lod(
 
 /// `sylva grow -o PLANT.skeleton.json`: the plant as data, unmeshed unless a picture is
 /// asked for too.
-fn skeleton(args: &GrowArgs, genome: &Genome, seed: u64) -> anyhow::Result<()> {
-    let roots = !args.hide_roots;
+fn skeleton(args: &GrowArgs, genome: &Genome, options: &GrowOptions) -> anyhow::Result<()> {
+    let roots = options.roots;
+    let seed = options.seed.unwrap_or_else(|| genome.default_seed());
     let growing = super::growing(genome);
     let (skeleton, png) = match &args.png {
         None => {
@@ -168,8 +167,11 @@ fn skeleton(args: &GrowArgs, genome: &Genome, seed: u64) -> anyhow::Result<()> {
             (skeleton, None)
         }
         Some(png) => {
-            let grown =
-                Grown::with_taper(genome.clone(), seed, roots, args.taper).in_file(&args.genome)?;
+            let plain = GrowOptions {
+                wind: None,
+                ..options.clone()
+            };
+            let grown = Grown::grow(genome.clone(), &plain).in_file(&args.genome)?;
             sylva::skeleton::check_budget(&grown.plant).in_file(&args.genome)?;
             let picture = picture(&grown.scene(), View::Iso, (800, 800))?;
             (Skeleton::of_grown(&grown), Some((png, picture)))

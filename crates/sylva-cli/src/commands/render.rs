@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use sylva::assets::{check_png, write_picture};
-use sylva::{Grown, InputError, load_genome};
+use sylva::{GrowOptions, Grown, InputError, load_genome};
 use sylva_mesh::render::View;
 
 use super::InFile;
@@ -50,6 +50,16 @@ pub struct RenderArgs {
     wind: super::WindArgs,
 }
 
+/// How `sylva render` grows a genome: its seed, roots and taper flags.
+fn grow_options(args: &RenderArgs) -> GrowOptions {
+    GrowOptions {
+        seed: args.seed,
+        roots: !args.hide_roots,
+        taper: args.taper,
+        ..GrowOptions::default()
+    }
+}
+
 /// `sylva render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     check_png(&args.output)?;
@@ -66,12 +76,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             .into());
         }
         let genome = load_genome(&args.file)?;
-        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
+        let options = GrowOptions {
+            lod: Some(levels as usize),
+            ..grow_options(args)
+        };
         let growing = super::growing(&genome);
-        let grown =
-            Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
+        let grown = Grown::grow(genome, &options).in_file(&args.file)?;
         drop(growing);
-        let chain = sylva::LodAssets::new(grown, levels as usize, None).in_file(&args.file)?;
+        let chain = sylva::LodAssets::new(grown, &options).in_file(&args.file)?;
         let png = lod_strip(&chain, args.view, args.size)?;
         sylva::files::write(&args.output, &png)?;
     } else if let Some(frames) = args.wind_frames {
@@ -82,12 +94,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let wind = args.wind.options(&args.output)?;
+        let options = GrowOptions {
+            wind: args.wind.options(&args.output)?,
+            ..grow_options(args)
+        };
         let genome = load_genome(&args.file)?;
-        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
         let growing = super::growing(&genome);
-        let grown = Grown::with_wind(genome, seed, !args.hide_roots, args.taper, wind)
-            .in_file(&args.file)?;
+        let grown = Grown::grow(genome, &options).in_file(&args.file)?;
         drop(growing);
         let png = wind_strip(&grown, frames as usize, args.view, args.size)?;
         sylva::files::write(&args.output, &png)?;
@@ -98,10 +111,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
         let genome = load_genome(&args.file)?;
-        let seed = args.seed.unwrap_or_else(|| genome.default_seed());
         let growing = super::growing(&genome);
-        let grown =
-            Grown::with_taper(genome, seed, !args.hide_roots, args.taper).in_file(&args.file)?;
+        let grown = Grown::grow(genome, &grow_options(args)).in_file(&args.file)?;
         drop(growing);
         write_picture(&grown.scene(), &args.output, args.view, args.size)?;
     }

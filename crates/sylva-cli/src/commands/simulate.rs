@@ -94,7 +94,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         path,
         "grow smaller plants (lower `max_modules` in the genomes' `physiology`)",
     )?;
-    let assets = SceneAssets::mesh(&placed).in_file(path)?;
+    let assets = SceneAssets::mesh(&placed, None).in_file(path)?;
     let scene = assets.scene();
     files
         .add_scene(&out.join("scene.glb"), &scene)
@@ -138,6 +138,6 @@ fn side_picture(o: &LateralLightOutcome, hint: MeshHint, config: &Path) -> anyho
         rotation: turn,
         ..Placed::new(name, plant, hint)
     });
-    let assets = SceneAssets::mesh(&placed).in_file(config)?;
+    let assets = SceneAssets::mesh(&placed, None).in_file(config)?;
     Ok(picture(&assets.scene(), View::Front, SCENE_PICTURE)?)
 }
