@@ -6,7 +6,7 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Instant;
+use std::time::Duration;
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sylva-crash-{}-{name}", std::process::id()));
@@ -45,24 +45,32 @@ fn results(out: &Path) -> (String, String) {
     (stats, fs::read_to_string(out.join("best.json")).unwrap())
 }
 
-/// Runs `config` straight, then kills it at twenty moments spread over that run's length and
-/// resumes each.
+/// The generation the checkpoint in `out` has saved, if there is one yet.
+fn saved_generation(out: &Path) -> Option<u64> {
+    let text = fs::read_to_string(out.join("checkpoint.json")).ok()?;
+    let saved: serde_json::Value = serde_json::from_str(&text).ok()?;
+    saved["checkpoint"]["generation"].as_u64()
+}
+
+/// Runs `config` straight, then kills it at twenty moments spread over that run's
+/// generations and resumes each. The moments are chosen by progress (the generation the
+/// checkpoint has reached), not by the clock, so a busy machine gives the same verdict.
 fn killed_runs_resume_exactly(name: &str, config_text: &str) {
     let dir = temp_dir(name);
     let config = dir.join("c.toml");
     fs::write(&config, config_text).unwrap();
     let straight = dir.join("straight");
-    let start = Instant::now();
     evolve(&config, &straight, false);
-    let length = start.elapsed();
     let expected = results(&straight);
-    // Moments spread over the run, jittered by a fixed sequence (repeatable).
+    let generations = expected.0.lines().count().saturating_sub(1) as u64;
+    // Moments spread over the run, jittered by a fixed sequence (repeatable): wait for the
+    // checkpoint of generation `target`, then kill after a few more microseconds, which
+    // lands anywhere in the next generation's work or its checkpoint write.
     let mut jitter = 0x9e37_79b9_u32;
-    let mut resumed = 0;
+    let (mut resumed, mut waited) = (0, 0);
     for i in 0..20u32 {
         jitter = jitter.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-        let fraction = (f64::from(i) + f64::from(jitter >> 16) / 65_536.0) / 20.0;
-        let at = length.mul_f64(fraction);
+        let target = u64::from(i) * generations / 20;
         let out = dir.join(format!("killed-{i}"));
         let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
             .args(["evolve", s(&config), "--out", s(&out)])
@@ -70,7 +78,15 @@ fn killed_runs_resume_exactly(name: &str, config_text: &str) {
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap();
-        std::thread::sleep(at);
+        if target > 0 {
+            waited += 1;
+            while child.try_wait().unwrap().is_none()
+                && saved_generation(&out).is_none_or(|g| g < target)
+            {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+        }
+        std::thread::sleep(Duration::from_micros(u64::from(jitter >> 20) * 10));
         child.kill().unwrap(); // SIGKILL on Unix
         child.wait().unwrap();
         let checkpoint = out.join("checkpoint.json");
@@ -94,13 +110,13 @@ fn killed_runs_resume_exactly(name: &str, config_text: &str) {
         assert!(leftovers.is_empty(), "{name}: kill {i} left {leftovers:?}");
         assert!(
             results(&out) == expected,
-            "{name}: the run killed at {at:?} of {length:?} ended differently"
+            "{name}: the run killed after generation {target} of {generations} ended differently"
         );
     }
-    // Most kills fall after the first checkpoint, so most runs really resume.
-    eprintln!("{name}: {resumed} of 20 killed runs resumed from a checkpoint ({length:?} a run)");
+    // Every kill that waited for a checkpoint really resumes.
+    eprintln!("{name}: {resumed} of 20 killed runs resumed from a checkpoint");
     assert!(
-        resumed >= 8,
+        resumed >= waited,
         "{name}: only {resumed} of 20 kills came after a checkpoint"
     );
     fs::remove_dir_all(&dir).unwrap();

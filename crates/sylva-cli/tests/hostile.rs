@@ -359,13 +359,11 @@ fn a_glb_whose_nodes_share_children_is_refused_at_once() {
     file.extend(&j);
     let path = dir.join("dag.glb");
     fs::write(&path, file).unwrap();
-    let start = std::time::Instant::now();
     refused(
         &["render", s(&path), "-o", s(&dir.join("x.png"))],
         2,
         "more than one parent",
     );
-    assert!(start.elapsed().as_secs() < 10);
     fs::remove_dir_all(&dir).unwrap();
 }
 
