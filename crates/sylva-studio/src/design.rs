@@ -21,7 +21,7 @@ use sylva_model::Model;
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, RunRow};
-use crate::error::{ApiError, config_error};
+use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::family::{archive_member, generation_row};
 use crate::http::{Body, first_null, join};
@@ -266,33 +266,36 @@ fn config_of(design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
             "fitness": fitness,
         },
     });
-    let value = toml::Value::try_from(&doc).map_err(|e| ApiError::bad("design", e))?;
-    let text = toml::to_string(&value).map_err(|e| ApiError::bad("design", e))?;
-    let config = Config::parse(FilePath::new("design"), &text)
-        .map_err(|e| config_error(&text, &e, |path| join(at, design_field(path))))?;
+    let config = Config::from_value(doc)
+        .map_err(|e| ApiError::unprocessable(join(at, &design_field(&e.field)), e.message))?;
     Ok((config, generations))
 }
 
 /// The design's field behind a field of the config it becomes (`automata.fitness.target.radius`
-/// is `target.radius`).
-fn design_field(config: &str) -> &str {
-    match config {
+/// is `target.radius`, `automata.fitness.grid.cells[2].at` is `grid.cells[2].cell`); the
+/// design as a whole for a field the studio sets itself.
+fn design_field(config: &str) -> String {
+    let field = match config {
         "run.population" => "population",
         "run.generations" => "generations",
         "run.seed" => "seed",
         "automata.fitness.num_target" => "num_target",
-        "automata.fitness.grid.at" => "grid.cells",
         path => match path.strip_prefix("automata.fitness.") {
             Some(rest)
-                if ["target", "weights", "grid"]
-                    .iter()
-                    .any(|part| rest == *part || rest.starts_with(&format!("{part}."))) =>
+                if ["target", "weights", "grid"].iter().any(|part| {
+                    rest == *part
+                        || rest.starts_with(&format!("{part}."))
+                        || rest.starts_with(&format!("{part}["))
+                }) =>
             {
-                rest
+                return rest
+                    .strip_suffix(".at")
+                    .map_or_else(|| rest.to_owned(), |cell| format!("{cell}.cell"));
             }
             _ => "",
         },
-    }
+    };
+    field.to_owned()
 }
 
 /// Checks painted cells against the grid, naming the cell (the config would only know the

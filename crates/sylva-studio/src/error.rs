@@ -75,51 +75,6 @@ impl ApiError {
     }
 }
 
-/// An error in a config the studio wrote (as TOML) from a request, as a 422 naming the
-/// config's field: the `[section]` above the error's line and the key on that line
-/// (`run.population`), never a word of the message (which may quote the request's values).
-/// `field` turns that config path into the request's own path.
-pub fn config_error(text: &str, e: &sylva::InputError, field: impl Fn(&str) -> String) -> ApiError {
-    let lines: Vec<&str> = text.lines().collect();
-    let upto = e.line.min(lines.len());
-    let section = lines[..upto]
-        .iter()
-        .filter_map(|l| l.trim().strip_prefix('[')?.strip_suffix(']'))
-        .next_back()
-        .map_or("", |s| s.trim_matches(['[', ']']));
-    let key_of = |line: &str| -> Option<String> {
-        let line = line.trim_start();
-        if line.starts_with('[') {
-            return None;
-        }
-        let (key, _) = line.split_once('=')?;
-        Some(key.trim().trim_matches('"').to_owned())
-    };
-    let on_line = upto.checked_sub(1).and_then(|i| key_of(lines[i]));
-    // An error placed on a table's header (a tagged table, read whole) names the key in the
-    // message: taken only when the table has that key, never a value from the request.
-    let key = on_line.unwrap_or_else(|| {
-        let named = e.message.split('`').nth(1).unwrap_or("");
-        let table_end = lines[upto..]
-            .iter()
-            .position(|l| l.trim_start().starts_with('['))
-            .map_or(lines.len(), |i| upto + i);
-        lines[upto..table_end]
-            .iter()
-            .filter_map(|l| key_of(l))
-            .find(|k| k == named)
-            .unwrap_or_default()
-    });
-    let key = key.as_str();
-    let path = [section, key]
-        .iter()
-        .filter(|s| !s.is_empty())
-        .copied()
-        .collect::<Vec<_>>()
-        .join(".");
-    ApiError::unprocessable(field(&path), &e.message)
-}
-
 /// An input error's message with its line and column, when it has them.
 pub fn input_message(e: &sylva::InputError) -> String {
     if e.line > 0 {

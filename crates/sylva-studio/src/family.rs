@@ -20,7 +20,7 @@ use sylva_model::Model;
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, NewPlant};
-use crate::error::{ApiError, config_error};
+use crate::error::ApiError;
 use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
 
@@ -142,10 +142,8 @@ fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     if let Some(b) = &request.bintree {
         doc["bintree"] = b.clone();
     }
-    let value = toml::Value::try_from(&doc).map_err(|e| ApiError::bad("config", e))?;
-    let text = toml::to_string(&value).map_err(|e| ApiError::bad("config", e))?;
-    Config::parse(FilePath::new("config"), &text)
-        .map_err(|e| config_error(&text, &e, |path| join("config", path)))
+    Config::from_value(doc)
+        .map_err(|e| ApiError::unprocessable(join("config", &e.field), e.message))
 }
 
 fn members(run: &Evolution) -> Vec<MemberView> {

@@ -13,6 +13,79 @@ use std::sync::Arc;
 
 use sylva_model::{DevelopError, GenomeError};
 
+/// An error in a value built in code rather than read from a file (a front end's form):
+/// the field by its JSON path in the value (`run.population`, `automata.fitness.target`)
+/// and what is wrong. The path never holds one of the value's values.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("`{field}`: {message}")]
+pub struct FieldError {
+    /// The field's JSON path (empty: the value as a whole).
+    pub field: String,
+    /// What is wrong and what was expected.
+    pub message: String,
+}
+
+impl FieldError {
+    /// An error about `field`.
+    pub fn new(field: impl Into<String>, message: impl ToString) -> FieldError {
+        FieldError {
+            field: field.into(),
+            message: message.to_string(),
+        }
+    }
+
+    /// A serde error found reading `sent`, naming the field where it was found; for a
+    /// missing field, that field; for an unknown field or variant, or a message naming a
+    /// field (`` `radius` must be ... ``, from a table read whole), that field when it is a
+    /// key of the object there.
+    pub fn of<E: std::fmt::Display>(
+        e: &serde_path_to_error::Error<E>,
+        sent: &serde_json::Value,
+    ) -> FieldError {
+        let path = e.path().to_string();
+        let path = if path == "." || path == "?" {
+            ""
+        } else {
+            &path
+        };
+        let message = e.inner().to_string();
+        let quoted = message.split('`').nth(1).unwrap_or("");
+        let is_key =
+            !quoted.is_empty() && at_path(sent, path).is_some_and(|v| v.get(quoted).is_some());
+        let field = if message.starts_with("missing field `") || is_key {
+            join(path, quoted)
+        } else {
+            path.to_owned()
+        };
+        FieldError { field, message }
+    }
+}
+
+/// `name` under the JSON path `path` (`a.b` and `c` give `a.b.c`; `[2]` gives `a.b[2]`).
+pub fn join(path: &str, name: &str) -> String {
+    match (path.is_empty(), name.is_empty()) {
+        (true, _) => name.to_owned(),
+        (false, true) => path.to_owned(),
+        (false, false) if name.starts_with('[') => format!("{path}{name}"),
+        (false, false) => format!("{path}.{name}"),
+    }
+}
+
+/// The value at a JSON path (`a.b[1].c`) of `value`.
+pub fn at_path<'v>(value: &'v serde_json::Value, path: &str) -> Option<&'v serde_json::Value> {
+    let mut at = value;
+    for part in path.split('.').filter(|p| !p.is_empty()) {
+        let (name, indices) = part.split_at(part.find('[').unwrap_or(part.len()));
+        if !name.is_empty() {
+            at = at.get(name)?;
+        }
+        for index in indices.split(['[', ']']).filter(|s| !s.is_empty()) {
+            at = at.get(index.parse::<usize>().ok()?)?;
+        }
+    }
+    Some(at)
+}
+
 /// Bad input: a malformed file, or a value a field or flag cannot take.
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 #[error("{location}: {message}")]

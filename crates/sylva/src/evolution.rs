@@ -48,7 +48,7 @@ use sylva_mesh::render::View;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
 
-use crate::error::{Error, InputError};
+use crate::error::{Error, FieldError, InputError};
 use crate::genome::Genome;
 use crate::registry::Registry;
 
@@ -532,6 +532,12 @@ impl Config {
             inner: Box::new(config),
             source: None,
         }
+    }
+
+    /// A config of any model the standard registry knows, built as values (a front end's
+    /// form) with the checks of a config file ([`Registry::config_from_value`]).
+    pub fn from_value(value: serde_json::Value) -> Result<Config, FieldError> {
+        Registry::standard().config_from_value(value)
     }
 
     /// Parses a config of any model the standard registry knows; errors point into `text`.

@@ -46,7 +46,7 @@ pub mod report;
 pub mod skeleton;
 
 pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
-pub use error::{Error, InputError};
+pub use error::{Error, FieldError, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
 pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};

@@ -16,7 +16,7 @@ use sylva_lsystem::LSystemModel;
 use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
 
-use crate::error::InputError;
+use crate::error::{FieldError, InputError};
 use crate::evolution::{Config, EvolveConfig};
 use crate::genome::{Genome, Settings};
 
@@ -35,6 +35,7 @@ pub struct ModelEntry {
 #[derive(Clone, Copy)]
 struct EvolveEntry {
     parse_config: fn(&Path, &str) -> Result<Config, InputError>,
+    config_from_value: fn(serde_json::Value) -> Result<Config, FieldError>,
     default_config: fn() -> Config,
 }
 
@@ -55,6 +56,7 @@ impl ModelEntry {
         ModelEntry {
             evolve: Some(EvolveEntry {
                 parse_config: parse_config::<M>,
+                config_from_value: config_from_value::<M>,
                 default_config: || Config::new(EvolveConfig::<M>::default()),
             }),
             ..ModelEntry::model::<M>()
@@ -98,6 +100,13 @@ fn random<M: Model + Default>(settings: Settings<'_>, seed: u64) -> Result<Genom
 
 fn parse_config<M: Evolve + Default>(path: &Path, text: &str) -> Result<Config, InputError> {
     EvolveConfig::<M>::parse(path, text).map(Config::new)
+}
+
+fn config_from_value<M: Evolve + Default>(value: serde_json::Value) -> Result<Config, FieldError> {
+    let sent = value.clone();
+    serde_path_to_error::deserialize::<_, EvolveConfig<M>>(value)
+        .map(Config::new)
+        .map_err(|e| FieldError::of(&e, &sent))
 }
 
 /// The models Sylva knows, in the order they are listed.
@@ -255,6 +264,44 @@ impl Registry {
                 name.unwrap_or_default(),
                 evolvable.join(", ")
             ))),
+        }
+    }
+
+    /// A config of any model that evolves, built as values rather than read from a file
+    /// (a front end's form): the same fields and checks as a config file's, as JSON
+    /// (`{"model": "automata", "run": {...}, "automata": {...}}`; `model` defaults to the
+    /// first model). An error names the field by its path in `value`
+    /// (`automata.fitness.target.radius`).
+    pub fn config_from_value(&self, value: serde_json::Value) -> Result<Config, FieldError> {
+        let name = match value.get("model") {
+            None => self.models.first().map(|m| m.name),
+            Some(serde_json::Value::String(name)) => Some(name.as_str()),
+            Some(other) => {
+                return Err(FieldError::new(
+                    "model",
+                    format!("expected a model's name, got {other}"),
+                ));
+            }
+        };
+        let entry = name.and_then(|n| self.get(n));
+        match entry.and_then(|e| e.evolve) {
+            Some(evolve) => (evolve.config_from_value)(value),
+            None => {
+                let evolvable: Vec<&str> = self
+                    .models
+                    .iter()
+                    .filter(|m| m.evolves())
+                    .map(|m| m.name)
+                    .collect();
+                Err(FieldError::new(
+                    "model",
+                    format!(
+                        "`{}` is not a model that evolves; expected one of: {}",
+                        name.unwrap_or_default(),
+                        evolvable.join(", ")
+                    ),
+                ))
+            }
         }
     }
 
