@@ -23,12 +23,12 @@ struct Cli {
     /// Memory Sylva may use, like 4G or 512M [default: half of the machine's memory, of its
     /// cgroup's memory limit or of what its address-space or data rlimit leaves, whichever
     /// is least]. Work that would need more is refused before it starts, with its estimate.
-    #[arg(long, global = true, value_parser = sylva_core::budget::parse_bytes)]
+    #[arg(long, global = true, value_parser = sylva::core::budget::parse_bytes)]
     max_memory: Option<u64>,
     /// Longest Sylva may work before it writes results, like 90s, 10m or 2h [default: 1h]:
     /// L-system growth (a breeding round, an experiment, a generation of a run) estimated to
     /// take longer is refused before it starts, with its estimate.
-    #[arg(long, global = true, value_parser = sylva_core::budget::parse_duration)]
+    #[arg(long, global = true, value_parser = sylva::core::budget::parse_duration)]
     max_time: Option<std::time::Duration>,
     #[command(subcommand)]
     command: Command,
@@ -65,14 +65,14 @@ fn main() -> ExitCode {
     diagnostic::install();
     let cli = Cli::parse();
     match cli.max_memory {
-        Some(bytes) => sylva_core::budget::set_max_memory(bytes),
+        Some(bytes) => sylva::core::budget::set_max_memory(bytes),
         // Worked out now, before any thread or buffer, so "mapped at start" is that.
         None => {
-            sylva_core::budget::default_budget();
+            sylva::core::budget::default_budget();
         }
     }
     if let Some(time) = cli.max_time {
-        sylva_core::budget::set_max_time(time);
+        sylva::core::budget::set_max_time(time);
     }
     let command = cli.command;
     // A panic would be a bug in Sylva: it is reported as one, in one line, with exit code 1.

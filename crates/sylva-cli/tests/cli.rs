@@ -7,7 +7,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use sylva_core::hash::stable_hash;
+use sylva::core::hash::stable_hash;
 
 #[path = "../../sylva/tests/common/mod.rs"]
 mod common;

@@ -10,7 +10,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use sylva_core::hash::stable_hash;
+use sylva::core::hash::stable_hash;
 
 fn sylva(args: &[&str]) {
     let out = Command::new(env!("CARGO_BIN_EXE_sylva"))

@@ -118,8 +118,8 @@ fn check(name: &str, path: &Path) -> Skeleton {
         }
         let material = &materials[seg.material as usize];
         assert_eq!(seg.kind, material.kind, "{at}");
-        let woody = matches!(seg.kind, sylva_core::MaterialKind::Bark)
-            || matches!(seg.kind, sylva_core::MaterialKind::Root);
+        let woody = matches!(seg.kind, sylva::core::MaterialKind::Bark)
+            || matches!(seg.kind, sylva::core::MaterialKind::Root);
         assert_eq!(seg.woody, woody, "{at}");
     }
     for (i, organ) in skeleton.organs.iter().enumerate() {
@@ -283,7 +283,7 @@ fn roots_are_in_the_skeleton_unless_hidden() {
     let hidden = grow(&[&example(name), "-o", s(&without), "--hide-roots"]);
     let meshed = grow(&[&example(name), "-o", s(&dir.join("h.glb")), "--hide-roots"]);
     assert_eq!(hidden, meshed);
-    let is_root = |k| k == sylva_core::MaterialKind::Root;
+    let is_root = |k| k == sylva::core::MaterialKind::Root;
     let with = check(name, &with);
     let without = check(name, &without);
     assert!(with.roots && !without.roots);

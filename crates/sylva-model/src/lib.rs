@@ -165,6 +165,12 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     fn growth_seconds(&self, _genome: &Self::Genome) -> Option<f64> {
         None
     }
+
+    /// A short text form of `genome` a person can copy and paste, for a model that has one
+    /// (PlantMaker's packed string); `None`, the default, otherwise.
+    fn packed(&self, _genome: &Self::Genome) -> Option<String> {
+        None
+    }
 }
 
 /// How much of the parents a crossover mixes, as PlantMaker's levels name it (Figure 9):

@@ -450,6 +450,10 @@ impl sylva_model::Model for PlantMakerModel {
     /// The paper's own controls: the level is the crossover's (Figure 9), and Depth d
     /// mutates each variable with probability 0.05·d by noise of 0.05 + 0.02·d of its range
     /// (Depth 2: 0.1 and 0.09).
+    fn packed(&self, genome: &PlantMaker) -> Option<String> {
+        Some(genome.to_packed())
+    }
+
     fn hand_settings(&self, knobs: sylva_model::Knobs) -> PlantMakerSettings {
         let d = f64::from(knobs.depth.get());
         PlantMakerSettings {

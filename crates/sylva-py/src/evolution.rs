@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use sylva::{Evolution as Run, Member as RunMember};
-use sylva_evolve::{GenerationStats, IndividualId};
+use sylva::{GenerationStats, IndividualId};
 
 use crate::errors::{IntoPy, bad_value, input_error};
 use crate::genome::Genome;
@@ -265,7 +265,7 @@ impl Evolution {
         f(&mut run)
     }
 
-    fn pool(config: &sylva::Config, threads: Option<u32>) -> PyResult<sylva_core::par::Pool> {
+    fn pool(config: &sylva::Config, threads: Option<u32>) -> PyResult<sylva::core::par::Pool> {
         let threads = threads.unwrap_or(config.run().threads);
         if threads > 1024 {
             return Err(bad_value(
@@ -273,7 +273,7 @@ impl Evolution {
                 format!("{threads}; expected 0 to 1024"),
             ));
         }
-        sylva_core::par::Pool::with_threads(threads as usize)
+        sylva::core::par::Pool::with_threads(threads as usize)
             .map_err(sylva::Error::from)
             .py()
     }

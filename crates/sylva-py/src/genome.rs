@@ -172,7 +172,7 @@ impl Genome {
     ) -> PyResult<Plant> {
         let genome = self.inner.clone();
         let taper = taper
-            .map(sylva_core::taper::PipeTaper::new)
+            .map(sylva::core::taper::PipeTaper::new)
             .transpose()
             .map_err(|e| bad_value("taper", e))?;
         let options = sylva::GrowOptions {
@@ -207,7 +207,7 @@ impl Genome {
     }
 
     fn __repr__(&self) -> String {
-        let hash = sylva_core::hash::stable_hash(self.inner.to_json().as_bytes());
+        let hash = sylva::core::hash::stable_hash(self.inner.to_json().as_bytes());
         format!("<sylva.Genome {} {hash:016x}>", self.inner.model())
     }
 

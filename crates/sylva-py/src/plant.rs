@@ -10,9 +10,9 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use sylva::assets::{Origin, Placed, SceneAssets};
+use sylva::core::measures::TreeMeasures;
 use sylva::files::Outputs;
-use sylva_core::measures::TreeMeasures;
-use sylva_mesh::render::View;
+use sylva::mesh::render::View;
 
 use crate::errors::{IntoPy, bad_value};
 use crate::genome::Genome;
@@ -195,7 +195,7 @@ struct Triangles {
 }
 
 impl Triangles {
-    fn of(mesh: &sylva_mesh::Mesh) -> Triangles {
+    fn of(mesh: &sylva::mesh::Mesh) -> Triangles {
         let count = mesh.triangle_count();
         let mut corners = Vec::with_capacity(count);
         let mut materials = Vec::with_capacity(count);
@@ -245,7 +245,7 @@ impl Mesh {
     /// The arrays of `mesh` and its `triangles`, both held by the frozen `owner`.
     fn view(
         owner: &Bound<'_, PyAny>,
-        mesh: &sylva_mesh::Mesh,
+        mesh: &sylva::mesh::Mesh,
         triangles: &Triangles,
     ) -> PyResult<Mesh> {
         let py = owner.py();
@@ -368,21 +368,21 @@ impl Scene {
     }
 }
 
-fn write_scene(scene: &sylva_mesh::Scene<'_>, path: &Path) -> Result<(), sylva::Error> {
+fn write_scene(scene: &sylva::mesh::Scene<'_>, path: &Path) -> Result<(), sylva::Error> {
     sylva::assets::asset_format(path)?;
     let mut out = Outputs::new();
     out.add_scene(path, scene)?;
     out.commit()
 }
 
-fn glb_bytes(scene: &sylva_mesh::Scene<'_>) -> Result<Vec<u8>, sylva::Error> {
-    sylva_mesh::export::check_scene(scene)?;
-    Ok(sylva_mesh::export::to_glb(scene)?)
+fn glb_bytes(scene: &sylva::mesh::Scene<'_>) -> Result<Vec<u8>, sylva::Error> {
+    sylva::mesh::export::check_scene(scene)?;
+    Ok(sylva::mesh::export::to_glb(scene)?)
 }
 
 fn render<'py>(
     py: Python<'py>,
-    scene: &sylva_mesh::Scene<'_>,
+    scene: &sylva::mesh::Scene<'_>,
     path: Option<PathBuf>,
     view: &str,
     size: (u32, u32),
@@ -417,7 +417,6 @@ pub fn garden(
     seed: u64,
     path: Option<PathBuf>,
 ) -> PyResult<Scene> {
-    use sylva_plantmaker::{Garden, PlantMakerModel};
     let (garden, source) = match path {
         Some(path) => {
             if !genomes.is_empty() {
@@ -427,9 +426,7 @@ pub fn garden(
                 ));
             }
             let text = sylva::files::read_text(&path).py()?;
-            let garden = Garden::from_json(&text)
-                .map_err(|e| sylva::InputError::genome(&path, &text, e))
-                .py()?;
+            let garden = sylva::garden::read(&path, &text).py()?;
             (garden, path)
         }
         None => {
@@ -449,31 +446,19 @@ pub fn garden(
                     ),
                 ));
             }
-            let mut typed = Vec::with_capacity(genomes.len());
-            for (i, g) in genomes.iter().enumerate() {
-                let genome = g.inner.get::<PlantMakerModel>().ok_or_else(|| {
-                    bad_value(
-                        format!("genomes[{i}]"),
-                        format!(
-                            "gardens grow `plantmaker` genomes; this is a `{}` genome",
-                            g.inner.model()
-                        ),
-                    )
+            let genomes: Vec<sylva::Genome> = genomes.iter().map(|g| g.inner.clone()).collect();
+            let garden = sylva::garden::plant(&genomes, count as usize, [area.0, area.1], seed)
+                .map_err(|e| match e {
+                    sylva::garden::PlanError::WrongModel { index, .. } => {
+                        bad_value(format!("genomes[{index}]"), e)
+                    }
+                    sylva::garden::PlanError::NoGenomes => bad_value("genomes", e),
                 })?;
-                typed.push(genome.clone());
-            }
-            let Some((first, rest)) = typed.split_first() else {
-                return Err(bad_value("genomes", "a garden needs at least one genome"));
-            };
-            let mut garden = Garden::new(first.clone(), count as usize, [area.0, area.1], seed);
-            for g in rest {
-                garden.add(g.clone(), count as usize);
-            }
             (garden, PathBuf::from("<garden>"))
         }
     };
     let assets = py
-        .detach(|| sylva::assets::garden_assets(&garden, &source, None))
+        .detach(|| sylva::garden::garden_assets(&garden, &source, None))
         .py()?;
     Ok(Scene::new(assets, Some(garden.to_json())))
 }
@@ -518,8 +503,8 @@ pub fn scene(
         .zip(positions.iter().zip(&turns))
         .enumerate()
         .map(|(i, (g, ((x, z), turn)))| Placed {
-            translation: sylva_core::glam::Vec3::new(*x, 0.0, *z),
-            rotation: sylva_core::glam::Quat::from_rotation_y(*turn),
+            translation: sylva::core::glam::Vec3::new(*x, 0.0, *z),
+            rotation: sylva::core::glam::Quat::from_rotation_y(*turn),
             extras: Some(Origin::of(&g.genome, g.seed).extras()),
             ..Placed::new(format!("plant-{i}"), &g.plant, g.genome.mesh_hint())
         })

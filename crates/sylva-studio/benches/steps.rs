@@ -36,7 +36,7 @@ fn steps(c: &mut Criterion) {
     let archive = Archive::open(&dir.join("bench.db")).unwrap();
     let studio = Studio::new(archive, Guard::default());
     for id in 0..127 {
-        sylva_mesh::texture::texture_png(id).unwrap();
+        sylva::mesh::texture::texture_png(id).unwrap();
     }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()

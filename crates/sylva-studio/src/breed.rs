@@ -13,8 +13,8 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
+use sylva::core::Plant;
 use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
-use sylva_core::Plant;
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, ParentRow, PlantRow};
@@ -24,7 +24,7 @@ use crate::plants::{Form, PreviewSize, genome_of, grow_shown, plant_bytes, previ
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// PlantMaker's name in files.
-const PLANTMAKER: &str = <sylva_plantmaker::PlantMakerModel as sylva_model::Model>::NAME;
+const PLANTMAKER: &str = sylva::registry::names::PLANTMAKER;
 
 /// Plants in the grid.
 pub const GRID: usize = 9;

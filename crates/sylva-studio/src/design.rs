@@ -16,8 +16,6 @@ use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::{Config, Evolution};
-use sylva_automata::AutomataModel;
-use sylva_model::Model;
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, RunRow};
@@ -27,7 +25,7 @@ use crate::family::{archive_member, generation_row};
 use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
 
-const AUTOMATA: &str = AutomataModel::NAME;
+const AUTOMATA: &str = sylva::registry::names::AUTOMATA;
 
 /// What a run tells the pages watching it: a generation's figures, or a change of status.
 #[derive(Clone, Debug)]

@@ -15,8 +15,6 @@ use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::{Config, Evolution, Member};
-use sylva_bintree::BinTreeModel;
-use sylva_model::Model;
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, NewPlant};
@@ -24,7 +22,7 @@ use crate::error::ApiError;
 use crate::http::{Body, first_null, join};
 use crate::sessions::{SessionView, session_of, view};
 
-const BINTREE: &str = BinTreeModel::NAME;
+const BINTREE: &str = sylva::registry::names::BINTREE;
 
 /// The largest family population.
 pub const MAX_POPULATION: u64 = 10_000;

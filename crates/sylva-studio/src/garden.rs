@@ -12,13 +12,8 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::Genome;
-use sylva::assets::{Placed, SceneAssets};
-use sylva_core::MaterialKind;
-use sylva_core::glam::Vec3;
-use sylva_lsystem::breed::{BreedSettings, breeding_genomes, grow_together_with};
-use sylva_lsystem::{LSystemGenome, LSystemModel};
-use sylva_mesh::{Scene, SceneNode};
-use sylva_model::Model;
+use sylva::biomorph::{self, BiomorphOptions, Biomorphs};
+use sylva::mesh::{Scene, SceneNode};
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, ParentRow, PlantRow};
@@ -124,18 +119,17 @@ impl GardenSettings {
         Ok(s)
     }
 
-    fn breed_settings(&self) -> BreedSettings {
-        let mut b = BreedSettings {
-            children: self.children as usize,
+    fn options(&self) -> BiomorphOptions {
+        BiomorphOptions {
+            children: self.children,
+            steps: self.steps,
             spacing: self.spacing as f32,
+            elevation: self.elevation,
+            azimuth: self.azimuth,
             // a person breeding by eye needs something to see, from empty rules too
             visible_children: true,
-            ..BreedSettings::default()
-        };
-        b.grow.steps = self.steps;
-        b.grow.world.light.elevation = self.elevation;
-        b.grow.world.light.azimuth = self.azimuth;
-        b
+            roots: false,
+        }
     }
 }
 
@@ -199,15 +193,17 @@ pub struct Start {
     seed: Option<u64>,
 }
 
-const LSYSTEM: &str = LSystemModel::NAME;
+const LSYSTEM: &str = biomorph::MODEL;
 
-fn lsystem_genome(genome: &Genome, field: &str) -> Result<LSystemGenome, ApiError> {
-    genome.get::<LSystemModel>().cloned().ok_or_else(|| {
-        ApiError::unprocessable(
+/// `genome`, when it can grow in a garden.
+fn lsystem_genome(genome: Genome, field: &str) -> Result<Genome, ApiError> {
+    match biomorph::grows(&genome) {
+        Ok(()) => Ok(genome),
+        Err(e) => Err(ApiError::unprocessable(
             field,
-            format!("a {} genome; gardens grow L-system plants", genome.model()),
-        )
-    })
+            format!("a {} genome; gardens grow L-system plants", e.model),
+        )),
+    }
 }
 
 /// Creates a garden session and grows its first garden.
@@ -222,7 +218,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
             let genome = example(&name)
                 .ok_or_else(|| ApiError::bad("start.example", format!("no example {name:?}")))?;
             (
-                lsystem_genome(&genome, "start.example")?,
+                lsystem_genome(genome, "start.example")?,
                 "example",
                 json!({"example": name}),
                 None,
@@ -231,7 +227,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
         Mother::Genome(text) => {
             let genome = crate::breed::parse_genome(&text, "start.genome")?;
             (
-                lsystem_genome(&genome, "start.genome")?,
+                lsystem_genome(genome, "start.genome")?,
                 "upload",
                 json!({}),
                 None,
@@ -245,13 +241,13 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
             })?;
             let genome = genome_of(&row)?;
             (
-                lsystem_genome(&genome, "start.plant")?,
+                lsystem_genome(genome, "start.plant")?,
                 "",
                 json!({}),
                 Some(id),
             )
         }
-        Mother::Empty(true) => (LSystemGenome::empty(), "empty", json!({}), None),
+        Mother::Empty(true) => (biomorph::empty_rules(), "empty", json!({}), None),
         Mother::Empty(false) => {
             return Err(ApiError::bad(
                 "start.empty",
@@ -268,7 +264,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
                 &NewPlant {
                     session: Some(id),
                     model: LSYSTEM,
-                    genome: &LSystemModel.write(&mother),
+                    genome: &mother.to_json(),
                     seed: 0,
                     operator,
                     settings: &op_settings,
@@ -327,7 +323,7 @@ fn garden_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, Garden
 
 /// A garden grown: each specimen's genome, figures and GLB, and the whole scene's GLB.
 struct Grown {
-    specimens: Vec<(LSystemGenome, bool, SpecimenView, Vec<u8>)>,
+    specimens: Vec<(Genome, bool, SpecimenView, Vec<u8>)>,
     scene: Vec<u8>,
 }
 
@@ -337,7 +333,7 @@ async fn grow_garden(
     studio: &Studio,
     session: i64,
     state: &GardenState,
-    mother: &LSystemGenome,
+    mother: &Genome,
     seq: i64,
 ) -> Result<Grown, ApiError> {
     let studio = studio.clone();
@@ -346,61 +342,45 @@ async fn grow_garden(
     let mother = mother.clone();
     let mother_id = state.mother;
     tokio::task::spawn_blocking(move || -> Result<Grown, ApiError> {
-        let mut rng = sylva_core::rng::seeded(seed);
-        let breed = settings.breed_settings();
-        let genomes = breeding_genomes(&mother, &breed, &mut rng);
+        let sown = Biomorphs::sow(
+            &mother,
+            std::path::Path::new("garden"),
+            &settings.options(),
+            seed,
+        )
+        .map_err(|e| ApiError::unprocessable("plant", e))?;
         let mut progress = crate::events::progress(&studio, session, "garden", settings.steps);
-        let garden = grow_together_with(genomes, &breed, &studio.pool, &mut progress)
-            .map_err(|e| ApiError::unprocessable("settings", sylva::error::chain(&e)))?;
-        let shown: Vec<_> = garden
-            .specimens
-            .iter()
-            .map(|s| s.plant.without(MaterialKind::Root))
-            .collect();
-        let hint = LSystemModel.mesh_hint();
-        let genomes: Vec<Genome> = garden
-            .specimens
-            .iter()
-            .map(|s| Genome::new(LSystemModel, s.genome.clone()))
-            .collect();
+        let garden = sown
+            .grow(&studio.pool, &mut progress)
+            .map_err(|e| ApiError::unprocessable("settings", e.message))?;
         let parents = [ParentRow {
             plant: mother_id,
             dominance: 1.0,
         }];
-        let node_extras = |i: usize| {
-            let (operator, parents): (&str, &[ParentRow]) = if garden.specimens[i].is_mother {
+        let node_extras = |specimen: &biomorph::Specimen| {
+            let (operator, parents): (&str, &[ParentRow]) = if specimen.is_mother {
                 ("mother", &[])
             } else {
                 ("mutate", &parents)
             };
-            extras(&genomes[i], seed, parents, operator)
+            extras(&specimen.genome, seed, parents, operator)
         };
-        let placed: Vec<Placed> = garden
-            .specimens
-            .iter()
-            .zip(&shown)
-            .enumerate()
-            .map(|(i, (s, plant))| Placed {
-                translation: Vec3::new(s.position.x, 0.0, s.position.y),
-                extras: Some(node_extras(i)),
-                ..Placed::new(format!("specimen-{i}"), plant, hint)
-            })
-            .collect();
-        let assets =
-            SceneAssets::mesh(&placed, None).map_err(|e| ApiError::library("settings", e))?;
-        let scene = sylva_mesh::export::to_glb(&assets.scene())
+        let assets = garden
+            .assets(|i, _| format!("specimen-{i}"), |_, s| node_extras(s))
+            .map_err(|e| ApiError::library("settings", e))?;
+        let scene = sylva::mesh::export::to_glb(&assets.scene())
             .map_err(|e| ApiError::library("settings", e.into()))?;
         let mut specimens = Vec::with_capacity(garden.specimens.len());
-        for (i, (s, mesh)) in garden.specimens.iter().zip(assets.meshes()).enumerate() {
+        for (s, mesh) in garden.specimens.iter().zip(assets.meshes()) {
             let mut node = SceneNode::new(LSYSTEM, mesh);
-            node.extras = Some(node_extras(i));
-            let glb = sylva_mesh::export::to_glb(&Scene::single(node))
+            node.extras = Some(node_extras(s));
+            let glb = sylva::mesh::export::to_glb(&Scene::single(node))
                 .map_err(|e| ApiError::library("settings", e.into()))?;
             let view = SpecimenView {
                 plant: 0,
                 is_mother: s.is_mother,
                 x: s.position.x,
-                z: s.position.y,
+                z: s.position.z,
                 biomass: s.stats.biomass,
                 light: s.stats.light,
                 leaves: s.stats.leaves(),
@@ -426,13 +406,13 @@ fn store_garden(
     grown: Grown,
 ) -> Result<GardenState, ApiError> {
     let settings = json!(state.settings);
-    let new_plant = |genome: &LSystemGenome, operator: &str, parent: i64| {
+    let new_plant = |genome: &Genome, operator: &str, parent: i64| {
         archive::insert_plant(
             c,
             &NewPlant {
                 session: Some(session),
                 model: LSYSTEM,
-                genome: &LSystemModel.write(genome),
+                genome: &genome.to_json(),
                 seed: 0,
                 operator,
                 settings: &settings,
@@ -487,7 +467,7 @@ async fn step(
 ) -> Result<SessionView, ApiError> {
     let (_, before) = garden_state(studio, id)?;
     let row = crate::plants::plant_row(studio, mother)?;
-    let genome = lsystem_genome(&genome_of(&row)?, "plant")?;
+    let genome = lsystem_genome(genome_of(&row)?, "plant")?;
     let state = GardenState {
         mother,
         settings: before.settings.with(settings)?,

@@ -125,7 +125,7 @@ pub struct Inner {
     /// Recently grown plants.
     pub plants: plants::PlantCache,
     /// Threads for growing many plants at once.
-    pub pool: sylva_core::par::Pool,
+    pub pool: sylva::core::par::Pool,
     /// One lock per session, so that two tabs' steps on one session queue up.
     locks: Mutex<HashMap<i64, Arc<tokio::sync::Mutex<()>>>>,
     /// Family runs in memory.
@@ -151,7 +151,7 @@ impl Studio {
             guard,
             meshes: plants::mesh_cache(),
             plants: plants::plant_cache(),
-            pool: sylva_core::par::Pool::with_threads(0).unwrap_or_default(),
+            pool: sylva::core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
             families: family::Families::default(),
             runs: design::Runs::default(),
@@ -303,7 +303,7 @@ fn warm_textures() {
         .name("sylva-textures".into())
         .spawn(|| {
             for id in GENOME_TEXTURES {
-                let _ = sylva_mesh::texture::texture_png(id);
+                let _ = sylva::mesh::texture::texture_png(id);
             }
         });
 }

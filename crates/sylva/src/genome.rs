@@ -36,6 +36,7 @@ trait AnyGenome: Send + Sync {
     fn default_seed(&self) -> u64;
     fn mesh_hint(&self) -> MeshHint;
     fn growth_seconds(&self) -> Option<f64>;
+    fn packed(&self) -> Option<String>;
     fn same(&self, other: &dyn AnyGenome) -> bool;
     fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError>;
     fn cross(
@@ -106,6 +107,10 @@ impl<M: Model> AnyGenome for Typed<M> {
 
     fn to_json(&self) -> String {
         self.model.write(&self.genome)
+    }
+
+    fn packed(&self) -> Option<String> {
+        self.model.packed(&self.genome)
     }
 
     fn to_value(&self) -> serde_json::Value {
@@ -190,6 +195,12 @@ impl Genome {
     /// The model's title.
     pub fn title(&self) -> &'static str {
         self.inner.title()
+    }
+
+    /// A short text form a person can copy and paste, for a model that has one
+    /// ([`sylva_model::Model::packed`]).
+    pub fn packed(&self) -> Option<String> {
+        self.inner.packed()
     }
 
     /// The typed genome, if this is a genome of model `M`.

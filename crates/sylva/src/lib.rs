@@ -11,6 +11,12 @@
 //!   level at about half the triangles of the one before, as files or one scene.
 //! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
 //!   origin, written as `PLANT.skeleton.json`.
+//! - [`biomorph`]: Bornhofen and Lattaud's design loop, a mother and her children grown
+//!   together in one voxel world ([`biomorph::Biomorphs`]).
+//! - [`experiment`]: their experiments, run from a config into a report, records and
+//!   assets ([`Experiment`]).
+//! - [`garden`]: PlantMaker gardens and forests, planned, estimated, grown and meshed or
+//!   streamed as a GLB.
 //! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
 //!   step, browse, checkpoint, resume.
 //! - [`report`]: `stats.csv`, `fitness.svg` and experiment reports.
@@ -36,9 +42,12 @@
 //! ```
 
 pub mod assets;
+pub mod biomorph;
 pub mod error;
 pub mod evolution;
+pub mod experiment;
 pub mod files;
+pub mod garden;
 pub mod genome;
 pub mod lod;
 pub mod registry;
@@ -48,8 +57,17 @@ pub mod skeleton;
 pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, FieldError, InputError};
 pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
+pub use experiment::Experiment;
 pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;
+pub use sylva_evolve::{GenerationStats, IndividualId};
+pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
+
+// The layers below, for front ends that need their types (plants, meshes, scenes, the
+// thread pool, budgets): a front end depends on `sylva` alone.
+pub use sylva_core as core;
+pub use sylva_mesh as mesh;
+pub use sylva_model as model;

@@ -115,6 +115,21 @@ pub struct Registry {
     models: Vec<ModelEntry>,
 }
 
+/// The standard models' names in files, for front ends whose modes follow one paper's
+/// model (the studio's design mode is Poncin's, its family mode Susinno's).
+pub mod names {
+    use sylva_model::Model;
+
+    /// Susinno's recursive binary tree.
+    pub const BINTREE: &str = sylva_bintree::BinTreeModel::NAME;
+    /// Poncin's GP trees compiled into turtle automata.
+    pub const AUTOMATA: &str = sylva_automata::AutomataModel::NAME;
+    /// Gal, Mahal and Sipper's PlantMaker.
+    pub const PLANTMAKER: &str = sylva_plantmaker::PlantMakerModel::NAME;
+    /// Bornhofen and Lattaud's L-system plants.
+    pub const LSYSTEM: &str = sylva_lsystem::LSystemModel::NAME;
+}
+
 static STANDARD: LazyLock<Registry> = LazyLock::new(|| {
     Registry::new()
         .with(ModelEntry::evolvable::<BinTreeModel>())

@@ -5,17 +5,13 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, check_scene_glb, picture};
+use sylva::InputError;
+use sylva::assets::picture;
+use sylva::biomorph::{BiomorphOptions, Biomorphs};
 use sylva::files::Outputs;
-use sylva::genome::load_genome_of;
-use sylva::{Genome, InputError};
-use sylva_core::glam::Vec3;
-use sylva_core::{MaterialKind, Plant};
-use sylva_lsystem::LSystemModel;
-use sylva_lsystem::breed::{BreedSettings, breeding_genomes, breeding_work, grow_together_with};
-use sylva_mesh::render::{self, SheetCell, SheetOptions, View};
-use sylva_mesh::{Scene, SceneNode};
-use sylva_model::Model;
+use sylva::load_genome;
+use sylva::mesh::render::{self, SheetCell, SheetOptions, View};
+use sylva::mesh::{Scene, SceneNode};
 
 use super::{InFile, SCENE_PICTURE};
 
@@ -43,39 +39,25 @@ pub struct BreedArgs {
 
 /// `sylva breed`.
 pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
-    let mother = load_genome_of::<LSystemModel>(&args.mother, "breeding grows")?;
-    let settings = BreedSettings {
-        children: args.children as usize,
-        ..BreedSettings::default()
+    let mother = load_genome(&args.mother)?;
+    let options = BiomorphOptions {
+        children: args.children,
+        roots: !args.hide_roots,
+        ..BiomorphOptions::default()
     };
     let pool = super::pool(args.threads)?;
-    let mut rng = sylva_core::rng::seeded(args.seed);
-    let genomes = breeding_genomes(&mother, &settings, &mut rng);
+    let sown = Biomorphs::sow(&mother, &args.mother, &options, args.seed)
+        .map_err(|e| InputError::file(&args.mother, format!("breeding grows {e}")))?;
     super::announce(
-        breeding_work(&genomes, &settings).seconds(pool.threads()),
-        format_args!(
-            "growing {} plants for {} steps",
-            genomes.len(),
-            settings.grow.steps
-        ),
+        sown.work().seconds(pool.threads()),
+        format_args!("growing {} plants for {} steps", sown.len(), sown.steps()),
         "lower `max_symbols` and `max_modules` in the mother's `physiology`",
     );
-    let bar = super::progress_bar(u64::from(settings.grow.steps), "growing: step");
-    let garden = grow_together_with(genomes, &settings, &pool, &mut |step| {
-        bar.set_position(u64::from(step))
-    })
-    .map_err(|e| InputError::file_error(&args.mother, &e))?;
+    let bar = super::progress_bar(u64::from(sown.steps()), "growing: step");
+    let garden = sown.grow(&pool, &mut |step| bar.set_position(u64::from(step)))?;
     bar.finish_and_clear();
     let mut out = Outputs::new();
     out.create_dir(&args.out)?;
-    let shown: Vec<Plant> = garden
-        .specimens
-        .iter()
-        .map(|s| match args.hide_roots {
-            true => s.plant.without(MaterialKind::Root),
-            false => s.plant.clone(),
-        })
-        .collect();
     let names: Vec<String> = garden
         .specimens
         .iter()
@@ -85,37 +67,16 @@ pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
             false => format!("child-{i}"),
         })
         .collect();
-    let hint = LSystemModel.mesh_hint();
-    let placed: Vec<Placed> = garden
-        .specimens
-        .iter()
-        .zip(&shown)
-        .zip(&names)
-        .map(|((specimen, plant), name)| {
-            let genome = Genome::new(LSystemModel, specimen.genome.clone());
-            Placed {
-                translation: Vec3::new(specimen.position.x, 0.0, specimen.position.y),
-                extras: Some(Origin::of(&genome, args.seed).extras()),
-                ..Placed::new(name.clone(), plant, hint)
-            }
-        })
-        .collect();
-    check_scene_glb(
-        &placed,
-        false,
-        &args.mother,
-        "grow smaller plants (lower `max_modules` in the mother's `physiology`)",
+    let assets = garden.assets(
+        |i, _| names[i].clone(),
+        |_, specimen| specimen.origin(args.seed).extras(),
     )?;
-    let assets = SceneAssets::mesh(&placed, None).in_file(&args.mother)?;
 
     let mut table =
         String::from("specimen,biomass_g,light,uptake,leaves,fine_roots,germinated,genome\n");
     for (specimen, name) in garden.specimens.iter().zip(&names) {
         let file = format!("{name}.json");
-        out.add(
-            &args.out.join(&file),
-            LSystemModel.write(&specimen.genome).as_bytes(),
-        )?;
+        out.add(&args.out.join(&file), specimen.genome.to_json().as_bytes())?;
         let s = &specimen.stats;
         let _ = writeln!(
             table,

@@ -9,12 +9,12 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
+use sylva::core::budget::Seconds;
+use sylva::core::taper::PipeTaper;
+use sylva::mesh::SceneNode;
+use sylva::mesh::render::{self, SheetCell, SheetOptions};
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
-use sylva_core::budget::Seconds;
-use sylva_core::taper::PipeTaper;
-use sylva_mesh::SceneNode;
-use sylva_mesh::render::{self, SheetCell, SheetOptions};
 
 use sylva::files::Outputs;
 
@@ -227,7 +227,7 @@ fn write_results(
     evolution: &Evolution,
     config: &Config,
     out: &Path,
-    pool: &sylva_core::par::Pool,
+    pool: &sylva::core::par::Pool,
 ) -> anyhow::Result<()> {
     let mut files = Outputs::new();
     files.add(&out.join("config.toml"), config.to_toml().as_bytes())?;
@@ -295,7 +295,7 @@ fn population_sheet(
     evolution: &Evolution,
     count: usize,
     taper: Option<PipeTaper>,
-    pool: &sylva_core::par::Pool,
+    pool: &sylva::core::par::Pool,
 ) -> anyhow::Result<Vec<u8>> {
     let chosen = evolution.fittest(count);
     let grown = chosen

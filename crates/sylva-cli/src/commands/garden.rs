@@ -3,17 +3,15 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{
-    GardenLayout, GardenNodes, SceneAssets, asset_format, check_garden, check_png, garden_glb,
-    garden_glb_options, garden_placed, garden_placements, grow_garden, picture,
-};
+use sylva::assets::{SceneAssets, asset_format, check_png, picture};
 use sylva::files::{Outputs, read_text};
-use sylva::genome::{expect_model, load_genome_of, parse_genome};
-use sylva::{Genome, InputError};
-use sylva_mesh::export::Format;
-use sylva_mesh::render::View;
-use sylva_plantmaker::garden::GARDEN_MODEL;
-use sylva_plantmaker::{Garden, PlantMakerModel};
+use sylva::garden::{
+    GardenLayout, GardenNodes, PlanError, check_garden, garden_glb, garden_glb_options,
+    garden_placed, garden_placements, grow_garden,
+};
+use sylva::mesh::export::Format;
+use sylva::mesh::render::View;
+use sylva::{Genome, InputError, load_genome, parse_genome};
 
 use super::{InFile, SCENE_PICTURE};
 
@@ -52,9 +50,6 @@ pub struct GardenArgs {
     wind: super::WindArgs,
 }
 
-/// What gardens grow, for errors.
-const PURPOSE: &str = "gardens grow";
-
 /// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
 /// scene (one node per plant, or per variant when instanced, each carrying its genome and
 /// seed) and the garden file.
@@ -67,11 +62,7 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
     }
     let first = &args.inputs[0];
     let text = read_text(first)?;
-    #[derive(serde::Deserialize)]
-    struct Header {
-        model: String,
-    }
-    let is_garden = serde_json::from_str::<Header>(&text).is_ok_and(|h| h.model == GARDEN_MODEL);
+    let is_garden = sylva::garden::is_garden_file(&text);
     let mut garden = if is_garden {
         if args.inputs.len() > 1 {
             return Err(InputError::file(
@@ -87,22 +78,19 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        Garden::from_json(&text).map_err(|e| InputError::genome(first, &text, e))?
+        sylva::garden::read(first, &text)?
     } else {
         // The first file is already read.
-        let genome: Genome = parse_genome(first, &text)?;
-        let mut garden = Garden::new(
-            expect_model::<PlantMakerModel>(first, &genome, PURPOSE)?,
-            args.count as usize,
-            [args.area.0, args.area.1],
-            args.seed,
-        );
+        let mut genomes: Vec<Genome> = vec![parse_genome(first, &text)?];
         for path in &args.inputs[1..] {
-            garden.add(
-                load_genome_of::<PlantMakerModel>(path, PURPOSE)?,
-                args.count as usize,
-            );
+            genomes.push(load_genome(path)?);
         }
+        let area = [args.area.0, args.area.1];
+        let mut garden = sylva::garden::plant(&genomes, args.count as usize, area, args.seed)
+            .map_err(|e| match e {
+                PlanError::WrongModel { index, .. } => InputError::file(&args.inputs[index], e),
+                PlanError::NoGenomes => InputError::new("inputs", e),
+            })?;
         garden.variants = args.variants;
         garden
     };

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use sylva::assets::{check_png, picture};
 use sylva::files::Outputs;
+use sylva::mesh::render::View;
 use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
 use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets, load_genome};
-use sylva_mesh::render::View;
 
 use super::InFile;
 
@@ -28,7 +28,7 @@ pub struct GrowArgs {
     /// Thicken the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3
     /// (off by default: each model's own radii).
     #[arg(long, value_name = "E", value_parser = super::parse_taper)]
-    taper: Option<sylva_core::taper::PipeTaper>,
+    taper: Option<sylva::core::taper::PipeTaper>,
     /// Leave the roots out.
     #[arg(long)]
     hide_roots: bool,
@@ -56,7 +56,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         wind,
     };
     let glb = options.glb_options();
-    if args.lod.is_some() && output != GrowOutput::Asset(sylva_mesh::export::Format::Glb) {
+    if args.lod.is_some() && output != GrowOutput::Asset(sylva::mesh::export::Format::Glb) {
         return Err(InputError::new(
             "--lod",
             "levels of detail are written as GLB files: give an output ending in .glb",
@@ -100,7 +100,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
                 format!(
                     " ({} finer joints left out: at most {})",
                     rig.dropped,
-                    sylva_mesh::wind::MAX_JOINTS
+                    sylva::mesh::wind::MAX_JOINTS
                 )
             } else {
                 String::new()

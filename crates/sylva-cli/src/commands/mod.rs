@@ -13,7 +13,7 @@ use std::fmt::Display;
 use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sylva_core::budget::Seconds;
+use sylva::core::budget::Seconds;
 
 /// Work estimated to take this long or longer is announced before it starts, seconds.
 const ANNOUNCE_SECONDS: f64 = 60.0;
@@ -21,7 +21,7 @@ const ANNOUNCE_SECONDS: f64 = 60.0;
 /// Says on stderr, before it starts, how long work may take when that is a minute or more
 /// (and within the time budget: beyond it the work is refused, with the estimate).
 pub fn announce(seconds: f64, what: impl Display, advice: &str) {
-    if seconds >= ANNOUNCE_SECONDS && seconds <= sylva_core::budget::max_time().as_secs_f64() {
+    if seconds >= ANNOUNCE_SECONDS && seconds <= sylva::core::budget::max_time().as_secs_f64() {
         eprintln!(
             "note: {what} may take up to about {} (estimated at the plants' bounds); {advice} \
              to make it shorter",
@@ -113,7 +113,7 @@ impl WindArgs {
     pub fn options(
         &self,
         output: &Path,
-    ) -> Result<Option<sylva_mesh::wind::WindOptions>, sylva::InputError> {
+    ) -> Result<Option<sylva::mesh::wind::WindOptions>, sylva::InputError> {
         if !self.wind {
             return Ok(None);
         }
@@ -133,15 +133,15 @@ impl WindArgs {
                 ),
             ));
         }
-        let defaults = sylva_mesh::wind::WindOptions::default();
+        let defaults = sylva::mesh::wind::WindOptions::default();
         let strength = self.wind_strength.unwrap_or(defaults.strength);
         let period = self.wind_period.unwrap_or(defaults.period);
-        sylva_mesh::wind::WindOptions::new(strength, period)
+        sylva::mesh::wind::WindOptions::new(strength, period)
             .map(Some)
             .map_err(|e| {
                 let flag = match e {
-                    sylva_mesh::wind::WindError::Strength(_) => "--wind-strength",
-                    sylva_mesh::wind::WindError::Period(_) => "--wind-period",
+                    sylva::mesh::wind::WindError::Strength(_) => "--wind-strength",
+                    sylva::mesh::wind::WindError::Period(_) => "--wind-period",
                 };
                 sylva::InputError::new(flag, e)
             })
@@ -190,8 +190,8 @@ impl QuantizeArgs {
 pub const SCENE_PICTURE: (u32, u32) = (1200, 800);
 
 /// The worker pool for `--threads` (0: one per core).
-pub fn pool(threads: u32) -> Result<sylva_core::par::Pool, sylva::Error> {
-    Ok(sylva_core::par::Pool::with_threads(threads as usize)?)
+pub fn pool(threads: u32) -> Result<sylva::core::par::Pool, sylva::Error> {
+    Ok(sylva::core::par::Pool::with_threads(threads as usize)?)
 }
 
 /// Parses `WIDTHxDEPTH` in metres, each from 0.1 to 100,000.
@@ -227,10 +227,10 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
 }
 
 /// Parses the pipe-model exponent of `--taper`, 2 to 3.
-pub fn parse_taper(text: &str) -> Result<sylva_core::taper::PipeTaper, String> {
+pub fn parse_taper(text: &str) -> Result<sylva::core::taper::PipeTaper, String> {
     let bad = || format!("expected the pipe-model exponent, a number from 2 to 3; got {text:?}");
     let e: f64 = text.trim().parse().map_err(|_| bad())?;
-    sylva_core::taper::PipeTaper::new(e).map_err(|_| bad())
+    sylva::core::taper::PipeTaper::new(e).map_err(|_| bad())
 }
 
 #[cfg(test)]

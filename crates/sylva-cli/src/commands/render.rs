@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use sylva::assets::{check_png, write_picture};
+use sylva::mesh::render::View;
 use sylva::{GrowOptions, Grown, InputError, load_genome};
-use sylva_mesh::render::View;
 
 use super::InFile;
 
@@ -32,7 +32,7 @@ pub struct RenderArgs {
     /// Thicken the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3
     /// (off by default: each model's own radii).
     #[arg(long, value_name = "E", value_parser = super::parse_taper)]
-    taper: Option<sylva_core::taper::PipeTaper>,
+    taper: Option<sylva::core::taper::PipeTaper>,
     /// Leave the roots out (genomes only).
     #[arg(long)]
     hide_roots: bool,
@@ -106,7 +106,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         sylva::files::write(&args.output, &png)?;
     } else if is_glb {
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
-        let imported = sylva_mesh::import::read_glb(&bytes)
+        let imported = sylva::mesh::import::read_glb(&bytes)
             .map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
@@ -126,7 +126,7 @@ fn lod_strip(
     view: View,
     (width, height): (u32, u32),
 ) -> anyhow::Result<Vec<u8>> {
-    use sylva_mesh::render::{self, SheetCell, SheetOptions};
+    use sylva::mesh::render::{self, SheetCell, SheetOptions};
     let cells: Vec<SheetCell> = (0..chain.levels.len())
         .map(|k| SheetCell {
             scene: chain.level_scene(k, "plant"),
@@ -143,7 +143,7 @@ fn lod_strip(
         view,
         title: None,
     };
-    let image = render::contact_sheet(&cells, &options, &sylva_core::par::Pool::Serial)
+    let image = render::contact_sheet(&cells, &options, &sylva::core::par::Pool::Serial)
         .map_err(sylva::Error::from)?;
     Ok(render::encode_png(&image).map_err(sylva::Error::from)?)
 }
@@ -163,16 +163,16 @@ fn wind_strip(
         .map(|k| rig.pose(&grown.mesh, period * k as f32 / frames as f32))
         .collect();
     let bounds =
-        sylva_mesh::Scene::single(sylva_mesh::SceneNode::new("plant", &grown.mesh)).bounds();
+        sylva::mesh::Scene::single(sylva::mesh::SceneNode::new("plant", &grown.mesh)).bounds();
     let step = 1.15 * (bounds.max.x - bounds.min.x).max(0.25 * (bounds.max.y - bounds.min.y));
     let nodes = posed
         .iter()
         .enumerate()
         .map(|(k, mesh)| {
-            let mut node = sylva_mesh::SceneNode::new(format!("frame-{k}"), mesh);
-            node.translation = sylva_core::glam::Vec3::X * (k as f32 * step);
+            let mut node = sylva::mesh::SceneNode::new(format!("frame-{k}"), mesh);
+            node.translation = sylva::core::glam::Vec3::X * (k as f32 * step);
             node
         })
         .collect();
-    sylva::assets::picture(&sylva_mesh::Scene { nodes }, view, size)
+    sylva::assets::picture(&sylva::mesh::Scene { nodes }, view, size)
 }

@@ -1,21 +1,12 @@
 //! `sylva simulate`: one of Bornhofen and Lattaud's experiments, its measured outcome as a
 //! report, per-step records, and the grown plants as a scene and a picture.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use sylva::assets::{Origin, Placed, SceneAssets, check_scene_glb, picture};
-use sylva::files::{Outputs, read_text};
-use sylva::genome::load_genome_of;
-use sylva::report::simulation_report;
-use sylva::{Genome, InputError};
-use sylva_core::glam::{Quat, Vec2, Vec3};
-use sylva_core::{MaterialKind, Plant};
-use sylva_lsystem::LSystemModel;
-use sylva_lsystem::experiments::{LateralLightOutcome, Simulation, SimulationOutcome};
-use sylva_lsystem::garden::records_csv;
-use sylva_mesh::render::View;
-use sylva_model::MeshHint;
-use sylva_model::Model;
+use sylva::Experiment;
+use sylva::assets::picture;
+use sylva::files::Outputs;
+use sylva::mesh::render::View;
 
 use super::{InFile, SCENE_PICTURE};
 
@@ -35,19 +26,9 @@ pub struct SimulateArgs {
 /// `sylva simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let path = &args.config;
-    let text = read_text(path)?;
-    let simulation: Simulation =
-        toml::from_str(&text).map_err(|e| InputError::toml(path, &text, &e))?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let genomes = simulation
-        .genome_files()
-        .iter()
-        .map(|file| load_genome_of::<LSystemModel>(&base.join(file), "experiments grow"))
-        .collect::<Result<Vec<_>, _>>()?;
+    let experiment = Experiment::load(path)?;
     let pool = super::pool(args.threads)?;
-    let work = simulation
-        .work(&genomes)
-        .map_err(|e| InputError::file_error(path, &e))?;
+    let work = experiment.work()?;
     super::announce(
         work.seconds(pool.threads()),
         format_args!("the experiment's {} garden steps", work.steps),
@@ -55,9 +36,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
          world",
     );
     let bar = super::progress_bar(work.steps, "growing: step");
-    let outcome = simulation
-        .run_with(&genomes, &pool, &mut |step| bar.set_position(step))
-        .map_err(|e| InputError::file_error(path, &e))?;
+    let result = experiment.run(&pool, &mut |step| bar.set_position(step))?;
     bar.finish_and_clear();
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = path
@@ -67,35 +46,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     });
     let mut files = Outputs::new();
     files.create_dir(&out)?;
-    let report = simulation_report(&outcome);
-    files.add(&out.join("report.txt"), report.as_bytes())?;
-    files.add(
-        &out.join("records.csv"),
-        records_csv(outcome.records()).as_bytes(),
-    )?;
-    let hint = LSystemModel.mesh_hint();
-    let placed: Vec<Placed> = outcome
-        .plants()
-        .iter()
-        .map(|p| {
-            // Each plant grew in a shared world; its genome and seed regrow it alone.
-            let mut extras = Origin::of(&Genome::new(LSystemModel, p.genome.clone()), 0).extras();
-            extras["biomass_g"] = p.biomass.into();
-            Placed {
-                translation: p.position,
-                extras: Some(extras),
-                ..Placed::new(p.label.clone(), &p.plant, hint)
-            }
-        })
-        .collect();
-    check_scene_glb(
-        &placed,
-        false,
-        path,
-        "grow smaller plants (lower `max_modules` in the genomes' `physiology`)",
-    )?;
-    let assets = SceneAssets::mesh(&placed, None).in_file(path)?;
-    let scene = assets.scene();
+    files.add(&out.join("report.txt"), result.report.as_bytes())?;
+    files.add(&out.join("records.csv"), result.records_csv.as_bytes())?;
+    let scene = result.scene.scene();
     files
         .add_scene(&out.join("scene.glb"), &scene)
         .in_file(path)?;
@@ -104,40 +57,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         &picture(&scene, View::Iso, SCENE_PICTURE)?,
     )?;
     let mut written = "report.txt, records.csv, scene.glb, scene.png".to_owned();
-    if let SimulationOutcome::LateralLight(o) = &outcome {
-        files.add(&out.join("side.png"), &side_picture(o, hint, path)?)?;
+    if let Some(side) = &result.side {
+        files.add(
+            &out.join("side.png"),
+            &picture(&side.scene(), View::Front, SCENE_PICTURE)?,
+        )?;
         written.push_str(", side.png");
     }
     files.commit()?;
-    print!("{report}");
+    print!("{}", result.report);
     println!("wrote {}/{{{written}}}", out.display());
     Ok(())
-}
-
-/// `side.png`: tree 1 under lateral light (left) beside tree 1 under vertical light
-/// (right), at one scale, roots left out, seen across the light: both are turned so that the
-/// lateral light comes from +X, the right of a front view, and set apart by their reach.
-fn side_picture(o: &LateralLightOutcome, hint: MeshHint, config: &Path) -> anyhow::Result<Vec<u8>> {
-    let t = o.towards_light;
-    let turn = Quat::from_rotation_y(t.y.atan2(t.x));
-    let lateral = o.plants[0].plant.without(MaterialKind::Root);
-    let vertical = o.control[0].plant.without(MaterialKind::Root);
-    let reach = |p: &Plant| {
-        p.segments()
-            .iter()
-            .map(|s| Vec2::new(s.end.x, s.end.z).length())
-            .fold(0.0, f32::max)
-    };
-    let gap = 0.25;
-    let placed = [
-        ("lateral light", &lateral, -(reach(&lateral) + gap)),
-        ("vertical light", &vertical, reach(&vertical) + gap),
-    ]
-    .map(|(name, plant, x)| Placed {
-        translation: Vec3::new(x, 0.0, 0.0),
-        rotation: turn,
-        ..Placed::new(name, plant, hint)
-    });
-    let assets = SceneAssets::mesh(&placed, None).in_file(config)?;
-    Ok(picture(&assets.scene(), View::Front, SCENE_PICTURE)?)
 }

@@ -1,0 +1,553 @@
+//! PlantMaker gardens and forests (Gal, Mahal and Sipper): many plants of a few genomes on
+//! one plot, in one scene. A garden is planned ([`plant`], or read from a garden file with
+//! [`read`]), estimated before it grows ([`check_garden`]), then either held as assets
+//! ([`garden_assets`]) or streamed as a GLB, growing and meshing one plant at a time
+//! ([`garden_glb`]). The command line's `sylva garden` and Python's `sylva.garden` run it.
+
+use std::path::Path;
+
+use serde_json::json;
+use sylva_core::Plant;
+use sylva_core::glam::Vec3;
+use sylva_mesh::Mesh;
+use sylva_mesh::export::{self, Glb, GlbNode, GlbOptions, MeshSource};
+use sylva_mesh::mesher::Mesher;
+use sylva_mesh::wind::WindOptions;
+use sylva_model::Model;
+use sylva_plantmaker::garden::GARDEN_MODEL;
+use sylva_plantmaker::{GrownGarden, Placement, PlantMakerModel};
+
+pub use sylva_plantmaker::Garden;
+
+use crate::assets::{Origin, Placed, SceneAssets, mesh_options};
+use crate::error::{Error, InputError};
+use crate::genome::Genome;
+
+/// The model whose plants gardens grow.
+pub const MODEL: &str = PlantMakerModel::NAME;
+
+/// True when `text` is a garden file (`"model": "garden"`) rather than a genome file.
+pub fn is_garden_file(text: &str) -> bool {
+    #[derive(serde::Deserialize)]
+    struct Header {
+        model: String,
+    }
+    serde_json::from_str::<Header>(text).is_ok_and(|h| h.model == GARDEN_MODEL)
+}
+
+/// Reads a garden file already read from `path`.
+pub fn read(path: &Path, text: &str) -> Result<Garden, InputError> {
+    Garden::from_json(text).map_err(|e| InputError::genome(path, text, e))
+}
+
+/// Why genomes cannot be planted as a garden.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PlanError {
+    /// No genome was given.
+    #[error("a garden needs at least one genome")]
+    NoGenomes,
+    /// A genome of another model than [`MODEL`]: its index among those given, and its model.
+    #[error("gardens grow `{MODEL}` genomes; this is a `{model}` genome")]
+    WrongModel {
+        /// Which genome, from 0.
+        index: usize,
+        /// Its model.
+        model: &'static str,
+    },
+}
+
+/// Plans a new garden: `count` plants of each genome on a plot `area` = (width, depth)
+/// metres centred on the origin, their seeds, places and turns drawn from `seed`.
+pub fn plant(
+    genomes: &[Genome],
+    count: usize,
+    area: [f64; 2],
+    seed: u64,
+) -> Result<Garden, PlanError> {
+    let mut typed = genomes.iter().enumerate().map(|(index, genome)| {
+        genome
+            .get::<PlantMakerModel>()
+            .cloned()
+            .ok_or(PlanError::WrongModel {
+                index,
+                model: genome.model(),
+            })
+    });
+    let first = typed.next().ok_or(PlanError::NoGenomes)??;
+    let mut garden = Garden::new(first, count, area, seed);
+    for genome in typed {
+        garden.add(genome?, count);
+    }
+    Ok(garden)
+}
+
+/// Grows a PlantMaker garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...),
+/// each standing at its placement and carrying its genome and seed, with a wind skin when
+/// `wind` is given. Errors name `source`, the garden's file (or whatever a front end calls
+/// it).
+pub fn garden_assets(
+    garden: &Garden,
+    source: &Path,
+    wind: Option<WindOptions>,
+) -> Result<SceneAssets, Error> {
+    let grown = grow_garden(garden, source)?;
+    SceneAssets::mesh(&garden_placed(garden, &grown), wind).map_err(|e| e.in_file(source))
+}
+
+/// Grows every plant of a PlantMaker garden and places it, unmeshed. Errors name `source`.
+pub fn grow_garden(garden: &Garden, source: &Path) -> Result<GrownGarden, Error> {
+    Ok(garden
+        .grow()
+        .map_err(|e| InputError::file_error(source, &e))?)
+}
+
+/// Where every plant of a PlantMaker garden stands, without keeping the plants
+/// ([`Garden::placements`]). Errors name `source`.
+pub fn garden_placements(garden: &Garden, source: &Path) -> Result<Vec<Placement>, Error> {
+    Ok(garden
+        .placements()
+        .map_err(|e| InputError::file_error(source, &e))?)
+}
+
+/// The plants of a grown garden as placed in its scene: one per placement (`plant-0`,
+/// `plant-1`, ...), each carrying its genome and seed; the plants of one variant share it.
+pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<'g>> {
+    let hint = PlantMakerModel.mesh_hint();
+    grown
+        .placements
+        .iter()
+        .enumerate()
+        .map(|(i, placement)| Placed {
+            translation: placement.translation,
+            rotation: placement.rotation(),
+            extras: Some(placement_extras(garden, placement)),
+            ..Placed::new(format!("plant-{i}"), &grown.plants[placement.plant], hint)
+        })
+        .collect()
+}
+
+/// The origin a garden plant's node carries: its genome and seed.
+fn placement_extras(garden: &Garden, placement: &Placement) -> serde_json::Value {
+    let genome = &garden.plants[placement.group].genome;
+    Origin::of(
+        &Genome::new(PlantMakerModel, genome.clone()),
+        placement.seed,
+    )
+    .extras()
+}
+
+/// The names and origin extras of a garden's nodes, one per placement (`plant-0`, …), which
+/// [`garden_glb`] lends to the GLB writer.
+pub struct GardenNodes {
+    names: Vec<String>,
+    extras: Vec<serde_json::Value>,
+}
+
+impl GardenNodes {
+    /// The nodes of `placements` (the garden's own).
+    pub fn of(garden: &Garden, placements: &[Placement]) -> GardenNodes {
+        GardenNodes {
+            names: (0..placements.len())
+                .map(|i| format!("plant-{i}"))
+                .collect(),
+            extras: placements
+                .iter()
+                .map(|p| placement_extras(garden, p))
+                .collect(),
+        }
+    }
+}
+
+/// The GLB of a garden from its placements alone ([`Garden::placements`]), laid out and ready
+/// to stream: each distinct plant is grown and meshed when the writer asks for it (twice:
+/// once to lay the file out, once to write its bytes) and dropped after, so memory holds the
+/// JSON, one plant and one mesh, however large the garden. The bytes are those of the grown
+/// garden's scene ([`garden_placed`]) written with the same options. No wind (a rig is made
+/// from its mesh, and the skins are written after every mesh).
+pub fn garden_glb<'a>(
+    garden: &'a Garden,
+    placements: &'a [Placement],
+    nodes: &'a GardenNodes,
+    options: GlbOptions,
+) -> Result<Glb<'a>, Error> {
+    // Meshes in order of first appearance, as the writer numbers shared ones.
+    let mut mesh_of: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    let mut plants: Vec<&Placement> = Vec::new();
+    let glb_nodes = placements
+        .iter()
+        .zip(&nodes.names)
+        .zip(&nodes.extras)
+        .map(|((p, name), extras)| {
+            let mesh = *mesh_of.entry(p.plant).or_insert_with(|| {
+                plants.push(p);
+                plants.len() - 1
+            });
+            GlbNode {
+                name,
+                mesh,
+                rig: None,
+                translation: p.translation,
+                rotation: p.rotation(),
+                extras: Some(extras),
+            }
+        })
+        .collect();
+    let source = GardenMeshes {
+        garden,
+        plants,
+        mesher: Mesher::new(mesh_options(PlantMakerModel.mesh_hint()))?,
+        mesh: Mesh::default(),
+    };
+    Ok(Glb::new(glb_nodes, Box::new(source), options)?)
+}
+
+/// Grows and meshes a garden's plants when the GLB writer asks for them, into one mesh.
+struct GardenMeshes<'a> {
+    garden: &'a Garden,
+    /// Per mesh, the first placement showing it.
+    plants: Vec<&'a Placement>,
+    mesher: Mesher,
+    mesh: Mesh,
+}
+
+impl MeshSource for GardenMeshes<'_> {
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_mesh::export::ExportError> {
+        let placement = self
+            .plants
+            .get(index)
+            .ok_or(sylva_mesh::export::ExportError::NoSuchMesh { index })?;
+        let plant = self.garden.develop(placement).map_err(|e| {
+            sylva_mesh::export::ExportError::Source {
+                index,
+                source: Box::new(e),
+            }
+        })?;
+        self.mesher.mesh_into(&plant, &mut self.mesh)?;
+        Ok(&self.mesh)
+    }
+}
+
+/// What a garden's scene will cost, estimated before its plants grow ([`estimate_garden`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GardenEstimate {
+    /// Plants placed.
+    pub plants: usize,
+    /// Distinct plants grown and meshed (fewer than `plants` in a forest of variants).
+    pub meshes: usize,
+    /// Bytes held at once while the scene is made and written.
+    pub memory: u64,
+    /// Bytes of the GLB file.
+    pub glb: u64,
+}
+
+/// How a garden's scene is made, for [`estimate_garden`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GardenLayout {
+    /// Streamed by [`garden_glb`]: each plant grown and meshed when the writer asks.
+    Streamed,
+    /// Every plant grown and meshed first ([`grow_garden`], [`SceneAssets`]), as for OBJ,
+    /// VRML, wind or a picture.
+    Held,
+}
+
+/// Estimates what a garden's scene holds and writes from the first plant of each genome
+/// (grown and meshed here), before the others grow: its mesh times the genome's distinct
+/// plants, its node (name, placement, and the origin extras that carry the genome) times
+/// the genome's count. The nodes' JSON is what grows with the count whatever the meshes:
+/// each plant's extras hold its genome. Errors name `source`.
+pub fn estimate_garden(
+    garden: &Garden,
+    source: &Path,
+    layout: GardenLayout,
+    options: &GlbOptions,
+) -> Result<GardenEstimate, Error> {
+    let count = garden.count();
+    if count > MAX_GARDEN_PLANTS {
+        let e = sylva_plantmaker::GardenError::TooManyPlants(count);
+        return Err(InputError::file_error(source, &e).into());
+    }
+    let hint = PlantMakerModel.mesh_hint();
+    let mut mesher = Mesher::new(mesh_options(hint))?;
+    let mut estimate = GardenEstimate {
+        plants: 0,
+        meshes: 0,
+        memory: 0,
+        glb: GLB_FIXED,
+    };
+    let mut largest_plant = 0u64;
+    let mut textures = 0u64;
+    for (group, g) in garden.plants.iter().enumerate() {
+        let Some(&seed) = g.seeds.first() else {
+            continue;
+        };
+        let count = g.seeds.len();
+        let distinct = garden.variants.map_or(count, |v| count.min(v as usize));
+        let plant = g.genome.develop(seed).map_err(|source_error| {
+            let e = sylva_plantmaker::GardenError::Develop {
+                group,
+                index: 0,
+                source: source_error,
+            };
+            InputError::file_error(source, &e)
+        })?;
+        let mesh = mesher
+            .mesh(&plant)
+            .map_err(|e| Error::from(e).in_file(source))?;
+        let (each, once) = export::mesh_binary_bytes(&mesh, options)?;
+        textures = textures.max(once);
+        let placement = Placement {
+            group,
+            index: count - 1,
+            seed,
+            plant: 0,
+            translation: Vec3::ZERO,
+            yaw: 0.0,
+            radius: 0.0,
+        };
+        let extras = placement_extras(garden, &placement);
+        let node = json!({
+            "name": format!("plant-{}", MAX_GARDEN_PLANTS),
+            "mesh": MAX_GARDEN_PLANTS,
+            "translation": [-12345.678, 0.0, 12345.678],
+            "rotation": [0.0, -0.70710677, 0.0, 0.70710677],
+            "extras": extras,
+        });
+        let text = serde_json::to_vec(&node).map_or(0, |t| t.len() as u64);
+        let extras_heap = json_heap_bytes(&node["extras"]) + VALUE;
+        let node_heap = json_heap_bytes(&node) + VALUE;
+        // Every plant holds its placement and its node's name and extras, lent to the
+        // writer. A node is written as JSON (held as a value, then as text whose buffer
+        // grows by doubling) for each plant, or for each variant when the plants of a
+        // variant are instanced (their extras are equal). A held scene copies the extras
+        // three more times on the way (the placed plants, the assets' nodes, the scene) and
+        // keeps every plant and mesh.
+        let instanced = garden.variants.is_some() && options.instancing;
+        let copies = match layout {
+            GardenLayout::Streamed => 1,
+            GardenLayout::Held => 4,
+        };
+        let nodes = if instanced { distinct } else { count } as u64;
+        let mesh_bytes = sylva_mesh::mesher::mesh_bytes(
+            mesh.positions.len() as u64,
+            mesh.triangle_count() as u64,
+        );
+        let per_mesh = PER_MESH_JSON
+            + match layout {
+                GardenLayout::Streamed => 0,
+                GardenLayout::Held => mesh_bytes + plant_bytes(&plant),
+            };
+        let memory = (PER_PLACEMENT + copies * extras_heap)
+            .saturating_mul(count as u64)
+            .saturating_add((node_heap + 2 * text).saturating_mul(nodes))
+            .saturating_add(per_mesh.saturating_mul(distinct as u64));
+        // An instance is a translation and a rotation in the binary chunk.
+        let instances = if instanced {
+            INSTANCE * count as u64
+        } else {
+            0
+        };
+        estimate.plants += count;
+        estimate.meshes += distinct;
+        estimate.memory = estimate.memory.saturating_add(memory);
+        estimate.glb = estimate
+            .glb
+            .saturating_add(each.saturating_mul(distinct as u64))
+            .saturating_add(text.saturating_mul(nodes))
+            .saturating_add(MESH_JSON.saturating_mul(distinct as u64))
+            .saturating_add(instances);
+        largest_plant = largest_plant.max(mesh_bytes + plant_bytes(&plant));
+    }
+    // The streamed plant and its mesh, one at a time.
+    estimate.memory = estimate.memory.saturating_add(largest_plant);
+    estimate.glb = estimate.glb.saturating_add(textures);
+    Ok(estimate)
+}
+
+/// Refuses, before its plants grow, a garden whose scene would not fit the memory budget or
+/// (`glb`) a GLB's 4 GiB by more than 5% ([`estimate_garden`]; the writer refuses the rest
+/// when it has counted every byte). Errors name `source` and the flags to change.
+pub fn check_garden(
+    garden: &Garden,
+    source: &Path,
+    layout: GardenLayout,
+    glb: bool,
+    options: &GlbOptions,
+) -> Result<GardenEstimate, Error> {
+    let estimate = estimate_garden(garden, source, layout, options)?;
+    let plants = estimate.plants;
+    let variants = if garden.variants.is_some() {
+        ""
+    } else {
+        ", or grow a forest of variants (`--variants K`)"
+    };
+    // The first plant of a genome stands for its others: an estimate just over the limit is
+    // left to the writer's exact count.
+    if glb && estimate.glb > u64::from(u32::MAX) / 20 * 21 {
+        return Err(InputError::file(
+            source,
+            format!(
+                "a garden of {plants} plants ({} meshes) would make a GLB of about {}, more \
+                 than the 4 GiB a GLB can hold; plant fewer (`--count`){variants}",
+                estimate.meshes,
+                sylva_core::budget::Bytes(estimate.glb)
+            ),
+        )
+        .into());
+    }
+    sylva_core::budget::check(
+        estimate.memory,
+        format_args!(
+            "a garden of {plants} plants (`--count`; each plant's node carries its genome)"
+        ),
+        format_args!("plant fewer"),
+    )
+    .map_err(|e| Error::from(e).in_file(source))?;
+    Ok(estimate)
+}
+
+/// Most plants of a garden, for the widest node a garden can write.
+const MAX_GARDEN_PLANTS: usize = sylva_plantmaker::garden::MAX_PLANTS;
+
+/// A `serde_json::Value` itself, where a vector or map holds it.
+const VALUE: u64 = std::mem::size_of::<serde_json::Value>() as u64;
+
+/// Bytes a placement holds besides its node: the placement, its footprint, its cell in the
+/// placing grid and its entry in the plan.
+const PER_PLACEMENT: u64 = std::mem::size_of::<Placement>() as u64 + 128;
+
+/// The JSON a distinct mesh adds to a GLB (its accessors, views and mesh entry): an upper
+/// figure (a conifer's mesh writes 1.2 KB).
+const MESH_JSON: u64 = 4096;
+
+/// What a distinct mesh's JSON holds in memory while the GLB is laid out (with the rest of
+/// the estimate, 1% to 16% above the peaks measured for conifer gardens of 300 to 20,000
+/// plants, streamed, instanced or held).
+const PER_MESH_JSON: u64 = 16 * 1024;
+
+/// Bytes an instance adds to a GLB's binary chunk: its translation and rotation.
+const INSTANCE: u64 = 12 + 16;
+
+/// A GLB's header, chunk headers and the JSON that does not grow with the plants.
+const GLB_FIXED: u64 = 4096;
+
+/// Heap bytes a JSON value holds (not counting the value itself): strings, arrays and
+/// maps (serde_json's `BTreeMap`, whose nodes hold eleven entries), each allocation rounded
+/// as the system allocator rounds it.
+fn json_heap_bytes(value: &serde_json::Value) -> u64 {
+    use serde_json::Value;
+    // glibc: 8 bytes of header, 16-byte steps, at least 32.
+    let chunk = |n: usize| -> u64 {
+        if n == 0 {
+            0
+        } else {
+            ((n as u64 + 8).next_multiple_of(16)).max(32)
+        }
+    };
+    match value {
+        Value::Null | Value::Bool(_) | Value::Number(_) => 0,
+        Value::String(s) => chunk(s.capacity()),
+        Value::Array(a) => {
+            chunk(a.capacity() * VALUE as usize) + a.iter().map(json_heap_bytes).sum::<u64>()
+        }
+        Value::Object(m) if m.is_empty() => 0,
+        Value::Object(m) => {
+            // A leaf holds 11 keys and values; maps built by insertion are about 2/3 full,
+            // and one internal node (a leaf with 12 edges) stands over about six leaves.
+            const LEAF: usize = 8 + 2 + 2 + 11 * (24 + 32);
+            let leaves = if m.len() <= 11 {
+                1
+            } else {
+                m.len().div_ceil(7)
+            };
+            let internal = if leaves > 1 { leaves.div_ceil(6) } else { 0 };
+            leaves as u64 * chunk(LEAF)
+                + internal as u64 * chunk(LEAF + 12 * 8)
+                + m.iter()
+                    .map(|(k, v)| chunk(k.capacity()) + json_heap_bytes(v))
+                    .sum::<u64>()
+        }
+    }
+}
+
+/// Bytes a grown plant holds: its segments and organs.
+fn plant_bytes(plant: &Plant) -> u64 {
+    (std::mem::size_of_val(plant.segments()) + std::mem::size_of_val(plant.organs())) as u64
+}
+
+/// How a garden's GLB is laid out, as its file says: a forest of variants is instanced
+/// unless `"instancing": false`; positions are quantised with `"quantize": true`.
+pub fn garden_glb_options(garden: &Garden) -> GlbOptions {
+    GlbOptions {
+        instancing: garden.variants.is_some() && garden.instancing != Some(false),
+        quantize: garden.quantize,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn conifer() -> sylva_plantmaker::PlantMaker {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/plantmaker/conifer.json"
+        );
+        crate::genome::load_genome_of::<PlantMakerModel>(Path::new(path), "gardens grow")
+            .expect("the example is a PlantMaker genome")
+    }
+
+    /// The GLB a garden streams, and its estimate.
+    fn written_and_estimated(garden: &Garden) -> (u64, GardenEstimate) {
+        let source = Path::new("conifer.json");
+        let options = garden_glb_options(garden);
+        let estimate = estimate_garden(garden, source, GardenLayout::Streamed, &options)
+            .expect("the garden is estimated");
+        let placements = garden_placements(garden, source).expect("the garden is placed");
+        let nodes = GardenNodes::of(garden, &placements);
+        let glb = garden_glb(garden, &placements, &nodes, options).expect("laid out");
+        (glb.stats().bytes, estimate)
+    }
+
+    #[test]
+    fn a_garden_is_estimated_from_its_first_plant() {
+        // Every plant its own mesh: the estimate is within 3% of the file (seeds differ).
+        let garden = Garden::new(conifer(), 12, [60.0, 60.0], 3);
+        let (bytes, estimate) = written_and_estimated(&garden);
+        assert_eq!((estimate.plants, estimate.meshes), (12, 12));
+        let ratio = estimate.glb as f64 / bytes as f64;
+        assert!((0.97..1.03).contains(&ratio), "{} / {bytes}", estimate.glb);
+        // A forest of 3 variants: 3 meshes, each placement an instance.
+        let mut forest = Garden::new(conifer(), 40, [80.0, 80.0], 3);
+        forest.variants = Some(3);
+        let (bytes, instanced) = written_and_estimated(&forest);
+        assert_eq!((instanced.plants, instanced.meshes), (40, 3));
+        let ratio = instanced.glb as f64 / bytes as f64;
+        assert!((0.97..1.03).contains(&ratio), "{} / {bytes}", instanced.glb);
+        // Memory grows with the plants however few the meshes: each node carries a genome.
+        let mut larger = forest.clone();
+        larger.plants[0].seeds.extend(1000..1040);
+        let estimate = |g: &Garden, layout| {
+            estimate_garden(g, Path::new("c.json"), layout, &garden_glb_options(g)).unwrap()
+        };
+        let grown = estimate(&larger, GardenLayout::Streamed).memory
+            - estimate(&forest, GardenLayout::Streamed).memory;
+        assert!(grown > 40 * 5000, "{grown}");
+        // A held scene keeps its plants and meshes, and more copies of the extras.
+        assert!(
+            estimate(&forest, GardenLayout::Held).memory
+                > estimate(&forest, GardenLayout::Streamed).memory
+        );
+    }
+
+    #[test]
+    fn json_values_are_weighed_as_the_allocator_holds_them() {
+        assert_eq!(json_heap_bytes(&json!(1.5)), 0);
+        // 40 bytes of string: 48 bytes of chunk.
+        assert_eq!(json_heap_bytes(&json!("x".repeat(40))), 48);
+        // Three values of 32 bytes, each a number.
+        assert_eq!(json_heap_bytes(&json!([1, 2, 3])), 112);
+        // One leaf of a B-tree (eleven slots) and a short key.
+        assert_eq!(json_heap_bytes(&json!({ "a": 1 })), 640 + 32);
+        assert_eq!(json_heap_bytes(&json!({})), 0);
+    }
+}
