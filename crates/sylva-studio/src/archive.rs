@@ -141,6 +141,101 @@ pub struct ParentRow {
     pub dominance: f64,
 }
 
+/// A session's mode: its `mode` in the archive, requests and the page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModeName {
+    /// PlantMaker's main window.
+    Breed,
+    /// The biomorph garden.
+    Garden,
+    /// The binary-tree family.
+    Family,
+    /// The GP designer.
+    Design,
+}
+
+impl ModeName {
+    /// Every mode, in the order the page lists them.
+    pub const ALL: [ModeName; 4] = [
+        ModeName::Breed,
+        ModeName::Garden,
+        ModeName::Family,
+        ModeName::Design,
+    ];
+
+    /// Its name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ModeName::Breed => "breed",
+            ModeName::Garden => "garden",
+            ModeName::Family => "family",
+            ModeName::Design => "design",
+        }
+    }
+
+    /// The mode of a name.
+    pub fn parse(name: &str) -> Option<ModeName> {
+        ModeName::ALL.into_iter().find(|m| m.as_str() == name)
+    }
+
+    /// The names, for an error: `breed, garden, family or design`.
+    pub fn expected() -> String {
+        let names: Vec<&str> = ModeName::ALL.iter().map(|m| m.as_str()).collect();
+        let (last, rest) = names.split_last().unwrap_or((&"", &[]));
+        format!("{} or {last}", rest.join(", "))
+    }
+}
+
+/// How a plant was made: its `operator` in the archive and in its exports' extras.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Operator {
+    /// A random genome of its model.
+    Random,
+    /// One of Sylva's example genomes.
+    Example,
+    /// A genome file a person gave.
+    Upload,
+    /// A crossover of chosen parents.
+    Cross,
+    /// A mutant of one parent.
+    Mutate,
+    /// A genome a person edited.
+    Edit,
+    /// The same genome grown with another seed.
+    Regrow,
+    /// A garden's mother as she stands in that garden.
+    Mother,
+    /// A member of a family's run.
+    Family,
+    /// A member of a design run.
+    Design,
+    /// Empty rules, the biomorph garden's start.
+    Empty,
+    /// An archived plant, again, at the start of a new session.
+    Branch,
+}
+
+impl Operator {
+    /// Its name in the archive.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Operator::Random => "random",
+            Operator::Example => "example",
+            Operator::Upload => "upload",
+            Operator::Cross => "cross",
+            Operator::Mutate => "mutate",
+            Operator::Edit => "edit",
+            Operator::Regrow => "regrow",
+            Operator::Mother => "mother",
+            Operator::Family => "family",
+            Operator::Design => "design",
+            Operator::Empty => "empty",
+            Operator::Branch => "branch",
+        }
+    }
+}
+
 /// A new plant.
 pub struct NewPlant<'a> {
     /// The session it is made in.
@@ -152,7 +247,7 @@ pub struct NewPlant<'a> {
     /// Its seed.
     pub seed: u64,
     /// How it was made.
-    pub operator: &'a str,
+    pub operator: Operator,
     /// The operator's settings.
     pub settings: &'a serde_json::Value,
     /// Its parents.
@@ -348,7 +443,7 @@ pub fn insert_plant(c: &Connection, p: &NewPlant<'_>) -> rusqlite::Result<i64> {
             p.model,
             p.genome,
             p.seed as i64,
-            p.operator,
+            p.operator.as_str(),
             p.settings.to_string(),
             now()
         ],
@@ -458,14 +553,14 @@ pub fn parents(c: &Connection, child: i64) -> rusqlite::Result<Vec<ParentRow>> {
 /// Inserts a session; returns its id.
 pub fn insert_session(
     c: &Connection,
-    mode: &str,
+    mode: ModeName,
     model: &str,
     title: &str,
     state: &serde_json::Value,
 ) -> rusqlite::Result<i64> {
     c.execute(
         "INSERT INTO sessions (mode, model, title, state, created) VALUES (?1, ?2, ?3, ?4, ?5)",
-        params![mode, model, title, state.to_string(), now()],
+        params![mode.as_str(), model, title, state.to_string(), now()],
     )?;
     Ok(c.last_insert_rowid())
 }
@@ -820,7 +915,7 @@ mod tests {
         let v = |n: i64| serde_json::json!({ "n": n });
         archive
             .transaction(|c| -> Result<(), ArchiveError> {
-                let s = insert_session(c, "breed", "plantmaker", "t", &v(0))?;
+                let s = insert_session(c, ModeName::Breed, "plantmaker", "t", &v(0))?;
                 record_step(c, s, &v(1), &v(0), &v(1))?;
                 record_step(c, s, &v(2), &v(1), &v(2))?;
                 set_undone(c, s, 2, true)?;

@@ -3,17 +3,11 @@
 //! name and one JSON object.
 
 use std::collections::HashMap;
-use std::convert::Infallible;
 use std::sync::Mutex;
 
-use axum::extract::{Path, State};
-use axum::response::sse::{Event, KeepAlive, Sse};
 use tokio::sync::broadcast;
-use tokio_stream::StreamExt;
-use tokio_stream::wrappers::BroadcastStream;
 
 use crate::Studio;
-use crate::error::ApiError;
 
 /// An event: its name and its data.
 #[derive(Clone, Debug)]
@@ -63,23 +57,4 @@ pub fn progress(
             studio.events.send(session, "progress", data);
         }
     }
-}
-
-/// `GET /api/sessions/{id}/events`: the session's events, beginning with what its mode says
-/// of where it stands (a design run's status).
-pub(crate) async fn stream(
-    State(studio): State<Studio>,
-    Path(id): Path<i64>,
-) -> Result<Sse<impl tokio_stream::Stream<Item = Result<Event, Infallible>>>, ApiError> {
-    let row = crate::sessions::session_row(&studio, id)?;
-    let receiver = studio.events.channel(id).subscribe();
-    let first = match row.mode.as_str() {
-        "design" => Some(crate::design::status_event(&studio, id)?),
-        _ => None,
-    };
-    let rest = BroadcastStream::new(receiver).filter_map(|e| e.ok());
-    let stream = tokio_stream::iter(first)
-        .chain(rest)
-        .map(|e| Ok(Event::default().event(e.name).data(e.data.to_string())));
-    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
 }

@@ -2,11 +2,12 @@
 //! the four ways the papers did, with every plant and choice kept in an SQLite archive.
 //!
 //! - [`archive`]: the SQLite archive ([`Archive`]): sessions, plants, parentage, steps, runs.
-//! - [`sessions`]: sessions of every mode, their views, undo and redo.
-//! - [`breed`]: PlantMaker's main window (the 3×3 grid, cross and mutate), for any model.
-//! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
-//! - [`family`]: the deciduous-evolution viewer's binary-tree population.
-//! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
+//! - [`modes`]: the modes behind one seam ([`modes::Mode`]): breed (PlantMaker's main
+//!   window, for any model), garden (the biomorph loop of L-system plants), family (the
+//!   binary-tree population) and design (the GP designer's runs); sessions start, branch,
+//!   undo and redo through it.
+//! - [`sessions`]: sessions as stored and viewed, examples, step seeds.
+//! - [`runs`]: evolution runs in the archive, shared by family and design.
 //! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
 //! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
@@ -27,18 +28,18 @@
 //! ```
 
 pub mod archive;
-pub mod breed;
 pub mod cache;
-pub mod design;
 pub mod error;
 pub mod events;
-pub mod family;
-pub mod garden;
 pub mod guard;
 pub mod http;
 pub mod listen;
+pub mod modes;
 pub mod plants;
+pub mod runs;
 pub mod sessions;
+
+use modes::{design, family};
 
 use std::collections::HashMap;
 use std::net::SocketAddr;
@@ -169,28 +170,14 @@ impl Studio {
 /// The studio's routes.
 pub fn router(studio: Studio) -> Router {
     let api = Router::new()
-        .route("/models", get(sessions::models))
+        .route("/models", get(modes::models))
         .route("/examples", get(sessions::examples))
-        .route("/sessions", get(sessions::list).post(sessions::create))
+        .route("/sessions", get(sessions::list).post(modes::create))
         .route("/sessions/{id}", get(sessions::get))
-        .route("/sessions/{id}/undo", post(sessions::undo))
-        .route("/sessions/{id}/redo", post(sessions::redo))
-        .route("/sessions/{id}/cross", post(breed::cross))
-        .route("/sessions/{id}/mutate", post(breed::mutate))
-        .route("/sessions/{id}/add", post(breed::add))
-        .route("/sessions/{id}/edit", post(breed::edit))
-        .route("/sessions/{id}/grow", post(garden::grow))
-        .route("/sessions/{id}/pick", post(garden::pick))
-        .route("/sessions/{id}/garden.glb", get(garden::scene))
-        .route("/sessions/{id}/generations", post(family::generations))
-        .route("/sessions/{id}/batch", post(family::batch))
-        .route("/sessions/{id}/stats", get(family::stats))
-        .route("/sessions/{id}/member", post(family::member))
-        .route("/sessions/{id}/design", post(design::redesign))
-        .route("/sessions/{id}/stop", post(design::stop))
-        .route("/sessions/{id}/resume", post(design::resume))
-        .route("/sessions/{id}/run", get(design::run))
-        .route("/sessions/{id}/events", get(events::stream))
+        .route("/sessions/{id}/undo", post(modes::undo))
+        .route("/sessions/{id}/redo", post(modes::redo))
+        .route("/sessions/{id}/events", get(modes::events))
+        .merge(modes::routes())
         .route("/plants", get(plants::list))
         .route("/plants/{id}", get(plants::get))
         .route("/plants/{id}/plant.glb", get(plants::glb))
@@ -203,7 +190,7 @@ pub fn router(studio: Studio) -> Router {
         .route("/plants/{id}/genome.json", get(plants::genome))
         .route("/plants/{id}/{file}", get(plants::texture))
         .route("/plants/{id}/lineage", get(plants::lineage))
-        .route("/plants/{id}/branch", post(plants::branch))
+        .route("/plants/{id}/branch", post(modes::branch))
         .fallback(|| async { ApiError::not_found("no such endpoint") });
     Router::new()
         .nest("/api", api)

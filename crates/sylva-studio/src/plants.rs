@@ -24,8 +24,6 @@ use crate::Studio;
 use crate::archive::{self, ParentRow, PlantRow};
 use crate::cache::Bounded;
 use crate::error::ApiError;
-use crate::http::Body;
-use crate::sessions::SessionView;
 
 /// GLBs kept in memory, by plant and form: at most 256, and 512 MB (a random PlantMaker
 /// plant's GLB in full can be 40 MB).
@@ -668,30 +666,14 @@ pub(crate) async fn lineage(
     Ok(Json(lineage))
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct BranchRequest {
-    mode: Option<String>,
-}
-
-/// `POST /api/plants/{id}/branch`: a new session that starts from this plant.
-pub(crate) async fn branch(
-    State(studio): State<Studio>,
-    Path(id): Path<i64>,
-    Body(request): Body<BranchRequest>,
-) -> Result<Json<SessionView>, ApiError> {
-    let row = plant_row(&studio, id)?;
-    let session = match request.mode.as_deref().unwrap_or("breed") {
-        "breed" => crate::breed::branch(&studio, &row).await?,
-        "garden" => crate::garden::branch(&studio, &row).await?,
-        other => {
-            return Err(ApiError::bad(
-                "mode",
-                format!("expected breed or garden, got {other:?}"),
-            ));
-        }
-    };
-    Ok(Json(crate::sessions::view(&studio, session)?))
+/// Reads a genome file's text, naming `field` and the line and column of any error.
+pub fn parse_genome(text: &str, field: &str) -> Result<Genome, ApiError> {
+    Registry::standard().parse_genome(text).map_err(|e| {
+        ApiError::unprocessable(
+            field,
+            format!("line {}, column {}: {}", e.line, e.column, e.message),
+        )
+    })
 }
 
 #[cfg(test)]

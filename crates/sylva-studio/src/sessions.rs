@@ -1,4 +1,5 @@
-//! Sessions: one line of breeding in one mode. A session's `state` is its view (the grid,
+//! Sessions: one line of breeding in one mode (started, stepped and moved in history by
+//! [`crate::modes`]). A session's `state` is its view (the grid,
 //! the garden, the family's generation, the design's run); every step a person takes is
 //! recorded with the view before and after it, so undo and redo move between views while
 //! every plant made stays in the archive.
@@ -10,10 +11,8 @@ use serde::Serialize;
 use sylva::{Genome, Registry};
 
 use crate::Studio;
-use crate::archive::{self, StepRow};
+use crate::archive::{self, ModeName, StepRow};
 use crate::error::ApiError;
-use crate::http::{Body, from_value};
-use crate::{breed, design, family, garden};
 
 /// A session as the page sees it.
 #[derive(Serialize)]
@@ -66,40 +65,23 @@ pub fn session_row(studio: &Studio, id: i64) -> Result<archive::SessionRow, ApiE
 }
 
 /// A session that must be of `mode`.
-pub fn session_of(studio: &Studio, id: i64, mode: &str) -> Result<archive::SessionRow, ApiError> {
+pub fn session_of(
+    studio: &Studio,
+    id: i64,
+    mode: ModeName,
+) -> Result<archive::SessionRow, ApiError> {
     let row = studio
         .archive
         .read(|c| archive::session(c, id))?
         .ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
-    if row.mode != mode {
+    if row.mode != mode.as_str() {
         return Err(ApiError::conflict(format!(
-            "session {id} is a {} session, not {mode}",
-            row.mode
+            "session {id} is a {} session, not {}",
+            row.mode,
+            mode.as_str()
         )));
     }
     Ok(row)
-}
-
-#[derive(Serialize)]
-pub(crate) struct ModelInfo {
-    name: &'static str,
-    title: &'static str,
-    evolves: bool,
-}
-
-/// `GET /api/models`.
-pub(crate) async fn models() -> Json<Vec<ModelInfo>> {
-    Json(
-        Registry::standard()
-            .models()
-            .iter()
-            .map(|m| ModelInfo {
-                name: m.name(),
-                title: m.title(),
-                evolves: m.evolves(),
-            })
-            .collect(),
-    )
 }
 
 /// The example genomes shipped with Sylva, built into the binary.
@@ -173,120 +155,12 @@ pub(crate) async fn list(
     ))
 }
 
-/// What `POST /api/sessions` takes: the mode and how it starts.
-pub enum NewSession {
-    /// PlantMaker's main window.
-    Breed(breed::Start),
-    /// The biomorph garden.
-    Garden(garden::Start),
-    /// The binary-tree family.
-    Family(family::Start),
-    /// The GP designer.
-    Design(design::Start),
-}
-
-impl NewSession {
-    /// Reads a request: `mode` says which mode's fields the rest are. (Read by hand rather
-    /// than as a serde tagged enum, which would lose the path of an error in the rest.)
-    pub fn from_json(request: serde_json::Value) -> Result<NewSession, ApiError> {
-        let serde_json::Value::Object(mut fields) = request else {
-            return Err(ApiError::bad("", "expected a JSON object with a `mode`"));
-        };
-        let modes = "breed, garden, family or design";
-        let mode = match fields.remove("mode") {
-            Some(serde_json::Value::String(mode)) => mode,
-            Some(other) => {
-                return Err(ApiError::bad(
-                    "mode",
-                    format!("expected {modes}, got {other}"),
-                ));
-            }
-            None => return Err(ApiError::bad("mode", format!("missing: expected {modes}"))),
-        };
-        let rest = serde_json::Value::Object(fields);
-        Ok(match mode.as_str() {
-            "breed" => NewSession::Breed(from_value(rest, "")?),
-            "garden" => NewSession::Garden(from_value(rest, "")?),
-            "family" => NewSession::Family(from_value(rest, "")?),
-            "design" => NewSession::Design(from_value(rest, "")?),
-            other => {
-                return Err(ApiError::bad(
-                    "mode",
-                    format!("expected {modes}, got {other:?}"),
-                ));
-            }
-        })
-    }
-}
-
-/// `POST /api/sessions`.
-pub(crate) async fn create(
-    State(studio): State<Studio>,
-    Body(request): Body<serde_json::Value>,
-) -> Result<Json<SessionView>, ApiError> {
-    let id = match NewSession::from_json(request)? {
-        NewSession::Breed(start) => breed::create(&studio, start).await?,
-        NewSession::Garden(start) => garden::create(&studio, start).await?,
-        NewSession::Family(start) => family::create(&studio, start).await?,
-        NewSession::Design(start) => design::create(&studio, start).await?,
-    };
-    Ok(Json(view(&studio, id)?))
-}
-
 /// `GET /api/sessions/{id}`.
 pub(crate) async fn get(
     State(studio): State<Studio>,
     Path(id): Path<i64>,
 ) -> Result<Json<SessionView>, ApiError> {
     Ok(Json(view(&studio, id)?))
-}
-
-/// `POST /api/sessions/{id}/undo`.
-pub(crate) async fn undo(
-    State(studio): State<Studio>,
-    Path(id): Path<i64>,
-) -> Result<Json<SessionView>, ApiError> {
-    move_in_history(&studio, id, true).await
-}
-
-/// `POST /api/sessions/{id}/redo`.
-pub(crate) async fn redo(
-    State(studio): State<Studio>,
-    Path(id): Path<i64>,
-) -> Result<Json<SessionView>, ApiError> {
-    move_in_history(&studio, id, false).await
-}
-
-async fn move_in_history(
-    studio: &Studio,
-    id: i64,
-    back: bool,
-) -> Result<Json<SessionView>, ApiError> {
-    let lock = studio.session_lock(id);
-    let _guard = lock.lock().await;
-    studio.archive.transaction(|c| -> Result<(), ApiError> {
-        archive::session(c, id)?.ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
-        let steps = archive::steps(c, id)?;
-        let step = if back {
-            steps.iter().rev().find(|s| !s.undone)
-        } else {
-            steps.iter().find(|s| s.undone)
-        };
-        let step = step.ok_or_else(|| {
-            ApiError::conflict(if back {
-                "nothing to undo"
-            } else {
-                "nothing to redo"
-            })
-        })?;
-        archive::set_undone(c, id, step.seq, back)?;
-        let state = if back { &step.before } else { &step.after };
-        archive::set_state(c, id, state)?;
-        Ok(())
-    })?;
-    // A family's run in memory may be at another generation now; it reloads when needed.
-    studio.families.forget(id);
-    Ok(Json(view(studio, id)?))
 }
 
 /// Seeds a step's random choices: the session's seed, the step's number and a stream, mixed

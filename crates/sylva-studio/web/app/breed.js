@@ -295,7 +295,8 @@ export function createBreedMode(ctx, root) {
     for (const m of ctx.models || []) {
       model.append(h("option", { value: m.name }, `${m.title || m.name} (${m.name})`));
     }
-    if ((ctx.models || []).some((m) => m.name === "plantmaker")) model.value = "plantmaker";
+    const preferred = (ctx.models || []).find((m) => m.default);
+    if (preferred) model.value = preferred.name;
     const startRandom = h("input", { type: "radio", name: "breed-start", value: "random", testid: "new-start-random" });
     const startExamples = h("input", { type: "radio", name: "breed-start", value: "examples", testid: "new-start-examples" });
     const startFiles = h("input", { type: "radio", name: "breed-start", value: "genomes", testid: "new-start-files" });

@@ -51,7 +51,7 @@ export function createDetail(ctx, panel) {
     genomeText.value = p.genome_text ?? JSON.stringify(p.genome, null, 2);
     const seed = h("input", { type: "text", inputmode: "numeric", testid: "regrow-seed", value: String(p.seed ?? 1), style: { width: "13em" } });
 
-    const isLsystem = (p.model || "").startsWith("lsystem");
+    const inGardens = ((ctx.models || []).find((m) => m.name === p.model)?.modes || []).includes("garden");
     const exportLink = (file, label, testid, download) =>
       h("a", { href: api.plantUrl(p.id, file), download, testid, class: "button" }, label);
 
@@ -75,7 +75,7 @@ export function createDetail(ctx, panel) {
       h("div", { class: "buttons" },
         h("button", { testid: "lineage-open", onclick: () => ctx.openLineage(p.id) }, "Lineage"),
         h("button", { testid: "branch", title: "A new breeding session that starts from this plant", onclick: () => branch("breed") }, "Branch from here"),
-        isLsystem ? h("button", { testid: "branch-garden", title: "A new garden with this plant as the mother", onclick: () => branch("garden") }, "Branch to a garden") : null,
+        inGardens ? h("button", { testid: "branch-garden", title: "A new garden with this plant as the mother", onclick: () => branch("garden") }, "Branch to a garden") : null,
         h("button", { testid: "add-to-grid", title: "Put this plant back in the current breeding grid", onclick: addToGrid }, "Add to grid"),
       ),
       h("h3", {}, "Export"),

@@ -230,7 +230,8 @@ export function createGardenMode(ctx, root) {
   }
 
   function newSessionForm({ cancel }) {
-    const examples = (ctx.examples || []).filter((e) => e.model === "lsystem");
+    const gardenModels = (ctx.models || []).filter((m) => (m.modes || []).includes("garden")).map((m) => m.name);
+    const examples = (ctx.examples || []).filter((e) => gardenModels.includes(e.model));
     const fromExample = h("input", { type: "radio", name: "garden-start", checked: true, testid: "garden-new-example-radio" });
     const fromEmpty = h("input", { type: "radio", name: "garden-start", testid: "garden-new-empty" });
     const fromPlant = h("input", { type: "radio", name: "garden-start", testid: "garden-new-plant-radio" });

@@ -17,9 +17,11 @@ use serde_json::json;
 use sylva::{Config, Evolution, Member};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, NewPlant};
+use crate::archive::{self, GenerationRow, ModeName, Operator};
 use crate::error::ApiError;
 use crate::http::{Body, first_null, join};
+use crate::modes::Mode;
+use crate::runs::{archive_member, finite, generation_row};
 use crate::sessions::{SessionView, session_of, view};
 
 const BINTREE: &str = sylva::registry::names::BINTREE;
@@ -156,24 +158,8 @@ fn members(run: &Evolution) -> Vec<MemberView> {
         .collect()
 }
 
-fn finite(v: f64) -> f64 {
-    if v.is_finite() { v } else { 0.0 }
-}
-
-/// The last generation's figures.
-pub fn generation_row(run: &Evolution) -> GenerationRow {
-    let last = run.stats().last();
-    GenerationRow {
-        generation: run.generation(),
-        best: last.map_or(0.0, |s| finite(s.best)),
-        mean: last.map_or(0.0, |s| finite(s.mean)),
-        best_terms: last.map_or_else(Vec::new, |s| s.best_terms.clone()),
-        plant: None,
-    }
-}
-
 /// Creates a family session: generation 0 made and evaluated.
-pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let config = config_of(&start.config)?;
     let pool = studio.pool.clone();
     let (run, checkpoint, toml) = tokio::task::spawn_blocking(move || -> Result<_, ApiError> {
@@ -184,7 +170,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
     })
     .await??;
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, "family", BINTREE, "Family", &json!({}))?;
+        let id = archive::insert_session(c, ModeName::Family, BINTREE, "Family", &json!({}))?;
         let run_id = archive::insert_run(c, id, &toml, 0)?;
         archive::save_run(c, run_id, Some(&checkpoint), 0, "stopped", None)?;
         archive::insert_checkpoint(c, run_id, 0, &checkpoint)?;
@@ -203,7 +189,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
 }
 
 fn family_state(studio: &Studio, id: i64) -> Result<FamilyState, ApiError> {
-    let row = session_of(studio, id, "family")?;
+    let row = session_of(studio, id, ModeName::Family)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -406,7 +392,14 @@ pub(crate) async fn member(
         .map(|f| f.terms().to_vec())
         .unwrap_or_default();
     let fitness = finite(member.total());
-    let plant = archive_member(&studio, id, state.run, state.generation, &member)?;
+    let plant = archive_member(
+        &studio,
+        id,
+        state.run,
+        state.generation,
+        &member,
+        Operator::Family,
+    )?;
     Ok(Json(MemberPlant {
         plant,
         fitness,
@@ -414,65 +407,32 @@ pub(crate) async fn member(
     }))
 }
 
-/// Archives a run's member as a plant, once (found again by run and member id).
-pub fn archive_member(
-    studio: &Studio,
-    session: i64,
-    run: i64,
-    generation: u32,
-    member: &Member,
-) -> Result<i64, ApiError> {
-    let text = member.genome.to_json();
-    let seed = member.genome.default_seed();
-    let settings = json!({
-        "run": run,
-        "generation": generation,
-        "member": member.id.0,
-        "fitness": finite(member.total()),
-    });
-    let operator = if session_of(studio, session, "design").is_ok() {
-        "design"
-    } else {
-        "family"
-    };
-    studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let found: Option<i64> = c
-            .query_row(
-                "SELECT id FROM plants WHERE session = ?1 AND json_extract(settings, '$.run') = ?2
-                 AND json_extract(settings, '$.member') = ?3",
-                rusqlite::params![session, run, member.id.0 as i64],
-                |r| r.get(0),
-            )
-            .ok();
-        if let Some(id) = found {
-            return Ok(id);
-        }
-        // Its parents, where they are archived too.
-        let mut parents = Vec::new();
-        for p in &member.origin.parents {
-            let found: Option<i64> = c
-                .query_row(
-                    "SELECT id FROM plants WHERE session = ?1 AND json_extract(settings, '$.run') = ?2
-                     AND json_extract(settings, '$.member') = ?3",
-                    rusqlite::params![session, run, p.0 as i64],
-                    |r| r.get(0),
-                )
-                .ok();
-            if let Some(plant) = found {
-                parents.push(archive::ParentRow { plant, dominance: 1.0 });
-            }
-        }
-        Ok(archive::insert_plant(
-            c,
-            &NewPlant {
-                session: Some(session),
-                model: member.genome.model(),
-                genome: &text,
-                seed,
-                operator,
-                settings: &settings,
-                parents: &parents,
-            },
-        )?)
-    })
+/// Family mode, behind the studio's mode seam.
+pub struct FamilyMode;
+
+impl Mode for FamilyMode {
+    const NAME: ModeName = ModeName::Family;
+    type Start = Start;
+
+    fn models(_: &sylva::Registry) -> Vec<&'static str> {
+        vec![BINTREE]
+    }
+
+    async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+        create(studio, start).await
+    }
+
+    fn routes() -> axum::Router<Studio> {
+        use axum::routing::{get, post};
+        axum::Router::new()
+            .route("/sessions/{id}/generations", post(generations))
+            .route("/sessions/{id}/batch", post(batch))
+            .route("/sessions/{id}/stats", get(stats))
+            .route("/sessions/{id}/member", post(member))
+    }
+
+    fn moved(studio: &Studio, session: i64) {
+        // The run in memory may be at another generation now; it reloads when needed.
+        studio.families.forget(session);
+    }
 }

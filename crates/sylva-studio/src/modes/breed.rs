@@ -17,14 +17,20 @@ use sylva::core::Plant;
 use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
-use crate::archive::{self, NewPlant, ParentRow, PlantRow};
+use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
-use crate::plants::{Form, PreviewSize, genome_of, grow_shown, plant_bytes, preview_glb};
+use crate::modes::Mode;
+use crate::plants::{
+    Form, PreviewSize, genome_of, grow_shown, parse_genome, plant_bytes, preview_glb,
+};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
-/// PlantMaker's name in files.
-const PLANTMAKER: &str = sylva::registry::names::PLANTMAKER;
+/// The model a new session breeds when the request names none: PlantMaker's, whose main
+/// window this mode is.
+pub fn default_model() -> &'static str {
+    sylva::registry::names::PLANTMAKER
+}
 
 /// Plants in the grid.
 pub const GRID: usize = 9;
@@ -80,7 +86,7 @@ pub struct Made {
     /// Its seed.
     pub seed: u64,
     /// How it was made.
-    pub operator: &'static str,
+    pub operator: Operator,
     /// The operator's settings.
     pub settings: serde_json::Value,
     /// Its parents.
@@ -95,7 +101,7 @@ impl Made {
     /// Grows `genome` with its default seed.
     fn grow(
         genome: Genome,
-        operator: &'static str,
+        operator: Operator,
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
@@ -106,7 +112,7 @@ impl Made {
     fn grow_with(
         genome: Genome,
         seed: u64,
-        operator: &'static str,
+        operator: Operator,
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
@@ -202,7 +208,7 @@ struct Sprout {
     genome: Genome,
     /// Its seed; the genome's default when `None`.
     seed: Option<u64>,
-    operator: &'static str,
+    operator: Operator,
     settings: serde_json::Value,
     parents: Vec<ParentRow>,
     /// Where the request named it (`start.genomes[2]`), for an error growing it.
@@ -212,7 +218,7 @@ struct Sprout {
 impl Sprout {
     fn new(
         genome: Genome,
-        operator: &'static str,
+        operator: Operator,
         settings: serde_json::Value,
         field: String,
     ) -> Sprout {
@@ -259,7 +265,12 @@ async fn make_plants(
                     .random(Settings::Default, s)
                     .map_err(|e| ApiError::unprocessable(field, input_message(&e)))?;
                 let at = sub(field, "random");
-                genomes.push(Sprout::new(genome, "random", json!({ "seed": s }), at));
+                genomes.push(Sprout::new(
+                    genome,
+                    Operator::Random,
+                    json!({ "seed": s }),
+                    at,
+                ));
             }
         }
         Plants::Examples(names) => {
@@ -283,7 +294,7 @@ async fn make_plants(
                 let at = sub(field, &format!("examples[{i}]"));
                 genomes.push(Sprout::new(
                     genome,
-                    "example",
+                    Operator::Example,
                     json!({ "example": name }),
                     at,
                 ));
@@ -300,7 +311,7 @@ async fn make_plants(
                         format!("a {} genome; this session breeds {model}", genome.model()),
                     ));
                 }
-                genomes.push(Sprout::new(genome, "upload", json!({}), f));
+                genomes.push(Sprout::new(genome, Operator::Upload, json!({}), f));
             }
         }
         Plants::Plants(ids) => {
@@ -317,7 +328,7 @@ async fn make_plants(
                             plant: row.id,
                             dominance: 1.0,
                         }],
-                        ..Sprout::new(genome_of(&row)?, "branch", json!({}), at)
+                        ..Sprout::new(genome_of(&row)?, Operator::Branch, json!({}), at)
                     });
                 }
             }
@@ -345,16 +356,6 @@ fn check_count(n: usize, field: &str) -> Result<(), ApiError> {
             format!("expected 1 to 9 entries, got {n}"),
         ))
     }
-}
-
-/// Reads a genome file's text, naming `field` and the line and column of any error.
-pub fn parse_genome(text: &str, field: &str) -> Result<Genome, ApiError> {
-    Registry::standard().parse_genome(text).map_err(|e| {
-        ApiError::unprocessable(
-            field,
-            format!("line {}, column {}: {}", e.line, e.column, e.message),
-        )
-    })
 }
 
 /// Grows sprouts side by side on the blocking pool.
@@ -387,7 +388,7 @@ async fn blocking_grow(studio: &Studio, sprouts: Vec<Sprout>) -> Result<Vec<Made
 
 /// The model named in a request, or PlantMaker.
 fn model_name(name: Option<&str>) -> Result<&'static str, ApiError> {
-    let name = name.unwrap_or(PLANTMAKER);
+    let name = name.unwrap_or(default_model());
     Registry::standard()
         .get(name)
         .map(|m| m.name())
@@ -446,7 +447,7 @@ const FILL_DEPTH: u8 = 2;
 
 /// Creates a breed session: its first plants, then, when they are fewer than the grid holds,
 /// mutants of them in turn (Depth 2) until all nine cells are filled.
-pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let model = model_name(start.model.as_deref())?;
     let seed = start.seed.unwrap_or(1);
     let plants = match start.start {
@@ -478,14 +479,14 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
                     .map_err(|e| ApiError::library("start", e))?;
                 Ok((child, Vec::new()))
             },
-            "mutate",
+            Operator::Mutate,
             json!({ "depth": FILL_DEPTH }),
         )
         .await?
     };
     let (id, ids) = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let title = format!("Breed {model}");
-        let id = archive::insert_session(c, "breed", model, &title, &json!({}))?;
+        let id = archive::insert_session(c, ModeName::Breed, model, &title, &json!({}))?;
         let mut ids = store(c, id, &made)?;
         let mut mutants = mutants;
         for (i, m) in mutants.iter_mut().enumerate() {
@@ -511,7 +512,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
 }
 
 /// A new breed session that starts from one archived plant.
-pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
+async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
     create(
         studio,
         Start {
@@ -525,7 +526,7 @@ pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiEr
 
 /// The breed session and its state.
 fn breed_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, BreedState), ApiError> {
-    let row = session_of(studio, id, "breed")?;
+    let row = session_of(studio, id, ModeName::Breed)?;
     let state: BreedState = serde_json::from_value(row.state.clone())
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
     Ok((row, state))
@@ -622,7 +623,7 @@ async fn breed_children(
     seed: u64,
     seq: i64,
     breed: impl Fn(usize, u64) -> Result<(Genome, Vec<ParentRow>), ApiError> + Send + Sync + 'static,
-    operator: &'static str,
+    operator: Operator,
     settings: serde_json::Value,
 ) -> Result<Vec<Made>, ApiError> {
     let studio = studio.clone();
@@ -714,7 +715,7 @@ pub(crate) async fn cross(
                 .collect();
             Ok((child, parents))
         },
-        "cross",
+        Operator::Cross,
         json!({ "level": level }),
     )
     .await?;
@@ -777,7 +778,7 @@ pub(crate) async fn mutate(
                 }],
             ))
         },
-        "mutate",
+        Operator::Mutate,
         json!({ "depth": depth }),
     )
     .await?;
@@ -911,7 +912,11 @@ pub(crate) async fn edit(
             "nothing changed: edit a field or give another seed",
         ));
     }
-    let operator = if same { "regrow" } else { "edit" };
+    let operator = if same {
+        Operator::Regrow
+    } else {
+        Operator::Edit
+    };
     let parents = vec![ParentRow {
         plant: old.id,
         dominance: 1.0,
@@ -924,7 +929,7 @@ pub(crate) async fn edit(
         e.field = "genome".into();
         e
     })?;
-    let action = json!({ "op": operator, "plant": old.id, "seed": seed });
+    let action = json!({ "op": operator.as_str(), "plant": old.id, "seed": seed });
     Ok(Json(record(
         &studio,
         id,
@@ -934,6 +939,35 @@ pub(crate) async fn edit(
         vec![made],
         Some(old.id),
     )?))
+}
+
+/// Breed mode, behind the studio's mode seam.
+pub struct BreedMode;
+
+impl Mode for BreedMode {
+    const NAME: ModeName = ModeName::Breed;
+    type Start = Start;
+
+    fn models(registry: &Registry) -> Vec<&'static str> {
+        registry.models().iter().map(|m| m.name()).collect()
+    }
+
+    async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+        create(studio, start).await
+    }
+
+    async fn branch(studio: &Studio, plant: &PlantRow) -> Result<i64, ApiError> {
+        branch(studio, plant).await
+    }
+
+    fn routes() -> axum::Router<Studio> {
+        use axum::routing::post;
+        axum::Router::new()
+            .route("/sessions/{id}/cross", post(cross))
+            .route("/sessions/{id}/mutate", post(mutate))
+            .route("/sessions/{id}/add", post(add))
+            .route("/sessions/{id}/edit", post(edit))
+    }
 }
 
 #[cfg(test)]

@@ -18,11 +18,12 @@ use serde_json::json;
 use sylva::{Config, Evolution};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, RunRow};
+use crate::archive::{self, GenerationRow, ModeName, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
-use crate::family::{archive_member, generation_row};
 use crate::http::{Body, first_null, join};
+use crate::modes::Mode;
+use crate::runs::{archive_member, generation_row};
 use crate::sessions::{SessionView, session_of, view};
 
 const AUTOMATA: &str = sylva::registry::names::AUTOMATA;
@@ -325,10 +326,10 @@ fn check_cells(grid: &GridDesign, at: &str) -> Result<(), ApiError> {
 }
 
 /// Creates a design session and starts its run.
-pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let (config, generations) = config_of(&start.design, "design")?;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, "design", AUTOMATA, "Design", &json!({}))?;
+        let id = archive::insert_session(c, ModeName::Design, AUTOMATA, "Design", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
         let state = DesignState {
             run,
@@ -367,7 +368,7 @@ pub(crate) async fn redesign(
 }
 
 fn design_state(studio: &Studio, id: i64) -> Result<DesignState, ApiError> {
-    let row = session_of(studio, id, "design")?;
+    let row = session_of(studio, id, ModeName::Design)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -485,7 +486,14 @@ fn save_generation(
     stop: &AtomicBool,
 ) -> Result<(), ApiError> {
     let best = evolution.best();
-    let plant = archive_member(studio, row.session, row.id, evolution.generation(), &best)?;
+    let plant = archive_member(
+        studio,
+        row.session,
+        row.id,
+        evolution.generation(),
+        &best,
+        Operator::Design,
+    )?;
     let checkpoint = evolution
         .checkpoint()
         .map_err(|e| ApiError::internal(sylva::error::chain(&e)))?;
@@ -655,5 +663,34 @@ pub fn resume_all(studio: &Studio) {
     };
     for run in runs {
         let _ = spawn(studio, run.id);
+    }
+}
+
+/// Design mode, behind the studio's mode seam.
+pub struct DesignMode;
+
+impl Mode for DesignMode {
+    const NAME: ModeName = ModeName::Design;
+    type Start = Start;
+
+    fn models(_: &sylva::Registry) -> Vec<&'static str> {
+        vec![AUTOMATA]
+    }
+
+    async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+        create(studio, start).await
+    }
+
+    fn routes() -> axum::Router<Studio> {
+        use axum::routing::{get, post};
+        axum::Router::new()
+            .route("/sessions/{id}/design", post(redesign))
+            .route("/sessions/{id}/stop", post(stop))
+            .route("/sessions/{id}/resume", post(resume))
+            .route("/sessions/{id}/run", get(run))
+    }
+
+    fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
+        status_event(studio, session).map(Some)
     }
 }

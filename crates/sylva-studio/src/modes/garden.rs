@@ -16,10 +16,11 @@ use sylva::biomorph::{self, BiomorphOptions, Biomorphs};
 use sylva::mesh::{Scene, SceneNode};
 
 use crate::Studio;
-use crate::archive::{self, NewPlant, ParentRow, PlantRow};
+use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::ApiError;
 use crate::http::Body;
-use crate::plants::{extras, genome_of};
+use crate::modes::Mode;
+use crate::plants::{extras, genome_of, parse_genome, plant_row};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// The garden's controls; each optional in a request (the session's otherwise).
@@ -206,11 +207,17 @@ fn lsystem_genome(genome: Genome, field: &str) -> Result<Genome, ApiError> {
     }
 }
 
+/// How a new garden's mother came: made now (archived as a new plant), or archived already.
+enum Came {
+    Made(Operator, serde_json::Value),
+    Archived(i64),
+}
+
 /// Creates a garden session and grows its first garden.
-pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let settings = GardenSettings::default().with(&start.settings)?;
     let seed = start.seed.unwrap_or(1);
-    let (mother, operator, op_settings, existing) = match start
+    let (mother, made) = match start
         .start
         .unwrap_or(Mother::Example("lsystem/herb".into()))
     {
@@ -219,35 +226,29 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
                 .ok_or_else(|| ApiError::bad("start.example", format!("no example {name:?}")))?;
             (
                 lsystem_genome(genome, "start.example")?,
-                "example",
-                json!({"example": name}),
-                None,
+                Came::Made(Operator::Example, json!({"example": name})),
             )
         }
         Mother::Genome(text) => {
-            let genome = crate::breed::parse_genome(&text, "start.genome")?;
+            let genome = parse_genome(&text, "start.genome")?;
             (
                 lsystem_genome(genome, "start.genome")?,
-                "upload",
-                json!({}),
-                None,
+                Came::Made(Operator::Upload, json!({})),
             )
         }
         Mother::Plant(id) => {
-            let row = crate::plants::plant_row(studio, id).map_err(|mut e| {
+            let row = plant_row(studio, id).map_err(|mut e| {
                 e.status = axum::http::StatusCode::BAD_REQUEST;
                 e.field = "start.plant".into();
                 e
             })?;
             let genome = genome_of(&row)?;
-            (
-                lsystem_genome(genome, "start.plant")?,
-                "",
-                json!({}),
-                Some(id),
-            )
+            (lsystem_genome(genome, "start.plant")?, Came::Archived(id))
         }
-        Mother::Empty(true) => (biomorph::empty_rules(), "empty", json!({}), None),
+        Mother::Empty(true) => (
+            biomorph::empty_rules(),
+            Came::Made(Operator::Empty, json!({})),
+        ),
         Mother::Empty(false) => {
             return Err(ApiError::bad(
                 "start.empty",
@@ -256,21 +257,21 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
         }
     };
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, "garden", LSYSTEM, "Garden", &json!({}))?;
-        let mother_id = match existing {
-            Some(m) => m,
-            None => archive::insert_plant(
+        let id = archive::insert_session(c, ModeName::Garden, LSYSTEM, "Garden", &json!({}))?;
+        let mother_id = match &made {
+            Came::Made(operator, settings) => archive::insert_plant(
                 c,
                 &NewPlant {
                     session: Some(id),
                     model: LSYSTEM,
                     genome: &mother.to_json(),
                     seed: 0,
-                    operator,
-                    settings: &op_settings,
+                    operator: *operator,
+                    settings,
                     parents: &[],
                 },
             )?,
+            Came::Archived(plant) => *plant,
         };
         let state = GardenState {
             mother: mother_id,
@@ -293,7 +294,7 @@ pub(crate) async fn create(studio: &Studio, start: Start) -> Result<i64, ApiErro
 }
 
 /// A new garden session whose mother is an archived plant.
-pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
+async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
     if row.model != LSYSTEM {
         return Err(ApiError::bad(
             "mode",
@@ -315,7 +316,7 @@ pub(crate) async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiEr
 }
 
 fn garden_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, GardenState), ApiError> {
-    let row = session_of(studio, id, "garden")?;
+    let row = session_of(studio, id, ModeName::Garden)?;
     let state: GardenState = serde_json::from_value(row.state.clone())
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
     Ok((row, state))
@@ -358,12 +359,12 @@ async fn grow_garden(
             dominance: 1.0,
         }];
         let node_extras = |specimen: &biomorph::Specimen| {
-            let (operator, parents): (&str, &[ParentRow]) = if specimen.is_mother {
-                ("mother", &[])
+            let (operator, parents): (Operator, &[ParentRow]) = if specimen.is_mother {
+                (Operator::Mother, &[])
             } else {
-                ("mutate", &parents)
+                (Operator::Mutate, &parents)
             };
-            extras(&specimen.genome, seed, parents, operator)
+            extras(&specimen.genome, seed, parents, operator.as_str())
         };
         let assets = garden
             .assets(|i, _| format!("specimen-{i}"), |_, s| node_extras(s))
@@ -406,7 +407,7 @@ fn store_garden(
     grown: Grown,
 ) -> Result<GardenState, ApiError> {
     let settings = json!(state.settings);
-    let new_plant = |genome: &Genome, operator: &str, parent: i64| {
+    let new_plant = |genome: &Genome, operator: Operator, parent: i64| {
         archive::insert_plant(
             c,
             &NewPlant {
@@ -430,11 +431,11 @@ fn store_garden(
         let id = if is_mother {
             let ours = archive::plant(c, state.mother)?.is_some_and(|r| r.session == Some(session));
             if !ours || archive::mesh(c, state.mother)?.is_some() {
-                mother = new_plant(&genome, "mother", state.mother)?;
+                mother = new_plant(&genome, Operator::Mother, state.mother)?;
             }
             mother
         } else {
-            new_plant(&genome, "mutate", mother)?
+            new_plant(&genome, Operator::Mutate, mother)?
         };
         archive::insert_mesh(c, id, &glb)?;
         view.plant = id;
@@ -466,7 +467,7 @@ async fn step(
     action: serde_json::Value,
 ) -> Result<SessionView, ApiError> {
     let (_, before) = garden_state(studio, id)?;
-    let row = crate::plants::plant_row(studio, mother)?;
+    let row = plant_row(studio, mother)?;
     let genome = lsystem_genome(genome_of(&row)?, "plant")?;
     let state = GardenState {
         mother,
@@ -541,4 +542,32 @@ pub(crate) async fn scene(
         .read(|c| archive::scene(c, scene))?
         .ok_or_else(|| ApiError::not_found(format!("scene {scene}")))?;
     Ok(([(header::CONTENT_TYPE, "model/gltf-binary")], glb).into_response())
+}
+
+/// Garden mode, behind the studio's mode seam.
+pub struct GardenMode;
+
+impl Mode for GardenMode {
+    const NAME: ModeName = ModeName::Garden;
+    type Start = Start;
+
+    fn models(_: &sylva::Registry) -> Vec<&'static str> {
+        vec![biomorph::MODEL]
+    }
+
+    async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+        create(studio, start).await
+    }
+
+    async fn branch(studio: &Studio, plant: &PlantRow) -> Result<i64, ApiError> {
+        branch(studio, plant).await
+    }
+
+    fn routes() -> axum::Router<Studio> {
+        use axum::routing::{get, post};
+        axum::Router::new()
+            .route("/sessions/{id}/grow", post(grow))
+            .route("/sessions/{id}/pick", post(pick))
+            .route("/sessions/{id}/garden.glb", get(scene))
+    }
 }
