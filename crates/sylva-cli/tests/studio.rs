@@ -879,6 +879,52 @@ fn genome_distance(a: &Value, b: &Value) -> f64 {
 }
 
 #[test]
+fn models_say_which_modes_hold_their_plants() {
+    let dir = temp_dir("capabilities");
+    let server = start(&dir, "127.0.0.1");
+    let models = get(&server, "/api/models");
+    let of = |name: &str| -> Value {
+        models
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == name)
+            .cloned()
+            .unwrap_or_else(|| panic!("{name} is listed: {models}"))
+    };
+    assert_eq!(of("plantmaker")["modes"], json!(["breed"]));
+    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden"]));
+    assert_eq!(of("bintree")["modes"], json!(["breed", "family"]));
+    assert_eq!(of("automata")["modes"], json!(["breed", "design"]));
+    let defaults: Vec<&Value> = models
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["default"] == true)
+        .collect();
+    assert_eq!(defaults.len(), 1, "{models}");
+    assert_eq!(defaults[0]["name"], "plantmaker");
+    // A mode that does not start from a plant says so, naming the modes that do.
+    let session = post(
+        &server,
+        "/api/sessions",
+        json!({"mode": "breed", "seed": 2}),
+    );
+    let plant = grid(&session)[0];
+    let (status, body) = request(
+        &server,
+        "POST",
+        &format!("/api/plants/{plant}/branch"),
+        br#"{"mode": "family"}"#,
+        true,
+    );
+    assert_eq!(status, 400, "{}", String::from_utf8_lossy(&body));
+    let error: Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!(error["field"], "mode");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn depth_means_the_same_in_every_model() {
     let dir = temp_dir("knobs");
     let server = start(&dir, "127.0.0.1");
