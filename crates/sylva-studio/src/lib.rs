@@ -50,6 +50,7 @@ use std::sync::{Arc, Mutex};
 use axum::Router;
 use axum::routing::{get, post};
 use rand::RngExt;
+use sylva::Registry;
 
 pub use archive::{Archive, ArchiveError};
 pub use error::ApiError;
@@ -66,6 +67,8 @@ pub struct Options {
     /// Host names the studio answers to besides its loopback names and bound address (a
     /// reverse proxy's name).
     pub allow_hosts: Vec<String>,
+    /// The models the studio knows. Default: [`Registry::standard`].
+    pub registry: Registry,
 }
 
 impl Default for Options {
@@ -75,6 +78,7 @@ impl Default for Options {
             port: 8417,
             db: PathBuf::from("sylva-studio.db"),
             allow_hosts: Vec::new(),
+            registry: Registry::standard().clone(),
         }
     }
 }
@@ -119,6 +123,8 @@ pub struct Studio(Arc<Inner>);
 pub struct Inner {
     /// The archive.
     pub archive: Archive,
+    /// The models it knows.
+    pub registry: Registry,
     /// Who may talk to the studio.
     pub guard: guard::Guard,
     /// Recently served meshes.
@@ -145,10 +151,16 @@ impl Deref for Studio {
 }
 
 impl Studio {
-    /// A studio on an archive, guarded by `guard`.
+    /// A studio of the standard models on an archive, guarded by `guard`.
     pub fn new(archive: Archive, guard: guard::Guard) -> Studio {
+        Studio::with_registry(archive, guard, Registry::standard().clone())
+    }
+
+    /// A studio of the models of `registry` (the standard ones and a user's own).
+    pub fn with_registry(archive: Archive, guard: guard::Guard, registry: Registry) -> Studio {
         Studio(Arc::new(Inner {
             archive,
+            registry,
             guard,
             meshes: plants::mesh_cache(),
             plants: plants::plant_cache(),
@@ -235,7 +247,7 @@ pub fn serve(options: Options) -> Result<(), StartError> {
     })?;
     let token = (!is_loopback(&options.host)).then(new_token);
     let guard = guard::Guard::new(&options.host, &options.allow_hosts, token.clone());
-    let studio = Studio::new(archive, guard);
+    let studio = Studio::with_registry(archive, guard, options.registry.clone());
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

@@ -86,8 +86,8 @@ impl PreviewSize {
 }
 
 /// A stored genome, read back.
-pub fn genome_of(row: &PlantRow) -> Result<Genome, ApiError> {
-    Registry::standard()
+pub fn genome_of(registry: &Registry, row: &PlantRow) -> Result<Genome, ApiError> {
+    registry
         .parse_genome(&row.genome)
         .map_err(|e| ApiError::internal(format!("plant {}'s stored genome: {}", row.id, e.message)))
 }
@@ -146,7 +146,7 @@ fn shown_plant(studio: &Studio, row: &PlantRow) -> Result<Arc<Plant>, ApiError> 
     if let Some(plant) = studio.plants.get(row.id) {
         return Ok(plant);
     }
-    let plant = Arc::new(grow_shown(&genome_of(row)?, row.seed)?);
+    let plant = Arc::new(grow_shown(&genome_of(&studio.registry, row)?, row.seed)?);
     studio
         .plants
         .put(row.id, plant.clone(), plant_bytes(&plant));
@@ -187,12 +187,16 @@ pub fn plant_form(studio: &Studio, id: i64, form: Form) -> Result<Arc<Vec<u8>>, 
     let row = row.ok_or_else(|| ApiError::not_found(format!("plant {id}")))?;
     let glb = match (stored, form) {
         (Some(glb), _) => glb,
-        (None, Form::Full { roots }) => {
-            grow_glb(&genome_of(&row)?, row.seed, roots, &parents, &row.operator)?
-        }
+        (None, Form::Full { roots }) => grow_glb(
+            &genome_of(&studio.registry, &row)?,
+            row.seed,
+            roots,
+            &parents,
+            &row.operator,
+        )?,
         (None, Form::Preview(size)) => {
             let plant = shown_plant(studio, &row)?;
-            preview_glb(&genome_of(&row)?, row.seed, &plant, size)?
+            preview_glb(&genome_of(&studio.registry, &row)?, row.seed, &plant, size)?
         }
     };
     let glb = Arc::new(glb);
@@ -549,7 +553,7 @@ pub(crate) async fn get(
         .archive
         .read(|c| Ok((archive::plant(c, id)?, archive::parents(c, id)?)))?;
     let row = row.ok_or_else(|| ApiError::not_found(format!("plant {id}")))?;
-    let genome = genome_of(&row)?;
+    let genome = genome_of(&studio.registry, &row)?;
     let value = genome.to_value();
     let mut list = Vec::new();
     fields(&value, "", &mut list);
@@ -667,8 +671,8 @@ pub(crate) async fn lineage(
 }
 
 /// Reads a genome file's text, naming `field` and the line and column of any error.
-pub fn parse_genome(text: &str, field: &str) -> Result<Genome, ApiError> {
-    Registry::standard().parse_genome(text).map_err(|e| {
+pub fn parse_genome(registry: &Registry, text: &str, field: &str) -> Result<Genome, ApiError> {
+    registry.parse_genome(text).map_err(|e| {
         ApiError::unprocessable(
             field,
             format!("line {}, column {}: {}", e.line, e.column, e.message),

@@ -91,18 +91,18 @@ pub fn session_of(
 struct ExampleFiles;
 
 /// An example genome by name (`plantmaker/fern`).
-pub fn example(name: &str) -> Option<Genome> {
+pub fn example(registry: &Registry, name: &str) -> Option<Genome> {
     let file = ExampleFiles::get(&format!("{name}.json"))?;
     let text = std::str::from_utf8(&file.data).ok()?;
-    Registry::standard().parse_genome(text).ok()
+    registry.parse_genome(text).ok()
 }
 
 /// Every example's name and model, sorted by name.
-pub fn example_list() -> Vec<(String, &'static str)> {
+pub fn example_list(registry: &Registry) -> Vec<(String, &'static str)> {
     let mut list: Vec<(String, &'static str)> = ExampleFiles::iter()
         .filter_map(|path| {
             let name = path.strip_suffix(".json")?.to_owned();
-            let genome = example(&name)?;
+            let genome = example(registry, &name)?;
             Some((name, genome.model()))
         })
         .collect();
@@ -117,9 +117,9 @@ pub(crate) struct ExampleInfo {
 }
 
 /// `GET /api/examples`.
-pub(crate) async fn examples() -> Json<Vec<ExampleInfo>> {
+pub(crate) async fn examples(State(studio): State<Studio>) -> Json<Vec<ExampleInfo>> {
     Json(
-        example_list()
+        example_list(&studio.registry)
             .into_iter()
             .map(|(name, model)| ExampleInfo { name, model })
             .collect(),

@@ -330,6 +330,8 @@ pub struct Config {
     inner: Box<dyn AnyConfig>,
     /// The file it was read from, named in errors.
     source: Option<PathBuf>,
+    /// The registry it was read with, which reads its start genomes; `None`: the standard.
+    registry: Option<Registry>,
 }
 
 /// Evaluations made so far by every run of this process, for a progress bar to read from
@@ -505,6 +507,7 @@ impl Clone for Config {
         Config {
             inner: self.inner.clone_box(),
             source: self.source.clone(),
+            registry: self.registry.clone(),
         }
     }
 }
@@ -531,7 +534,22 @@ impl Config {
         Config {
             inner: Box::new(config),
             source: None,
+            registry: None,
         }
+    }
+
+    /// This config, read from `path` with `registry` (which reads its start genomes).
+    pub(crate) fn read_with(mut self, path: Option<&Path>, registry: &Registry) -> Config {
+        self.source = path.map(Path::to_owned);
+        if !std::ptr::eq(registry, Registry::standard()) {
+            self.registry = Some(registry.clone());
+        }
+        self
+    }
+
+    /// The registry the config was read with.
+    pub fn registry(&self) -> &Registry {
+        self.registry.as_ref().unwrap_or(Registry::standard())
     }
 
     /// A config of any model the standard registry knows, built as values (a front end's
@@ -542,9 +560,7 @@ impl Config {
 
     /// Parses a config of any model the standard registry knows; errors point into `text`.
     pub fn parse(path: &Path, text: &str) -> Result<Config, InputError> {
-        let mut config = Registry::standard().parse_config(path, text)?;
-        config.source = Some(path.to_owned());
-        Ok(config)
+        Registry::standard().parse_config(path, text)
     }
 
     /// How errors name the config: its file, or "config" for one built in code.
@@ -605,14 +621,14 @@ impl Config {
     }
 
     /// Reads the genome files of [`Config::start_files`] from `base` (the config file's
-    /// folder).
+    /// folder), with the registry the config was read with.
     pub fn load_start(&self, base: &Path) -> Result<Vec<Genome>, InputError> {
         let model = self.model();
         self.start_files()
             .iter()
             .map(|file| {
                 let path = base.join(file);
-                let genome = crate::genome::load_genome(&path)?;
+                let genome = self.registry().load_genome(&path)?;
                 if genome.model() == model {
                     Ok(genome)
                 } else {

@@ -16,7 +16,6 @@ use sylva_model::{
 };
 
 use crate::error::{Error, InputError};
-use crate::files::read_text;
 use crate::registry::Registry;
 
 /// A genome of any model.
@@ -285,8 +284,7 @@ impl fmt::Debug for Genome {
 /// Reads a genome file of any model the standard registry knows; errors point at the line
 /// and column.
 pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
-    let text = read_text(path)?;
-    parse_genome(path, &text)
+    Registry::standard().load_genome(path)
 }
 
 /// Parses a genome file already read from `path`.

@@ -109,6 +109,14 @@ fn config_from_value<M: Evolve + Default>(value: serde_json::Value) -> Result<Co
         .map_err(|e| FieldError::of(&e, &sent))
 }
 
+impl std::fmt::Debug for Registry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list()
+            .entries(self.models.iter().map(|m| m.name))
+            .finish()
+    }
+}
+
 /// The models Sylva knows, in the order they are listed.
 #[derive(Clone)]
 pub struct Registry {
@@ -223,6 +231,20 @@ impl Registry {
         names.join(", ")
     }
 
+    /// Reads a genome file of any model this registry knows; errors name the file, line and
+    /// column.
+    pub fn load_genome(&self, path: &Path) -> Result<Genome, InputError> {
+        let text = crate::files::read_text(path)?;
+        self.parse_genome(&text)
+            .map_err(|e| InputError::genome(path, &text, e))
+    }
+
+    /// Reads an evolution config file of any model this registry knows that evolves.
+    pub fn load_config(&self, path: &Path) -> Result<Config, InputError> {
+        let text = crate::files::read_text(path)?;
+        self.parse_config(path, &text)
+    }
+
     /// Parses a genome file: the header (`model`, `format`) first, then the model's fields.
     /// Errors carry the line and column.
     pub fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError> {
@@ -268,7 +290,9 @@ impl Registry {
         };
         let name = header.model.as_ref().map(|n| n.get_ref().as_str());
         match entry.and_then(|e| e.evolve) {
-            Some(evolve) => (evolve.parse_config)(path, text),
+            Some(evolve) => {
+                (evolve.parse_config)(path, text).map(|c| c.read_with(Some(path), self))
+            }
             None if entry.is_some() => Err(refuse(format!(
                 "model `{}` does not evolve without a person; models that do: {}",
                 name.unwrap_or_default(),
@@ -300,7 +324,7 @@ impl Registry {
         };
         let entry = name.and_then(|n| self.get(n));
         match entry.and_then(|e| e.evolve) {
-            Some(evolve) => (evolve.config_from_value)(value),
+            Some(evolve) => (evolve.config_from_value)(value).map(|c| c.read_with(None, self)),
             None => {
                 let evolvable: Vec<&str> = self
                     .models

@@ -29,6 +29,7 @@ pub fn run(args: &StudioArgs) -> anyhow::Result<()> {
         port: args.port,
         db: args.db.clone(),
         allow_hosts: args.allow_hosts.clone(),
+        registry: sylva::Registry::standard().clone(),
     })?;
     Ok(())
 }

@@ -256,7 +256,8 @@ async fn make_plants(
                     format!("expected 1 to 9, got {n}"),
                 ));
             }
-            let entry = Registry::standard()
+            let entry = studio
+                .registry
                 .get(model)
                 .ok_or_else(|| ApiError::internal(format!("no model {model}")))?;
             for i in 0..n {
@@ -276,7 +277,7 @@ async fn make_plants(
         Plants::Examples(names) => {
             check_count(names.len(), &sub(field, "examples"))?;
             for (i, name) in names.into_iter().enumerate() {
-                let genome = example(&name).ok_or_else(|| {
+                let genome = example(&studio.registry, &name).ok_or_else(|| {
                     ApiError::bad(
                         sub(field, &format!("examples[{i}]")),
                         format!("no example {name:?}"),
@@ -304,7 +305,7 @@ async fn make_plants(
             check_count(texts.len(), &sub(field, "genomes"))?;
             for (i, text) in texts.iter().enumerate() {
                 let f = sub(field, &format!("genomes[{i}]"));
-                let genome = parse_genome(text, &f)?;
+                let genome = parse_genome(&studio.registry, text, &f)?;
                 if genome.model() != model {
                     return Err(ApiError::unprocessable(
                         f,
@@ -328,7 +329,12 @@ async fn make_plants(
                             plant: row.id,
                             dominance: 1.0,
                         }],
-                        ..Sprout::new(genome_of(&row)?, Operator::Branch, json!({}), at)
+                        ..Sprout::new(
+                            genome_of(&studio.registry, &row)?,
+                            Operator::Branch,
+                            json!({}),
+                            at,
+                        )
                     });
                 }
             }
@@ -387,19 +393,12 @@ async fn blocking_grow(studio: &Studio, sprouts: Vec<Sprout>) -> Result<Vec<Made
 }
 
 /// The model named in a request, or PlantMaker.
-fn model_name(name: Option<&str>) -> Result<&'static str, ApiError> {
+fn model_name(registry: &Registry, name: Option<&str>) -> Result<&'static str, ApiError> {
     let name = name.unwrap_or(default_model());
-    Registry::standard()
-        .get(name)
-        .map(|m| m.name())
-        .ok_or_else(|| {
-            let known: Vec<_> = Registry::standard()
-                .models()
-                .iter()
-                .map(|m| m.name())
-                .collect();
-            ApiError::bad("model", format!("expected one of {known:?}, got {name:?}"))
-        })
+    registry.get(name).map(|m| m.name()).ok_or_else(|| {
+        let known: Vec<_> = registry.models().iter().map(|m| m.name()).collect();
+        ApiError::bad("model", format!("expected one of {known:?}, got {name:?}"))
+    })
 }
 
 /// Puts `first` (in order) at the head of the grid with dominance `step`; the rest keep
@@ -428,8 +427,8 @@ fn promote(grid: &[Cell], first: &[i64], step: i64) -> Vec<Cell> {
 /// What a breed session starts from when not told: the model's examples, and random
 /// genomes up to a full grid when it has fewer than two. (Random PlantMaker genomes grow
 /// plants of up to a million triangles; the paper's users, too, began from chosen plants.)
-fn default_start(model: &str) -> Plants {
-    let examples: Vec<String> = crate::sessions::example_list()
+fn default_start(registry: &Registry, model: &str) -> Plants {
+    let examples: Vec<String> = crate::sessions::example_list(registry)
         .into_iter()
         .filter(|(_, m)| *m == model)
         .map(|(name, _)| name)
@@ -448,11 +447,11 @@ const FILL_DEPTH: u8 = 2;
 /// Creates a breed session: its first plants, then, when they are fewer than the grid holds,
 /// mutants of them in turn (Depth 2) until all nine cells are filled.
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let model = model_name(start.model.as_deref())?;
+    let model = model_name(&studio.registry, start.model.as_deref())?;
     let seed = start.seed.unwrap_or(1);
     let plants = match start.start {
         Some(plants) => plants,
-        None => default_start(model),
+        None => default_start(&studio.registry, model),
     };
     let (made, reused) = make_plants(studio, model, plants, seed, 0, "start", None).await?;
     // A new session reuses no plant: archived plants enter it as branches (above).
@@ -686,7 +685,10 @@ pub(crate) async fn cross(
         }
     }
     let rows = archived(&studio, &ids, &row.model, "parents")?;
-    let genomes = rows.iter().map(genome_of).collect::<Result<Vec<_>, _>>()?;
+    let genomes = rows
+        .iter()
+        .map(|row| genome_of(&studio.registry, row))
+        .collect::<Result<Vec<_>, _>>()?;
     let level = request.level.unwrap_or_default();
     let count = children(request.children, GRID.saturating_sub(ids.len()).max(1))?;
     let knobs = Knobs {
@@ -757,7 +759,7 @@ pub(crate) async fn mutate(
     };
     let count = children(request.children, GRID - 1)?;
     let parent = archived_one(&studio, request.plant, &row.model, "plant")?;
-    let genome = genome_of(&parent)?;
+    let genome = genome_of(&studio.registry, &parent)?;
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
     let parent_id = parent.id;
@@ -803,7 +805,7 @@ pub(crate) async fn add(
     let lock = studio.session_lock(id);
     let _guard = lock.lock().await;
     let (row, state) = breed_state(&studio, id)?;
-    let model = model_name(Some(&row.model))?;
+    let model = model_name(&studio.registry, Some(&row.model))?;
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let (made, reused) = make_plants(&studio, model, plants, state.seed, seq, "", Some(id)).await?;
     let action = json!({ "op": "add", "plants": reused });
@@ -864,7 +866,7 @@ pub(crate) async fn edit(
     let _guard = lock.lock().await;
     let (row, state) = breed_state(&studio, id)?;
     let old = archived_one(&studio, request.plant, &row.model, "plant")?;
-    let original = genome_of(&old)?;
+    let original = genome_of(&studio.registry, &old)?;
     let genome = match (&request.genome, request.fields.is_empty()) {
         (None, true) => original.clone(),
         (None, false) => {
@@ -879,10 +881,12 @@ pub(crate) async fn edit(
                     )
                 })?;
             }
-            parse_genome(&value.to_string(), "fields")?
+            parse_genome(&studio.registry, &value.to_string(), "fields")?
         }
-        (Some(serde_json::Value::String(text)), true) => parse_genome(text, "genome")?,
-        (Some(value), true) => parse_genome(&value.to_string(), "genome")?,
+        (Some(serde_json::Value::String(text)), true) => {
+            parse_genome(&studio.registry, text, "genome")?
+        }
+        (Some(value), true) => parse_genome(&studio.registry, &value.to_string(), "genome")?,
         (Some(_), false) => {
             return Err(ApiError::bad(
                 "fields",

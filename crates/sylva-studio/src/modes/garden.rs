@@ -222,7 +222,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         .unwrap_or(Mother::Example("lsystem/herb".into()))
     {
         Mother::Example(name) => {
-            let genome = example(&name)
+            let genome = example(&studio.registry, &name)
                 .ok_or_else(|| ApiError::bad("start.example", format!("no example {name:?}")))?;
             (
                 lsystem_genome(genome, "start.example")?,
@@ -230,7 +230,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
             )
         }
         Mother::Genome(text) => {
-            let genome = parse_genome(&text, "start.genome")?;
+            let genome = parse_genome(&studio.registry, &text, "start.genome")?;
             (
                 lsystem_genome(genome, "start.genome")?,
                 Came::Made(Operator::Upload, json!({})),
@@ -242,7 +242,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
                 e.field = "start.plant".into();
                 e
             })?;
-            let genome = genome_of(&row)?;
+            let genome = genome_of(&studio.registry, &row)?;
             (lsystem_genome(genome, "start.plant")?, Came::Archived(id))
         }
         Mother::Empty(true) => (
@@ -468,7 +468,7 @@ async fn step(
 ) -> Result<SessionView, ApiError> {
     let (_, before) = garden_state(studio, id)?;
     let row = plant_row(studio, mother)?;
-    let genome = lsystem_genome(genome_of(&row)?, "plant")?;
+    let genome = lsystem_genome(genome_of(&studio.registry, &row)?, "plant")?;
     let state = GardenState {
         mother,
         settings: before.settings.with(settings)?,

@@ -269,8 +269,8 @@ pub(crate) struct ModelInfo {
 }
 
 /// `GET /api/models`.
-pub(crate) async fn models() -> Json<Vec<ModelInfo>> {
-    let registry = Registry::standard();
+pub(crate) async fn models(State(studio): State<Studio>) -> Json<Vec<ModelInfo>> {
+    let registry = &studio.registry;
     let per_mode: Vec<(ModeName, Vec<&str>)> = ModeName::ALL
         .into_iter()
         .map(|name| (name, with_mode!(name, M => M::models(registry))))
