@@ -1,0 +1,44 @@
+//! The checkpoint file: the effective config and the engine's checkpoint, from which a
+//! run resumes exactly.
+
+use std::path::Path;
+
+use serde::Serialize;
+use sylva_evolve::{Checkpoint, Problem};
+use sylva_model::Evolve;
+
+use crate::error::InputError;
+
+use super::schema::EvolveConfig;
+
+/// The checkpoint file: the effective config and the engine's checkpoint.
+#[derive(Serialize)]
+#[serde(bound = "")]
+pub(super) struct SavedRunRef<'a, M: Evolve> {
+    pub(super) config: &'a EvolveConfig<M>,
+    pub(super) checkpoint: Checkpoint<<M::Problem as Problem>::Genome>,
+}
+
+pub(super) struct SavedRun<M: Evolve> {
+    pub(super) config: EvolveConfig<M>,
+    pub(super) checkpoint: Checkpoint<<M::Problem as Problem>::Genome>,
+}
+
+impl<M: Evolve + Default> SavedRun<M> {
+    /// Reads a checkpoint. Sections of other models in its config (checkpoints of Sylva
+    /// before 0.2 wrote every model's) are passed over.
+    pub(super) fn parse(path: &Path, text: &str) -> Result<Self, InputError> {
+        let mut value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+        let bad = |e: serde_json::Error| InputError::file(path, e);
+        if let Some(config) = value.get_mut("config").and_then(|c| c.as_object_mut()) {
+            config.retain(|k, _| matches!(k.as_str(), "model" | "run" | "output") || k == M::NAME);
+        }
+        let config = value.get("config").cloned().unwrap_or_default();
+        let checkpoint = value.get("checkpoint").cloned().unwrap_or_default();
+        Ok(SavedRun {
+            config: serde_json::from_value(config).map_err(bad)?,
+            checkpoint: serde_json::from_value(checkpoint).map_err(bad)?,
+        })
+    }
+}

@@ -1,0 +1,336 @@
+//! A config of any model ([`Config`]), and what it takes to start or resume a run of it.
+
+use std::any::Any;
+use std::path::{Path, PathBuf};
+
+use sylva_core::par::Pool;
+use sylva_evolve::{Run, RunSettings};
+use sylva_model::Evolve;
+
+use crate::error::{Error, FieldError, InputError};
+use crate::genome::Genome;
+use crate::registry::Registry;
+
+use super::checkpoint::SavedRun;
+use super::run::Evolution;
+use super::schema::{EvolveConfig, OutputConfig, RunConfig};
+
+/// An evolution config of any model.
+pub struct Config {
+    pub(super) inner: Box<dyn AnyConfig>,
+    /// The file it was read from, named in errors.
+    source: Option<PathBuf>,
+    /// The registry it was read with, which reads its start genomes; `None`: the standard.
+    registry: Option<Registry>,
+}
+
+/// Evaluations made so far by every run of this process, for a progress bar to read from
+/// another thread while a generation is bred ([`sylva_evolve::problem::evaluations`]).
+pub fn evaluations_done() -> u64 {
+    sylva_evolve::problem::evaluations()
+}
+
+/// How long a generation of a run may take ([`Config::generation_time`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenerationTime {
+    /// Seconds, at the settings' bounds.
+    pub seconds: f64,
+    /// What a generation does, naming the settings it follows.
+    pub what: String,
+    /// What to change to make it shorter.
+    pub advice: String,
+}
+
+/// What every typed config can do, object-safe. Implemented once, for [`EvolveConfig`].
+pub(super) trait AnyConfig: Send + Sync {
+    fn model(&self) -> &'static str;
+    fn run(&self) -> &RunConfig;
+    fn run_mut(&mut self) -> &mut RunConfig;
+    fn output(&self) -> &OutputConfig;
+    fn to_toml(&self) -> String;
+    fn start_files(&self) -> Vec<PathBuf>;
+    fn clone_box(&self) -> Box<dyn AnyConfig>;
+    fn as_any(&self) -> &dyn Any;
+    fn start(&self, source: &str, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error>;
+    fn resume(&self, source: &str, path: &Path, text: &str, pool: Pool)
+    -> Result<Evolution, Error>;
+    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime>;
+}
+
+impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
+    fn model(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn run(&self) -> &RunConfig {
+        &self.run
+    }
+
+    fn run_mut(&mut self) -> &mut RunConfig {
+        &mut self.run
+    }
+
+    fn output(&self) -> &OutputConfig {
+        &self.output
+    }
+
+    fn to_toml(&self) -> String {
+        EvolveConfig::to_toml(self)
+    }
+
+    fn start_files(&self) -> Vec<PathBuf> {
+        self.model.start_files(&self.settings)
+    }
+
+    fn clone_box(&self) -> Box<dyn AnyConfig> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn start(&self, source: &str, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error> {
+        let mut typed = Vec::with_capacity(start.len());
+        for (i, g) in start.iter().enumerate() {
+            typed.push(g.get::<M>().cloned().ok_or_else(|| {
+                InputError::new(
+                    format!("start genome {}", i + 1),
+                    format!(
+                        "this run evolves `{}` genomes; this is a `{}` genome",
+                        M::NAME,
+                        g.model()
+                    ),
+                )
+            })?);
+        }
+        let (seed, population) = (self.run.seed, self.run.population as usize);
+        // A population and its offspring, each genome at the settings' bounds.
+        let genome = self.model.genome_bytes(&self.settings);
+        sylva_core::budget::check(
+            (population as u64).saturating_mul(genome).saturating_mul(2),
+            format_args!("a population of {population} (`population`)"),
+            "breed a smaller population, or smaller genomes",
+        )
+        .map_err(|e| InputError::new(source, e))?;
+        let setup = setup(&self.model, &self.settings, typed, seed, population, source)?;
+        // The settings are valid; generation 0 grows as the run is made.
+        if let Some(t) = self.generation_time(&start, pool.threads()) {
+            sylva_core::budget::check_time(t.seconds, t.what, t.advice)
+                .map_err(|e| InputError::new(source, e))?;
+        }
+        let settings = RunSettings {
+            seed,
+            population,
+            keep_history: 0,
+        };
+        let run = Run::with_genomes(setup.problem, setup.strategy, pool, settings, setup.first)
+            .map_err(|e| InputError::new("[run]", e))?;
+        let evolution = Evolution::typed(self.clone(), run);
+        evolution.check_finite(source)?;
+        Ok(evolution)
+    }
+
+    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
+        let first = start.first().and_then(|g| g.get::<M>());
+        let t = self.model.evaluation_time(&self.settings, first)?;
+        let population = self.run.population as usize;
+        // A generation evaluates up to `population` genomes, side by side on the threads.
+        let threads = threads.clamp(1, population.max(1));
+        let rounds = population.div_ceil(threads);
+        let on = match threads {
+            1 => "1 thread".to_owned(),
+            n => format!("{n} threads"),
+        };
+        Some(GenerationTime {
+            seconds: t.seconds * rounds as f64,
+            what: format!(
+                "a generation of {population} genomes (`population`) on {on}, each {}",
+                t.what
+            ),
+            advice: t.advice,
+        })
+    }
+
+    fn resume(
+        &self,
+        source: &str,
+        path: &Path,
+        text: &str,
+        pool: Pool,
+    ) -> Result<Evolution, Error> {
+        let saved = SavedRun::<M>::parse(path, text)?;
+        if saved.config.resumable() != self.resumable() {
+            return Err(InputError::file(
+                path,
+                "the checkpoint was written by a different config (only `generations`, \
+                 `threads` and `checkpoint_seconds` may change when resuming)",
+            )
+            .into());
+        }
+        let setup = setup(&self.model, &self.settings, Vec::new(), 0, 0, source)?;
+        let run = Run::resume(setup.problem, setup.strategy, pool, saved.checkpoint)
+            .map_err(|e| InputError::file(path, e))?;
+        let evolution = Evolution::typed(self.clone(), run);
+        evolution.check_finite(source)?;
+        Ok(evolution)
+    }
+}
+
+/// The model's problem and strategy for `settings`; a refusal names the config (`source`)
+/// and the model's section.
+fn setup<M: Evolve>(
+    model: &M,
+    settings: &M::Settings,
+    start: Vec<M::Genome>,
+    seed: u64,
+    population: usize,
+    source: &str,
+) -> Result<sylva_model::Setup<M>, InputError> {
+    model
+        .setup(settings, start, seed, population)
+        .map_err(|e| InputError::new(source, format!("[{}.{}]: {}", M::NAME, e.field, e.message)))
+}
+
+impl Clone for Config {
+    fn clone(&self) -> Self {
+        Config {
+            inner: self.inner.clone_box(),
+            source: self.source.clone(),
+            registry: self.registry.clone(),
+        }
+    }
+}
+
+impl Default for Config {
+    /// The built-in default run: the first model of the standard registry (binary trees),
+    /// every setting at its default.
+    fn default() -> Self {
+        Registry::standard()
+            .default_config()
+            .unwrap_or_else(|| Config::new(EvolveConfig::<sylva_bintree::BinTreeModel>::default()))
+    }
+}
+
+impl std::fmt::Debug for Config {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.to_toml())
+    }
+}
+
+impl Config {
+    /// A config of model `M`.
+    pub fn new<M: Evolve + Default>(config: EvolveConfig<M>) -> Config {
+        Config {
+            inner: Box::new(config),
+            source: None,
+            registry: None,
+        }
+    }
+
+    /// This config, read from `path` with `registry` (which reads its start genomes).
+    pub(crate) fn read_with(mut self, path: Option<&Path>, registry: &Registry) -> Config {
+        self.source = path.map(Path::to_owned);
+        if !std::ptr::eq(registry, Registry::standard()) {
+            self.registry = Some(registry.clone());
+        }
+        self
+    }
+
+    /// The registry the config was read with.
+    pub fn registry(&self) -> &Registry {
+        self.registry.as_ref().unwrap_or(Registry::standard())
+    }
+
+    /// A config of any model the standard registry knows, built as values (a front end's
+    /// form) with the checks of a config file ([`Registry::config_from_value`]).
+    pub fn from_value(value: serde_json::Value) -> Result<Config, FieldError> {
+        Registry::standard().config_from_value(value)
+    }
+
+    /// Parses a config of any model the standard registry knows; errors point into `text`.
+    pub fn parse(path: &Path, text: &str) -> Result<Config, InputError> {
+        Registry::standard().parse_config(path, text)
+    }
+
+    /// How errors name the config: its file, or "config" for one built in code.
+    pub(super) fn source(&self) -> String {
+        self.source
+            .as_ref()
+            .map_or_else(|| "config".to_owned(), |p| p.display().to_string())
+    }
+
+    /// Reads and parses a config file.
+    pub fn load(path: &Path) -> Result<Config, InputError> {
+        let text = crate::files::read_text(path)?;
+        Config::parse(path, &text)
+    }
+
+    /// The model evolved.
+    pub fn model(&self) -> &'static str {
+        self.inner.model()
+    }
+
+    /// Run size and seed.
+    pub fn run(&self) -> &RunConfig {
+        self.inner.run()
+    }
+
+    /// Run size and seed, to change (the command line's flags do).
+    pub fn run_mut(&mut self) -> &mut RunConfig {
+        self.inner.run_mut()
+    }
+
+    /// What a run writes.
+    pub fn output(&self) -> &OutputConfig {
+        self.inner.output()
+    }
+
+    /// The config as TOML.
+    pub fn to_toml(&self) -> String {
+        self.inner.to_toml()
+    }
+
+    /// The typed config, if this is a config of model `M`.
+    pub fn get<M: Evolve + Default>(&self) -> Option<&EvolveConfig<M>> {
+        self.inner.as_any().downcast_ref()
+    }
+
+    /// Genome files the model's settings name as the first generation's origin, relative
+    /// to the config file.
+    pub fn start_files(&self) -> Vec<PathBuf> {
+        self.inner.start_files()
+    }
+
+    /// How long a generation of this run may take on `threads` threads, for models whose
+    /// genomes can take long to grow (L-system plants); `None` for the others. `start` holds
+    /// the start genomes ([`Config::load_start`]). [`Evolution::start`] refuses a run whose
+    /// generation is over the time budget.
+    pub fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
+        self.inner.generation_time(start, threads)
+    }
+
+    /// Reads the genome files of [`Config::start_files`] from `base` (the config file's
+    /// folder), with the registry the config was read with.
+    pub fn load_start(&self, base: &Path) -> Result<Vec<Genome>, InputError> {
+        let model = self.model();
+        self.start_files()
+            .iter()
+            .map(|file| {
+                let path = base.join(file);
+                let genome = self.registry().load_genome(&path)?;
+                if genome.model() == model {
+                    Ok(genome)
+                } else {
+                    Err(InputError::file(
+                        &path,
+                        format!(
+                            "`start` genomes must be `{model}` genomes, not `{}`",
+                            genome.model()
+                        ),
+                    ))
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,288 @@
+//! What an evolution config file holds: the model's name, `[run]`, the model's own
+//! section and `[output]`, every number checked as it is read.
+
+use std::marker::PhantomData;
+use std::path::Path;
+
+use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
+use serde::ser::SerializeStruct;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use sylva_core::taper::PipeTaper;
+use sylva_mesh::render::View;
+use sylva_mesh::wind::WindOptions;
+use sylva_model::Evolve;
+
+use crate::error::InputError;
+
+/// Run size and seed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// Generations bred after the first, 0 to 1,000,000. Default 150.
+    #[serde(deserialize_with = "generations")]
+    pub generations: u32,
+    /// Individuals per generation, 1 to 1,000,000. Default 400.
+    #[serde(deserialize_with = "population")]
+    pub population: u32,
+    /// Seed of every random choice. Default 1.
+    pub seed: u64,
+    /// Worker threads, 0 (one per core) to 1024. Default 0. Results do not depend on it.
+    #[serde(deserialize_with = "threads")]
+    pub threads: u32,
+    /// Seconds between checkpoints, 0 (every generation) to 3600. Default 2. A run also
+    /// checkpoints when it ends.
+    #[serde(deserialize_with = "checkpoint_seconds")]
+    pub checkpoint_seconds: f64,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig {
+            generations: 150,
+            population: 400,
+            seed: 1,
+            threads: 0,
+            checkpoint_seconds: 2.0,
+        }
+    }
+}
+
+sylva_core::ranged!(generations: u32, "generations", 0, 1_000_000);
+sylva_core::ranged!(population: u32, "population", 1, 1_000_000);
+sylva_core::ranged!(threads: u32, "threads", 0, 1024);
+sylva_core::ranged!(checkpoint_seconds: f64, "checkpoint_seconds", 0.0, 3600.0, " s");
+
+/// What a run writes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputConfig {
+    /// Width and height of `best.png`, 64 to 4096 pixels. Default 800.
+    #[serde(deserialize_with = "image_size")]
+    pub image_size: u32,
+    /// View of `best.png`. Default iso.
+    #[serde(with = "view_name")]
+    pub view: View,
+    /// Individuals shown on the contact sheet (the best ones), 1 to 400. Default 48.
+    #[serde(deserialize_with = "sheet_size")]
+    pub sheet_size: u32,
+    /// The pipe-model exponent `E`, 2 to 3, for the best plant and the sheet: radius ∝
+    /// (tips above)^(1/E), as `sylva grow --taper E`. Default none: each model's own radii
+    /// (evolution scores the plants as grown, without it).
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "taper")]
+    pub taper: Option<f64>,
+    /// A wind skin and clip in `best.glb`, as `sylva grow --wind`: `wind = {}` for the
+    /// defaults, or `wind = { strength = 2.0, period = 3.0 }`. Default none.
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "wind")]
+    pub wind: Option<WindConfig>,
+}
+
+/// `[output] wind`: the wind of `best.glb`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WindConfig {
+    /// Sway, 0 to 10. Default 1.
+    pub strength: f32,
+    /// Seconds of the clip, 0.5 to 60. Default 4.
+    pub period: f32,
+}
+
+impl Default for WindConfig {
+    fn default() -> Self {
+        let d = WindOptions::default();
+        WindConfig {
+            strength: d.strength,
+            period: d.period,
+        }
+    }
+}
+
+/// Reads `wind`, its numbers checked.
+fn wind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<WindConfig>, D::Error> {
+    let wind = WindConfig::deserialize(d)?;
+    WindOptions::new(wind.strength, wind.period).map_err(serde::de::Error::custom)?;
+    Ok(Some(wind))
+}
+
+impl OutputConfig {
+    /// The taper the outputs are grown with, if any.
+    pub fn pipe_taper(&self) -> Option<PipeTaper> {
+        self.taper.and_then(|e| PipeTaper::new(e).ok())
+    }
+
+    /// The wind of `best.glb`, if any.
+    pub fn wind_options(&self) -> Option<WindOptions> {
+        self.wind
+            .and_then(|w| WindOptions::new(w.strength, w.period).ok())
+    }
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        OutputConfig {
+            image_size: 800,
+            view: View::Iso,
+            sheet_size: 48,
+            taper: None,
+            wind: None,
+        }
+    }
+}
+
+/// Reads `taper`, checked to lie in 2..=3.
+fn taper<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let exponent = f64::deserialize(d)?;
+    match PipeTaper::new(exponent) {
+        Ok(_) => Ok(Some(exponent)),
+        Err(_) => Err(serde::de::Error::custom(format!(
+            "`taper` must be a number from 2 to 3 (the pipe-model exponent), got {exponent}"
+        ))),
+    }
+}
+
+sylva_core::ranged!(image_size: u32, "image_size", 64, 4096);
+sylva_core::ranged!(sheet_size: u32, "sheet_size", 1, 400);
+
+mod view_name {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+    use sylva_mesh::render::View;
+
+    pub fn serialize<S: Serializer>(v: &View, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(v)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<View, D::Error> {
+        String::deserialize(d)?.parse().map_err(D::Error::custom)
+    }
+}
+
+/// An evolution config of model `M`: `model`, `[run]`, the model's settings under its
+/// name, and `[output]`.
+#[derive(Clone, Debug, Default)]
+pub struct EvolveConfig<M: Evolve> {
+    /// The model.
+    pub model: M,
+    /// Run size and seed.
+    pub run: RunConfig,
+    /// The model's settings.
+    pub settings: M::Settings,
+    /// What a run writes.
+    pub output: OutputConfig,
+}
+
+impl<M: Evolve> PartialEq for EvolveConfig<M> {
+    fn eq(&self, other: &Self) -> bool {
+        self.run == other.run && self.settings == other.settings && self.output == other.output
+    }
+}
+
+impl<M: Evolve> Serialize for EvolveConfig<M> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut st = s.serialize_struct("EvolveConfig", 4)?;
+        st.serialize_field("model", M::NAME)?;
+        st.serialize_field("run", &self.run)?;
+        st.serialize_field(M::NAME, &self.settings)?;
+        st.serialize_field("output", &self.output)?;
+        st.end()
+    }
+}
+
+impl<'de, M: Evolve + Default> Deserialize<'de> for EvolveConfig<M> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_map(ConfigVisitor(PhantomData))
+    }
+}
+
+struct ConfigVisitor<M>(PhantomData<M>);
+
+/// The keys of a config, in the order they are named in errors.
+enum Key {
+    Model,
+    Run,
+    Settings,
+    Output,
+}
+
+impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
+    type Value = EvolveConfig<M>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "an evolution config of `{}`", M::NAME)
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<EvolveConfig<M>, A::Error> {
+        let mut config = EvolveConfig::<M>::default();
+        while let Some(key) = map.next_key_seed(KeySeed(M::NAME))? {
+            match key {
+                Key::Model => map.next_value_seed(NameSeed(M::NAME))?,
+                Key::Run => config.run = map.next_value()?,
+                Key::Settings => config.settings = map.next_value()?,
+                Key::Output => config.output = map.next_value()?,
+            }
+        }
+        Ok(config)
+    }
+}
+
+/// Reads a key of a config of the model named `.0`; unknown keys are refused here, so the
+/// error points at the key.
+struct KeySeed(&'static str);
+
+impl<'de> DeserializeSeed<'de> for KeySeed {
+    type Value = Key;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Key, D::Error> {
+        let key = String::deserialize(d)?;
+        match key.as_str() {
+            "model" => Ok(Key::Model),
+            "run" => Ok(Key::Run),
+            "output" => Ok(Key::Output),
+            k if k == self.0 => Ok(Key::Settings),
+            k => Err(de::Error::custom(format!(
+                "unknown field `{k}`: this config evolves `{}` (set `model` to evolve another \
+                 model); expected `model`, `run`, `{}` or `output`",
+                self.0, self.0
+            ))),
+        }
+    }
+}
+
+/// Reads the `model` field, which must name the model `.0`.
+struct NameSeed(&'static str);
+
+impl<'de> DeserializeSeed<'de> for NameSeed {
+    type Value = ();
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        let name = String::deserialize(d)?;
+        if name == self.0 {
+            Ok(())
+        } else {
+            Err(de::Error::custom(format!(
+                "`model` is `{name}`, but this is a config of `{}`",
+                self.0
+            )))
+        }
+    }
+}
+
+impl<M: Evolve + Default> EvolveConfig<M> {
+    /// Parses a config of model `M` from TOML; errors point into `text`.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, InputError> {
+        toml::from_str(text).map_err(|e| InputError::toml(path, text, &e))
+    }
+
+    /// The config as TOML (what a run records next to its results).
+    pub fn to_toml(&self) -> String {
+        // Configs hold only range-checked numbers, strings and tables (each after the plain
+        // values of its parent), which TOML always writes; failing here is a bug.
+        toml::to_string(self).expect("configs serialise as TOML")
+    }
+
+    /// The parts that must match for a run to resume: everything but the length of the
+    /// run, the thread count and the checkpoint interval.
+    pub(super) fn resumable(&self) -> Self {
+        let mut c = self.clone();
+        c.run.generations = 0;
+        c.run.threads = 0;
+        c.run.checkpoint_seconds = 0.0;
+        c
+    }
+}
