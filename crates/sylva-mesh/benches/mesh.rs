@@ -11,11 +11,8 @@ use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::{Mesh, Scene, SceneNode, export};
 use sylva_mesh::{lod, wind};
 
-#[path = "../tests/common/mod.rs"]
-mod common;
-
 fn mesh_tree(c: &mut Criterion) {
-    let plant = common::bench_tree();
+    let plant = sylva_testkit::bench_tree();
     let mut mesher = Mesher::new(MeshOptions::default()).expect("default options are legal");
     let mut mesh = Mesh::default();
     let stats = mesher

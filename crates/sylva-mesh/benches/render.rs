@@ -13,11 +13,8 @@ use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::render::{RenderOptions, Renderer};
 use sylva_mesh::{Scene, SceneNode};
 
-#[path = "../tests/common/mod.rs"]
-mod common;
-
 fn render(c: &mut Criterion) {
-    let plant = common::binary_tree(9, 8);
+    let plant = sylva_testkit::binary_tree(9, 8);
     let mesh = mesh_plant(&plant, &MeshOptions::default()).unwrap();
     eprintln!("render tree: {} triangles", mesh.triangle_count());
     let scene = Scene::single(SceneNode::new("tree", &mesh));

@@ -4,8 +4,6 @@
 //! trunks, and leaves and flowers).
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
-mod common;
-
 use std::f32::consts::{FRAC_PI_2, TAU};
 use std::path::PathBuf;
 
@@ -106,7 +104,7 @@ fn write_textured_pictures() {
     // Trees: bark, leaf and petal textures of one row each.
     let trees: Vec<(String, Mesh)> = (0..3)
         .map(|k| {
-            let mut plant = common::binary_tree(4, 6);
+            let mut plant = sylva_testkit::binary_tree(4, 6);
             for (m, id) in [k, 3 + k, 6 + k].into_iter().enumerate() {
                 plant.set_texture(MaterialId(m as u16), Some(id)).unwrap();
             }
@@ -209,7 +207,7 @@ fn write_textured_pictures() {
     sheet(&cells, View::Top, "Leaves and flowers", "organs");
 
     // An untextured tree, to compare with the pictures before textures existed.
-    let plain = mesh_plant(&common::binary_tree(4, 6), &MeshOptions::default()).unwrap();
+    let plain = mesh_plant(&sylva_testkit::binary_tree(4, 6), &MeshOptions::default()).unwrap();
     let plain = Scene::single(SceneNode::new("tree", &plain));
     write_png(
         &out("untextured-tree"),

@@ -18,8 +18,6 @@ fn windy(seed: u64, roots: bool, wind: Option<WindOptions>) -> GrowOptions {
     }
 }
 
-mod common;
-
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -96,7 +94,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
     let file = dir.join("garden.glb");
     std::fs::write(&file, &glb).unwrap();
     files.push(file);
-    common::validate(&files);
+    sylva_testkit::validate(&files);
     // three.js's GLTFLoader and AnimationMixer, under Node: the joints move and the loop closes.
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let out = std::process::Command::new("node")
