@@ -44,9 +44,9 @@ use sylva_core::taper::PipeTaper;
 use sylva_evolve::{
     Checkpoint, Fitness, GenerationStats, IndividualId, Origin, Problem, Run, RunSettings,
 };
-use sylva_mesh::render::View;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
+use sylva_render::View;
 
 use crate::error::{Error, FieldError, InputError};
 use crate::genome::Genome;
@@ -182,7 +182,7 @@ sylva_core::ranged!(sheet_size: u32, "sheet_size", 1, 400);
 
 mod view_name {
     use serde::{Deserialize, Deserializer, Serializer, de::Error};
-    use sylva_mesh::render::View;
+    use sylva_render::View;
 
     pub fn serialize<S: Serializer>(v: &View, s: S) -> Result<S::Ok, S::Error> {
         s.collect_str(v)

@@ -398,7 +398,7 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     let glb = dir.join("cylinder.glb");
     export(&grown.scene(), &glb).unwrap();
     sylva_testkit::validate(std::slice::from_ref(&glb));
-    let imported = sylva_mesh::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
+    let imported = sylva_gltf::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
     assert_eq!(imported.scene().nodes.len(), 1);
     let bytes = std::fs::read(&glb).unwrap();
     assert!(String::from_utf8_lossy(&bytes).contains(r#""model":"cylinder""#));

@@ -12,7 +12,7 @@ use std::process::Command;
 use serde_json::json;
 use sylva_core::glam::{Quat, Vec2, Vec3};
 use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
-use sylva_mesh::export::write_scene;
+use sylva_gltf::export::write_scene;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 

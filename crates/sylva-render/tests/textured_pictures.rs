@@ -1,5 +1,5 @@
 //! Pictures of the generated textures and of textured plants, to look at:
-//! `cargo test -p sylva-mesh --test textured_pictures -- --ignored`, then open
+//! `cargo test -p sylva-render --test textured_pictures -- --ignored`, then open
 //! `$TMPDIR/textured-*.png` (the flat textures tiled 2 × 2, the textures on quads, trees,
 //! trunks, and leaves and flowers).
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
@@ -11,11 +11,11 @@ use image::{GrayImage, imageops};
 use sylva_core::glam::{Quat, Vec2, Vec3};
 use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-use sylva_mesh::render::{
-    self, RenderOptions, SheetCell, SheetOptions, View, contact_sheet, write_png,
-};
 use sylva_mesh::texture::{TEXTURE_COUNT, TEXTURE_SIZE, TextureFamily, texture, texture_info};
 use sylva_mesh::{Mesh, Primitive, Scene, SceneNode};
+use sylva_render::{
+    RenderOptions, SheetCell, SheetOptions, View, contact_sheet, render, write_png,
+};
 
 fn out(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("textured-{name}.png"))
@@ -122,7 +122,7 @@ fn write_textured_pictures() {
     sheet(&cells, View::Iso, "Textured trees", "trees");
     let one = Scene::single(SceneNode::new("tree", &trees[0].1));
     let options = RenderOptions::default();
-    write_png(&out("tree"), &render::render(&one, &options).unwrap()).unwrap();
+    write_png(&out("tree"), &render(&one, &options).unwrap()).unwrap();
 
     // Trunks close up: one tapering, slightly bent axis per bark.
     let trunks: Vec<Mesh> = (0..3u16)
@@ -209,9 +209,5 @@ fn write_textured_pictures() {
     // An untextured tree, to compare with the pictures before textures existed.
     let plain = mesh_plant(&sylva_testkit::binary_tree(4, 6), &MeshOptions::default()).unwrap();
     let plain = Scene::single(SceneNode::new("tree", &plain));
-    write_png(
-        &out("untextured-tree"),
-        &render::render(&plain, &options).unwrap(),
-    )
-    .unwrap();
+    write_png(&out("untextured-tree"), &render(&plain, &options).unwrap()).unwrap();
 }
