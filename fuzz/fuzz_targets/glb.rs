@@ -1,4 +1,4 @@
-//! The GLB (binary glTF 2.0) reader: `sylva_mesh::import::read_glb`.
+//! The GLB (binary glTF 2.0) reader: `sylva_gltf::import::read_glb`.
 //!
 //! A custom mutator keeps the GLB framing: half the time it mutates only the JSON chunk and
 //! writes the chunk and file lengths back, so that changes to the JSON (a huge
@@ -9,7 +9,7 @@ include!("common.rs");
 
 fuzz_target!(|data: &[u8]| {
     set_budget();
-    let _ = sylva_mesh::import::read_glb(data);
+    let _ = sylva_gltf::import::read_glb(data);
 });
 
 fn u32_at(b: &[u8], at: usize) -> Option<u32> {

@@ -117,8 +117,8 @@ fn chords_keep_the_tips_with_few_segments() {
 #[ignore = "writes pictures to /tmp"]
 fn render_the_helix() {
     use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-    use sylva_mesh::render::{RenderOptions, View, render, write_png};
     use sylva_mesh::{Scene, SceneNode};
+    use sylva_render::{RenderOptions, View, render, write_png};
 
     let (_, plant) = helix();
     let mesh = mesh_plant(&plant, &MeshOptions::default()).unwrap();

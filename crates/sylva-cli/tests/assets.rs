@@ -2,8 +2,6 @@
 //! Assets as engines take them: lean materials (one per organ kind, shades in `COLOR_0`),
 //! checked with the Khronos validator and three.js's GLTFLoader.
 
-#[path = "../../sylva/tests/common/mod.rs"]
-mod common;
 mod support;
 use support::{example, s, sylva, temp_dir, three_scene};
 
@@ -19,7 +17,7 @@ fn shades_become_vertex_colours_of_one_material_per_kind() {
         let run = sylva(&["grow", &example(genome), "-o", s(out)]);
         assert!(run.status.success(), "{run:?}");
     }
-    common::validate(&[bush.clone(), helix.clone()]);
+    sylva_testkit::validate(&[bush.clone(), helix.clone()]);
     let seen = three_scene(&[bush, helix]);
     // The bush's 29 shades: bark, leaf and flower, each with vertex colours on.
     let names: Vec<&str> = seen[0]["materials"]
@@ -60,7 +58,7 @@ fn levels_of_detail_halve_and_load_as_named_siblings() {
         .collect();
     let mut all = levels.clone();
     all.push(tree.clone());
-    common::validate(&all);
+    sylva_testkit::validate(&all);
     let seen = three_scene(&all);
     let group = &seen[4];
     let names: Vec<&str> = group["nodes"]
@@ -124,7 +122,7 @@ fn levels_of_detail_halve_and_load_as_named_siblings() {
         "--wind",
     ]);
     assert!(run.status.success(), "{run:?}");
-    common::validate(&[windy.clone(), dir.join("windy_LOD2.glb")]);
+    sylva_testkit::validate(&[windy.clone(), dir.join("windy_LOD2.glb")]);
 
     // Refused before any work: a format without levels, and counts out of range.
     for (output, lod) in [("tree.obj", "3"), ("tree.glb", "1"), ("tree.glb", "9")] {
@@ -188,7 +186,7 @@ fn grow_quantizes_single_plants_and_their_levels() {
         dir.join("small_LOD0.glb"),
         dir.join("small_LOD1.glb"),
     ];
-    common::validate(&files);
+    sylva_testkit::validate(&files);
     assert!(std::fs::metadata(&files[2]).unwrap().len() < std::fs::metadata(&plain).unwrap().len());
     let seen = three_scene(&files[..3]);
     // Quantised or not, three.js puts the plant in the same place, to a millimetre.

@@ -9,9 +9,7 @@ use std::process::{Command, Output};
 
 use sylva::core::hash::stable_hash;
 
-#[path = "../../sylva/tests/common/mod.rs"]
-mod common;
-use common::validate;
+use sylva_testkit::validate;
 
 fn sylva(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sylva"))

@@ -7,8 +7,6 @@
 
 use std::path::{Path, PathBuf};
 
-#[path = "../../sylva/tests/common/mod.rs"]
-mod common;
 mod support;
 use support::{example, s, sylva, temp_dir, three_scene};
 
@@ -94,7 +92,7 @@ fn variants_are_instanced_one_node_per_variant() {
         }
     }
     let glb = dir.join("forest.glb");
-    common::validate(std::slice::from_ref(&glb));
+    sylva_testkit::validate(std::slice::from_ref(&glb));
     // three.js draws an InstancedMesh per primitive, 60 plants in all.
     let seen = &three_scene(std::slice::from_ref(&glb))[0];
     assert_eq!(seen["nodes"].as_array().unwrap().len(), 6);
@@ -129,7 +127,7 @@ fn variants_are_instanced_one_node_per_variant() {
     let seen = &three_scene(&[dir.join("plain.glb")])[0];
     assert_eq!(seen["instanced"], 0);
     assert_eq!(seen["triangles"], three_scene(&[glb])[0]["triangles"]);
-    common::validate(&[dir.join("plain.glb")]);
+    sylva_testkit::validate(&[dir.join("plain.glb")]);
     regrows_the_same(&dir, "plain", &plain);
     // The flag adds to what a garden file says.
     let again = dir.join("forest-plain.glb");
@@ -142,7 +140,7 @@ fn variants_are_instanced_one_node_per_variant() {
 
 /// Every vertex of a GLB as Sylva's reader places it in the world.
 fn world_vertices(glb: &[u8]) -> Vec<[f32; 3]> {
-    let scene = sylva::mesh::import::read_glb(glb).unwrap();
+    let scene = sylva::gltf::import::read_glb(glb).unwrap();
     scene
         .meshes
         .iter()
@@ -192,7 +190,7 @@ fn quantised_forests_keep_every_position_within_half_a_step() {
             "{name}: {worst} m off, tallest {tallest} m"
         );
     }
-    common::validate(&files);
+    sylva_testkit::validate(&files);
     // three.js draws as many triangles as from the float files, in the same place: each
     // file's world box is the float file's (three.js bounds an InstancedMesh by its
     // geometry's box, so instanced files are compared with instanced ones).
@@ -246,7 +244,7 @@ fn wind_forests_stay_plain_and_refuse_quantisation() {
     let json = gltf(&bytes);
     assert!(json.get("extensionsUsed").is_none());
     assert_eq!(json["skins"].as_array().unwrap().len(), 60);
-    common::validate(&[dir.join("wind.glb")]);
+    sylva_testkit::validate(&[dir.join("wind.glb")]);
     let glb = dir.join("w.glb");
     let tulip = example("plantmaker/tulip.json");
     let refused = |args: &[&str], flag: &str| {

@@ -11,9 +11,6 @@ use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
 
-#[path = "../../sylva/tests/common/mod.rs"]
-mod common;
-
 /// A studio server run by a test; killed (SIGKILL) when dropped.
 struct Server {
     child: Child,
@@ -316,7 +313,7 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
     assert_eq!(status, 200);
     let file = dir.join("child.glb");
     std::fs::write(&file, &glb).unwrap();
-    common::validate(std::slice::from_ref(&file));
+    sylva_testkit::validate(std::slice::from_ref(&file));
     let json_chunk = String::from_utf8_lossy(
         &glb[20..20 + u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize],
     )
@@ -1372,7 +1369,7 @@ fn gardens_and_families_step_and_undo() {
     assert_eq!(status, 200);
     let file = dir.join("garden.glb");
     std::fs::write(&file, glb).unwrap();
-    common::validate(std::slice::from_ref(&file));
+    sylva_testkit::validate(std::slice::from_ref(&file));
     let undone = post(&server, &format!("/api/sessions/{id}/undo"), json!({}));
     assert_eq!(undone["state"], next["state"]);
 

@@ -5,8 +5,6 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-#[path = "../../sylva/tests/common/mod.rs"]
-mod common;
 mod support;
 use support::{example, sylva, temp_dir as temp};
 
@@ -86,7 +84,7 @@ fn grow_garden_and_evolve_write_wind_that_plays() {
     let effective = std::fs::read_to_string(run.join("config.toml")).unwrap();
     assert!(effective.contains("[output.wind]") && effective.contains("strength = 1.5"));
     let files = [tree, garden, run.join("best.glb")];
-    common::validate(&files);
+    sylva_testkit::validate(&files);
     three_plays(&files);
     std::fs::remove_dir_all(&dir).unwrap();
 }

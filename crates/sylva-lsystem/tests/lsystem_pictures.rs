@@ -12,8 +12,8 @@ use sylva_lsystem::LSystemGenome;
 use sylva_lsystem::experiments::{Simulation, SimulationOutcome};
 use sylva_lsystem::garden::GrowSettings;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-use sylva_mesh::render::{RenderOptions, View, render, write_png};
 use sylva_mesh::{Scene, SceneNode};
+use sylva_render::{RenderOptions, View, render, write_png};
 
 fn examples() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/lsystem")

@@ -1,24 +1,25 @@
-//! From a [`Plant`](sylva_core::Plant) to triangles, files and pictures.
+//! From a [`Plant`](sylva_core::Plant) to triangles: the mesher and what every writer and the
+//! renderer read.
 //!
 //! - [`mesh`]: the [`Mesh`] type (shared vertices, one primitive per material).
 //! - [`mesher`]: [`Mesher`](mesher::Mesher) turns a plant into a mesh (generalised cylinders
 //!   along each axis, parallel-transport frames, shared rings, caps, leaves and flowers, all
 //!   with texture coordinates).
 //! - [`scene`]: [`Scene`], meshes placed in the world with their origin data.
-//! - [`export`]: GLB (glTF 2.0 binary), OBJ with MTL, VRML97.
-//! - [`import`]: GLB files read back, for pictures of any GLB.
-//! - [`lod`]: levels of detail, a chain of simplified plants at about half the triangles each.
-//! - [`render`]: a software z-buffer renderer writing PNG, and contact sheets.
 //! - [`texture`]: bark, leaf and petal textures generated from a material's texture id.
+//! - [`wind`]: a skin and a looping sway clip for a meshed plant, carried by a
+//!   [`SceneNode`] to the GLB writer.
+//!
+//! How it fits: this crate is the bottom of the geometry layers, on `sylva-core` alone. Files
+//! (GLB, OBJ, VRML97, STL, the GLB reader and levels of detail) are `sylva-gltf`; pictures
+//! (the software renderer and contact sheets) are `sylva-render`. Both read the meshes,
+//! scenes and textures made here, and neither depends on the other; the `sylva` library
+//! re-exports all three (`sylva::mesh`, `sylva::gltf`, `sylva::render`).
 //!
 //! A mesh never knows which model made the plant.
 
-pub mod export;
-pub mod import;
-pub mod lod;
 pub mod mesh;
 pub mod mesher;
-pub mod render;
 pub mod scene;
 pub mod texture;
 pub mod wind;

@@ -2,14 +2,12 @@
 //! triangles, the same every time.
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
-mod common;
-
 use sylva_core::glam::Vec3;
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 
 #[test]
 fn bench_tree_is_big_valid_and_deterministic() {
-    let plant = common::bench_tree();
+    let plant = sylva_testkit::bench_tree();
     let mut mesher = Mesher::new(MeshOptions::default()).expect("default options");
     let mesh = mesher.mesh(&plant).expect("the tree meshes");
     assert!(

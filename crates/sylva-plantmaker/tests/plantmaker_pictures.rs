@@ -11,12 +11,12 @@ use std::path::{Path, PathBuf};
 
 use sylva_core::Plant;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-use sylva_mesh::render::{
-    RenderOptions, SheetCell, SheetOptions, View, contact_sheet, render, write_png,
-};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_plantmaker::variation::breed;
 use sylva_plantmaker::{Garden, Level, Mutation, Operator, Parent, PlantMaker};
+use sylva_render::{
+    RenderOptions, SheetCell, SheetOptions, View, contact_sheet, render, write_png,
+};
 
 fn examples() -> Vec<(String, PlantMaker)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/plantmaker");

@@ -12,7 +12,7 @@ use pyo3::types::{PyBytes, PyDict, PyList};
 use sylva::assets::{Origin, Placed, SceneAssets};
 use sylva::core::measures::TreeMeasures;
 use sylva::files::Outputs;
-use sylva::mesh::render::View;
+use sylva::render::View;
 
 use crate::errors::{IntoPy, bad_value};
 use crate::genome::Genome;
@@ -376,8 +376,8 @@ fn write_scene(scene: &sylva::mesh::Scene<'_>, path: &Path) -> Result<(), sylva:
 }
 
 fn glb_bytes(scene: &sylva::mesh::Scene<'_>) -> Result<Vec<u8>, sylva::Error> {
-    sylva::mesh::export::check_scene(scene)?;
-    Ok(sylva::mesh::export::to_glb(scene)?)
+    sylva::gltf::export::check_scene(scene)?;
+    Ok(sylva::gltf::export::to_glb(scene)?)
 }
 
 fn render<'py>(

@@ -17,7 +17,7 @@ use serde_json::json;
 use sylva::assets::Origin;
 use sylva::core::Plant;
 use sylva::mesh::SceneNode;
-use sylva::mesh::render::View;
+use sylva::render::View;
 use sylva::{Genome, GrowOptions, Grown, Preview, Registry};
 
 use crate::Studio;
@@ -119,7 +119,7 @@ pub fn grow_glb(
     let mut node = SceneNode::new(genome.model(), &grown.mesh);
     node.extras = Some(extras(genome, seed, parents, operator));
     let scene = sylva::mesh::Scene::single(node);
-    sylva::mesh::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
+    sylva::gltf::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
 }
 
 /// A preview GLB of `size` of `plant` (grown from `genome` with `seed`, roots left out), for
@@ -133,7 +133,7 @@ pub fn preview_glb(
 ) -> Result<Vec<u8>, ApiError> {
     let preview = Preview::of(genome, seed, plant, size.triangles())
         .map_err(|e| ApiError::library("genome", e))?;
-    sylva::mesh::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
+    sylva::gltf::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
 }
 
 /// Grows a genome as the views show it: roots left out.
@@ -251,8 +251,8 @@ pub(crate) async fn preview(
     Ok(glb_response(&glb))
 }
 
-fn imported(glb: &[u8]) -> Result<sylva::mesh::import::ImportedScene, ApiError> {
-    sylva::mesh::import::read_glb(glb)
+fn imported(glb: &[u8]) -> Result<sylva::gltf::import::ImportedScene, ApiError> {
+    sylva::gltf::import::read_glb(glb)
         .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))
 }
 
@@ -277,7 +277,7 @@ pub(crate) async fn mtl(
 fn obj_files(studio: &Studio, id: i64) -> Result<(String, String), ApiError> {
     let glb = plant_glb(studio, id, false)?;
     let scene = imported(&glb)?;
-    Ok(sylva::mesh::export::to_obj(&scene.scene(), "plant.mtl"))
+    Ok(sylva::gltf::export::to_obj(&scene.scene(), "plant.mtl"))
 }
 
 /// `GET /api/plants/{id}/plant.zip`: the OBJ export in one download: `plant-ID.obj`, the
@@ -291,7 +291,7 @@ pub(crate) async fn obj_zip(
         let glb = plant_glb(&studio, id, false)?;
         let scene = imported(&glb)?;
         let obj = format!("plant-{id}.obj");
-        let files = sylva::mesh::export::scene_files(std::path::Path::new(&obj), &scene.scene())
+        let files = sylva::gltf::export::scene_files(std::path::Path::new(&obj), &scene.scene())
             .map_err(|e| ApiError::internal(format!("exporting OBJ: {e}")))?;
         zip_files(&files).map_err(|e| ApiError::internal(format!("writing the zip: {e}")))
     })
@@ -327,7 +327,7 @@ pub(crate) async fn stl(
 ) -> Result<Response, ApiError> {
     let stl = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
         let glb = plant_glb(&studio, id, false)?;
-        Ok(sylva::mesh::export::to_stl(&imported(&glb)?.scene()))
+        Ok(sylva::gltf::export::to_stl(&imported(&glb)?.scene()))
     })
     .await??;
     Ok(download(stl, "model/stl", &format!("plant-{id}.stl")))
@@ -417,7 +417,7 @@ pub(crate) async fn texture(
         .ok_or_else(not_found)?;
     let named = tokio::task::spawn_blocking(move || -> Result<bool, ApiError> {
         let glb = plant_glb(&studio, id, false)?;
-        let ids = sylva::mesh::import::texture_ids(&glb)
+        let ids = sylva::gltf::import::texture_ids(&glb)
             .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))?;
         Ok(ids.contains(&texture))
     })

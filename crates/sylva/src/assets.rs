@@ -15,12 +15,12 @@ use sylva_core::glam::{Quat, Vec3};
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
 use sylva_evolve::IndividualId;
-use sylva_mesh::export::{self, Format, GlbOptions};
+use sylva_gltf::export::{self, Format, GlbOptions};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
-use sylva_mesh::render::{self, RenderOptions, View};
 use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 use sylva_model::MeshHint;
+use sylva_render::{RenderOptions, View};
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
@@ -438,8 +438,8 @@ pub fn picture(scene: &Scene<'_>, view: View, size: (u32, u32)) -> Result<Vec<u8
         view,
         ..RenderOptions::default()
     };
-    let image = render::render(scene, &options)?;
-    Ok(render::encode_png(&image)?)
+    let image = sylva_render::render(scene, &options)?;
+    Ok(sylva_render::encode_png(&image)?)
 }
 
 /// Renders a scene and writes it as a PNG file.

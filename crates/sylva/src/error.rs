@@ -216,10 +216,10 @@ pub enum Error {
     Mesh(#[from] sylva_mesh::mesher::MeshError),
     /// A scene could not be written.
     #[error(transparent)]
-    Export(#[from] sylva_mesh::export::ExportError),
+    Export(#[from] sylva_gltf::export::ExportError),
     /// A picture could not be drawn or written.
     #[error("drawing a picture")]
-    Render(#[from] sylva_mesh::render::RenderError),
+    Render(#[from] sylva_render::RenderError),
     /// Work that would not fit in the memory budget (`--max-memory`).
     #[error("not enough memory")]
     Budget(#[from] sylva_core::budget::OverBudget),
@@ -242,7 +242,7 @@ impl Error {
     /// allows (a plant, mesh or file too large, growth too long): the user's to change, like
     /// bad input.
     pub fn is_limit(&self) -> bool {
-        use sylva_mesh::export::ExportError;
+        use sylva_gltf::export::ExportError;
         use sylva_mesh::mesher::MeshError;
         // `Export` is transparent: its source is the export error's source, not itself.
         if matches!(self, Error::Export(ExportError::TooLarge { .. })) {

@@ -6,7 +6,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use sylva_mesh::export::{Format, Glb, GlbOptions};
+use sylva_gltf::export::{Format, Glb, GlbOptions};
 
 use crate::error::{Error, InputError};
 
@@ -177,7 +177,7 @@ impl Outputs {
         if Format::from_path(path)? == Format::Glb {
             return self.add_glb(path, &mut Glb::of_scene(scene, *options)?);
         }
-        for (file, bytes) in sylva_mesh::export::scene_files(path, scene)? {
+        for (file, bytes) in sylva_gltf::export::scene_files(path, scene)? {
             self.add(&file, &bytes)?;
         }
         Ok(())

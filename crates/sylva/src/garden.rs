@@ -9,8 +9,8 @@ use std::path::Path;
 use serde_json::json;
 use sylva_core::Plant;
 use sylva_core::glam::Vec3;
+use sylva_gltf::export::{self, Glb, GlbNode, GlbOptions, MeshSource};
 use sylva_mesh::Mesh;
-use sylva_mesh::export::{self, Glb, GlbNode, GlbOptions, MeshSource};
 use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::Model;
@@ -211,13 +211,13 @@ struct GardenMeshes<'a> {
 }
 
 impl MeshSource for GardenMeshes<'_> {
-    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_mesh::export::ExportError> {
+    fn mesh(&mut self, index: usize) -> Result<&Mesh, sylva_gltf::export::ExportError> {
         let placement = self
             .plants
             .get(index)
-            .ok_or(sylva_mesh::export::ExportError::NoSuchMesh { index })?;
+            .ok_or(sylva_gltf::export::ExportError::NoSuchMesh { index })?;
         let plant = self.garden.develop(placement).map_err(|e| {
-            sylva_mesh::export::ExportError::Source {
+            sylva_gltf::export::ExportError::Source {
                 index,
                 source: Box::new(e),
             }

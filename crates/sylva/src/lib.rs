@@ -66,8 +66,10 @@ pub use sylva_evolve::{GenerationStats, IndividualId};
 pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 
-// The layers below, for front ends that need their types (plants, meshes, scenes, the
-// thread pool, budgets): a front end depends on `sylva` alone.
+// The layers below, for front ends that need their types (plants, meshes, scenes, files,
+// pictures, the thread pool, budgets): a front end depends on `sylva` alone.
 pub use sylva_core as core;
+pub use sylva_gltf as gltf;
 pub use sylva_mesh as mesh;
 pub use sylva_model as model;
+pub use sylva_render as render;

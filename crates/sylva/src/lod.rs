@@ -1,11 +1,11 @@
-//! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_mesh::lod`]),
+//! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_gltf::lod`]),
 //! each alone in its own scene, or all of them as sibling nodes named `NAME_LOD0`,
 //! `NAME_LOD1`, … (the Unity naming convention) with each level's screen coverage in its
 //! node's extras. And a [`Preview`]: the one level a view of a given size needs, meshed
 //! without meshing the plant in full.
 
 use serde_json::json;
-use sylva_mesh::lod::{LodError, LodLevel, lod_levels};
+use sylva_gltf::lod::{LodError, LodLevel, lod_levels};
 use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::Rig;
 use sylva_mesh::{Mesh, Scene, SceneNode};
@@ -47,7 +47,7 @@ impl LodAssets {
                 "--lod",
                 format!(
                     "{n} levels asked for, expected 2 to {}",
-                    sylva_mesh::lod::MAX_LEVELS
+                    sylva_gltf::lod::MAX_LEVELS
                 ),
             )),
             other => Error::Input(InputError::new("--lod", other.to_string())),
@@ -108,7 +108,7 @@ impl LodAssets {
 }
 
 /// A plant grown and meshed at the first level of its chain within a triangle budget
-/// ([`sylva_mesh::lod::preview`]): what a view a few hundred pixels wide needs, however
+/// ([`sylva_gltf::lod::preview`]): what a view a few hundred pixels wide needs, however
 /// large the plant. Only the preview is meshed; the plant in full is counted, not meshed.
 pub struct Preview {
     /// The preview's mesh.
@@ -147,7 +147,7 @@ impl Preview {
         let options = mesh_options(genome.mesh_hint());
         let full_triangles = Mesher::new(options.clone())?.counts(plant)?.triangles;
         let level =
-            sylva_mesh::lod::preview(plant, &options, max_triangles).map_err(|e| match e {
+            sylva_gltf::lod::preview(plant, &options, max_triangles).map_err(|e| match e {
                 LodError::Mesh(e) => Error::Mesh(e),
                 other => Error::Input(InputError::new("preview", other.to_string())),
             })?;

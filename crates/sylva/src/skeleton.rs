@@ -32,7 +32,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, OrganKind, Plant};
-use sylva_mesh::export::Format;
+use sylva_gltf::export::Format;
 
 use crate::assets::Grown;
 use crate::error::{Error, InputError};

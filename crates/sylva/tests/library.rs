@@ -20,8 +20,6 @@ fn seeded(seed: u64) -> GrowOptions {
 }
 use sylva_core::par::Pool;
 
-mod common;
-
 fn example(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -399,8 +397,8 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     std::fs::create_dir_all(&dir).unwrap();
     let glb = dir.join("cylinder.glb");
     export(&grown.scene(), &glb).unwrap();
-    common::validate(std::slice::from_ref(&glb));
-    let imported = sylva_mesh::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
+    sylva_testkit::validate(std::slice::from_ref(&glb));
+    let imported = sylva_gltf::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
     assert_eq!(imported.scene().nodes.len(), 1);
     let bytes = std::fs::read(&glb).unwrap();
     assert!(String::from_utf8_lossy(&bytes).contains(r#""model":"cylinder""#));

@@ -18,8 +18,6 @@ fn windy(seed: u64, roots: bool, wind: Option<WindOptions>) -> GrowOptions {
     }
 }
 
-mod common;
-
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -49,7 +47,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
         let grown = Grown::grow(genome, &windy(seed, false, Some(WindOptions::default()))).unwrap();
         let rig = grown.rig.as_ref().unwrap();
         assert!(rig.joints.len() >= 2, "{name}: {} joints", rig.joints.len());
-        let glb = sylva_mesh::export::to_glb(&grown.scene()).unwrap();
+        let glb = sylva_gltf::export::to_glb(&grown.scene()).unwrap();
         let json = gltf(&glb);
         assert_eq!(json["animations"][0]["name"], "wind", "{name}");
         assert_eq!(json["skins"].as_array().unwrap().len(), 1);
@@ -62,7 +60,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
             rig.joints.len()
         );
         // Sylva's own reader takes it back (the rest pose), as `sylva render` does.
-        let back = sylva_mesh::import::read_glb(&glb).unwrap();
+        let back = sylva_gltf::import::read_glb(&glb).unwrap();
         assert_eq!(
             back.scene().triangle_count(),
             grown.mesh.triangle_count(),
@@ -82,7 +80,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
         })
         .collect();
     let assets = SceneAssets::mesh(&placed, Some(WindOptions::default())).unwrap();
-    let glb = sylva_mesh::export::to_glb(&assets.scene()).unwrap();
+    let glb = sylva_gltf::export::to_glb(&assets.scene()).unwrap();
     let json = gltf(&glb);
     assert_eq!(json["skins"].as_array().unwrap().len(), 3);
     assert_eq!(json["animations"].as_array().unwrap().len(), 1);
@@ -96,7 +94,7 @@ fn wind_glbs_of_every_model_are_validator_clean() {
     let file = dir.join("garden.glb");
     std::fs::write(&file, &glb).unwrap();
     files.push(file);
-    common::validate(&files);
+    sylva_testkit::validate(&files);
     // three.js's GLTFLoader and AnimationMixer, under Node: the joints move and the loop closes.
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let out = std::process::Command::new("node")
@@ -119,8 +117,8 @@ fn without_wind_the_bytes_are_unchanged() {
     let plain = Grown::grow(genome.clone(), &windy(0, true, None)).unwrap();
     let none = Grown::grow(genome, &windy(0, true, None)).unwrap();
     assert_eq!(
-        sylva_mesh::export::to_glb(&plain.scene()).unwrap(),
-        sylva_mesh::export::to_glb(&none.scene()).unwrap()
+        sylva_gltf::export::to_glb(&plain.scene()).unwrap(),
+        sylva_gltf::export::to_glb(&none.scene()).unwrap()
     );
 }
 
@@ -154,8 +152,7 @@ fn wind_strips() {
             })
             .collect();
         let scene = sylva_mesh::Scene { nodes };
-        let png =
-            sylva::assets::picture(&scene, sylva_mesh::render::View::Front, (1600, 420)).unwrap();
+        let png = sylva::assets::picture(&scene, sylva_render::View::Front, (1600, 420)).unwrap();
         let out = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../target")
             .join(format!(

@@ -10,8 +10,8 @@ use sylva::assets::picture;
 use sylva::biomorph::{BiomorphOptions, Biomorphs};
 use sylva::files::Outputs;
 use sylva::load_genome;
-use sylva::mesh::render::{self, SheetCell, SheetOptions, View};
 use sylva::mesh::{Scene, SceneNode};
+use sylva::render::{self, SheetCell, SheetOptions, View};
 
 use super::{InFile, SCENE_PICTURE};
 

@@ -12,7 +12,7 @@ use sylva::assets::{guide_mesh, picture};
 use sylva::core::budget::Seconds;
 use sylva::core::taper::PipeTaper;
 use sylva::mesh::SceneNode;
-use sylva::mesh::render::{self, SheetCell, SheetOptions};
+use sylva::render::{self, SheetCell, SheetOptions};
 use sylva::report::{fitness_svg, stats_csv};
 use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
 

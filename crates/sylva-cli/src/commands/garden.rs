@@ -9,8 +9,8 @@ use sylva::garden::{
     GardenLayout, GardenNodes, PlanError, check_garden, garden_glb, garden_glb_options,
     garden_placed, garden_placements, grow_garden,
 };
-use sylva::mesh::export::Format;
-use sylva::mesh::render::View;
+use sylva::gltf::export::Format;
+use sylva::render::View;
 use sylva::{Genome, InputError, load_genome, parse_genome};
 
 use super::{InFile, SCENE_PICTURE};

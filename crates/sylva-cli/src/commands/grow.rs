@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use sylva::assets::{check_png, picture};
 use sylva::files::Outputs;
-use sylva::mesh::render::View;
+use sylva::render::View;
 use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
 use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets, load_genome};
 
@@ -56,7 +56,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         wind,
     };
     let glb = options.glb_options();
-    if args.lod.is_some() && output != GrowOutput::Asset(sylva::mesh::export::Format::Glb) {
+    if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {
         return Err(InputError::new(
             "--lod",
             "levels of detail are written as GLB files: give an output ending in .glb",

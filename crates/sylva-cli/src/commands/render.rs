@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use sylva::assets::{check_png, write_picture};
-use sylva::mesh::render::View;
+use sylva::render::View;
 use sylva::{GrowOptions, Grown, InputError, load_genome};
 
 use super::InFile;
@@ -106,7 +106,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         sylva::files::write(&args.output, &png)?;
     } else if is_glb {
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
-        let imported = sylva::mesh::import::read_glb(&bytes)
+        let imported = sylva::gltf::import::read_glb(&bytes)
             .map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
@@ -126,7 +126,7 @@ fn lod_strip(
     view: View,
     (width, height): (u32, u32),
 ) -> anyhow::Result<Vec<u8>> {
-    use sylva::mesh::render::{self, SheetCell, SheetOptions};
+    use sylva::render::{self, SheetCell, SheetOptions};
     let cells: Vec<SheetCell> = (0..chain.levels.len())
         .map(|k| SheetCell {
             scene: chain.level_scene(k, "plant"),

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use sylva::Experiment;
 use sylva::assets::picture;
 use sylva::files::Outputs;
-use sylva::mesh::render::View;
+use sylva::render::View;
 
 use super::{InFile, SCENE_PICTURE};
 

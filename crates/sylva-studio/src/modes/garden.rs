@@ -369,13 +369,13 @@ async fn grow_garden(
         let assets = garden
             .assets(|i, _| format!("specimen-{i}"), |_, s| node_extras(s))
             .map_err(|e| ApiError::library("settings", e))?;
-        let scene = sylva::mesh::export::to_glb(&assets.scene())
+        let scene = sylva::gltf::export::to_glb(&assets.scene())
             .map_err(|e| ApiError::library("settings", e.into()))?;
         let mut specimens = Vec::with_capacity(garden.specimens.len());
         for (s, mesh) in garden.specimens.iter().zip(assets.meshes()) {
             let mut node = SceneNode::new(LSYSTEM, mesh);
             node.extras = Some(node_extras(s));
-            let glb = sylva::mesh::export::to_glb(&Scene::single(node))
+            let glb = sylva::gltf::export::to_glb(&Scene::single(node))
                 .map_err(|e| ApiError::library("settings", e.into()))?;
             let view = SpecimenView {
                 plant: 0,

@@ -4,7 +4,7 @@
 // Nothing renders in a loop: a stage draws when asked (a plant arrived, a control moved, the
 // page resized, a turntable turned) and then tells whoever waits for the paint.
 //
-// The look follows Sylva's own renderer (sylva-mesh's render module): a pale sky, a soft
+// The look follows Sylva's own renderer (the sylva-render crate): a pale sky, a soft
 // checkered ground that fades out at its rim, a hemisphere light, a warm sun from the upper
 // front-left and a cool fill from the right, the plant filling its view. The sun casts soft
 // shadows in detail views (garden, family, design); grid cells have a contact shadow.

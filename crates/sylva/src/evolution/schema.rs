@@ -8,9 +8,9 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::ser::SerializeStruct;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::taper::PipeTaper;
-use sylva_mesh::render::View;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
+use sylva_render::View;
 
 use crate::error::InputError;
 
@@ -144,7 +144,7 @@ sylva_core::ranged!(sheet_size: u32, "sheet_size", 1, 400);
 
 mod view_name {
     use serde::{Deserialize, Deserializer, Serializer, de::Error};
-    use sylva_mesh::render::View;
+    use sylva_render::View;
 
     pub fn serialize<S: Serializer>(v: &View, s: S) -> Result<S::Ok, S::Error> {
         s.collect_str(v)

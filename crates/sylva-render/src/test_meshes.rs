@@ -7,8 +7,7 @@ use sylva_core::{
     Material, MaterialKind,
     glam::{Quat, Vec3},
 };
-
-use crate::mesh::{Mesh, Primitive};
+use sylva_mesh::mesh::{Mesh, Primitive};
 
 /// A material of a given linear colour.
 pub fn material(kind: MaterialKind, color: [f32; 3]) -> Material {

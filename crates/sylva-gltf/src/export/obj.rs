@@ -19,10 +19,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use sylva_core::glam::Vec3;
+use sylva_mesh::scene::Scene;
+use sylva_mesh::texture::{texture_file_name, texture_info};
 
 use super::{push_float, push_vec3, token, valid_triangles};
-use crate::scene::Scene;
-use crate::texture::{texture_file_name, texture_info};
 
 /// Encodes `scene` as OBJ text and the text of its MTL file, which the OBJ names as
 /// `mtl_file_name` in its `mtllib` line. Never fails: indices out of range are dropped and
@@ -142,8 +142,8 @@ fn write_material(mtl: &mut String, name: &str, color: [f32; 3]) {
 mod tests {
     use super::*;
     use crate::export::tests::small_mesh;
-    use crate::scene::SceneNode;
     use sylva_core::glam::Quat;
+    use sylva_mesh::scene::SceneNode;
 
     fn lines<'a>(text: &'a str, prefix: &str) -> Vec<&'a str> {
         text.lines().filter(|l| l.starts_with(prefix)).collect()

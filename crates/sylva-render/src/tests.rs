@@ -5,11 +5,11 @@ use sylva_core::{
     MaterialKind,
     glam::{Quat, Vec3},
 };
+use sylva_mesh::mesh::Mesh;
+use sylva_mesh::scene::{Scene, SceneNode};
 
 use super::test_meshes::{add_box, add_quad, empty, material, tree};
 use super::*;
-use crate::mesh::Mesh;
-use crate::scene::{Scene, SceneNode};
 
 const RED: [f32; 3] = [0.8, 0.05, 0.05];
 const BLUE: [f32; 3] = [0.05, 0.05, 0.8];
@@ -281,7 +281,7 @@ fn empty_scene_gives_ground_or_background() {
     let mut nan = empty(RED);
     nan.positions = vec![[f32::NAN; 3]; 3];
     nan.normals = vec![[0.0, 1.0, 0.0]; 3];
-    nan.primitives = vec![crate::mesh::Primitive {
+    nan.primitives = vec![sylva_mesh::mesh::Primitive {
         material: 0,
         indices: vec![0, 1, 2],
     }];
@@ -302,7 +302,7 @@ fn bad_vertices_and_indices_are_skipped() {
     }
     // Out-of-range indices, a dangling material and a NaN normal and colour.
     dirty.primitives[0].indices.extend([0, 1, 999]);
-    dirty.primitives.push(crate::mesh::Primitive {
+    dirty.primitives.push(sylva_mesh::mesh::Primitive {
         material: 7,
         indices: vec![0, 1],
     });
@@ -322,7 +322,7 @@ fn bad_vertices_and_indices_are_skipped() {
     let mut flat = empty(RED);
     flat.positions = vec![[0.0; 3], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0]];
     flat.normals = vec![[0.0, 0.0, 1.0]; 3];
-    flat.primitives = vec![crate::mesh::Primitive {
+    flat.primitives = vec![sylva_mesh::mesh::Primitive {
         material: 0,
         indices: vec![0, 1, 2, 0, 0, 0],
     }];

@@ -8,8 +8,7 @@
 //! little-endian f32) and a zero attribute count (u16).
 
 use sylva_core::glam::Vec3;
-
-use crate::scene::Scene;
+use sylva_mesh::scene::Scene;
 
 /// Millimetres per metre.
 const MM: f32 = 1000.0;
@@ -70,9 +69,9 @@ pub fn to_stl(scene: &Scene) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::SceneNode;
-    use crate::{Mesh, Primitive};
     use sylva_core::{Material, MaterialKind};
+    use sylva_mesh::scene::SceneNode;
+    use sylva_mesh::{Mesh, Primitive};
 
     fn f32_at(bytes: &[u8], at: usize) -> f32 {
         f32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])

@@ -1,6 +1,6 @@
 //! Writing a [`Scene`] to files: GLB (glTF 2.0 binary), OBJ with MTL, VRML97 and STL.
 //!
-//! - [`to_glb`]: one glTF node per [`SceneNode`](crate::SceneNode), one glTF mesh per distinct
+//! - [`to_glb`]: one glTF node per [`SceneNode`](sylva_mesh::SceneNode), one glTF mesh per distinct
 //!   [`Mesh`] (nodes borrowing the same mesh share it), the node's extras kept as glTF
 //!   `extras`. Checked by the Khronos validator in the tests. [`to_glb_with`] and
 //!   [`GlbOptions`] add instancing (`EXT_mesh_gpu_instancing`) and quantisation
@@ -13,7 +13,7 @@
 //! - [`write_scene`]: picks the format from the file extension ([`Format::from_path`]) and
 //!   writes atomically, so a reader never sees half a file.
 //!
-//! Textures ([`crate::texture`]): a GLB embeds the PNG of each texture id its materials use.
+//! Textures ([`sylva_mesh::texture`]): a GLB embeds the PNG of each texture id its materials use.
 //! OBJ and VRML97 refer to PNG files next to the model, named `<stem>_tex<id>.png` after the
 //! model's file stem (made a single word, see [`texture_files`]); [`write_scene`] writes them
 //! before the files that name them.
@@ -22,7 +22,8 @@
 //!
 //! ```no_run
 //! use sylva_core::{Plant, PlantMeta, glam::Vec3};
-//! use sylva_mesh::{Scene, SceneNode, export, mesher::{MeshOptions, mesh_plant}};
+//! use sylva_gltf::export;
+//! use sylva_mesh::{Scene, SceneNode, mesher::{MeshOptions, mesh_plant}};
 //!
 //! let mut plant = Plant::new(PlantMeta::default());
 //! plant.add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.05), None, false, Plant::BARK)?;
@@ -42,6 +43,8 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::{Path, PathBuf};
 
+use sylva_mesh::mesh::Mesh;
+use sylva_mesh::scene::Scene;
 use thiserror::Error;
 
 pub(crate) use glb::IMAGE_NAME_PREFIX;
@@ -52,9 +55,6 @@ pub use glb::{
 pub use obj::to_obj;
 pub use stl::to_stl;
 pub use vrml::{DEFAULT_TEXTURE_STEM, to_vrml, to_vrml_with_textures};
-
-use crate::mesh::Mesh;
-use crate::scene::Scene;
 
 /// Why a scene could not be exported.
 #[derive(Debug, Error)]
@@ -177,7 +177,7 @@ pub enum ExportError {
     },
     /// A [`MeshSource`] could not make a mesh.
     #[error("meshing")]
-    Mesh(#[from] crate::mesher::MeshError),
+    Mesh(#[from] sylva_mesh::mesher::MeshError),
     /// A [`MeshSource`] could not make the plant to mesh.
     #[error("growing the plant of mesh {index}")]
     Source {
@@ -307,9 +307,12 @@ pub fn texture_files(scene: &Scene, stem: &str) -> Result<Vec<(String, Vec<u8>)>
     used_textures(scene)
         .into_iter()
         .map(|id| {
-            let png = crate::texture::texture_png(id)
+            let png = sylva_mesh::texture::texture_png(id)
                 .map_err(|source| ExportError::Png { id, source })?;
-            Ok((crate::texture::texture_file_name(&stem, id), png.to_vec()))
+            Ok((
+                sylva_mesh::texture::texture_file_name(&stem, id),
+                png.to_vec(),
+            ))
         })
         .collect()
 }
@@ -489,10 +492,10 @@ fn token(name: &str) -> String {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::mesher::{MeshOptions, mesh_plant};
-    use crate::scene::SceneNode;
     use sylva_core::glam::{Quat, Vec2, Vec3};
     use sylva_core::{Organ, OrganKind, Plant, PlantMeta};
+    use sylva_mesh::mesher::{MeshOptions, mesh_plant};
+    use sylva_mesh::scene::SceneNode;
 
     /// A small plant with a trunk, a branch, a leaf and a flower.
     pub(crate) fn small_plant() -> Plant {
@@ -613,7 +616,7 @@ pub(crate) mod tests {
             "one PNG per texture id, named as the files refer to them; no temporary files"
         );
         let png = std::fs::read(dir.path().join("p_tex5.png")).unwrap();
-        assert_eq!(png, crate::texture::texture(5).png().unwrap());
+        assert_eq!(png, sylva_mesh::texture::texture(5).png().unwrap());
         let obj = std::fs::read_to_string(dir.path().join("my tree.obj")).unwrap();
         assert!(obj.contains("mtllib my_tree.mtl\n"));
         let mtl = std::fs::read_to_string(dir.path().join("my_tree.mtl")).unwrap();

@@ -50,8 +50,7 @@ use sylva_core::{
     Organ, OrganKind, Plant,
     glam::{Mat3, Quat, Vec2, Vec3},
 };
-
-use crate::mesher::{MeshError, MeshOptions, Mesher};
+use sylva_mesh::mesher::{MeshError, MeshOptions, Mesher};
 
 /// Most levels in a chain (level 0 included).
 pub const MAX_LEVELS: usize = 8;

@@ -19,11 +19,11 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use sylva_core::glam::Vec3;
+use sylva_mesh::mesh::Mesh;
+use sylva_mesh::scene::Scene;
+use sylva_mesh::texture::{texture_file_name, texture_info};
 
 use super::{push_float, push_vec3, token, valid_triangles};
-use crate::mesh::Mesh;
-use crate::scene::Scene;
-use crate::texture::{texture_file_name, texture_info};
 
 /// The stem [`to_vrml`] names texture files after: `scene_tex<id>.png`.
 pub const DEFAULT_TEXTURE_STEM: &str = "scene";
@@ -157,8 +157,8 @@ fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool, stem: &str)
 mod tests {
     use super::*;
     use crate::export::tests::small_mesh;
-    use crate::scene::SceneNode;
     use sylva_core::glam::Quat;
+    use sylva_mesh::scene::SceneNode;
 
     fn balanced(text: &str) -> bool {
         let mut stack = Vec::new();

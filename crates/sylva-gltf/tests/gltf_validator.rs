@@ -6,15 +6,13 @@
 //! skips, when either is missing.
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::json;
 use sylva_core::glam::{Quat, Vec2, Vec3};
 use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
-use sylva_mesh::export::write_scene;
+use sylva_gltf::export::write_scene;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
 use sylva_mesh::{Mesh, Scene, SceneNode};
 
@@ -51,7 +49,7 @@ fn mesh(plant: &Plant) -> Mesh {
 
 /// A small tree with leaves, flowers and, below ground, roots ending in root tips.
 fn tree_with_organs() -> Plant {
-    let mut plant = common::binary_tree(4, 6);
+    let mut plant = sylva_testkit::binary_tree(4, 6);
     let root = plant
         .add_material(Material::of_kind(MaterialKind::Root))
         .expect("a fourth material fits");
@@ -105,7 +103,7 @@ fn written_glbs_pass_the_khronos_validator() {
     write("tree.glb", &Scene::single(node));
 
     // Two nodes sharing one mesh and a third with another, placed and turned.
-    let small = mesh(&common::binary_tree(2, 3));
+    let small = mesh(&sylva_testkit::binary_tree(2, 3));
     let mut a = SceneNode::new("a", &tree);
     a.translation = Vec3::new(-3.0, 0.0, 0.0);
     let mut b = SceneNode::new("b", &tree);
@@ -148,7 +146,7 @@ fn written_glbs_pass_the_khronos_validator() {
         textured.set_texture(MaterialId(m as u16), t).unwrap();
     }
     let textured = mesh(&textured);
-    let mut other = common::binary_tree(2, 3);
+    let mut other = sylva_testkit::binary_tree(2, 3);
     other.set_texture(Plant::LEAF, Some(3)).unwrap();
     other.set_texture(Plant::FLOWER, Some(16)).unwrap();
     let other = mesh(&other);
@@ -163,7 +161,7 @@ fn written_glbs_pass_the_khronos_validator() {
     );
 
     // Past 65 535 vertices: 32-bit indices.    // Past 65 535 vertices: 32-bit indices.
-    let big = mesh(&common::binary_tree(8, 12));
+    let big = mesh(&sylva_testkit::binary_tree(8, 12));
     assert!(big.vertex_count() > 65_535, "{}", big.vertex_count());
     write("big.glb", &Scene::single(SceneNode::new("big", &big)));
 

@@ -1,10 +1,8 @@
 //! Pictures of the generated textures and of textured plants, to look at:
-//! `cargo test -p sylva-mesh --test textured_pictures -- --ignored`, then open
+//! `cargo test -p sylva-render --test textured_pictures -- --ignored`, then open
 //! `$TMPDIR/textured-*.png` (the flat textures tiled 2 × 2, the textures on quads, trees,
 //! trunks, and leaves and flowers).
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
-
-mod common;
 
 use std::f32::consts::{FRAC_PI_2, TAU};
 use std::path::PathBuf;
@@ -13,11 +11,11 @@ use image::{GrayImage, imageops};
 use sylva_core::glam::{Quat, Vec2, Vec3};
 use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-use sylva_mesh::render::{
-    self, RenderOptions, SheetCell, SheetOptions, View, contact_sheet, write_png,
-};
 use sylva_mesh::texture::{TEXTURE_COUNT, TEXTURE_SIZE, TextureFamily, texture, texture_info};
 use sylva_mesh::{Mesh, Primitive, Scene, SceneNode};
+use sylva_render::{
+    RenderOptions, SheetCell, SheetOptions, View, contact_sheet, render, write_png,
+};
 
 fn out(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("textured-{name}.png"))
@@ -106,7 +104,7 @@ fn write_textured_pictures() {
     // Trees: bark, leaf and petal textures of one row each.
     let trees: Vec<(String, Mesh)> = (0..3)
         .map(|k| {
-            let mut plant = common::binary_tree(4, 6);
+            let mut plant = sylva_testkit::binary_tree(4, 6);
             for (m, id) in [k, 3 + k, 6 + k].into_iter().enumerate() {
                 plant.set_texture(MaterialId(m as u16), Some(id)).unwrap();
             }
@@ -124,7 +122,7 @@ fn write_textured_pictures() {
     sheet(&cells, View::Iso, "Textured trees", "trees");
     let one = Scene::single(SceneNode::new("tree", &trees[0].1));
     let options = RenderOptions::default();
-    write_png(&out("tree"), &render::render(&one, &options).unwrap()).unwrap();
+    write_png(&out("tree"), &render(&one, &options).unwrap()).unwrap();
 
     // Trunks close up: one tapering, slightly bent axis per bark.
     let trunks: Vec<Mesh> = (0..3u16)
@@ -209,11 +207,7 @@ fn write_textured_pictures() {
     sheet(&cells, View::Top, "Leaves and flowers", "organs");
 
     // An untextured tree, to compare with the pictures before textures existed.
-    let plain = mesh_plant(&common::binary_tree(4, 6), &MeshOptions::default()).unwrap();
+    let plain = mesh_plant(&sylva_testkit::binary_tree(4, 6), &MeshOptions::default()).unwrap();
     let plain = Scene::single(SceneNode::new("tree", &plain));
-    write_png(
-        &out("untextured-tree"),
-        &render::render(&plain, &options).unwrap(),
-    )
-    .unwrap();
+    write_png(&out("untextured-tree"), &render(&plain, &options).unwrap()).unwrap();
 }

@@ -1,9 +1,46 @@
-//! Test plants shared by the integration tests and the benchmarks (which include this file
-//! with `#[path]`).
-#![allow(dead_code)]
+//! Test helpers shared by Sylva's crates, as a dev-dependency only (never published).
+//!
+//! - [`binary_tree`] and [`bench_tree`]: deterministic test plants grown with the turtle, for
+//!   the mesher's, the writers' and the renderer's tests and benchmarks.
+//! - [`validate`]: runs the Khronos glTF validator on written GLB files, for every crate
+//!   whose tests write them (the GLB writer's, the library's and the command line's).
+//!
+//! It depends on `sylva-core` alone, so any crate above it may use it in its tests.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use sylva_core::glam::{Quat, Vec2};
 use sylva_core::{Organ, OrganKind, Plant, PlantMeta, SegmentId, Turtle};
+
+/// Runs the Khronos glTF validator (`tools/gltf-validator`, installed by
+/// `npm ci --prefix tools/gltf-validator`) on `glbs`; every GLB must have zero errors and zero
+/// warnings.
+///
+/// # Panics
+///
+/// When the validator is not installed, Node.js does not run, or any file has an error or a
+/// warning (the validator's report is in the message).
+pub fn validate(glbs: &[PathBuf]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let script = root.join("tools/gltf-validator/validate.mjs");
+    assert!(
+        root.join("tools/gltf-validator/node_modules/gltf-validator")
+            .exists(),
+        "the validator is not installed: run `npm ci --prefix tools/gltf-validator`"
+    );
+    let out = Command::new("node")
+        .arg(&script)
+        .args(glbs)
+        .output()
+        .expect("node runs (install Node.js)");
+    assert!(
+        out.status.success(),
+        "validator: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
 
 /// A deterministic recursive binary tree grown with the turtle: `2^(depth+1) - 1` axes of
 /// `segments_per_axis` gently spiralling, tapering segments each; every tip carries a leaf and
@@ -38,6 +75,7 @@ pub fn bench_tree() -> Plant {
     binary_tree(10, 24)
 }
 
+/// One axis of the tree and the depth it grows to.
 struct Axis {
     level: u32,
     depth: u32,
@@ -46,6 +84,8 @@ struct Axis {
     radius: f32,
 }
 
+/// Grows `axis` from the turtle, then its two children (or, at the last level, a leaf and
+/// every third time a flower); `tips` counts the tips grown so far.
 fn grow_axis(
     plant: &mut Plant,
     turtle: &mut Turtle,

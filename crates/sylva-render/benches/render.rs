@@ -2,7 +2,7 @@
 //! test tree at 800 x 800 with 2x supersampling, with and without ground and shadows, and
 //! with textured bark, leaves and flowers.
 //!
-//! Run with `cargo bench -p sylva-mesh --bench render`.
+//! Run with `cargo bench -p sylva-render --bench render`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
 
 use std::hint::black_box;
@@ -10,14 +10,11 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use sylva_core::MaterialId;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
-use sylva_mesh::render::{RenderOptions, Renderer};
 use sylva_mesh::{Scene, SceneNode};
-
-#[path = "../tests/common/mod.rs"]
-mod common;
+use sylva_render::{RenderOptions, Renderer};
 
 fn render(c: &mut Criterion) {
-    let plant = common::binary_tree(9, 8);
+    let plant = sylva_testkit::binary_tree(9, 8);
     let mesh = mesh_plant(&plant, &MeshOptions::default()).unwrap();
     eprintln!("render tree: {} triangles", mesh.triangle_count());
     let scene = Scene::single(SceneNode::new("tree", &mesh));

@@ -17,8 +17,7 @@
 //! is shared by triangles of two colours, whose colour a vertex attribute could not hold.
 
 use sylva_core::{Material, MaterialKind};
-
-use crate::mesh::Mesh;
+use sylva_mesh::mesh::Mesh;
 
 /// No primitive has claimed this vertex yet.
 const UNCLAIMED: u32 = u32::MAX;
@@ -139,7 +138,7 @@ fn ratio(color: [f32; 3], base: [f32; 3]) -> [u8; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Primitive;
+    use sylva_mesh::mesh::Primitive;
 
     fn material(kind: MaterialKind, color: [f32; 3], texture: Option<u16>) -> Material {
         Material {

@@ -4,7 +4,7 @@
 //! order, so the sheet is byte-identical to rendering the cells one by one.
 //!
 //! ```
-//! use sylva_mesh::render::{SheetCell, SheetOptions, contact_sheet};
+//! use sylva_render::{SheetCell, SheetOptions, contact_sheet};
 //! use sylva_mesh::Scene;
 //! use sylva_core::par::Pool;
 //!
@@ -14,15 +14,15 @@
 //! let options = SheetOptions { cell_width: 64, cell_height: 80, ..Default::default() };
 //! let sheet = contact_sheet(&cells, &options, &Pool::Serial)?;
 //! assert_eq!(sheet.dimensions(), (3 * 64, 2 * 80)); // 5 cells: 3 columns, 2 rows
-//! # Ok::<(), sylva_mesh::render::RenderError>(())
+//! # Ok::<(), sylva_render::RenderError>(())
 //! ```
 
 use image::{Rgb, RgbImage};
 use sylva_core::par::Pool;
+use sylva_mesh::scene::Scene;
 
 use super::text::{GLYPH, draw_text, fit_text, text_width};
 use super::{MAX_SIZE, MIN_SIZE, RenderError, RenderOptions, Renderer, View};
-use crate::scene::Scene;
 
 /// Height of the caption strip under each picture: an 8-pixel line with 4 pixels above and
 /// below.

@@ -12,15 +12,20 @@
 //! every front-facing triangle, with fixed-point edge functions, a depth buffer and
 //! per-sample Lambert shading from perspective-correct interpolated vertex normals (hemisphere
 //! ambient, shadowed key light from the upper front-left, cool fill). A material with a
-//! texture id multiplies its colour by that [`texture`](crate::texture), sampled at the
+//! texture id multiplies its colour by that [`texture`](sylva_mesh::texture), sampled at the
 //! perspective-correct texture coordinates with trilinear filtering; the renderer makes each
 //! texture once and keeps it. The picture is drawn
 //! at `supersample` times the size and box-filtered down in linear light. Invalid input never
 //! panics: vertices that are not finite (or beyond ±1e15 m) drop their triangles, zero-area
 //! and back-facing triangles are skipped, an empty scene gives the ground alone.
 //!
+//! How it fits: it draws the scenes, meshes and textures of `sylva-mesh` and depends on
+//! nothing else of Sylva's but `sylva-core`: it neither writes nor reads model files (a
+//! picture of a GLB file is its scene read back by `sylva-gltf`'s reader, then drawn here).
+//! The `sylva` library re-exports it as `sylva::render`.
+//!
 //! ```
-//! use sylva_mesh::render::{RenderOptions, View, render};
+//! use sylva_render::{RenderOptions, View, render};
 //! use sylva_mesh::{Mesh, Primitive, Scene, SceneNode};
 //! use sylva_core::{Material, MaterialKind};
 //!
@@ -37,9 +42,9 @@
 //! let options = RenderOptions { width: 64, height: 48, view: View::Iso, ..Default::default() };
 //! let image = render(&scene, &options)?;
 //! assert_eq!(image.dimensions(), (64, 48));
-//! let png = sylva_mesh::render::encode_png(&image)?;
+//! let png = sylva_render::encode_png(&image)?;
 //! assert!(png.starts_with(b"\x89PNG"));
-//! # Ok::<(), sylva_mesh::render::RenderError>(())
+//! # Ok::<(), sylva_render::RenderError>(())
 //! ```
 
 mod camera;
@@ -64,8 +69,8 @@ use sylva_core::{
     Aabb,
     glam::{Vec2, Vec3},
 };
+use sylva_mesh::scene::{Scene, SceneNode};
 
-use crate::scene::{Scene, SceneNode};
 use camera::{Camera, Fit};
 use raster::{Cull, ScreenVert, Tri};
 use shade::{GROUND_SEGMENTS, Ground, Lights, ShadowMap};
@@ -411,7 +416,7 @@ impl Renderer {
     }
 
     /// Draws a node's depth into the shadow map. Only faces turned to the light are drawn:
-    /// meshes are closed or double-sided (see [`crate::mesh`]), so they are enough.
+    /// meshes are closed or double-sided (see [`sylva_mesh::mesh`]), so they are enough.
     fn draw_shadow(&mut self, node: &SceneNode) {
         let Renderer { shadow, verts, .. } = self;
         verts.clear();

@@ -24,9 +24,8 @@ use std::collections::{HashMap, HashSet};
 use serde_json::Value;
 use sylva_core::glam::{Mat3, Mat4, Quat, Vec3};
 use sylva_core::{Material, MaterialKind};
-
-use crate::mesh::{Mesh, Primitive};
-use crate::scene::{Scene, SceneNode};
+use sylva_mesh::mesh::{Mesh, Primitive};
+use sylva_mesh::scene::{Scene, SceneNode};
 
 /// Most shades one primitive's `COLOR_0` is split into; triangles of further shades keep
 /// the material's base colour (Sylva's own files have a few dozen).
@@ -281,7 +280,7 @@ impl Reader<'_> {
             });
         }
         sylva_core::budget::check(
-            crate::mesher::mesh_bytes(vertices, indices / 3),
+            sylva_mesh::mesher::mesh_bytes(vertices, indices / 3),
             format_args!(
                 "reading a GLB of {vertices} vertices and {} triangles",
                 indices / 3

@@ -1,4 +1,4 @@
-//! Texture sampling for the renderer: [`crate::texture`] pictures as linear-light mip chains,
+//! Texture sampling for the renderer: [`sylva_mesh::texture`] pictures as linear-light mip chains,
 //! made once per id and kept by the [`Renderer`](super::Renderer).
 //!
 //! Each triangle picks a level of detail from how many texels cover one sample (its texture
@@ -14,9 +14,9 @@
 //! ```
 
 use std::collections::HashMap;
+use sylva_mesh::texture::texture;
 
 use super::shade::{floor_i64, to_linear_table};
-use crate::texture::texture;
 
 /// One level of a mip chain: `size` × `size` linear grey texels.
 #[derive(Clone, Debug)]
@@ -144,7 +144,7 @@ mod tests {
         let sizes: Vec<usize> = t.levels.iter().map(|l| l.size).collect();
         assert_eq!(
             sizes.first(),
-            Some(&(crate::texture::TEXTURE_SIZE as usize))
+            Some(&(sylva_mesh::texture::TEXTURE_SIZE as usize))
         );
         assert_eq!(sizes.last(), Some(&1));
         let mean = |l: &Level| l.texels.iter().sum::<f32>() / l.texels.len() as f32;
@@ -181,7 +181,7 @@ mod tests {
         let t = MipTexture::new(0);
         assert_eq!(t.lod(0.0), 0.0);
         assert_eq!(t.lod(f32::NAN), 0.0);
-        let size = crate::texture::TEXTURE_SIZE as f32;
+        let size = sylva_mesh::texture::TEXTURE_SIZE as f32;
         // Four texels per sample: one level down.
         assert!((t.lod(4.0 / (size * size)) - 1.0).abs() < 1e-5);
         assert_eq!(t.lod(1e9), (t.levels.len() - 1) as f32);

@@ -2,7 +2,7 @@
 //!
 //! Layout: one glTF node per scene node, all at the root of one scene; one glTF mesh per
 //! distinct [`Mesh`] (nodes that borrow the same mesh, compared by address, share it); one
-//! primitive per [`Primitive`](crate::Primitive), all sharing the mesh's POSITION and NORMAL
+//! primitive per [`Primitive`](sylva_mesh::Primitive), all sharing the mesh's POSITION and NORMAL
 //! accessors. Primitives whose material has a texture also share a TEXCOORD_0 accessor
 //! (`(0, 0)` throughout for a mesh without `uvs`); the others have none, since the validator
 //! reports texture coordinates no material reads as unused, and a mesh without textured
@@ -18,7 +18,7 @@
 //! attributes); other meshes are written with one primitive per material as above.
 //!
 //! A material with a texture id also gets `baseColorTexture`: each distinct id used is one
-//! PNG ([`crate::texture`]) embedded in its own buffer view (no `target`), an `image` named
+//! PNG ([`sylva_mesh::texture`]) embedded in its own buffer view (no `target`), an `image` named
 //! `sylva-texture-<id>` (which [`crate::import`] reads back as the id), and a `texture`
 //! with a sampler that repeats in u, and in v for bark or clamps to the edge for leaves and
 //! petals, with trilinear filtering. The colour stays in `baseColorFactor`, which glTF
@@ -28,7 +28,7 @@
 //! attributes and a skin's (below); each starts on a 4-byte boundary and has its `target` set.
 //! A skinned mesh's `JOINTS_0` (4 bytes), `WEIGHTS_0` (4 normalised bytes) and `_WIND` (a
 //! float) share one view of stride 12, so each vertex's influence is worked out once, as it
-//! is written ([`crate::wind::Rig::for_each_influence`]). The JSON chunk is
+//! is written ([`sylva_mesh::wind::Rig::for_each_influence`]). The JSON chunk is
 //! padded with spaces and the BIN chunk with zeros to 4 bytes. A mesh with no triangles gives
 //! a node without a mesh. The JSON is built with `serde_json`, whose maps keep a fixed key
 //! order, so output is deterministic.
@@ -64,11 +64,11 @@ use std::io::{self, BufWriter, Write};
 
 use serde_json::{Map, Value, json};
 use sylva_core::glam::{Quat, Vec3};
+use sylva_mesh::mesh::Mesh;
+use sylva_mesh::scene::Scene;
+use sylva_mesh::wind::Rig;
 
 use super::{ExportError, check_mesh, check_node, check_scene};
-use crate::mesh::Mesh;
-use crate::scene::Scene;
-use crate::wind::Rig;
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const GLB_VERSION: u32 = 2;
@@ -237,7 +237,7 @@ pub fn mesh_binary_bytes(mesh: &Mesh, options: &GlbOptions) -> Result<(u64, u64)
 /// so writing fails only on I/O.
 ///
 /// ```
-/// use sylva_mesh::export::{Glb, GlbOptions, to_glb};
+/// use sylva_gltf::export::{Glb, GlbOptions, to_glb};
 /// use sylva_mesh::Scene;
 ///
 /// let scene = Scene::default();
@@ -875,7 +875,7 @@ impl<S: Sink> Writer<S> {
                 self.quantized_positions_normals(mesh, d)
             }
         };
-        let textured = |p: &crate::Primitive| {
+        let textured = |p: &sylva_mesh::Primitive| {
             !p.indices.is_empty() && mesh.materials[p.material].texture.is_some()
         };
         let texcoord = if mesh.primitives.iter().any(textured) {
@@ -919,7 +919,7 @@ impl<S: Sink> Writer<S> {
                 "count": count, "type": "VEC4",
             }))
         });
-        let draws: Vec<(&sylva_core::Material, Vec<&crate::Primitive>)> = match &lean {
+        let draws: Vec<(&sylva_core::Material, Vec<&sylva_mesh::Primitive>)> = match &lean {
             Some(plan) => plan
                 .materials
                 .iter()
@@ -1191,8 +1191,8 @@ impl<S: Sink> Writer<S> {
         if let Some(&t) = self.texture_of.get(&id) {
             return Ok(t);
         }
-        let png =
-            crate::texture::texture_png(id).map_err(|source| ExportError::Png { id, source })?;
+        let png = sylva_mesh::texture::texture_png(id)
+            .map_err(|source| ExportError::Png { id, source })?;
         let start = self.bin.len();
         self.bin.put(&png);
         let view = self.untargeted_view(start);
@@ -1202,7 +1202,7 @@ impl<S: Sink> Writer<S> {
             "mimeType": "image/png",
             "name": format!("{IMAGE_NAME_PREFIX}{id}"),
         }));
-        let repeats = crate::texture::texture_info(id).family.repeats_v();
+        let repeats = sylva_mesh::texture::texture_info(id).family.repeats_v();
         let slot = usize::from(!repeats);
         let sampler = match self.sampler_of[slot] {
             Some(s) => s,
@@ -1218,7 +1218,7 @@ impl<S: Sink> Writer<S> {
             }
         };
         self.textures.push(json!({
-            "name": crate::texture::texture_info(id).name,
+            "name": sylva_mesh::texture::texture_info(id).name,
             "sampler": sampler,
             "source": self.images.len() - 1,
         }));
@@ -1290,7 +1290,7 @@ fn short(x: f32) -> f64 {
 mod tests {
     use super::*;
     use crate::export::tests::small_mesh;
-    use crate::scene::SceneNode;
+    use sylva_mesh::scene::SceneNode;
 
     fn u32_at(b: &[u8], at: usize) -> u32 {
         u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
@@ -1381,7 +1381,7 @@ mod tests {
         mesh.materials.push(darker);
         let half = mesh.primitives[0].indices.len() / 6 * 3;
         let moved = mesh.primitives[0].indices.split_off(half);
-        mesh.primitives.push(crate::Primitive {
+        mesh.primitives.push(sylva_mesh::Primitive {
             material: mesh.materials.len() - 1,
             indices: moved,
         });
@@ -1398,15 +1398,16 @@ mod tests {
         let mut textured = small_mesh();
         textured.materials[0].texture = Some(0);
         textured.materials[1].texture = Some(3);
-        let (rigged, sources) = crate::mesher::Mesher::new(crate::mesher::MeshOptions::default())
-            .unwrap()
-            .mesh_with_sources(&plant)
-            .unwrap();
-        let rig = crate::wind::rig(
+        let (rigged, sources) =
+            sylva_mesh::mesher::Mesher::new(sylva_mesh::mesher::MeshOptions::default())
+                .unwrap()
+                .mesh_with_sources(&plant)
+                .unwrap();
+        let rig = sylva_mesh::wind::rig(
             &plant,
             &rigged,
             sources,
-            &crate::wind::WindOptions::default(),
+            &sylva_mesh::wind::WindOptions::default(),
         );
         let mut wide = Mesh {
             materials: vec![sylva_core::Material::of_kind(
@@ -1418,7 +1419,7 @@ mod tests {
             wide.positions.push([i as f32 * 1e-3, (i % 3) as f32, 0.0]);
             wide.normals.push([0.0, 0.0, 1.0]);
         }
-        wide.primitives.push(crate::Primitive {
+        wide.primitives.push(sylva_mesh::Primitive {
             material: 0,
             indices: vec![0, 1, 2, 69_997, 69_998, 69_999],
         });
@@ -1923,7 +1924,7 @@ mod tests {
             mesh.positions.push([i as f32, (i % 3) as f32, 0.0]);
             mesh.normals.push([0.0, 0.0, 1.0]);
         }
-        mesh.primitives.push(crate::Primitive {
+        mesh.primitives.push(sylva_mesh::Primitive {
             material: 0,
             indices: vec![0, 1, 2, 69_997, 69_998, 69_999],
         });
@@ -1962,7 +1963,7 @@ mod tests {
             let id: u16 = image["name"].as_str().unwrap()[IMAGE_NAME_PREFIX.len()..]
                 .parse()
                 .unwrap();
-            assert_eq!(png, crate::texture::texture(id).png().unwrap());
+            assert_eq!(png, sylva_mesh::texture::texture(id).png().unwrap());
         }
         // Bark repeats both ways; the leaf texture is clamped along v.
         let samplers = json["samplers"].as_array().unwrap();

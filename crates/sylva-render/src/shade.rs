@@ -331,7 +331,7 @@ mod tests {
 
     #[test]
     fn key_light_is_above_front_left() {
-        use crate::render::{View, camera::Camera};
+        use crate::{View, camera::Camera};
         let lights = Lights::for_camera(&Camera::looking(View::Front, Vec3::ZERO, 1.0));
         assert!(lights.key.x < 0.0 && lights.key.y > 0.5 && lights.key.z > 0.0);
         assert!((lights.key.length() - 1.0).abs() < 1e-5);
