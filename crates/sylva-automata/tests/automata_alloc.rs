@@ -1,6 +1,6 @@
 //! Compiling and growing with a warmed-up `Program`, `Simulator` and `Plant` allocates
-//! nothing: evolution runs this tens of thousands of times a second. (This binary holds one
-//! test, so the global counts are its own.)
+//! nothing: evolution runs this tens of thousands of times a second. (This binary runs without
+//! libtest's harness, on its main thread alone, so the global counts are its own.)
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use std::alloc::System;
@@ -17,7 +17,11 @@ static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
 const HELIX: &str = include_str!("../../../examples/automata/helix.json");
 
-#[test]
+fn main() {
+    steady_state_growth_does_not_allocate();
+    println!("automata_alloc: steady_state_growth_does_not_allocate ... ok");
+}
+
 fn steady_state_growth_does_not_allocate() {
     let helix = AutomataGenome::from_json(HELIX).unwrap();
     let config = GpConfig::default();
