@@ -5,7 +5,14 @@
 //! - [`validate`]: runs the Khronos glTF validator on written GLB files, for every crate
 //!   whose tests write them (the GLB writer's, the library's and the command line's).
 //!
-//! It depends on `sylva-core` alone, so any crate above it may use it in its tests.
+//! - [`toy`] (feature `toy`): a fifth model, a cylinder that evolves towards a height, for
+//!   tests that show a model of one's own flowing through the library and the studio.
+//!
+//! It depends on `sylva-core` alone (and, with `toy`, on the model traits and the engine),
+//! so any crate above it may use it in its tests.
+
+#[cfg(feature = "toy")]
+pub mod toy;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

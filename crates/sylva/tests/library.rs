@@ -273,113 +273,18 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
     assert!(parents.len() >= 2, "{parents:?}");
 }
 
-/// A toy fifth model, added through the trait alone: one cylinder of a given height.
-mod cylinder {
-    use rand::{Rng, RngExt};
-    use serde::{Deserialize, Serialize};
-    use sylva_core::Plant;
-    use sylva_core::glam::Vec3;
-    use sylva_model::{
-        Bred, DevelopError, FormatV1, Model, Parent, VariationError, model_tag, plant_meta,
-        two_most_dominant,
-    };
-
-    model_tag!(
-        /// `"model": "cylinder"`.
-        CylinderTag,
-        "cylinder"
-    );
-
-    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-    #[serde(deny_unknown_fields)]
-    pub struct CylinderGenome {
-        pub model: CylinderTag,
-        pub format: FormatV1,
-        #[serde(deserialize_with = "height")]
-        pub height: f32,
-        #[serde(deserialize_with = "radius")]
-        pub radius: f32,
-    }
-
-    sylva_core::ranged!(height: f32, "height", 0.01, 100.0, " m");
-    sylva_core::ranged!(radius: f32, "radius", 0.001, 10.0, " m");
-
-    #[derive(Clone, Copy, Debug, Default)]
-    pub struct Cylinder;
-
-    impl Model for Cylinder {
-        type Genome = CylinderGenome;
-        type Settings = ();
-        const NAME: &'static str = "cylinder";
-        const TITLE: &'static str = "Cylinders";
-
-        fn develop(&self, g: &CylinderGenome, seed: u64) -> Result<Plant, DevelopError> {
-            let mut plant = Plant::new(plant_meta::<Self>(g, seed));
-            let top = Vec3::Y * g.height;
-            plant.add_segment(
-                Vec3::ZERO,
-                top,
-                (g.radius, g.radius),
-                None,
-                false,
-                Plant::BARK,
-            )?;
-            Ok(plant)
-        }
-
-        fn hand_settings(&self, _: sylva_model::Knobs) {}
-
-        fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> CylinderGenome {
-            CylinderGenome {
-                model: CylinderTag,
-                format: FormatV1,
-                height: rng.random_range(0.5..5.0),
-                radius: rng.random_range(0.05..0.5),
-            }
-        }
-
-        fn mutate<R: Rng + ?Sized>(
-            &self,
-            g: &CylinderGenome,
-            _: &(),
-            rng: &mut R,
-        ) -> CylinderGenome {
-            CylinderGenome {
-                height: (g.height * rng.random_range(0.8..1.25)).clamp(0.01, 100.0),
-                ..g.clone()
-            }
-        }
-
-        fn cross<R: Rng + ?Sized>(
-            &self,
-            parents: &[Parent<'_, CylinderGenome>],
-            _: &(),
-            _: &mut R,
-        ) -> Result<Bred<CylinderGenome>, VariationError> {
-            let (a, b) = two_most_dominant(parents)?;
-            let genome = CylinderGenome {
-                height: parents[a].genome.height,
-                ..parents[b].genome.clone()
-            };
-            Ok(Bred {
-                genome,
-                parents: vec![a, b],
-            })
-        }
-    }
-}
-
 #[test]
 fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     use sylva_model::Model;
-    // The registry line: the standard four and the cylinder.
+    use sylva_testkit::toy::Cylinder;
+    // The registry line: the standard four and the cylinder (`sylva_testkit::toy`).
     let registry = Registry::standard()
         .clone()
-        .with(ModelEntry::model::<cylinder::Cylinder>());
+        .with(ModelEntry::evolvable::<Cylinder>());
     let text = r#"{"model": "cylinder", "format": 1, "height": 2.5, "radius": 0.2}"#;
     let genome = registry.parse_genome(text).unwrap();
     assert_eq!(genome.model(), "cylinder");
-    assert_eq!(genome.get::<cylinder::Cylinder>().unwrap().height, 2.5);
+    assert_eq!(genome.get::<Cylinder>().unwrap().height, 2.5);
     // Its files are checked like any model's: ranges, unknown fields, positions.
     let e = registry
         .parse_genome(r#"{"model": "cylinder", "format": 1, "height": -1, "radius": 0.2}"#)
@@ -404,21 +309,56 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     assert!(String::from_utf8_lossy(&bytes).contains(r#""model":"cylinder""#));
     // Bred by hand like the four.
     let child = genome.mutate(Settings::Default, 1).unwrap();
-    assert_eq!(child.model(), cylinder::Cylinder::NAME);
+    assert_eq!(child.model(), Cylinder::NAME);
     let random = registry
         .get("cylinder")
         .unwrap()
         .random(Settings::Default, 2)
         .unwrap();
     let (bred, _) = Genome::cross(&[(&genome, 2.0), (&random, 1.0)], Settings::Default, 3).unwrap();
-    assert_eq!(bred.get::<cylinder::Cylinder>().unwrap().height, 2.5);
-    // It does not evolve: the registry says so when a config names it.
-    assert!(!registry.get("cylinder").unwrap().evolves());
-    let e = registry
-        .parse_config(Path::new("c.toml"), "model = \"cylinder\"\n")
-        .err()
-        .unwrap();
-    assert!(e.message.contains("does not evolve"), "{}", e.message);
+    assert_eq!(bred.get::<Cylinder>().unwrap().height, 2.5);
+    // It evolves through a config file that names a start genome file, read with the same
+    // registry; the run checkpoints and resumes exactly.
+    std::fs::write(dir.join("start.json"), text).unwrap();
+    std::fs::write(
+        dir.join("c.toml"),
+        "model = \"cylinder\"\n[run]\ngenerations = 12\npopulation = 30\nseed = 4\n\
+         [cylinder]\ntarget = 7.0\nstart = [\"start.json\"]\n",
+    )
+    .unwrap();
+    let config = registry.load_config(&dir.join("c.toml")).unwrap();
+    assert_eq!(config.model(), "cylinder");
+    assert!(
+        Config::load(&dir.join("c.toml")).is_err(),
+        "the standard registry does not know it"
+    );
+    let start = config.load_start(&dir).unwrap();
+    assert_eq!(start, vec![genome.clone()]);
+    let pool = || Pool::with_threads(2).unwrap();
+    let mut straight = Evolution::start(&config, start.clone(), pool()).unwrap();
+    let mut halted = Evolution::start(&config, start, pool()).unwrap();
+    for _ in 0..6 {
+        halted.step().unwrap();
+    }
+    let checkpoint = halted.checkpoint().unwrap();
+    let mut resumed = Evolution::resume(&config, Path::new("c.json"), &checkpoint, pool()).unwrap();
+    for _ in 0..12 {
+        straight.step().unwrap();
+    }
+    for _ in 6..12 {
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.best(), straight.best());
+    let figures = |run: &Evolution| -> Vec<(u32, f64, f64)> {
+        // Everything but the wall-clock seconds.
+        run.stats()
+            .iter()
+            .map(|s| (s.generation, s.best, s.mean))
+            .collect()
+    };
+    assert_eq!(figures(&resumed), figures(&straight));
+    let best = straight.best().genome.get::<Cylinder>().unwrap().height;
+    assert!((best - 7.0).abs() < 1.0, "evolved towards 7 m: {best}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
