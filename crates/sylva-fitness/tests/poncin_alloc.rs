@@ -58,7 +58,7 @@ fn scoring_does_not_allocate_once_warm() {
         cells: vec![],
     })
     .unwrap();
-    // Both pair modes, each with one of the thickness measures.
+    // Every pair mode with every thickness measure.
     let measures = [
         ThickMeasure::Endpoints,
         ThickMeasure::Taper,
@@ -67,7 +67,7 @@ fn scoring_does_not_allocate_once_warm() {
     ];
     let configs: Vec<PoncinFitness> = [PairMode::Exact, PairMode::Sampled]
         .into_iter()
-        .zip(measures)
+        .flat_map(|mode| measures.map(|measure| (mode, measure)))
         .map(|(mode, measure)| PoncinFitness {
             weights: PoncinWeights {
                 angle: 1.0,
@@ -110,5 +110,10 @@ fn scoring_does_not_allocate_once_warm() {
         }
     }
     let change = region.change();
+    assert_eq!(
+        configs.len(),
+        8,
+        "two pair modes by four thickness measures"
+    );
     assert_eq!((change.allocations, change.reallocations), (0, 0));
 }
