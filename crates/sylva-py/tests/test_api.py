@@ -272,25 +272,27 @@ def test_long_calls_release_the_gil():
     run = sylva.Evolution(config, threads=1)
     run.step()
     ticks = 0
+    inside = False
     done = threading.Event()
 
     def count():
         nonlocal ticks
         while not done.is_set():
-            ticks += 1
+            if inside:
+                ticks += 1
             time.sleep(0.001)
 
     ticker = threading.Thread(target=count)
     ticker.start()
-    started = time.perf_counter()
+    inside = True
     run.run(30)
-    elapsed = time.perf_counter() - started
+    inside = False
     done.set()
     ticker.join()
-    assert elapsed > 0.1, "the run must last long enough to tell"
-    # Held, the GIL would let the ticker in only every 5 ms switch interval at best, and
-    # not at all inside one Rust call.
-    assert ticks > elapsed * 1000 / 4, (ticks, elapsed)
+    # Held, the GIL would let the ticker in only at the bytecode boundaries just before and
+    # after the one Rust call (a tick or two); released, it ticks all through the call's
+    # hundreds of milliseconds. No clock is read, so a busy machine gives the same verdict.
+    assert ticks >= 10, ticks
 
 
 def test_gardens_and_scenes():
