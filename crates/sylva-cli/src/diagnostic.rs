@@ -64,7 +64,7 @@ struct Shown {
 
 impl Shown {
     fn of(e: &InputError) -> Shown {
-        let snippet = e.snippet.as_ref().map(|(text, range)| {
+        let snippet = e.snippet.as_deref().map(|(text, range)| {
             let name = e
                 .path
                 .as_ref()

@@ -28,8 +28,26 @@ fn raise(name: &str, message: String, place: Option<&sylva::InputError>) -> PyEr
     })
 }
 
-/// An [`sylva::InputError`] as a Python `InputError` with its place.
+/// An [`sylva::InputError`] as a Python `InputError` with its place; a file that is not
+/// there, or may not be read, as Python's own `FileNotFoundError` or `PermissionError` (an
+/// `OSError` with its errno, message and file name).
 pub fn input_error(e: &sylva::InputError) -> PyErr {
+    let os_error = match e.io {
+        Some(std::io::ErrorKind::NotFound) => Some(("FileNotFoundError", "ENOENT")),
+        Some(std::io::ErrorKind::PermissionDenied) => Some(("PermissionError", "EACCES")),
+        _ => None,
+    };
+    if let (Some((class, errno)), Some(path)) = (os_error, &e.path) {
+        let made = Python::attach(|py| -> PyResult<PyErr> {
+            let errno = py.import("errno")?.getattr(errno)?;
+            let class = py.import("builtins")?.getattr(class)?;
+            let error = class.call1((errno, e.to_string(), path.display().to_string()))?;
+            Ok(PyErr::from_value(error))
+        });
+        if let Ok(error) = made {
+            return error;
+        }
+    }
     raise("InputError", e.to_string(), Some(e))
 }
 

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use numpy::ndarray::{ArrayView, ArrayView1, ArrayView2, Dimension};
 use numpy::npyffi::{_PyArray_GET_ITEM_DATA, NPY_ARRAY_WRITEABLE};
-use numpy::{PyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray, PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
@@ -118,12 +118,37 @@ impl Plant {
         to_py(py, &serde_json::to_value(m).unwrap_or_default())
     }
 
-    /// The plant as data: what `sylva grow -o PLANT.skeleton.json` writes (segments, organs,
-    /// materials, origin, taper), as a dict. See docs/skeleton.md.
-    fn skeleton<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let text = sylva::Skeleton::of_grown(&self.grown).to_json();
-        // Through Python's own reader, so floats come out as the file writes them.
-        py.import("json")?.call_method1("loads", (text,))
+    /// The plant as data: the fields `sylva grow -o PLANT.skeleton.json` writes (origin,
+    /// taper, roots, materials), with its `segments` and `organs` as dicts of numpy arrays,
+    /// one row per segment or organ and one array per field of the file (`start` is an
+    /// (N, 3) array, `parent` holds -1 for none, `kind` a list of names). See
+    /// docs/skeleton.md; [`Plant::skeleton_json`] gives the file's text.
+    fn skeleton<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let skeleton = sylva::Skeleton::of_grown(&self.grown);
+        let out = PyDict::new(py);
+        out.set_item("format", skeleton.format)?;
+        out.set_item("kind", &skeleton.kind)?;
+        out.set_item("sylva_version", &skeleton.sylva_version)?;
+        // Through JSON text, so the small parts' floats read as the file writes them (0.2,
+        // not the f32's 0.20000000298...).
+        let loads = py.import("json")?.getattr("loads")?;
+        let json = |text: serde_json::Result<String>| loads.call1((text.unwrap_or_default(),));
+        out.set_item("origin", json(serde_json::to_string(&skeleton.origin))?)?;
+        out.set_item("taper", json(serde_json::to_string(&skeleton.taper))?)?;
+        out.set_item("roots", skeleton.roots)?;
+        out.set_item(
+            "materials",
+            json(serde_json::to_string(&skeleton.materials))?,
+        )?;
+        out.set_item("segments", segment_arrays(py, &skeleton.segments)?)?;
+        out.set_item("organs", organ_arrays(py, &skeleton.organs)?)?;
+        Ok(out)
+    }
+
+    /// The plant as data in the skeleton file's own text (JSON), as `sylva grow -o
+    /// PLANT.skeleton.json` writes it.
+    fn skeleton_json(&self) -> String {
+        sylva::Skeleton::of_grown(&self.grown).to_json()
     }
 
     /// The mesh, as read-only numpy arrays that view the plant's own memory (no copy).
@@ -511,4 +536,87 @@ pub fn scene(
         .collect();
     let assets = py.detach(|| SceneAssets::mesh(&placed, None)).py()?;
     Ok(Scene::new(assets, None))
+}
+
+/// A column of `rows`: one value each.
+fn column<'py, R, T: numpy::Element>(
+    py: Python<'py>,
+    rows: &[R],
+    value: impl Fn(&R) -> T,
+) -> Bound<'py, PyArray1<T>> {
+    PyArray1::from_vec(py, rows.iter().map(value).collect())
+}
+
+/// A column of `rows` with `N` numbers each, as an (rows, N) array.
+fn columns<'py, R, const N: usize>(
+    py: Python<'py>,
+    rows: &[R],
+    value: impl Fn(&R) -> [f32; N],
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let flat: Vec<f32> = rows.iter().flat_map(value).collect();
+    PyArray1::from_vec(py, flat).reshape([rows.len(), N])
+}
+
+/// Names of enum values (`"bark"`, `"leaf"`) as a list, each name made once.
+fn names<'py, K: Copy + PartialEq + serde::Serialize>(
+    py: Python<'py>,
+    kinds: impl Iterator<Item = K>,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut made: Vec<(K, Bound<'py, PyAny>)> = Vec::new();
+    let list = PyList::empty(py);
+    for kind in kinds {
+        let name = match made.iter().find(|(k, _)| *k == kind) {
+            Some((_, name)) => name.clone(),
+            None => {
+                let name = match serde_json::to_value(kind) {
+                    Ok(serde_json::Value::String(s)) => s.into_pyobject(py)?.into_any(),
+                    _ => py.None().into_bound(py),
+                };
+                made.push((kind, name.clone()));
+                name
+            }
+        };
+        list.append(name)?;
+    }
+    Ok(list)
+}
+
+/// A parent index, or -1 for none.
+fn parent_index(parent: Option<u32>) -> i64 {
+    parent.map_or(-1, i64::from)
+}
+
+fn segment_arrays<'py>(
+    py: Python<'py>,
+    segments: &[sylva::skeleton::SkeletonSegment],
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("start", columns(py, segments, |s| s.start)?)?;
+    out.set_item("end", columns(py, segments, |s| s.end)?)?;
+    out.set_item("start_radius", column(py, segments, |s| s.start_radius))?;
+    out.set_item("end_radius", column(py, segments, |s| s.end_radius))?;
+    out.set_item("order", column(py, segments, |s| s.order))?;
+    out.set_item("parent", column(py, segments, |s| parent_index(s.parent)))?;
+    out.set_item("lateral", column(py, segments, |s| s.lateral))?;
+    out.set_item("material", column(py, segments, |s| s.material))?;
+    out.set_item("kind", names(py, segments.iter().map(|s| s.kind))?)?;
+    out.set_item("woody", column(py, segments, |s| s.woody))?;
+    Ok(out)
+}
+
+fn organ_arrays<'py>(
+    py: Python<'py>,
+    organs: &[sylva::skeleton::SkeletonOrgan],
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("kind", names(py, organs.iter().map(|o| o.kind))?)?;
+    out.set_item("position", columns(py, organs, |o| o.position)?)?;
+    out.set_item("orientation", columns(py, organs, |o| o.orientation)?)?;
+    out.set_item("axis", columns(py, organs, |o| o.axis)?)?;
+    out.set_item("normal", columns(py, organs, |o| o.normal)?)?;
+    out.set_item("length", column(py, organs, |o| o.length))?;
+    out.set_item("width", column(py, organs, |o| o.width))?;
+    out.set_item("parent", column(py, organs, |o| parent_index(o.parent)))?;
+    out.set_item("material", column(py, organs, |o| o.material))?;
+    Ok(out)
 }

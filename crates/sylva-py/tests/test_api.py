@@ -159,13 +159,29 @@ def test_the_skeleton_is_the_plant_as_data():
     assert (skeleton["kind"], skeleton["format"]) == ("sylva-skeleton", 1)
     assert skeleton["origin"]["model"] == "lsystem" and skeleton["origin"]["seed"] == plant.seed
     assert skeleton["taper"] == {"pipe_exponent": 2.5} and skeleton["roots"] is False
-    segments = skeleton["segments"]
-    assert len(segments) == plant.segments and len(skeleton["organs"]) == plant.organs
-    assert not any(s["kind"] == "root" for s in segments)
-    for i, s in enumerate(segments):
-        assert s["parent"] is None or s["parent"] < i
-        assert s["end_radius"] <= s["start_radius"] or not s["woody"]
-    assert skeleton == genome.grow(roots=False, taper=2.5).skeleton()
+    segments, organs = skeleton["segments"], skeleton["organs"]
+    n = plant.segments
+    assert segments["start"].shape == (n, 3) and segments["end"].shape == (n, 3)
+    assert segments["start"].dtype == np.float32 and segments["parent"].dtype == np.int64
+    assert len(segments["kind"]) == n and organs["position"].shape == (plant.organs, 3)
+    assert "root" not in segments["kind"]
+    # Parents come first (-1: none); woody radii taper towards the tips.
+    assert (segments["parent"] < np.arange(n)).all()
+    woody = segments["woody"]
+    assert (segments["end_radius"][woody] <= segments["start_radius"][woody]).all()
+    # The same plant as the skeleton file says, value for value.
+    file = json.loads(plant.skeleton_json())
+    assert file["origin"] == skeleton["origin"] and file["materials"] == skeleton["materials"]
+    for i in (0, n // 2, n - 1):
+        row = file["segments"][i]
+        assert segments["start"][i].tolist() == pytest.approx(row["start"])
+        assert segments["parent"][i] == (-1 if row["parent"] is None else row["parent"])
+        assert segments["kind"][i] == row["kind"] and segments["order"][i] == row["order"]
+    assert [o["kind"] for o in file["organs"]] == organs["kind"]
+    again = genome.grow(roots=False, taper=2.5).skeleton()
+    for part in ("segments", "organs"):
+        for field, values in skeleton[part].items():
+            assert np.array_equal(np.asarray(values), np.asarray(again[part][field])), field
 
 
 def test_cross_keeps_models_apart():
@@ -221,8 +237,12 @@ def test_bad_genome_files_name_the_place(tmp_path):
         sylva.Genome.from_dict({"model": "fern", "format": 1})
     with pytest.raises(ValueError):
         sylva.Genome.from_dict({"model": "bintree", "depth": math.inf})
-    with pytest.raises(sylva.SylvaError):
+    # A file that is not there is Python's own FileNotFoundError (an OSError).
+    with pytest.raises(FileNotFoundError, match="missing.json") as missing:
         sylva.Genome.load(tmp_path / "missing.json")
+    assert missing.value.filename == str(tmp_path / "missing.json")
+    with pytest.raises(OSError):
+        sylva.Config.load(tmp_path / "missing.toml")
 
 
 def test_evolution_steps_checkpoints_and_resumes(tmp_path):

@@ -120,7 +120,7 @@ def test_an_island_that_cannot_start_reports_why():
     config = sylva.Config.from_dict(
         {"model": "plantmaker", "run": {"population": 4}, "plantmaker": {"start": ["missing.json"]}}
     )
-    with pytest.raises(sylva.InputError, match="missing.json"):
+    with pytest.raises(FileNotFoundError, match="missing.json"):
         sylva.islands(config, backend="local", islands=2)
 
 

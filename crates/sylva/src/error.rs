@@ -100,8 +100,13 @@ pub struct InputError {
     pub column: usize,
     /// What is wrong and what was expected.
     pub message: String,
-    /// The text the error is in and the byte range of the offending part.
-    pub snippet: Option<(Arc<str>, Range<usize>)>,
+    /// The text the error is in and the byte range of the offending part (boxed: errors
+    /// stay small to return).
+    pub snippet: Option<Box<(Arc<str>, Range<usize>)>>,
+    /// For a file that could not be opened or read, why, as the system said (not found,
+    /// permission denied), so front ends can raise their own kind of error (Python's
+    /// `FileNotFoundError`).
+    pub io: Option<std::io::ErrorKind>,
 }
 
 impl InputError {
@@ -114,6 +119,7 @@ impl InputError {
             column: 0,
             message: message.to_string(),
             snippet: None,
+            io: None,
         }
     }
 
@@ -161,7 +167,8 @@ impl InputError {
             line,
             column,
             message,
-            snippet: Some((Arc::from(text), start..end)),
+            snippet: Some(Box::new((Arc::from(text), start..end))),
+            io: None,
         }
     }
 

@@ -37,7 +37,10 @@ pub fn read_text(path: &Path) -> Result<String, InputError> {
 /// after `limit` bytes too.
 pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
     use std::io::Read;
-    let cannot = |e: std::io::Error| InputError::file(path, format!("cannot read: {e}"));
+    let cannot = |e: std::io::Error| InputError {
+        io: Some(e.kind()),
+        ..InputError::file(path, format!("cannot read: {e}"))
+    };
     let file = std::fs::File::open(path).map_err(cannot)?;
     if file.metadata().map_err(cannot)?.is_dir() {
         return Err(InputError::file(path, "is a folder, not a file"));
