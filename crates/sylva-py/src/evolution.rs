@@ -301,16 +301,37 @@ fn row<'py>(
 
 #[pymethods]
 impl Evolution {
-    /// Starts a run: generation 0 made and scored. `start` genomes are its first members
-    /// (the config's `start` files when left out); `threads` overrides the config's.
+    /// Starts a run: generation 0 made and scored. `config` is a `Config`, a dict, or the
+    /// path of a config file (as `islands()` takes it). `start` genomes are its first
+    /// members (the config's `start` files when left out); `threads` overrides the config's.
     #[new]
     #[pyo3(signature = (config, start = None, threads = None))]
     fn new(
         py: Python<'_>,
-        config: &Config,
+        config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
         threads: Option<u32>,
     ) -> PyResult<Evolution> {
+        let given;
+        let config: &Config = if let Ok(config) = config.cast::<Config>() {
+            given = config.borrow().clone();
+            &given
+        } else if config.is_instance_of::<pyo3::types::PyDict>() {
+            given = Config::from_dict(config, None)?;
+            &given
+        } else {
+            let path: PathBuf = config.extract().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "expected a Config, a dict or the path of a config file, got {}",
+                    config
+                        .get_type()
+                        .name()
+                        .map_or_else(|_| "?".into(), |n| n.to_string())
+                ))
+            })?;
+            given = Config::load(path)?;
+            &given
+        };
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
             None => config.inner.load_start(&config.base).py()?,

@@ -6,11 +6,13 @@ use pyo3::types::PyDict;
 
 use crate::errors::bad_value;
 
-/// A Python value as JSON; NaN and infinities are refused, naming `what`.
+/// A Python value as JSON; NaN and infinities are refused, naming `what`. numpy scalars and
+/// arrays count as the numbers and lists they hold (`np.float32(0.3)` is 0.3).
 pub fn from_py(value: &Bound<'_, PyAny>, what: &str) -> PyResult<serde_json::Value> {
     let py = value.py();
     let kwargs = PyDict::new(py);
     kwargs.set_item("allow_nan", false)?;
+    kwargs.set_item("default", numpy_values(py)?)?;
     let text: String = py
         .import("json")?
         .call_method("dumps", (value,), Some(&kwargs))
@@ -32,4 +34,21 @@ pub fn pointer(field: &str) -> String {
         .split('.')
         .map(|k| format!("/{}", k.replace('~', "~0").replace('/', "~1")))
         .collect()
+}
+
+/// `json.dumps`'s `default`: a numpy value as the Python value it holds (`tolist()`), and
+/// anything else refused as `json` refuses it.
+fn numpy_values(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyCFunction>> {
+    pyo3::types::PyCFunction::new_closure(py, None, None, |args, _| -> PyResult<Py<PyAny>> {
+        let value = args.get_item(0)?;
+        let kind = value.get_type();
+        let module: String = kind.getattr("__module__")?.extract().unwrap_or_default();
+        if module == "numpy" || module.starts_with("numpy.") {
+            return Ok(value.call_method0("tolist")?.unbind());
+        }
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "Object of type {} is not JSON serializable",
+            kind.name()?
+        )))
+    })
 }

@@ -16,6 +16,7 @@ mod errors;
 mod evolution;
 mod genome;
 mod json;
+mod pair;
 mod plant;
 
 use pyo3::prelude::*;

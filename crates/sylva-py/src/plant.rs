@@ -17,6 +17,7 @@ use sylva::render::View;
 use crate::errors::{IntoPy, bad_value};
 use crate::genome::Genome;
 use crate::json::to_py;
+use crate::pair::Pair;
 
 /// A grown genome: its plant's measures, its mesh, and the files it exports to.
 #[pyclass(module = "sylva", name = "Plant", frozen)]
@@ -175,15 +176,15 @@ impl Plant {
 
     /// Renders a picture of the plant: PNG bytes, also written to `path` when given.
     /// `view` is "front", "side", "top" or "iso"; `size` is (width, height) in pixels.
-    #[pyo3(signature = (path = None, view = "iso", size = (800, 800)))]
+    #[pyo3(signature = (path = None, view = "iso", size = Pair(800, 800)))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         path: Option<PathBuf>,
         view: &str,
-        size: (u32, u32),
+        size: Pair<u32>,
     ) -> PyResult<Bound<'py, PyBytes>> {
-        render(py, &self.grown.scene(), path, view, size)
+        render(py, &self.grown.scene(), path, view, size.into())
     }
 
     fn __repr__(&self) -> String {
@@ -377,15 +378,15 @@ impl Scene {
     }
 
     /// Renders a picture of the scene: PNG bytes, also written to `path` when given.
-    #[pyo3(signature = (path = None, view = "iso", size = (1200, 800)))]
+    #[pyo3(signature = (path = None, view = "iso", size = Pair(1200, 800)))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         path: Option<PathBuf>,
         view: &str,
-        size: (u32, u32),
+        size: Pair<u32>,
     ) -> PyResult<Bound<'py, PyBytes>> {
-        render(py, &self.assets.scene(), path, view, size)
+        render(py, &self.assets.scene(), path, view, size.into())
     }
 
     fn __repr__(&self) -> String {
@@ -433,15 +434,16 @@ fn render<'py>(
 /// Or give `path`, a garden file (`*.garden.json`), to grow the garden it describes.
 /// Releases the GIL.
 #[pyfunction]
-#[pyo3(signature = (genomes = Vec::new(), count = 20, area = (20.0, 20.0), seed = 1, path = None))]
+#[pyo3(signature = (genomes = Vec::new(), count = 20, area = Pair(20.0, 20.0), seed = 1, path = None))]
 pub fn garden(
     py: Python<'_>,
     genomes: Vec<Genome>,
     count: u32,
-    area: (f64, f64),
+    area: Pair<f64>,
     seed: u64,
     path: Option<PathBuf>,
 ) -> PyResult<Scene> {
+    let area: (f64, f64) = area.into();
     let (garden, source) = match path {
         Some(path) => {
             if !genomes.is_empty() {

@@ -337,3 +337,33 @@ def test_gardens_and_scenes():
         sylva.scene(plants, [(0, 0)])
     with pytest.raises(sylva.InputError):
         sylva.scene(plants, [(0, 0), (1, math.inf), (0, 1)])
+
+
+def test_python_values_are_taken_as_python_code_gives_them(tmp_path):
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    plant = tulip.grow(seed=np.int64(3), taper=np.float32(2.5))
+    # A pair is any sequence of two: a tuple, a list, a numpy array.
+    png = plant.render(size=[64, 48])
+    assert png == plant.render(size=(64, 48)) == plant.render(size=np.array([64, 48]))
+    assert struct.unpack(">II", png[16:24]) == (64, 48)
+    with pytest.raises(TypeError, match="two values"):
+        plant.render(size=[64, 48, 2])
+    with pytest.raises(TypeError, match="two values"):
+        plant.render(size="64")
+    assert sylva.garden([tulip], count=2, area=[4, 4]).plants == 2
+    # numpy scalars are the numbers they hold, in fields and dicts.
+    oak = sylva.Genome.load(GENOMES["bintree"])
+    assert oak.with_field("length_ratio", np.float32(0.75))["length_ratio"] == pytest.approx(0.75)
+    assert oak.with_field("depth", np.int64(4))["depth"] == 4
+    config = sylva.Config.from_dict({"run": {"population": np.int64(8), "generations": 1}})
+    assert config.to_dict()["run"]["population"] == 8
+    with pytest.raises(sylva.InputError, match="not JSON"):
+        sylva.Config.from_dict({"run": {"population": {1, 2}}})
+    # A run starts from a Config, a dict or a config file's path, as islands() does.
+    path = tmp_path / "c.toml"
+    path.write_text('model = "bintree"\n[run]\npopulation = 8\ngenerations = 1\nseed = 2\n')
+    runs = [sylva.Evolution(c, threads=1) for c in (sylva.Config.load(path), str(path), path)]
+    runs.append(sylva.Evolution({"model": "bintree", "run": {"population": 8, "seed": 2}}, threads=1))
+    assert len({r.best().genome.to_json() for r in runs}) == 1
+    with pytest.raises(TypeError, match="Config, a dict or the path"):
+        sylva.Evolution(42)
