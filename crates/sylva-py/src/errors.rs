@@ -18,14 +18,66 @@ fn raise(name: &str, message: String, place: Option<&sylva::InputError>) -> PyEr
                 kwargs.set_item("path", e.path.as_ref().map(|p| p.display().to_string()))?;
                 kwargs.set_item("line", e.line)?;
                 kwargs.set_item("column", e.column)?;
-                kwargs.set_item("detail", &e.message)?;
+                kwargs.set_item("detail", in_python_words(&e.message))?;
             }
-            Ok(PyErr::from_value(class.call((message,), Some(&kwargs))?))
+            Ok(PyErr::from_value(
+                class.call((in_python_words(&message),), Some(&kwargs))?,
+            ))
         })();
         // Without the package's Python half (an import of the bare module), the error still
         // comes through, as the exception the import raised.
         made.unwrap_or_else(|e| e)
     })
+}
+
+/// How serde and the library name types and values, and how Python does (`expected u32` is
+/// `expected a non-negative int`); longer names first.
+const PYTHON_WORDS: &[(&str, &str)] = &[
+    ("expected usize", "expected a non-negative int"),
+    ("expected isize", "expected an int"),
+    ("expected u64", "expected a non-negative int"),
+    ("expected u32", "expected a non-negative int"),
+    ("expected u16", "expected a non-negative int"),
+    ("expected u8", "expected a non-negative int"),
+    ("expected i64", "expected an int"),
+    ("expected i32", "expected an int"),
+    ("expected i16", "expected an int"),
+    ("expected i8", "expected an int"),
+    ("expected f64", "expected a float"),
+    ("expected f32", "expected a float"),
+    ("expected a string", "expected a str"),
+    ("expected a boolean", "expected a bool"),
+    ("expected a sequence", "expected a list"),
+    ("expected a map", "expected a dict"),
+    ("boolean `true`", "bool True"),
+    ("boolean `false`", "bool False"),
+    ("floating point `", "float `"),
+    ("integer `", "int `"),
+    ("type: string", "type: str"),
+    ("type: sequence", "type: list"),
+    ("type: map", "type: dict"),
+    ("unit value", "None"),
+];
+
+/// `message` in Python's words for types and values ([`PYTHON_WORDS`]); a word is replaced
+/// only where it ends (`u8` is not the start of `u80`).
+fn in_python_words(message: &str) -> String {
+    let mut out = message.to_owned();
+    for (rust, python) in PYTHON_WORDS {
+        let mut from = 0;
+        while let Some(at) = out[from..].find(rust).map(|i| i + from) {
+            let end = at + rust.len();
+            let whole = rust.ends_with(['`', ' '])
+                || !out[end..].starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_');
+            if whole {
+                out.replace_range(at..end, python);
+                from = at + python.len();
+            } else {
+                from = end;
+            }
+        }
+    }
+    out
 }
 
 /// An [`sylva::InputError`] as a Python `InputError` with its place; a file that is not
@@ -82,5 +134,29 @@ impl<T> IntoPy<T> for Result<T, sylva::Error> {
 impl<T> IntoPy<T> for Result<T, sylva::InputError> {
     fn py(self) -> PyResult<T> {
         self.map_err(|e| input_error(&e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::in_python_words;
+
+    #[test]
+    fn messages_speak_python() {
+        assert_eq!(
+            in_python_words("invalid type: string \"abc\", expected i64"),
+            "invalid type: str \"abc\", expected an int"
+        );
+        assert_eq!(
+            in_python_words("invalid value: integer `-1`, expected u64"),
+            "invalid value: int `-1`, expected a non-negative int"
+        );
+        assert_eq!(
+            in_python_words("invalid type: boolean `true`, expected f64"),
+            "invalid type: bool True, expected a float"
+        );
+        // Only whole words: a name that merely starts like one is left alone.
+        assert_eq!(in_python_words("expected u80"), "expected u80");
+        assert_eq!(in_python_words("expected a stringy"), "expected a stringy");
     }
 }

@@ -367,3 +367,15 @@ def test_python_values_are_taken_as_python_code_gives_them(tmp_path):
     assert len({r.best().genome.to_json() for r in runs}) == 1
     with pytest.raises(TypeError, match="Config, a dict or the path"):
         sylva.Evolution(42)
+
+
+def test_messages_speak_python():
+    with pytest.raises(sylva.InputError) as e:
+        sylva.Config.from_dict({"run": {"population": "abc"}})
+    assert 'str "abc", expected an int' in str(e.value), str(e.value)
+    with pytest.raises(sylva.InputError) as e:
+        sylva.Config.from_dict({"run": {"seed": -1}})
+    assert "expected a non-negative int" in str(e.value) and "u64" not in str(e.value)
+    with pytest.raises(sylva.InputError) as e:
+        sylva.Genome.from_dict({"model": "bintree", "format": 1, "depth": True})
+    assert "bool True" in str(e.value) and "i64" not in e.value.detail
