@@ -29,7 +29,7 @@ const DICT: &str = "<config dict>";
 
 impl Config {
     fn parse(text: &str, source: &Path, base: PathBuf) -> PyResult<Config> {
-        let inner = sylva::Config::parse(source, text).py()?;
+        let inner = crate::registry().parse_config(source, text).py()?;
         Ok(Config { inner, base })
     }
 
@@ -41,7 +41,8 @@ impl Config {
             run.insert(field.to_owned(), value);
         }
         let text = toml::to_string(&table).map_err(|e| bad_value(field, e))?;
-        let inner = sylva::Config::parse(Path::new(DICT), &text)
+        let inner = (self.inner.registry())
+            .parse_config(Path::new(DICT), &text)
             .map_err(|e| field_error(e, &text))
             .map_err(|e| input_error(&e))?;
         Ok(Config {
@@ -82,7 +83,7 @@ impl Config {
     /// Reads a config file; genome files it names are found next to it.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Config> {
-        let inner = sylva::Config::load(&path).py()?;
+        let inner = crate::registry().load_config(&path).py()?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(Config { inner, base })
     }
@@ -103,7 +104,8 @@ impl Config {
         let value = from_py(data, "config dict")?;
         let text =
             toml::to_string(&value).map_err(|e| bad_value(DICT, format!("not a config: {e}")))?;
-        let inner = sylva::Config::parse(Path::new(DICT), &text)
+        let inner = crate::registry()
+            .parse_config(Path::new(DICT), &text)
             .map_err(|e| input_error(&field_error(e, &text)))?;
         Ok(Config {
             inner,
@@ -111,11 +113,12 @@ impl Config {
         })
     }
 
-    /// The default config (binary trees, every setting at its default).
+    /// The default config (of the first model, binary trees, every setting at its
+    /// default).
     #[staticmethod]
     fn default() -> Config {
         Config {
-            inner: sylva::Config::default(),
+            inner: crate::registry().default_config().unwrap_or_default(),
             base: PathBuf::new(),
         }
     }

@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sylva::Registry;
 
 use crate::errors::{IntoPy, bad_value};
 use crate::json::{from_py, pointer, to_py};
@@ -22,7 +21,10 @@ pub struct Genome {
 
 impl Genome {
     fn parse(text: &str, source: &str) -> PyResult<Genome> {
-        let inner = sylva::parse_genome(Path::new(source), text).py()?;
+        let inner = crate::registry()
+            .parse_genome(text)
+            .map_err(|e| sylva::InputError::genome(Path::new(source), text, e))
+            .py()?;
         Ok(Genome { inner })
     }
 
@@ -38,7 +40,7 @@ impl Genome {
     /// Reads a genome file of any model.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Genome> {
-        let inner = sylva::load_genome(&path).py()?;
+        let inner = crate::registry().load_genome(&path).py()?;
         Ok(Genome { inner })
     }
 
@@ -62,7 +64,7 @@ impl Genome {
     #[staticmethod]
     #[pyo3(signature = (model, seed, settings = None))]
     fn random(model: &str, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
-        let registry = Registry::standard();
+        let registry = crate::registry();
         let entry = registry.get(model).ok_or_else(|| {
             let names: Vec<&str> = registry.models().iter().map(|m| m.name()).collect();
             bad_value(
@@ -153,8 +155,9 @@ impl Genome {
         })?;
         *slot = new;
         let text = serde_json::to_string_pretty(&genome).unwrap_or_default();
-        let inner = Registry::standard()
-            .parse_genome(&text)
+        let inner = self
+            .inner
+            .reparse(&text)
             .map_err(|e| bad_value(field, e.message))?;
         Ok(Genome { inner })
     }
@@ -285,7 +288,7 @@ pub fn _rust_grow_seconds(
 #[pyfunction]
 pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let dict = PyDict::new(py);
-    for m in Registry::standard().models() {
+    for m in crate::registry().models() {
         dict.set_item(m.name(), m.title())?;
     }
     Ok(dict)

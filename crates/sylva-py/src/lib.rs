@@ -9,6 +9,9 @@
 //! - [`evolution`]: `Config`, `Evolution` (step, browse, checkpoint, migrants), `Member`;
 //! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`.
 //!
+//! The module reads and makes genomes and configs with the models it was made with
+//! ([`init`]): Sylva's four, or a registry of a crate's own.
+//!
 //! Calls that grow, mesh, render, write or breed release the GIL. The pure-Python half
 //! (`python/sylva`) adds island evolution on Ray or a local process pool.
 
@@ -19,11 +22,53 @@ mod json;
 mod pair;
 mod plant;
 
-use pyo3::prelude::*;
+use std::sync::OnceLock;
 
-/// Sylva's native module.
+use pyo3::prelude::*;
+use sylva::Registry;
+
+/// The models this module knows, given when the module is made ([`init`]).
+static MODELS: OnceLock<Registry> = OnceLock::new();
+
+/// The models genome files, configs and random genomes are read and made with: the
+/// registry the module was made with, or Sylva's four.
+pub(crate) fn registry() -> &'static Registry {
+    MODELS.get().unwrap_or(Registry::standard())
+}
+
+/// Sylva's native module, with Sylva's four models.
+#[cfg(feature = "module")]
 #[pymodule]
 fn _sylva(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    init(m, Registry::standard().clone())
+}
+
+/// Fills `m` with Sylva's classes and functions, reading and making genomes and configs
+/// with `registry`. A crate that adds its own models builds its module with this (and this
+/// crate without its default `module` feature):
+///
+/// ```ignore
+/// #[pymodule]
+/// fn _mytrees(m: &Bound<'_, PyModule>) -> PyResult<()> {
+///     let models = sylva::Registry::standard().clone().with(ModelEntry::of::<MyModel>());
+///     _sylva::init(m, models)
+/// }
+/// ```
+///
+/// A process holds one registry: making a second module with other models raises
+/// `ImportError`.
+pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
+    let names = |r: &Registry| r.models().iter().map(|e| e.name()).collect::<Vec<_>>();
+    let wanted = names(&registry);
+    let held = names(MODELS.get_or_init(|| registry));
+    if held != wanted {
+        return Err(pyo3::exceptions::PyImportError::new_err(format!(
+            "Sylva's native module is already loaded in this process with the models {}; \
+             it cannot also be loaded with {}",
+            held.join(", "),
+            wanted.join(", ")
+        )));
+    }
     m.add_class::<genome::Genome>()?;
     m.add_class::<plant::Plant>()?;
     m.add_class::<plant::Mesh>()?;

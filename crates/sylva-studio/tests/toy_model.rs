@@ -74,7 +74,7 @@ fn grid(session: &Value) -> Vec<i64> {
 fn a_studio_of_a_users_registry_breeds_its_models() {
     let registry = Registry::standard()
         .clone()
-        .with(ModelEntry::evolvable::<Cylinder>());
+        .with(ModelEntry::of::<Cylinder>());
     let (studio, dir) = studio("own", registry);
     // Listed, with the modes that hold every model's plants.
     let models = json_of(&studio, "GET", "/api/models", None);

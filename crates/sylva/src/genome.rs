@@ -1,49 +1,25 @@
 //! A genome of any model ([`Genome`]), read from files, grown, and varied by hand.
 //!
-//! A `Genome` holds a model's typed genome and the model itself, behind one object-safe
-//! trait, so front ends handle genomes of any model alike while every operation runs the
-//! model's own code. [`Genome::get`] gives the typed genome back for model-specific work.
+//! A `Genome` holds a model's typed genome beside the model's handle (the crate's one
+//! object-safe face of a model, `erased.rs`), so front ends handle genomes of any model
+//! alike while every operation runs the model's own code. [`Genome::get`] gives the typed genome back for model-specific work.
 
-use std::any::Any;
 use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
 use sylva_core::Plant;
-use sylva_core::rng::ChaCha8Rng;
-use sylva_model::{
-    Bred, DevelopError, GenomeError, Knobs, MeshHint, Model, Parent, VariationError,
-};
+use sylva_model::{Evolve, GenomeError, Knobs, MeshHint, Model, VariationError};
 
+use crate::erased::{DynModel, Value};
 use crate::error::{Error, InputError};
 use crate::registry::Registry;
 
 /// A genome of any model.
 #[derive(Clone)]
 pub struct Genome {
-    inner: Arc<dyn AnyGenome>,
-}
-
-/// What every typed genome can do, object-safe. Implemented once, for [`Typed`].
-trait AnyGenome: Send + Sync {
-    fn model_name(&self) -> &'static str;
-    fn title(&self) -> &'static str;
-    fn as_any(&self) -> &dyn Any;
-    fn to_json(&self) -> String;
-    fn to_value(&self) -> serde_json::Value;
-    fn develop(&self, seed: u64) -> Result<Plant, DevelopError>;
-    fn default_seed(&self) -> u64;
-    fn mesh_hint(&self) -> MeshHint;
-    fn growth_seconds(&self) -> Option<f64>;
-    fn packed(&self) -> Option<String>;
-    fn same(&self, other: &dyn AnyGenome) -> bool;
-    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError>;
-    fn cross(
-        &self,
-        parents: &[(&Genome, f64)],
-        settings: Settings<'_>,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<(Genome, Vec<usize>), Error>;
+    model: Arc<dyn DynModel>,
+    genome: Arc<Value>,
 }
 
 /// What breeding by hand follows.
@@ -66,18 +42,6 @@ impl<'a> From<Option<&'a serde_json::Value>> for Settings<'a> {
     }
 }
 
-/// A model's genome with the model it belongs to.
-struct Typed<M: Model> {
-    model: M,
-    genome: M::Genome,
-}
-
-impl<M: Model> Typed<M> {
-    fn settings(&self, settings: Settings<'_>) -> Result<M::Settings, InputError> {
-        settings_of(&self.model, settings)
-    }
-}
-
 /// Model `M`'s settings for `settings`.
 pub(crate) fn settings_of<M: Model>(
     model: &M,
@@ -91,115 +55,39 @@ pub(crate) fn settings_of<M: Model>(
     }
 }
 
-impl<M: Model> AnyGenome for Typed<M> {
-    fn model_name(&self) -> &'static str {
-        M::NAME
-    }
-
-    fn title(&self) -> &'static str {
-        M::TITLE
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        &self.genome
-    }
-
-    fn to_json(&self) -> String {
-        self.model.write(&self.genome)
-    }
-
-    fn packed(&self) -> Option<String> {
-        self.model.packed(&self.genome)
-    }
-
-    fn to_value(&self) -> serde_json::Value {
-        serde_json::to_value(&self.genome).unwrap_or(serde_json::Value::Null)
-    }
-
-    fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
-        self.model.develop(&self.genome, seed)
-    }
-
-    fn default_seed(&self) -> u64 {
-        self.model.default_seed(&self.genome)
-    }
-
-    fn mesh_hint(&self) -> MeshHint {
-        self.model.mesh_hint()
-    }
-
-    fn growth_seconds(&self) -> Option<f64> {
-        self.model.growth_seconds(&self.genome)
-    }
-
-    fn same(&self, other: &dyn AnyGenome) -> bool {
-        other.model_name() == M::NAME
-            && other
-                .as_any()
-                .downcast_ref::<M::Genome>()
-                .is_some_and(|g| *g == self.genome)
-    }
-
-    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError> {
-        let settings = self.settings(settings)?;
-        let child = self.model.mutate(&self.genome, &settings, rng);
-        Ok(Genome::new(self.model.clone(), child))
-    }
-
-    fn cross(
-        &self,
-        parents: &[(&Genome, f64)],
-        settings: Settings<'_>,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<(Genome, Vec<usize>), Error> {
-        let settings = self.settings(settings)?;
-        let mut typed = Vec::with_capacity(parents.len());
-        for (i, (g, dominance)) in parents.iter().enumerate() {
-            let genome = g.get::<M>().ok_or_else(|| {
-                InputError::new(
-                    format!("parent {i}"),
-                    format!(
-                        "a `{}` genome cannot be crossed with `{}` genomes",
-                        g.model(),
-                        M::NAME
-                    ),
-                )
-            })?;
-            typed.push(Parent {
-                genome,
-                dominance: *dominance,
-            });
-        }
-        let Bred { genome, parents } = self
-            .model
-            .cross(&typed, &settings, rng)
-            .map_err(|e: VariationError| InputError::new("parents", e))?;
-        Ok((Genome::new(self.model.clone(), genome), parents))
-    }
-}
-
 impl Genome {
     /// A genome of `model`.
-    pub fn new<M: Model>(model: M, genome: M::Genome) -> Genome {
+    pub fn new<M: Evolve + Default>(model: M, genome: M::Genome) -> Genome {
+        Genome::erased(Arc::new(model), Box::new(genome))
+    }
+
+    /// `genome`, made by `model`.
+    pub(crate) fn erased(model: Arc<dyn DynModel>, genome: Box<Value>) -> Genome {
         Genome {
-            inner: Arc::new(Typed { model, genome }),
+            model,
+            genome: genome.into(),
         }
+    }
+
+    /// A genome of this genome's model.
+    fn sibling(&self, genome: Box<Value>) -> Genome {
+        Genome::erased(self.model.clone(), genome)
     }
 
     /// The model's name in files.
     pub fn model(&self) -> &'static str {
-        self.inner.model_name()
+        self.model.name()
     }
 
     /// The model's title.
     pub fn title(&self) -> &'static str {
-        self.inner.title()
+        self.model.title()
     }
 
     /// A short text form a person can copy and paste, for a model that has one
     /// ([`sylva_model::Model::packed`]).
     pub fn packed(&self) -> Option<String> {
-        self.inner.packed()
+        self.model.packed(&*self.genome)
     }
 
     /// The typed genome, if this is a genome of model `M`.
@@ -207,48 +95,57 @@ impl Genome {
         if self.model() != M::NAME {
             return None;
         }
-        self.inner.as_any().downcast_ref::<M::Genome>()
+        self.genome.downcast_ref::<M::Genome>()
     }
 
     /// The genome file's text: pretty JSON ending with a newline.
     pub fn to_json(&self) -> String {
-        self.inner.to_json()
+        self.model.write(&*self.genome)
     }
 
     /// The genome as a JSON value (for the extras of exported assets).
     pub fn to_value(&self) -> serde_json::Value {
-        self.inner.to_value()
+        self.model.to_value(&*self.genome)
+    }
+
+    /// A genome of the same model from a genome file's text (a field changed by hand);
+    /// errors carry the line and column.
+    pub fn reparse(&self, text: &str) -> Result<Genome, GenomeError> {
+        Ok(self.sibling(self.model.parse_genome(text)?))
     }
 
     /// Grows the plant with `seed`.
     pub fn develop(&self, seed: u64) -> Result<Plant, Error> {
-        self.inner.develop(seed).map_err(|source| Error::Develop {
-            model: self.model(),
-            source,
-        })
+        self.model
+            .develop(&*self.genome, seed)
+            .map_err(|source| Error::Develop {
+                model: self.model(),
+                source,
+            })
     }
 
     /// The seed the genome grows with when none is given.
     pub fn default_seed(&self) -> u64 {
-        self.inner.default_seed()
+        self.model.default_seed(&*self.genome)
     }
 
     /// How the model's plants are best meshed.
     pub fn mesh_hint(&self) -> MeshHint {
-        self.inner.mesh_hint()
+        self.model.mesh_hint()
     }
 
     /// Seconds growing it may take on one core, for models whose growth can take long
     /// (L-system plants); `None` for the others.
     pub fn growth_seconds(&self) -> Option<f64> {
-        self.inner.growth_seconds()
+        self.model.growth_seconds(&*self.genome)
     }
 
     /// A mutated copy, made by the model's own mutation with `settings` (the model's
     /// settings as JSON, or its defaults), drawing from the stream of `seed`.
     pub fn mutate(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, Error> {
         let mut rng = sylva_core::rng::seeded(seed);
-        Ok(self.inner.mutate(settings, &mut rng)?)
+        let child = self.model.mutate(&*self.genome, settings, &mut rng)?;
+        Ok(self.sibling(child))
     }
 
     /// A child of two or more parents of one model, each with a dominance weight, made by
@@ -262,13 +159,14 @@ impl Genome {
             return Err(InputError::new("parents", VariationError::TooFewParents(0)).into());
         };
         let mut rng = sylva_core::rng::seeded(seed);
-        first.inner.cross(parents, settings, &mut rng)
+        let (child, gave) = first.model.cross(parents, settings, &mut rng)?;
+        Ok((first.sibling(child), gave))
     }
 }
 
 impl PartialEq for Genome {
     fn eq(&self, other: &Genome) -> bool {
-        self.inner.same(other.inner.as_ref())
+        self.model() == other.model() && self.model.same(&*self.genome, &*other.genome)
     }
 }
 

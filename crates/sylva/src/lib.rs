@@ -43,6 +43,7 @@
 
 pub mod assets;
 pub mod biomorph;
+mod erased;
 pub mod error;
 pub mod evolution;
 pub mod experiment;

@@ -2,117 +2,72 @@
 //! files and evolution configs name their model; the registry reads the name and hands the
 //! rest to that model.
 //!
-//! Adding a model is its crate (a type that implements [`Model`], and [`Evolve`] if it
-//! evolves) and one line in [`Registry::standard`]. A front end can also build a registry
+//! Adding a model is its crate (a type that implements [`Model`](sylva_model::Model) and
+//! [`Evolve`]) and one line in [`Registry::standard`]. A front end can also build a registry
 //! of its own ([`Registry::with`]), as the test that adds a toy model does.
 
 use std::path::Path;
-use std::sync::LazyLock;
+use std::sync::{Arc, LazyLock};
 
 use serde::Deserialize;
 use sylva_automata::AutomataModel;
 use sylva_bintree::BinTreeModel;
 use sylva_lsystem::LSystemModel;
-use sylva_model::{Evolve, GenomeError, Model};
+use sylva_model::{Evolve, GenomeError};
 use sylva_plantmaker::PlantMakerModel;
 
+use crate::erased::DynModel;
 use crate::error::{FieldError, InputError};
-use crate::evolution::{Config, EvolveConfig};
+use crate::evolution::Config;
 use crate::genome::{Genome, Settings};
 
-/// A model the library knows: its name and title, how to read its genome files and make
-/// random genomes, and, if it evolves, how to read its configs.
-#[derive(Clone, Copy)]
+/// A model the library knows: its name and title, how to read its genome files, configs
+/// and checkpoints, make random genomes and run its evolution.
+#[derive(Clone)]
 pub struct ModelEntry {
-    name: &'static str,
-    title: &'static str,
-    parse: fn(&str) -> Result<Genome, GenomeError>,
-    random: fn(Settings<'_>, u64) -> Result<Genome, InputError>,
-    evolve: Option<EvolveEntry>,
-}
-
-/// What an entry of a model that evolves adds.
-#[derive(Clone, Copy)]
-struct EvolveEntry {
-    parse_config: fn(&Path, &str) -> Result<Config, InputError>,
-    config_from_value: fn(serde_json::Value) -> Result<Config, FieldError>,
-    default_config: fn() -> Config,
+    model: Arc<dyn DynModel>,
 }
 
 impl ModelEntry {
-    /// A model that grows and is varied by hand.
-    pub fn model<M: Model + Default>() -> ModelEntry {
+    /// Model `M`, with its default settings.
+    pub fn of<M: Evolve + Default>() -> ModelEntry {
         ModelEntry {
-            name: M::NAME,
-            title: M::TITLE,
-            parse: parse::<M>,
-            random: random::<M>,
-            evolve: None,
-        }
-    }
-
-    /// A model that also evolves without a person.
-    pub fn evolvable<M: Evolve + Default>() -> ModelEntry {
-        ModelEntry {
-            evolve: Some(EvolveEntry {
-                parse_config: parse_config::<M>,
-                config_from_value: config_from_value::<M>,
-                default_config: || Config::new(EvolveConfig::<M>::default()),
-            }),
-            ..ModelEntry::model::<M>()
+            model: Arc::new(M::default()),
         }
     }
 
     /// The model's name in files.
     pub fn name(&self) -> &'static str {
-        self.name
+        self.model.name()
     }
 
     /// The model's title.
     pub fn title(&self) -> &'static str {
-        self.title
-    }
-
-    /// Whether the model evolves without a person.
-    pub fn evolves(&self) -> bool {
-        self.evolve.is_some()
+        self.model.title()
     }
 
     /// A random genome, made by the model with `settings` (its settings as JSON, or its
     /// defaults) from the stream of `seed`.
     pub fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
-        (self.random)(settings, seed)
+        let genome = self.model.random(settings, seed)?;
+        Ok(Genome::erased(self.model.clone(), genome))
     }
-}
 
-fn parse<M: Model + Default>(text: &str) -> Result<Genome, GenomeError> {
-    let model = M::default();
-    let genome = model.parse(text)?;
-    Ok(Genome::new(model, genome))
-}
+    /// The model's default config.
+    pub fn default_config(&self) -> Config {
+        Config::erased(self.model.clone(), self.model.default_config())
+    }
 
-fn random<M: Model + Default>(settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
-    let model = M::default();
-    let settings = crate::genome::settings_of(&model, settings)?;
-    let genome = model.random(&settings, &mut sylva_core::rng::seeded(seed));
-    Ok(Genome::new(model, genome))
-}
-
-fn parse_config<M: Evolve + Default>(path: &Path, text: &str) -> Result<Config, InputError> {
-    EvolveConfig::<M>::parse(path, text).map(Config::new)
-}
-
-fn config_from_value<M: Evolve + Default>(value: serde_json::Value) -> Result<Config, FieldError> {
-    let sent = value.clone();
-    serde_path_to_error::deserialize::<_, EvolveConfig<M>>(value)
-        .map(Config::new)
-        .map_err(|e| FieldError::of(&e, &sent))
+    fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError> {
+        let genome = self.model.parse_genome(text)?;
+        Ok(Genome::erased(self.model.clone(), genome))
+    }
 }
 
 impl std::fmt::Debug for Registry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_list()
-            .entries(self.models.iter().map(|m| m.name))
+            .entries(self.models.iter().map(|m| m.name()))
             .finish()
     }
 }
@@ -140,10 +95,10 @@ pub mod names {
 
 static STANDARD: LazyLock<Registry> = LazyLock::new(|| {
     Registry::new()
-        .with(ModelEntry::evolvable::<BinTreeModel>())
-        .with(ModelEntry::evolvable::<AutomataModel>())
-        .with(ModelEntry::evolvable::<PlantMakerModel>())
-        .with(ModelEntry::evolvable::<LSystemModel>())
+        .with(ModelEntry::of::<BinTreeModel>())
+        .with(ModelEntry::of::<AutomataModel>())
+        .with(ModelEntry::of::<PlantMakerModel>())
+        .with(ModelEntry::of::<LSystemModel>())
 });
 
 /// Reads the header of a genome file (`model` and `format`; every other field is the
@@ -177,7 +132,7 @@ impl<'de> serde::de::Visitor<'de> for HeaderSeed<'_> {
                             self.0.names()
                         ))
                     })?;
-                    model = Some(entry.name);
+                    model = Some(entry.name());
                 }
                 "format" => {
                     map.next_value::<sylva_model::FormatV1>()?;
@@ -211,7 +166,7 @@ impl Registry {
 
     /// This registry and one more model (a model of the same name is replaced).
     pub fn with(mut self, entry: ModelEntry) -> Registry {
-        self.models.retain(|m| m.name != entry.name);
+        self.models.retain(|m| m.name() != entry.name());
         self.models.push(entry);
         self
     }
@@ -223,11 +178,11 @@ impl Registry {
 
     /// A model by name.
     pub fn get(&self, name: &str) -> Option<&ModelEntry> {
-        self.models.iter().find(|m| m.name == name)
+        self.models.iter().find(|m| m.name() == name)
     }
 
     fn names(&self) -> String {
-        let names: Vec<&str> = self.models.iter().map(|m| m.name).collect();
+        let names: Vec<&str> = self.models.iter().map(|m| m.name()).collect();
         names.join(", ")
     }
 
@@ -253,7 +208,7 @@ impl Registry {
         let name = HeaderSeed(self).deserialize(&mut de)?;
         de.end()?;
         match name.and_then(|n| self.get(n)) {
-            Some(entry) => (entry.parse)(text),
+            Some(entry) => entry.parse_genome(text),
             None => Err(GenomeError {
                 message: format!(
                     "missing field `model`: a genome file names its model, one of: {}",
@@ -265,8 +220,8 @@ impl Registry {
         }
     }
 
-    /// Parses an evolution config of any model that evolves; `model` defaults to the first
-    /// model. Errors point into `text`.
+    /// Parses an evolution config of any model; `model` defaults to the first model.
+    /// Errors point into `text`.
     pub fn parse_config(&self, path: &Path, text: &str) -> Result<Config, InputError> {
         #[derive(Deserialize)]
         struct ConfigHeader {
@@ -274,47 +229,39 @@ impl Registry {
         }
         let header: ConfigHeader =
             toml::from_str(text).map_err(|e| InputError::toml(path, text, &e))?;
-        let (entry, span) = match &header.model {
-            Some(name) => (self.get(name.get_ref()), Some(name.span())),
-            None => (self.models.first(), None),
+        let entry = match &header.model {
+            Some(name) => self.get(name.get_ref()).ok_or_else(|| {
+                InputError::spanned(
+                    path,
+                    text,
+                    name.span(),
+                    format!(
+                        "unknown model `{}`; expected one of: {}",
+                        name.get_ref(),
+                        self.names()
+                    ),
+                )
+            })?,
+            None => self.first().map_err(|e| InputError::file(path, e))?,
         };
-        let evolvable: Vec<&str> = self
-            .models
-            .iter()
-            .filter(|m| m.evolves())
-            .map(|m| m.name)
-            .collect();
-        let refuse = |message: String| match span.clone() {
-            Some(span) => InputError::spanned(path, text, span, message),
-            None => InputError::file(path, message),
-        };
-        let name = header.model.as_ref().map(|n| n.get_ref().as_str());
-        match entry.and_then(|e| e.evolve) {
-            Some(evolve) => {
-                (evolve.parse_config)(path, text).map(|c| c.read_with(Some(path), self))
-            }
-            None if entry.is_some() => Err(refuse(format!(
-                "model `{}` does not evolve without a person; models that do: {}",
-                name.unwrap_or_default(),
-                evolvable.join(", ")
-            ))),
-            None => Err(refuse(format!(
-                "unknown model `{}`; expected one of: {}",
-                name.unwrap_or_default(),
-                evolvable.join(", ")
-            ))),
-        }
+        let config = entry.model.parse_config(path, text)?;
+        Ok(Config::erased(entry.model.clone(), config).read_with(Some(path), self))
     }
 
-    /// A config of any model that evolves, built as values rather than read from a file
-    /// (a front end's form): the same fields and checks as a config file's, as JSON
+    /// A config of any model, built as values rather than read from a file (a front end's
+    /// form): the same fields and checks as a config file's, as JSON
     /// (`{"model": "automata", "run": {...}, "automata": {...}}`; `model` defaults to the
     /// first model). An error names the field by its path in `value`
     /// (`automata.fitness.target.radius`).
     pub fn config_from_value(&self, value: serde_json::Value) -> Result<Config, FieldError> {
-        let name = match value.get("model") {
-            None => self.models.first().map(|m| m.name),
-            Some(serde_json::Value::String(name)) => Some(name.as_str()),
+        let entry = match value.get("model") {
+            None => self.first().map_err(|e| FieldError::new("model", e))?,
+            Some(serde_json::Value::String(name)) => self.get(name).ok_or_else(|| {
+                FieldError::new(
+                    "model",
+                    format!("unknown model `{name}`; expected one of: {}", self.names()),
+                )
+            })?,
             Some(other) => {
                 return Err(FieldError::new(
                     "model",
@@ -322,33 +269,19 @@ impl Registry {
                 ));
             }
         };
-        let entry = name.and_then(|n| self.get(n));
-        match entry.and_then(|e| e.evolve) {
-            Some(evolve) => (evolve.config_from_value)(value).map(|c| c.read_with(None, self)),
-            None => {
-                let evolvable: Vec<&str> = self
-                    .models
-                    .iter()
-                    .filter(|m| m.evolves())
-                    .map(|m| m.name)
-                    .collect();
-                Err(FieldError::new(
-                    "model",
-                    format!(
-                        "`{}` is not a model that evolves; expected one of: {}",
-                        name.unwrap_or_default(),
-                        evolvable.join(", ")
-                    ),
-                ))
-            }
-        }
+        let config = entry.model.config_from_value(value)?;
+        Ok(Config::erased(entry.model.clone(), config).read_with(None, self))
     }
 
-    /// The default config of the first model that evolves (none if no model does).
+    /// The default config of the first model (none if the registry is empty).
     pub fn default_config(&self) -> Option<Config> {
+        self.models.first().map(ModelEntry::default_config)
+    }
+
+    /// The first model, the default of configs that name none.
+    fn first(&self) -> Result<&ModelEntry, String> {
         self.models
-            .iter()
-            .find_map(|m| m.evolve)
-            .map(|e| (e.default_config)())
+            .first()
+            .ok_or_else(|| "this registry has no models".to_owned())
     }
 }

@@ -280,7 +280,7 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     // The registry line: the standard four and the cylinder (`sylva_testkit::toy`).
     let registry = Registry::standard()
         .clone()
-        .with(ModelEntry::evolvable::<Cylinder>());
+        .with(ModelEntry::of::<Cylinder>());
     let text = r#"{"model": "cylinder", "format": 1, "height": 2.5, "radius": 0.2}"#;
     let genome = registry.parse_genome(text).unwrap();
     assert_eq!(genome.model(), "cylinder");

@@ -261,7 +261,6 @@ pub(crate) async fn events(
 pub(crate) struct ModelInfo {
     name: &'static str,
     title: &'static str,
-    evolves: bool,
     /// The modes whose sessions hold its plants.
     modes: Vec<ModeName>,
     /// The model a new breed session starts with.
@@ -282,7 +281,6 @@ pub(crate) async fn models(State(studio): State<Studio>) -> Json<Vec<ModelInfo>>
             .map(|m| ModelInfo {
                 name: m.name(),
                 title: m.title(),
-                evolves: m.evolves(),
                 modes: per_mode
                     .iter()
                     .filter(|(_, models)| models.contains(&m.name()))

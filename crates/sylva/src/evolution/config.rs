@@ -1,23 +1,26 @@
 //! A config of any model ([`Config`]), and what it takes to start or resume a run of it.
 
-use std::any::Any;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use sylva_core::par::Pool;
 use sylva_evolve::{Run, RunSettings};
 use sylva_model::Evolve;
 
+use crate::erased::{DynModel, Value};
 use crate::error::{Error, FieldError, InputError};
 use crate::genome::Genome;
 use crate::registry::Registry;
 
 use super::checkpoint::SavedRun;
-use super::run::Evolution;
+use super::run::TypedRun;
 use super::schema::{EvolveConfig, OutputConfig, RunConfig};
 
 /// An evolution config of any model.
 pub struct Config {
-    pub(super) inner: Box<dyn AnyConfig>,
+    model: Arc<dyn DynModel>,
+    /// The model's `EvolveConfig`.
+    config: Box<Value>,
     /// The file it was read from, named in errors.
     source: Option<PathBuf>,
     /// The registry it was read with, which reads its start genomes; `None`: the standard.
@@ -41,97 +44,95 @@ pub struct GenerationTime {
     pub advice: String,
 }
 
-/// What every typed config can do, object-safe. Implemented once, for [`EvolveConfig`].
-pub(super) trait AnyConfig: Send + Sync {
-    fn model(&self) -> &'static str;
-    fn run(&self) -> &RunConfig;
-    fn run_mut(&mut self) -> &mut RunConfig;
-    fn output(&self) -> &OutputConfig;
-    fn to_toml(&self) -> String;
-    fn start_files(&self) -> Vec<PathBuf>;
-    fn clone_box(&self) -> Box<dyn AnyConfig>;
-    fn as_any(&self) -> &dyn Any;
-    fn start(&self, source: &str, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error>;
-    fn resume(&self, source: &str, path: &Path, text: &str, pool: Pool)
-    -> Result<Evolution, Error>;
-    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime>;
+/// Starts a run of `config`: generation 0 made and evaluated. A refusal names the config
+/// (`source`).
+pub(crate) fn start<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    source: &str,
+    start: Vec<Genome>,
+    pool: Pool,
+) -> Result<TypedRun<M>, Error> {
+    let mut typed = Vec::with_capacity(start.len());
+    for (i, g) in start.iter().enumerate() {
+        typed.push(g.get::<M>().cloned().ok_or_else(|| {
+            InputError::new(
+                format!("start genome {}", i + 1),
+                format!(
+                    "this run evolves `{}` genomes; this is a `{}` genome",
+                    M::NAME,
+                    g.model()
+                ),
+            )
+        })?);
+    }
+    let (seed, population) = (config.run.seed, config.run.population as usize);
+    // A population and its offspring, each genome at the settings' bounds.
+    let genome = config.model.genome_bytes(&config.settings);
+    sylva_core::budget::check(
+        (population as u64).saturating_mul(genome).saturating_mul(2),
+        format_args!("a population of {population} (`population`)"),
+        "breed a smaller population, or smaller genomes",
+    )
+    .map_err(|e| InputError::new(source, e))?;
+    let setup = setup(
+        &config.model,
+        &config.settings,
+        typed,
+        seed,
+        population,
+        source,
+    )?;
+    // The settings are valid; generation 0 grows as the run is made.
+    if let Some(t) = config.generation_time(&start, pool.threads()) {
+        sylva_core::budget::check_time(t.seconds, t.what, t.advice)
+            .map_err(|e| InputError::new(source, e))?;
+    }
+    let settings = RunSettings {
+        seed,
+        population,
+        keep_history: 0,
+    };
+    let run = Run::with_genomes(setup.problem, setup.strategy, pool, settings, setup.first)
+        .map_err(|e| InputError::new("[run]", e))?;
+    Ok(TypedRun {
+        config: config.clone(),
+        run,
+    })
 }
 
-impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
-    fn model(&self) -> &'static str {
-        M::NAME
-    }
-
-    fn run(&self) -> &RunConfig {
-        &self.run
-    }
-
-    fn run_mut(&mut self) -> &mut RunConfig {
-        &mut self.run
-    }
-
-    fn output(&self) -> &OutputConfig {
-        &self.output
-    }
-
-    fn to_toml(&self) -> String {
-        EvolveConfig::to_toml(self)
-    }
-
-    fn start_files(&self) -> Vec<PathBuf> {
-        self.model.start_files(&self.settings)
-    }
-
-    fn clone_box(&self) -> Box<dyn AnyConfig> {
-        Box::new(self.clone())
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn start(&self, source: &str, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error> {
-        let mut typed = Vec::with_capacity(start.len());
-        for (i, g) in start.iter().enumerate() {
-            typed.push(g.get::<M>().cloned().ok_or_else(|| {
-                InputError::new(
-                    format!("start genome {}", i + 1),
-                    format!(
-                        "this run evolves `{}` genomes; this is a `{}` genome",
-                        M::NAME,
-                        g.model()
-                    ),
-                )
-            })?);
-        }
-        let (seed, population) = (self.run.seed, self.run.population as usize);
-        // A population and its offspring, each genome at the settings' bounds.
-        let genome = self.model.genome_bytes(&self.settings);
-        sylva_core::budget::check(
-            (population as u64).saturating_mul(genome).saturating_mul(2),
-            format_args!("a population of {population} (`population`)"),
-            "breed a smaller population, or smaller genomes",
+/// Resumes the run of `config` saved in a checkpoint's `text` (read from `path`).
+pub(crate) fn resume<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    source: &str,
+    path: &Path,
+    text: &str,
+    pool: Pool,
+) -> Result<TypedRun<M>, Error> {
+    let saved = SavedRun::<M>::parse(path, text)?;
+    if saved.config.resumable() != config.resumable() {
+        return Err(InputError::file(
+            path,
+            "the checkpoint was written by a different config (only `generations`, \
+             `threads` and `checkpoint_seconds` may change when resuming)",
         )
-        .map_err(|e| InputError::new(source, e))?;
-        let setup = setup(&self.model, &self.settings, typed, seed, population, source)?;
-        // The settings are valid; generation 0 grows as the run is made.
-        if let Some(t) = self.generation_time(&start, pool.threads()) {
-            sylva_core::budget::check_time(t.seconds, t.what, t.advice)
-                .map_err(|e| InputError::new(source, e))?;
-        }
-        let settings = RunSettings {
-            seed,
-            population,
-            keep_history: 0,
-        };
-        let run = Run::with_genomes(setup.problem, setup.strategy, pool, settings, setup.first)
-            .map_err(|e| InputError::new("[run]", e))?;
-        let evolution = Evolution::typed(self.clone(), run);
-        evolution.check_finite(source)?;
-        Ok(evolution)
+        .into());
     }
+    let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
+    let run = Run::resume(setup.problem, setup.strategy, pool, saved.checkpoint)
+        .map_err(|e| InputError::file(path, e))?;
+    Ok(TypedRun {
+        config: config.clone(),
+        run,
+    })
+}
 
-    fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
+impl<M: Evolve + Default> EvolveConfig<M> {
+    /// How long a generation may take on `threads` threads ([`Config::generation_time`]).
+    pub(crate) fn generation_time(
+        &self,
+        start: &[Genome],
+        threads: usize,
+    ) -> Option<GenerationTime> {
         let first = start.first().and_then(|g| g.get::<M>());
         let t = self.model.evaluation_time(&self.settings, first)?;
         let population = self.run.population as usize;
@@ -150,30 +151,6 @@ impl<M: Evolve + Default> AnyConfig for EvolveConfig<M> {
             ),
             advice: t.advice,
         })
-    }
-
-    fn resume(
-        &self,
-        source: &str,
-        path: &Path,
-        text: &str,
-        pool: Pool,
-    ) -> Result<Evolution, Error> {
-        let saved = SavedRun::<M>::parse(path, text)?;
-        if saved.config.resumable() != self.resumable() {
-            return Err(InputError::file(
-                path,
-                "the checkpoint was written by a different config (only `generations`, \
-                 `threads` and `checkpoint_seconds` may change when resuming)",
-            )
-            .into());
-        }
-        let setup = setup(&self.model, &self.settings, Vec::new(), 0, 0, source)?;
-        let run = Run::resume(setup.problem, setup.strategy, pool, saved.checkpoint)
-            .map_err(|e| InputError::file(path, e))?;
-        let evolution = Evolution::typed(self.clone(), run);
-        evolution.check_finite(source)?;
-        Ok(evolution)
     }
 }
 
@@ -195,7 +172,8 @@ fn setup<M: Evolve>(
 impl Clone for Config {
     fn clone(&self) -> Self {
         Config {
-            inner: self.inner.clone_box(),
+            model: self.model.clone(),
+            config: self.model.clone_config(&*self.config),
             source: self.source.clone(),
             registry: self.registry.clone(),
         }
@@ -221,11 +199,22 @@ impl std::fmt::Debug for Config {
 impl Config {
     /// A config of model `M`.
     pub fn new<M: Evolve + Default>(config: EvolveConfig<M>) -> Config {
+        Config::erased(Arc::new(config.model.clone()), Box::new(config))
+    }
+
+    /// `config`, of `model`.
+    pub(crate) fn erased(model: Arc<dyn DynModel>, config: Box<Value>) -> Config {
         Config {
-            inner: Box::new(config),
+            model,
+            config,
             source: None,
             registry: None,
         }
+    }
+
+    /// The model's handle and its typed config, for starting and resuming runs.
+    pub(super) fn parts(&self) -> (&Arc<dyn DynModel>, &Value) {
+        (&self.model, &*self.config)
     }
 
     /// This config, read from `path` with `registry` (which reads its start genomes).
@@ -268,46 +257,46 @@ impl Config {
 
     /// The model evolved.
     pub fn model(&self) -> &'static str {
-        self.inner.model()
+        self.model.name()
     }
 
     /// Run size and seed.
     pub fn run(&self) -> &RunConfig {
-        self.inner.run()
+        self.model.run_settings(&*self.config)
     }
 
     /// Run size and seed, to change (the command line's flags do).
     pub fn run_mut(&mut self) -> &mut RunConfig {
-        self.inner.run_mut()
+        self.model.run_settings_mut(&mut *self.config)
     }
 
     /// What a run writes.
     pub fn output(&self) -> &OutputConfig {
-        self.inner.output()
+        self.model.output(&*self.config)
     }
 
     /// The config as TOML.
     pub fn to_toml(&self) -> String {
-        self.inner.to_toml()
+        self.model.to_toml(&*self.config)
     }
 
     /// The typed config, if this is a config of model `M`.
     pub fn get<M: Evolve + Default>(&self) -> Option<&EvolveConfig<M>> {
-        self.inner.as_any().downcast_ref()
+        self.config.downcast_ref()
     }
 
     /// Genome files the model's settings name as the first generation's origin, relative
     /// to the config file.
     pub fn start_files(&self) -> Vec<PathBuf> {
-        self.inner.start_files()
+        self.model.start_files(&*self.config)
     }
 
     /// How long a generation of this run may take on `threads` threads, for models whose
     /// genomes can take long to grow (L-system plants); `None` for the others. `start` holds
-    /// the start genomes ([`Config::load_start`]). [`Evolution::start`] refuses a run whose
+    /// the start genomes ([`Config::load_start`]). [`Evolution::start`](super::Evolution::start) refuses a run whose
     /// generation is over the time budget.
     pub fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
-        self.inner.generation_time(start, threads)
+        self.model.generation_time(&*self.config, start, threads)
     }
 
     /// Reads the genome files of [`Config::start_files`] from `base` (the config file's

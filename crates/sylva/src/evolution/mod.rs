@@ -36,6 +36,8 @@
 //! - `config.rs`: [`Config`], a config of any model, and what it takes to start or resume
 //!   a run of it.
 //! - `run.rs`: [`Evolution`], a run of any model, and its [`Member`]s.
+//!
+//! Each holds its model's handle (`erased.rs`) beside the typed value.
 //! - `checkpoint.rs`: the checkpoint file a run resumes from.
 
 mod checkpoint;
@@ -44,5 +46,7 @@ mod run;
 mod schema;
 
 pub use config::{Config, GenerationTime, evaluations_done};
+pub(crate) use config::{resume, start};
+pub(crate) use run::TypedRun;
 pub use run::{Evolution, Member};
 pub use schema::{EvolveConfig, OutputConfig, RunConfig, WindConfig};

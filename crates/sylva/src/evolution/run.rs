@@ -1,12 +1,14 @@
 //! A run of any model ([`Evolution`]) and its members.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use sylva_core::Plant;
 use sylva_core::par::Pool;
 use sylva_evolve::{Fitness, GenerationStats, IndividualId, Origin, Problem, Run};
 use sylva_model::Evolve;
 
+use crate::erased::{DynModel, RunValue};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
@@ -36,36 +38,22 @@ impl Member {
 
 /// An evolution run of any model.
 pub struct Evolution {
-    inner: Box<dyn AnyRun>,
+    model: Arc<dyn DynModel>,
+    /// The model's `TypedRun`.
+    run: Box<RunValue>,
 }
 
-/// What every typed run can do, object-safe. Implemented once, for [`TypedRun`].
-trait AnyRun: Send {
-    fn config(&self) -> Config;
-    fn title(&self) -> &'static str;
-    fn step(&mut self) -> &GenerationStats;
-    fn generation(&self) -> u32;
-    fn stats(&self) -> &[GenerationStats];
-    fn term_names(&self) -> &[String];
-    fn population(&self) -> Vec<Member>;
-    fn fittest(&self, count: usize) -> Vec<Member>;
-    fn best(&self) -> Member;
-    fn member(&self, id: IndividualId) -> Option<Member>;
-    fn generation_members(&self, generation: u32) -> Option<Vec<Member>>;
-    fn keep_history(&mut self, generations: usize);
-    fn checkpoint(&self) -> Result<String, Error>;
-    fn guides(&self) -> Option<Plant>;
-    fn emigrants(&self, count: usize) -> Vec<String>;
-    fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError>;
-}
-
-struct TypedRun<M: Evolve> {
-    config: EvolveConfig<M>,
-    run: Run<M::Problem, M::Strategy>,
+/// A run of model `M` with the config it follows.
+pub(crate) struct TypedRun<M: Evolve> {
+    pub(crate) config: EvolveConfig<M>,
+    pub(crate) run: Run<M::Problem, M::Strategy>,
 }
 
 impl<M: Evolve + Default> TypedRun<M> {
-    fn member(&self, ind: &sylva_evolve::Individual<<M::Problem as Problem>::Genome>) -> Member {
+    pub(crate) fn member(
+        &self,
+        ind: &sylva_evolve::Individual<<M::Problem as Problem>::Genome>,
+    ) -> Member {
         let model = &self.config.model;
         Member {
             id: ind.id,
@@ -77,34 +65,8 @@ impl<M: Evolve + Default> TypedRun<M> {
             origin: ind.origin.clone(),
         }
     }
-}
 
-impl<M: Evolve + Default> AnyRun for TypedRun<M> {
-    fn config(&self) -> Config {
-        Config::new(self.config.clone())
-    }
-
-    fn title(&self) -> &'static str {
-        M::TITLE
-    }
-
-    fn step(&mut self) -> &GenerationStats {
-        self.run.step()
-    }
-
-    fn generation(&self) -> u32 {
-        self.run.generation()
-    }
-
-    fn stats(&self) -> &[GenerationStats] {
-        self.run.stats()
-    }
-
-    fn term_names(&self) -> &[String] {
-        self.run.term_names()
-    }
-
-    fn population(&self) -> Vec<Member> {
+    pub(crate) fn population(&self) -> Vec<Member> {
         self.run
             .population()
             .iter()
@@ -112,7 +74,7 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
             .collect()
     }
 
-    fn fittest(&self, count: usize) -> Vec<Member> {
+    pub(crate) fn fittest(&self, count: usize) -> Vec<Member> {
         let population = self.run.population();
         sylva_evolve::fittest(population, count)
             .into_iter()
@@ -120,24 +82,7 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
             .collect()
     }
 
-    fn best(&self) -> Member {
-        self.member(self.run.best())
-    }
-
-    fn member(&self, id: IndividualId) -> Option<Member> {
-        self.run.find(id).map(|i| TypedRun::member(self, i))
-    }
-
-    fn generation_members(&self, generation: u32) -> Option<Vec<Member>> {
-        let pop = self.run.generation_population(generation)?;
-        Some(pop.iter().map(|i| TypedRun::member(self, i)).collect())
-    }
-
-    fn keep_history(&mut self, generations: usize) {
-        self.run.set_keep_history(generations);
-    }
-
-    fn checkpoint(&self) -> Result<String, Error> {
+    pub(crate) fn checkpoint(&self) -> Result<String, Error> {
         let saved = SavedRunRef::<M> {
             config: &self.config,
             checkpoint: self.run.checkpoint(),
@@ -147,11 +92,7 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
             .map_err(Error::from)
     }
 
-    fn guides(&self) -> Option<Plant> {
-        self.config.model.guides(self.run.problem())
-    }
-
-    fn emigrants(&self, count: usize) -> Vec<String> {
+    pub(crate) fn emigrants(&self, count: usize) -> Vec<String> {
         let population = self.run.population();
         sylva_evolve::fittest(population, count)
             .into_iter()
@@ -159,7 +100,10 @@ impl<M: Evolve + Default> AnyRun for TypedRun<M> {
             .collect()
     }
 
-    fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError> {
+    pub(crate) fn immigrate(
+        &mut self,
+        migrants: &[String],
+    ) -> Result<Vec<IndividualId>, InputError> {
         let genomes = migrants
             .iter()
             .enumerate()
@@ -190,19 +134,13 @@ impl std::fmt::Debug for Evolution {
 }
 
 impl Evolution {
-    pub(super) fn typed<M: Evolve + Default>(
-        config: EvolveConfig<M>,
-        run: Run<M::Problem, M::Strategy>,
-    ) -> Self {
-        Evolution {
-            inner: Box::new(TypedRun { config, run }),
-        }
-    }
-
     /// Starts a run: generation 0 made and evaluated. `start` holds the first members (of
     /// the config's model; the model may add mutants of them), the rest is random.
     pub fn start(config: &Config, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error> {
-        config.inner.start(&config.source(), start, pool)
+        let (model, typed) = config.parts();
+        let source = config.source();
+        let run = model.start(typed, &source, start, pool)?;
+        Evolution::checked(model, run, &source)
     }
 
     /// Resumes the run saved in a checkpoint's `text` (read from `path`), which must have
@@ -214,23 +152,36 @@ impl Evolution {
         text: &str,
         pool: Pool,
     ) -> Result<Evolution, Error> {
-        config.inner.resume(&config.source(), path, text, pool)
+        let (model, typed) = config.parts();
+        let source = config.source();
+        let run = model.resume(typed, &source, path, text, pool)?;
+        Evolution::checked(model, run, &source)
+    }
+
+    /// The run, if its generation has a member with a finite fitness.
+    fn checked(model: &Arc<dyn DynModel>, run: Box<RunValue>, source: &str) -> Result<Self, Error> {
+        let evolution = Evolution {
+            model: model.clone(),
+            run,
+        };
+        evolution.check_finite(source)?;
+        Ok(evolution)
     }
 
     /// The effective config.
     pub fn config(&self) -> Config {
-        self.inner.config()
+        Config::erased(self.model.clone(), self.model.effective_config(&*self.run))
     }
 
     /// The model's title, for plots.
     pub fn title(&self) -> &'static str {
-        self.inner.title()
+        self.model.title()
     }
 
     /// Breeds one generation and returns its statistics. A generation in which no member
     /// has a finite fitness stops the run with an error: its settings cannot score.
     pub fn step(&mut self) -> Result<&GenerationStats, Error> {
-        self.inner.step();
+        self.model.step(&mut *self.run);
         self.check_finite("the run")?;
         Ok(self.stats().last().expect("a run has statistics"))
     }
@@ -248,7 +199,7 @@ impl Evolution {
     }
 
     /// An error if no member of the last generation has a finite fitness.
-    pub(super) fn check_finite(&self, source: &str) -> Result<(), InputError> {
+    fn check_finite(&self, source: &str) -> Result<(), InputError> {
         match self.stats().last() {
             Some(s) if !s.best.is_finite() => Err(InputError::new(
                 source,
@@ -267,49 +218,49 @@ impl Evolution {
 
     /// The last completed generation.
     pub fn generation(&self) -> u32 {
-        self.inner.generation()
+        self.model.generation(&*self.run)
     }
 
     /// Statistics of every generation so far, one row each.
     pub fn stats(&self) -> &[GenerationStats] {
-        self.inner.stats()
+        self.model.stats(&*self.run)
     }
 
     /// Names of the fitness terms, in the order of each row's terms.
     pub fn term_names(&self) -> &[String] {
-        self.inner.term_names()
+        self.model.term_names(&*self.run)
     }
 
     /// The current population, in slot order.
     pub fn population(&self) -> Vec<Member> {
-        self.inner.population()
+        self.model.population(&*self.run)
     }
 
     /// The `count` fittest members of the current population, fittest first (ties go to the
     /// lower slot).
     pub fn fittest(&self, count: usize) -> Vec<Member> {
-        self.inner.fittest(count)
+        self.model.fittest(&*self.run, count)
     }
 
     /// The best member of the current population (ties go to the lowest slot).
     pub fn best(&self) -> Member {
-        self.inner.best()
+        self.model.best(&*self.run)
     }
 
     /// A member by id, in the current population or a kept generation.
     pub fn member(&self, id: IndividualId) -> Option<Member> {
-        self.inner.member(id)
+        self.model.member(&*self.run, id)
     }
 
     /// The population of `generation`, if it is the current one or still kept.
     pub fn generation_members(&self, generation: u32) -> Option<Vec<Member>> {
-        self.inner.generation_members(generation)
+        self.model.generation_members(&*self.run, generation)
     }
 
     /// Keeps the last `generations` generations for browsing (0, the default, keeps only the
     /// current one).
     pub fn keep_history(&mut self, generations: usize) {
-        self.inner.keep_history(generations);
+        self.model.keep_history(&mut *self.run, generations);
     }
 
     /// A member's family, as far as kept generations reach: the member, then its parents,
@@ -332,19 +283,19 @@ impl Evolution {
     /// The checkpoint file's text (JSON): the effective config and everything needed to
     /// resume.
     pub fn checkpoint(&self) -> Result<String, Error> {
-        self.inner.checkpoint()
+        self.model.checkpoint(&*self.run)
     }
 
     /// Guides drawn beside plants in pictures (a target surface, forbidden cells), if the
     /// model's fitness has any.
     pub fn guides(&self) -> Option<Plant> {
-        self.inner.guides()
+        self.model.guides(&*self.run)
     }
 
     /// The `count` fittest genomes of the current population, fittest first, as the engine
     /// evolves them (JSON text): what an island sends to its neighbours.
     pub fn emigrants(&self, count: usize) -> Vec<String> {
-        self.inner.emigrants(count)
+        self.model.emigrants(&*self.run, count)
     }
 
     /// Puts migrants from [`Evolution::emigrants`] of another run of the same config (its
@@ -352,6 +303,6 @@ impl Evolution {
     /// evaluates them; returns their new ids. Nothing changes if any migrant is not a genome
     /// of this run.
     pub fn immigrate(&mut self, migrants: &[String]) -> Result<Vec<IndividualId>, InputError> {
-        self.inner.immigrate(migrants)
+        self.model.immigrate(&mut *self.run, migrants)
     }
 }
