@@ -39,6 +39,9 @@ enum Command {
     /// Evolve plants; writes stats.csv, best.json, best.glb, best.png, fitness.svg,
     /// population.png and a checkpoint into the run directory.
     Evolve(commands::evolve::EvolveArgs),
+    /// Evolve a plant whose outline matches a picture (PNG or JPEG) in any model, or the
+    /// one that matches it best; writes what `evolve` writes and overlay.png.
+    Match(commands::matching::MatchArgs),
     /// Grow one genome into a 3D asset (format from the extension: .glb, .obj, .wrl, .stl), or
     /// write its skeleton as data (.skeleton.json).
     Grow(commands::grow::GrowArgs),
@@ -80,6 +83,7 @@ fn main() -> ExitCode {
     let result = std::panic::catch_unwind(|| match command {
         Command::Evolve(args) => commands::evolve::run(&args),
         Command::Grow(args) => commands::grow::run(&args),
+        Command::Match(args) => commands::matching::run(&args),
         Command::Garden(args) => commands::garden::run(&args),
         Command::Simulate(args) => commands::simulate::run(&args),
         Command::Breed(args) => commands::breed::run(&args),

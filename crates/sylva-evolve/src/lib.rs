@@ -5,6 +5,7 @@
 //!   ([`problem::evaluations`]), for progress bars.
 //! - [`Mutate`] and [`Crossover`]: variation operators, one method each, randomness passed in.
 //! - [`Strategy`]: how one generation becomes the next; [`MeanReplacement`] is Susinno's.
+//! - [`WithTerm`]: a problem with one more [`Term`] (a target outline) beside its own.
 //! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,
 //!   elitism), as Poncin's GP runs used.
 //! - [`Pool`]: the one seam where work goes parallel (serial or rayon), results kept in
@@ -57,6 +58,7 @@ pub mod individual;
 pub mod problem;
 pub mod run;
 pub mod strategy;
+pub mod term;
 pub mod variation;
 
 pub use fitness::{Fitness, MAX_TERMS};
@@ -67,4 +69,5 @@ pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSetting
 pub use strategy::{Breeding, MeanReplacement, Strategy, fittest};
 pub use sylva_core::par::Pool;
 pub use sylva_core::rng;
+pub use term::{Added, Term, WithTerm};
 pub use variation::{Crossover, Mutate};

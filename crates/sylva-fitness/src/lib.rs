@@ -4,6 +4,8 @@
 //!   from any plant, and his weighted fitness ([`SusinnoWeights`]), reported term by term.
 //! - [`poncin`]: Poncin's terms for GP-grown trees (target surface, branch count, spread,
 //!   thickness, density grid) and their weighted total ([`PoncinFitness`]).
+//! - [`silhouette`]: the outline term: a plant's silhouette against a target outline
+//!   ([`silhouette::Outline`]), as intersection over union.
 //!
 //! ```
 //! use sylva_fitness::{SusinnoWeights, TreeMeasures};
@@ -18,6 +20,7 @@
 //! ```
 
 pub mod poncin;
+pub mod silhouette;
 pub mod tree;
 
 pub use poncin::{PoncinFitness, PoncinScore, PoncinScratch, PoncinWeights};

@@ -75,7 +75,7 @@ use std::path::PathBuf;
 use rand::Rng;
 use serde::{Serialize, de::DeserializeOwned};
 use sylva_core::{Plant, PlantError, PlantMeta, hash::stable_hash};
-use sylva_evolve::{Problem, Strategy};
+use sylva_evolve::{Problem, Strategy, WithTerm};
 
 pub use file::{FormatV1, GenomeError};
 
@@ -364,8 +364,9 @@ pub fn genome_hash<G: Serialize>(genome: &G) -> u64 {
 pub trait Evolve: Model {
     /// The problem the engine solves.
     type Problem: Problem<Genome: Serialize + DeserializeOwned> + Clone + Send + 'static;
-    /// How one generation becomes the next.
-    type Strategy: Strategy<Self::Problem> + Send + 'static;
+    /// How one generation becomes the next: of the problem, and of the problem with one
+    /// more term (a target outline; every generic strategy is both).
+    type Strategy: Strategy<Self::Problem> + Strategy<WithTerm<Self::Problem>> + Send + 'static;
 
     /// Genome files the settings name (relative to the config file), read by the caller and
     /// given to [`Evolve::setup`] as `start`.

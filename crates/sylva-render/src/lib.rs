@@ -3,6 +3,7 @@
 //! - [`render`] (or a reusable [`Renderer`]) draws a scene from a [`View`] into an
 //!   [`image::RgbImage`], framed automatically so the whole scene fills the picture.
 //! - [`contact_sheet`] lays out many small captioned renders in a grid.
+//! - [`overlay`] draws two outlines over each other (a plant on its target).
 //! - [`encode_png`] and [`write_png`] (atomic) save the result.
 //!
 //! How a picture is made: a mild perspective camera looks at the scene from the chosen view
@@ -48,6 +49,7 @@
 //! ```
 
 mod camera;
+pub mod overlay;
 mod raster;
 mod shade;
 mod sheet;

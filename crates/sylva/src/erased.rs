@@ -84,6 +84,7 @@ pub(crate) trait DynModel: Send + Sync {
         &self,
         config: &Value,
         source: &str,
+        base: &Path,
         start: Vec<Genome>,
         pool: Pool,
     ) -> Result<Box<RunValue>, Error>;
@@ -91,6 +92,7 @@ pub(crate) trait DynModel: Send + Sync {
         &self,
         config: &Value,
         source: &str,
+        base: &Path,
         path: &Path,
         text: &str,
         pool: Pool,
@@ -300,21 +302,30 @@ impl<M: Evolve + Default> DynModel for M {
         &self,
         c: &Value,
         source: &str,
+        base: &Path,
         first: Vec<Genome>,
         pool: Pool,
     ) -> Result<Box<RunValue>, Error> {
-        Ok(Box::new(start(config::<M>(c), source, first, pool)?))
+        Ok(Box::new(start(config::<M>(c), source, base, first, pool)?))
     }
 
     fn resume(
         &self,
         c: &Value,
         source: &str,
+        base: &Path,
         path: &Path,
         text: &str,
         pool: Pool,
     ) -> Result<Box<RunValue>, Error> {
-        Ok(Box::new(resume(config::<M>(c), source, path, text, pool)?))
+        Ok(Box::new(resume(
+            config::<M>(c),
+            source,
+            base,
+            path,
+            text,
+            pool,
+        )?))
     }
 
     fn effective_config(&self, r: &RunValue) -> Box<Value> {
@@ -371,7 +382,11 @@ impl<M: Evolve + Default> DynModel for M {
 
     fn guides(&self, r: &RunValue) -> Option<Plant> {
         let r = run::<M>(r);
-        Evolve::guides(&r.config.model, r.run.problem())
+        // The model's own guides mean nothing when its terms do not count.
+        if r.config.outline.as_ref().is_some_and(|o| !o.beside) {
+            return None;
+        }
+        Evolve::guides(&r.config.model, &r.run.problem().problem)
     }
 
     fn emigrants(&self, r: &RunValue, count: usize) -> Vec<String> {

@@ -51,6 +51,7 @@ pub mod files;
 pub mod garden;
 pub mod genome;
 pub mod lod;
+pub mod picture;
 pub mod registry;
 pub mod report;
 pub mod skeleton;

@@ -18,10 +18,10 @@ use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
 
 use sylva::files::Outputs;
 
-const CHECKPOINT: &str = "checkpoint.json";
+pub(super) const CHECKPOINT: &str = "checkpoint.json";
 
 /// Every file a run writes in its folder.
-const FILES: [&str; 8] = [
+pub(super) const FILES: [&str; 8] = [
     CHECKPOINT,
     "config.toml",
     "stats.csv",
@@ -106,7 +106,7 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     // A run killed while writing left temporary files: they go.
     sylva::files::remove_leftovers(&out, &FILES);
     breed(&mut evolution, &config, &checkpoint)?;
-    write_results(&evolution, &config, &out, &pool)
+    write_results(&evolution, &config, &out, &pool, Vec::new())
 }
 
 /// A bar over the genomes of `generations` generations of `population`, showing generation
@@ -221,15 +221,19 @@ fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyho
     Ok(())
 }
 
-/// Writes the config, statistics, plot, best genome with its asset and picture, and the
-/// contact sheet of the best members.
-fn write_results(
+/// Writes the config, statistics, plot, best genome with its asset and picture, the
+/// contact sheet of the best members, and `extra` files (name, bytes), all or none.
+pub(super) fn write_results(
     evolution: &Evolution,
     config: &Config,
     out: &Path,
     pool: &sylva::core::par::Pool,
+    extra: Vec<(&str, Vec<u8>)>,
 ) -> anyhow::Result<()> {
     let mut files = Outputs::new();
+    for (name, bytes) in &extra {
+        files.add(&out.join(name), bytes)?;
+    }
     files.add(&out.join("config.toml"), config.to_toml().as_bytes())?;
     let stats = evolution.stats();
     files.add(
@@ -279,9 +283,10 @@ fn write_results(
         evaluations,
         evaluations as f64 / seconds.max(1e-9),
     );
+    let extra: String = extra.iter().map(|(name, _)| format!(", {name}")).collect();
     println!(
         "best plant: {} segments, {} organs, {} triangles; wrote {}/{{stats.csv, best.json, \
-         best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json}}",
+         best.glb, best.png, fitness.svg, population.png, config.toml, checkpoint.json{extra}}}",
         grown.plant.segments().len(),
         grown.plant.organs().len(),
         grown.mesh.triangle_count(),

@@ -32,7 +32,9 @@ impl<M: Evolve + Default> SavedRun<M> {
             serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
         let bad = |e: serde_json::Error| InputError::file(path, e);
         if let Some(config) = value.get_mut("config").and_then(|c| c.as_object_mut()) {
-            config.retain(|k, _| matches!(k.as_str(), "model" | "run" | "output") || k == M::NAME);
+            config.retain(|k, _| {
+                matches!(k.as_str(), "model" | "run" | "output" | "match") || k == M::NAME
+            });
         }
         let config = value.get("config").cloned().unwrap_or_default();
         let checkpoint = value.get("checkpoint").cloned().unwrap_or_default();
@@ -41,4 +43,16 @@ impl<M: Evolve + Default> SavedRun<M> {
             checkpoint: serde_json::from_value(checkpoint).map_err(bad)?,
         })
     }
+}
+
+/// The model a checkpoint's run evolves (its `config.model`), to resume it without its
+/// config file.
+pub fn checkpoint_model(path: &Path, text: &str) -> Result<String, InputError> {
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+    value
+        .pointer("/config/model")
+        .and_then(|m| m.as_str())
+        .map(str::to_owned)
+        .ok_or_else(|| InputError::file(path, "not a checkpoint: it names no `config.model`"))
 }

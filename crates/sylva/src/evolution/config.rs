@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use sylva_core::par::Pool;
-use sylva_evolve::{Run, RunSettings};
+use sylva_evolve::{Run, RunSettings, WithTerm};
 use sylva_model::Evolve;
 
 use crate::erased::{DynModel, Value};
@@ -25,6 +25,9 @@ pub struct Config {
     source: Option<PathBuf>,
     /// The registry it was read with, which reads its start genomes; `None`: the standard.
     registry: Option<Registry>,
+    /// The folder its files (start genomes, target pictures) are found in, when it is not
+    /// the config file's.
+    base: Option<PathBuf>,
 }
 
 /// Evaluations made so far by every run of this process, for a progress bar to read from
@@ -49,6 +52,7 @@ pub struct GenerationTime {
 pub(crate) fn start<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
+    base: &Path,
     start: Vec<Genome>,
     pool: Pool,
 ) -> Result<TypedRun<M>, Error> {
@@ -82,6 +86,7 @@ pub(crate) fn start<M: Evolve + Default>(
         population,
         source,
     )?;
+    let problem = with_term(config, setup.problem, base)?;
     // The settings are valid; generation 0 grows as the run is made.
     if let Some(t) = config.generation_time(&start, pool.threads()) {
         sylva_core::budget::check_time(t.seconds, t.what, t.advice)
@@ -92,7 +97,7 @@ pub(crate) fn start<M: Evolve + Default>(
         population,
         keep_history: 0,
     };
-    let run = Run::with_genomes(setup.problem, setup.strategy, pool, settings, setup.first)
+    let run = Run::with_genomes(problem, setup.strategy, pool, settings, setup.first)
         .map_err(|e| InputError::new("[run]", e))?;
     Ok(TypedRun {
         config: config.clone(),
@@ -104,6 +109,7 @@ pub(crate) fn start<M: Evolve + Default>(
 pub(crate) fn resume<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
+    base: &Path,
     path: &Path,
     text: &str,
     pool: Pool,
@@ -118,7 +124,8 @@ pub(crate) fn resume<M: Evolve + Default>(
         .into());
     }
     let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
-    let run = Run::resume(setup.problem, setup.strategy, pool, saved.checkpoint)
+    let problem = with_term(config, setup.problem, base)?;
+    let run = Run::resume(problem, setup.strategy, pool, saved.checkpoint)
         .map_err(|e| InputError::file(path, e))?;
     Ok(TypedRun {
         config: config.clone(),
@@ -154,6 +161,21 @@ impl<M: Evolve + Default> EvolveConfig<M> {
     }
 }
 
+/// The model's problem with the config's `[match]` term, if it has one, its pictures read
+/// relative to `base`.
+fn with_term<M: Evolve>(
+    config: &EvolveConfig<M>,
+    problem: M::Problem,
+    base: &Path,
+) -> Result<WithTerm<M::Problem>, InputError> {
+    let added = config
+        .outline
+        .as_ref()
+        .map(|outline| super::outline::added(&config.model, outline, base))
+        .transpose()?;
+    Ok(WithTerm { problem, added })
+}
+
 /// The model's problem and strategy for `settings`; a refusal names the config (`source`)
 /// and the model's section.
 fn setup<M: Evolve>(
@@ -176,6 +198,7 @@ impl Clone for Config {
             config: self.model.clone_config(&*self.config),
             source: self.source.clone(),
             registry: self.registry.clone(),
+            base: self.base.clone(),
         }
     }
 }
@@ -209,6 +232,7 @@ impl Config {
             config,
             source: None,
             registry: None,
+            base: None,
         }
     }
 
@@ -224,6 +248,22 @@ impl Config {
             self.registry = Some(registry.clone());
         }
         self
+    }
+
+    /// The folder the files it names (start genomes, target pictures) are found in: the one
+    /// set with [`Config::set_base`], else the config file's, else the current folder.
+    pub fn base(&self) -> PathBuf {
+        match (&self.base, &self.source) {
+            (Some(base), _) => base.clone(),
+            (None, Some(source)) => source.parent().map(Path::to_owned).unwrap_or_default(),
+            (None, None) => PathBuf::new(),
+        }
+    }
+
+    /// Finds the files the config names in `base` (a config built in code, or read from
+    /// text).
+    pub fn set_base(&mut self, base: impl Into<PathBuf>) {
+        self.base = Some(base.into());
     }
 
     /// The registry the config was read with.

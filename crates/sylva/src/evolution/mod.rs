@@ -39,14 +39,17 @@
 //!
 //! Each holds its model's handle (`erased.rs`) beside the typed value.
 //! - `checkpoint.rs`: the checkpoint file a run resumes from.
+//! - `outline.rs`: the `[match]` term, a plant's silhouette against target pictures.
 
 mod checkpoint;
 mod config;
+pub mod outline;
 mod run;
 mod schema;
 
+pub use checkpoint::checkpoint_model;
 pub use config::{Config, GenerationTime, evaluations_done};
 pub(crate) use config::{resume, start};
 pub(crate) use run::TypedRun;
 pub use run::{Evolution, Member};
-pub use schema::{EvolveConfig, OutputConfig, RunConfig, WindConfig};
+pub use schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig, WindConfig};

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use sylva_core::Plant;
 use sylva_core::par::Pool;
-use sylva_evolve::{Fitness, GenerationStats, IndividualId, Origin, Problem, Run};
+use sylva_evolve::{Fitness, GenerationStats, IndividualId, Origin, Problem, Run, WithTerm};
 use sylva_model::Evolve;
 
 use crate::erased::{DynModel, RunValue};
@@ -46,7 +46,7 @@ pub struct Evolution {
 /// A run of model `M` with the config it follows.
 pub(crate) struct TypedRun<M: Evolve> {
     pub(crate) config: EvolveConfig<M>,
-    pub(crate) run: Run<M::Problem, M::Strategy>,
+    pub(crate) run: Run<WithTerm<M::Problem>, M::Strategy>,
 }
 
 impl<M: Evolve + Default> TypedRun<M> {
@@ -59,7 +59,7 @@ impl<M: Evolve + Default> TypedRun<M> {
             id: ind.id,
             genome: Genome::new(
                 model.clone(),
-                model.genome_file(self.run.problem(), &ind.genome),
+                model.genome_file(&self.run.problem().problem, &ind.genome),
             ),
             fitness: ind.fitness,
             origin: ind.origin.clone(),
@@ -139,7 +139,7 @@ impl Evolution {
     pub fn start(config: &Config, start: Vec<Genome>, pool: Pool) -> Result<Evolution, Error> {
         let (model, typed) = config.parts();
         let source = config.source();
-        let run = model.start(typed, &source, start, pool)?;
+        let run = model.start(typed, &source, &config.base(), start, pool)?;
         Evolution::checked(model, run, &source)
     }
 
@@ -154,7 +154,7 @@ impl Evolution {
     ) -> Result<Evolution, Error> {
         let (model, typed) = config.parts();
         let source = config.source();
-        let run = model.resume(typed, &source, path, text, pool)?;
+        let run = model.resume(typed, &source, &config.base(), path, text, pool)?;
         Evolution::checked(model, run, &source)
     }
 

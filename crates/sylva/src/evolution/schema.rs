@@ -2,7 +2,7 @@
 //! section and `[output]`, every number checked as it is read.
 
 use std::marker::PhantomData;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::ser::SerializeStruct;
@@ -13,6 +13,7 @@ use sylva_model::Evolve;
 use sylva_render::View;
 
 use crate::error::InputError;
+use crate::picture::Threshold;
 
 /// Run size and seed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -103,6 +104,49 @@ fn wind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<WindConfig>, D:
     Ok(Some(wind))
 }
 
+/// `[match]`: a target outline the plant's silhouette should match, as a fitness term
+/// (`iou`, 0 to 1) beside the model's own terms or alone ([docs/match.md]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MatchConfig {
+    /// The target seen from the front (looking along -Z): a PNG or JPEG file, relative to
+    /// the config file. Required.
+    pub front: PathBuf,
+    /// The target seen from the side (looking along +X), scored too. Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<PathBuf>,
+    /// How ink is told from background: `"otsu"` (the default; a photo against the sky
+    /// works) or a luminance 0 to 1 that ink is darker than. Pictures with transparent
+    /// pixels use their alpha channel instead.
+    #[serde(default)]
+    pub threshold: Threshold,
+    /// The term's weight in the total, 0 to 1,000,000. Default 1.
+    #[serde(default = "one", deserialize_with = "match_weight")]
+    pub weight: f64,
+    /// Whether the model's own terms count beside the outline. Default true; `false`: the
+    /// outline alone decides (what `sylva match` writes).
+    #[serde(default = "yes")]
+    pub beside: bool,
+    /// Rows the outlines are compared at, 16 to 512. Default 64.
+    #[serde(default = "sixty_four", deserialize_with = "match_rows")]
+    pub rows: u32,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn sixty_four() -> u32 {
+    64
+}
+
+sylva_core::ranged!(match_weight: f64, "weight", 0.0, 1_000_000.0);
+sylva_core::ranged!(match_rows: u32, "rows", 16, 512);
+
 impl OutputConfig {
     /// The taper the outputs are grown with, if any.
     pub fn pipe_taper(&self) -> Option<PipeTaper> {
@@ -167,21 +211,29 @@ pub struct EvolveConfig<M: Evolve> {
     pub settings: M::Settings,
     /// What a run writes.
     pub output: OutputConfig,
+    /// A target outline to match, if any (`[match]`).
+    pub outline: Option<MatchConfig>,
 }
 
 impl<M: Evolve> PartialEq for EvolveConfig<M> {
     fn eq(&self, other: &Self) -> bool {
-        self.run == other.run && self.settings == other.settings && self.output == other.output
+        self.run == other.run
+            && self.settings == other.settings
+            && self.output == other.output
+            && self.outline == other.outline
     }
 }
 
 impl<M: Evolve> Serialize for EvolveConfig<M> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut st = s.serialize_struct("EvolveConfig", 4)?;
+        let mut st = s.serialize_struct("EvolveConfig", 5)?;
         st.serialize_field("model", M::NAME)?;
         st.serialize_field("run", &self.run)?;
         st.serialize_field(M::NAME, &self.settings)?;
         st.serialize_field("output", &self.output)?;
+        if let Some(outline) = &self.outline {
+            st.serialize_field("match", outline)?;
+        }
         st.end()
     }
 }
@@ -200,6 +252,7 @@ enum Key {
     Run,
     Settings,
     Output,
+    Match,
 }
 
 impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
@@ -217,6 +270,7 @@ impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
                 Key::Run => config.run = map.next_value()?,
                 Key::Settings => config.settings = map.next_value()?,
                 Key::Output => config.output = map.next_value()?,
+                Key::Match => config.outline = Some(map.next_value()?),
             }
         }
         Ok(config)
@@ -235,10 +289,11 @@ impl<'de> DeserializeSeed<'de> for KeySeed {
             "model" => Ok(Key::Model),
             "run" => Ok(Key::Run),
             "output" => Ok(Key::Output),
+            "match" => Ok(Key::Match),
             k if k == self.0 => Ok(Key::Settings),
             k => Err(de::Error::custom(format!(
                 "unknown field `{k}`: this config evolves `{}` (set `model` to evolve another \
-                 model); expected `model`, `run`, `{}` or `output`",
+                 model); expected `model`, `run`, `{}`, `output` or `match`",
                 self.0, self.0
             ))),
         }

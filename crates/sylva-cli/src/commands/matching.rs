@@ -1,0 +1,300 @@
+//! `sylva match`: evolve a plant whose outline matches a picture, in any model (or the
+//! model that matches it best), for a number of generations or seconds; writes what
+//! `sylva evolve` writes and `overlay.png`.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sylva::core::budget::Seconds;
+use sylva::evolution::outline::{TERM, match_config, outlines, overlay};
+use sylva::evolution::{MatchConfig, RunConfig};
+use sylva::picture::Threshold;
+use sylva::{Config, Evolution, InputError, Registry};
+
+use super::evolve::{CHECKPOINT, FILES, write_results};
+
+/// Arguments of `sylva match`.
+#[derive(clap::Args)]
+pub struct MatchArgs {
+    /// The target: a PNG or JPEG of the plant's outline seen from the front (dark ink on a
+    /// light background, a photo against the sky, or the opaque pixels of a cut-out).
+    target: PathBuf,
+    /// The target seen from the side (looking along +X), scored too [default: the front
+    /// picture: a tree looks much alike from every side, and a plant matched from one view
+    /// alone may be flat or lean away in depth].
+    #[arg(long)]
+    side: Option<PathBuf>,
+    /// The model to evolve, or `auto`: each model briefly, then on with the best.
+    #[arg(long, default_value = "auto")]
+    model: String,
+    /// Generations to breed after the first (instead of --seconds); the same target, seed
+    /// and generations give the same bytes.
+    #[arg(long, conflicts_with = "seconds",
+          value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+    generations: Option<u32>,
+    /// Seconds to breed for, 1 to 86400 [default: 60].
+    #[arg(long, value_parser = parse_seconds)]
+    seconds: Option<f64>,
+    /// Individuals per generation.
+    #[arg(long, default_value_t = 100,
+          value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    population: u32,
+    /// Seed of every random choice.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// What is ink: `otsu` (the default) or a luminance from 0 to 1 that ink is darker than.
+    #[arg(long, default_value = "otsu", value_parser = parse_threshold)]
+    threshold: Threshold,
+    /// Worker threads; 0 means one per core. Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
+    threads: u32,
+    /// Run directory [default: runs/match-<target>-seed<seed>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Continue the run saved in the run directory's checkpoint.
+    #[arg(long)]
+    resume: bool,
+}
+
+/// How long a run breeds.
+#[derive(Clone, Copy)]
+enum Limit {
+    Generations(u32),
+    Seconds(f64),
+}
+
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if (1.0..=86_400.0).contains(&s) => Ok(s),
+        _ => Err(format!("expected seconds from 1 to 86400; got {text:?}")),
+    }
+}
+
+fn parse_threshold(text: &str) -> Result<Threshold, String> {
+    match text.trim() {
+        "otsu" => Ok(Threshold::Otsu),
+        t => match t.parse::<f32>() {
+            Ok(l) if (0.0..=1.0).contains(&l) => Ok(Threshold::Level(l)),
+            _ => Err(format!(
+                "expected `otsu` or a luminance from 0 to 1; got {text:?}"
+            )),
+        },
+    }
+}
+
+/// `sylva match`.
+pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
+    let target = MatchConfig {
+        front: absolute(&args.target),
+        side: Some(absolute(args.side.as_ref().unwrap_or(&args.target))),
+        threshold: args.threshold,
+        weight: 1.0,
+        beside: false,
+        rows: 64,
+    };
+    // The pictures are read first: a bad one is refused before anything is written.
+    outlines(&target, Path::new(""))?;
+    let limit = match (args.generations, args.seconds) {
+        (Some(n), _) => Limit::Generations(n),
+        (None, seconds) => Limit::Seconds(seconds.unwrap_or(60.0)),
+    };
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args
+            .target
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy();
+        PathBuf::from(format!("runs/match-{stem}-seed{}", args.seed))
+    });
+    let run = RunConfig {
+        generations: match limit {
+            Limit::Generations(n) => n,
+            Limit::Seconds(_) => 1_000_000,
+        },
+        population: args.population,
+        seed: args.seed,
+        threads: args.threads,
+        ..RunConfig::default()
+    };
+    let registry = Registry::standard();
+    let pool = super::pool(args.threads)?;
+    let checkpoint = out.join(CHECKPOINT);
+    let config_of = |model: &str| {
+        match_config(registry, model, &run, &target)
+            .map_err(|e| InputError::new("--model", format!("{}: {}", e.field, e.message)))
+    };
+    let (mut evolution, config, elsewhere) = if args.resume {
+        let text = sylva::files::read_text(&checkpoint)?;
+        let model = sylva::evolution::checkpoint_model(&checkpoint, &text)?;
+        let config = config_of(&model)?;
+        let evolution = Evolution::resume(&config, &checkpoint, &text, pool.clone())?;
+        (evolution, config, 0.0)
+    } else if args.model == "auto" {
+        auto(registry, &config_of, limit, &pool)?
+    } else {
+        let config = config_of(&args.model)?;
+        let evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
+        (evolution, config, 0.0)
+    };
+    sylva::files::create_dir(&out)?;
+    let mut files = FILES.to_vec();
+    files.push("overlay.png");
+    sylva::files::remove_leftovers(&out, &files);
+    breed(&mut evolution, &config, limit, &checkpoint, elsewhere)?;
+    // The config written is the run's: its generations are the ones bred.
+    let mut config = evolution.config();
+    config.run_mut().generations = evolution.generation();
+    let best = evolution.best();
+    let (picture, iou) = overlay(&target, Path::new(""), &best.genome)?;
+    write_results(
+        &evolution,
+        &config,
+        &out,
+        &pool,
+        vec![("overlay.png", picture)],
+    )?;
+    println!("outline IoU {iou:.3} ({}, front view)", evolution.title());
+    Ok(())
+}
+
+/// The share of a run each model gets in a trial of `--model auto`.
+const TRIAL_SHARE: f64 = 0.1;
+
+/// `--model auto`: a short run of each model whose generations fit the trial, then the
+/// run of the model whose best plant matches the outline best (the first on a tie), and
+/// the seconds spent on the others.
+fn auto(
+    registry: &Registry,
+    config_of: &dyn Fn(&str) -> Result<Config, InputError>,
+    limit: Limit,
+    pool: &sylva::core::par::Pool,
+) -> anyhow::Result<(Evolution, Config, f64)> {
+    let started = Instant::now();
+    let trial = match limit {
+        Limit::Generations(n) => Limit::Generations(((f64::from(n) * TRIAL_SHARE) as u32).max(1)),
+        Limit::Seconds(s) => Limit::Seconds(s * TRIAL_SHARE),
+    };
+    let mut best: Option<(f64, Evolution, Config)> = None;
+    for entry in registry.models() {
+        let config = config_of(entry.name())?;
+        // A model whose generation may take longer than a trial (or, counting generations,
+        // than a tenth of the default minute) is left out: its plants grow slowly.
+        let allowance = match trial {
+            Limit::Seconds(s) => s,
+            Limit::Generations(_) => 60.0 * TRIAL_SHARE,
+        };
+        if let Some(t) = config.generation_time(&[], pool.threads())
+            && t.seconds > allowance
+        {
+            eprintln!(
+                "auto: {} left out: a generation may take {} (more than {} of a trial)",
+                entry.name(),
+                Seconds(t.seconds),
+                Seconds(allowance)
+            );
+            continue;
+        }
+        let mut evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
+        breed_quietly(&mut evolution, trial)?;
+        let iou = best_iou(&evolution);
+        eprintln!(
+            "auto: {} reached IoU {iou:.3} in {} generations",
+            entry.name(),
+            evolution.generation()
+        );
+        if best.as_ref().is_none_or(|(b, _, _)| iou > *b) {
+            best = Some((iou, evolution, config));
+        }
+    }
+    let (_, evolution, config) =
+        best.ok_or_else(|| InputError::new("--model", "no model fits the time given"))?;
+    let own: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
+    let elsewhere = (started.elapsed().as_secs_f64() - own).max(0.0);
+    Ok((evolution, config, elsewhere))
+}
+
+/// The outline IoU of the run's best member.
+fn best_iou(evolution: &Evolution) -> f64 {
+    let at = evolution.term_names().iter().position(|n| n == TERM);
+    let best = evolution.best();
+    match (at, best.fitness) {
+        (Some(at), Some(f)) => f.terms()[at],
+        _ => 0.0,
+    }
+}
+
+fn breed_quietly(evolution: &mut Evolution, limit: Limit) -> anyhow::Result<()> {
+    let started = Instant::now();
+    while !done_from(evolution, limit, started) {
+        evolution.step()?;
+    }
+    Ok(())
+}
+
+/// Breeds until `limit`, showing the best IoU and checkpointing as it goes; `elsewhere`
+/// seconds were spent on other runs (the trials of `--model auto`) and count too.
+fn breed(
+    evolution: &mut Evolution,
+    config: &Config,
+    limit: Limit,
+    checkpoint: &Path,
+    elsewhere: f64,
+) -> anyhow::Result<()> {
+    let bar = match limit {
+        Limit::Generations(n) => ProgressBar::new(u64::from(n)).with_style(
+            ProgressStyle::with_template(
+                "{spinner} generation {pos}/{len} {bar:30} best IoU {msg} ({elapsed}, eta {eta})",
+            )
+            .expect("the template is valid"),
+        ),
+        Limit::Seconds(s) => ProgressBar::new(s.ceil() as u64).with_style(
+            ProgressStyle::with_template("{spinner} {pos}/{len} s {bar:30} best IoU {msg}")
+                .expect("the template is valid"),
+        ),
+    };
+    let started = Instant::now();
+    let already = elsewhere + evolution.stats().iter().map(|g| g.seconds).sum::<f64>();
+    let show = |evolution: &Evolution| {
+        bar.set_position(match limit {
+            Limit::Generations(_) => u64::from(evolution.generation()),
+            Limit::Seconds(_) => (already + started.elapsed().as_secs_f64()) as u64,
+        });
+        bar.set_message(format!(
+            "{:.3} (generation {})",
+            best_iou(evolution),
+            evolution.generation()
+        ));
+    };
+    let save = |evolution: &Evolution| -> anyhow::Result<()> {
+        sylva::files::write(checkpoint, evolution.checkpoint()?.as_bytes())?;
+        Ok(())
+    };
+    show(evolution);
+    let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
+    let mut last_save = Instant::now();
+    let limit = match limit {
+        Limit::Seconds(s) => Limit::Seconds(s - already),
+        generations => generations,
+    };
+    while !done_from(evolution, limit, started) {
+        evolution.step()?;
+        show(evolution);
+        if last_save.elapsed() >= every {
+            save(evolution)?;
+            last_save = Instant::now();
+        }
+    }
+    save(evolution)?;
+    bar.finish_and_clear();
+    Ok(())
+}
+
+/// Whether this process has bred as long as `limit` asks (seconds counted from `started`).
+fn done_from(evolution: &Evolution, limit: Limit, started: Instant) -> bool {
+    match limit {
+        Limit::Generations(n) => evolution.generation() >= n,
+        Limit::Seconds(s) => started.elapsed().as_secs_f64() >= s,
+    }
+}

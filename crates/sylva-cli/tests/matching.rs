@@ -1,0 +1,154 @@
+//! `sylva match` as a designer drives it: a picture in, a plant whose outline matches it
+//! out, with every file `sylva evolve` writes and `overlay.png`; the same target, seed and
+//! generations give the same bytes; a run resumes after it stops as if it never had; and
+//! a bad picture gets exit code 2 naming the file, with nothing written.
+#![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+mod support;
+use support::{example, s, sylva, temp_dir};
+
+fn ok(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn target() -> PathBuf {
+    PathBuf::from(example("match/round.png"))
+}
+
+/// A quick match of the round target by binary trees, `generations` long, into `out`.
+fn quick(out: &Path, generations: &str, resume: bool) -> Output {
+    let mut args = vec![
+        "match",
+        s(&target()).to_owned().leak(),
+        "--model",
+        "bintree",
+        "--generations",
+        generations,
+        "--population",
+        "16",
+        "--seed",
+        "3",
+        "--out",
+        s(out),
+    ];
+    if resume {
+        args.push("--resume");
+    }
+    sylva(&args)
+}
+
+/// Every file of a run as bytes, but for wall-clock seconds (`stats.csv`'s last column,
+/// the checkpoint).
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+        .into_iter()
+        .map(|name| {
+            let bytes = fs::read(dir.join(&name)).unwrap();
+            let bytes = match name.as_str() {
+                // The checkpoint holds each generation's wall-clock seconds.
+                "checkpoint.json" => Vec::new(),
+                "stats.csv" => String::from_utf8(bytes)
+                    .unwrap()
+                    .lines()
+                    .map(|l| l.rsplit_once(',').map_or(l, |(a, _)| a).to_owned() + "\n")
+                    .collect::<String>()
+                    .into_bytes(),
+                _ => bytes,
+            };
+            (name, bytes)
+        })
+        .collect()
+}
+
+#[test]
+fn a_match_writes_every_file_the_same_each_time_and_resumes() {
+    let dir = temp_dir("files");
+    let (first, second, resumed) = (dir.join("a"), dir.join("b"), dir.join("c"));
+    let said = ok(&quick(&first, "12", false));
+    assert!(said.contains("outline IoU"), "{said}");
+    let names: Vec<String> = files(&first).into_iter().map(|(n, _)| n).collect();
+    for name in [
+        "best.glb",
+        "best.json",
+        "best.png",
+        "checkpoint.json",
+        "config.toml",
+        "fitness.svg",
+        "overlay.png",
+        "population.png",
+        "stats.csv",
+    ] {
+        assert!(
+            names.contains(&name.to_owned()),
+            "{name} missing: {names:?}"
+        );
+    }
+    let stats = fs::read_to_string(first.join("stats.csv")).unwrap();
+    assert!(stats.starts_with("generation,best,mean,iou,"), "{stats}");
+    assert_eq!(
+        stats.lines().count(),
+        14,
+        "a header and generations 0 to 12"
+    );
+    let config = fs::read_to_string(first.join("config.toml")).unwrap();
+    assert!(
+        config.contains("[match]") && config.contains("beside = false"),
+        "{config}"
+    );
+    assert!(config.contains("generations = 12"), "{config}");
+    // The same target, seed and generations: the same bytes.
+    ok(&quick(&second, "12", false));
+    // Stopped at 5 and resumed to 12: as if it never stopped.
+    ok(&quick(&resumed, "5", false));
+    ok(&quick(&resumed, "12", true));
+    let (a, b, c) = (files(&first), files(&second), files(&resumed));
+    for ((name, x), ((_, y), (_, z))) in a.iter().zip(b.iter().zip(&c)) {
+        assert!(x == y, "{name} differs between two equal runs");
+        assert!(x == z, "{name} differs after a resume");
+    }
+}
+
+#[test]
+fn bad_pictures_are_refused_naming_the_file_and_nothing_is_written() {
+    let dir = temp_dir("bad");
+    let text = dir.join("notes.png");
+    fs::write(&text, "this is not a picture\n").unwrap();
+    let blank = dir.join("blank.png");
+    // A white picture: two empty outlines without a caption.
+    let white = sylva::render::overlay::overlay(40, 40, 1, |_, _| false, |_, _| false, "");
+    fs::write(&blank, sylva::render::encode_png(&white).unwrap()).unwrap();
+    let missing = dir.join("missing.png");
+    for (file, expected) in [
+        (&text, "not a PNG or JPEG picture"),
+        (&blank, "no ink"),
+        (&missing, "missing.png"),
+    ] {
+        let out = dir.join("out");
+        let output = sylva(&["match", s(file), "--generations", "1", "--out", s(&out)]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(s(file)), "{stderr}");
+        assert!(stderr.contains(expected), "{stderr}");
+        assert!(!out.exists(), "nothing is written for {}", file.display());
+    }
+    // A threshold out of range is refused by name.
+    let output = sylva(&["match", s(&target()), "--threshold", "1.5"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("luminance"));
+}

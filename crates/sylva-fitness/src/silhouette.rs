@@ -1,0 +1,540 @@
+//! The outline term: how well a plant's silhouette, seen from the front or the side,
+//! overlaps a target outline (a designer's picture), as intersection over union.
+//!
+//! Both outlines are normalised before they are compared, so the term asks for a shape, not
+//! a size or a place: each is cropped to the bounding box of its ink, scaled so that box is
+//! [`Outline::rows`] pixels tall with its aspect kept, stood on the bottom row and centred
+//! horizontally on a canvas [`CANVAS_ASPECT`] times as wide as it is tall.
+//!
+//! A plant is drawn straight into that canvas, without the renderer: each stem segment of
+//! the shoot is a tapered band (a quadrilateral), each leaf and flower its blade's
+//! quadrilateral, filled by scanlines into a bitmap of 64-bit words; roots (root material
+//! and root tips) are left out. Intersection and union are popcounts over the words. Once
+//! a [`Scratch`] is warm, scoring allocates nothing.
+
+use sylva_core::Plant;
+use sylva_core::glam::{Vec2, Vec3};
+use sylva_core::plant::{MaterialKind, OrganKind};
+
+/// How much wider than tall the comparison canvas is: outlines up to this aspect are
+/// compared whole (a target wider than this is refused as not plant-like).
+pub const CANVAS_ASPECT: u32 = 3;
+
+/// A picture of one bit per pixel: ink or not. Rows run top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Bitmap {
+    width: u32,
+    height: u32,
+    words_per_row: usize,
+    words: Vec<u64>,
+}
+
+impl Bitmap {
+    /// An empty (inkless) bitmap.
+    pub fn new(width: u32, height: u32) -> Bitmap {
+        let words_per_row = (width as usize).div_ceil(64);
+        Bitmap {
+            width,
+            height,
+            words_per_row,
+            words: vec![0; words_per_row * height as usize],
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Whether pixel (`x`, `y`) is ink; pixels outside are not.
+    pub fn get(&self, x: u32, y: u32) -> bool {
+        x < self.width
+            && y < self.height
+            && self.words[y as usize * self.words_per_row + x as usize / 64] >> (x % 64) & 1 == 1
+    }
+
+    /// Inks pixel (`x`, `y`); pixels outside are ignored.
+    pub fn set(&mut self, x: u32, y: u32) {
+        if x < self.width && y < self.height {
+            self.words[y as usize * self.words_per_row + x as usize / 64] |= 1 << (x % 64);
+        }
+    }
+
+    /// Inks pixels `x0..x1` of row `y` (clipped to the bitmap).
+    pub fn fill_span(&mut self, y: u32, x0: u32, x1: u32) {
+        let x1 = x1.min(self.width);
+        if y >= self.height || x0 >= x1 {
+            return;
+        }
+        let row = &mut self.words[y as usize * self.words_per_row..][..self.words_per_row];
+        let (first, last) = (x0 as usize / 64, (x1 as usize - 1) / 64);
+        for (i, word) in row.iter_mut().enumerate().take(last + 1).skip(first) {
+            let lo = if i == first { x0 % 64 } else { 0 };
+            let hi = if i == last { (x1 - 1) % 64 + 1 } else { 64 };
+            let bits = if hi - lo == 64 {
+                u64::MAX
+            } else {
+                ((1u64 << (hi - lo)) - 1) << lo
+            };
+            *word |= bits;
+        }
+    }
+
+    /// Clears every pixel, keeping the size.
+    pub fn clear(&mut self) {
+        self.words.fill(0);
+    }
+
+    /// Pixels of ink.
+    pub fn ink(&self) -> u64 {
+        self.words.iter().map(|w| u64::from(w.count_ones())).sum()
+    }
+
+    /// The smallest box holding every pixel of ink, as `(x0, y0, x1, y1)` (ends exclusive);
+    /// `None` for a bitmap without ink.
+    pub fn ink_bounds(&self) -> Option<(u32, u32, u32, u32)> {
+        let mut bounds: Option<(u32, u32, u32, u32)> = None;
+        for y in 0..self.height {
+            let row = &self.words[y as usize * self.words_per_row..][..self.words_per_row];
+            let Some(first) = row.iter().position(|&w| w != 0) else {
+                continue;
+            };
+            let last = row.iter().rposition(|&w| w != 0).unwrap_or(first);
+            let x0 = first as u32 * 64 + row[first].trailing_zeros();
+            let x1 = last as u32 * 64 + 64 - row[last].leading_zeros();
+            bounds = Some(match bounds {
+                None => (x0, y, x1, y + 1),
+                Some((a, b, c, _)) => (a.min(x0), b, c.max(x1), y + 1),
+            });
+        }
+        bounds
+    }
+
+    /// Intersection over union with `other` (of the same size): 1 for equal bitmaps, 0 for
+    /// disjoint ones, and 0 when neither has ink.
+    pub fn iou(&self, other: &Bitmap) -> f64 {
+        debug_assert_eq!((self.width, self.height), (other.width, other.height));
+        let (mut both, mut either) = (0u64, 0u64);
+        for (a, b) in self.words.iter().zip(&other.words) {
+            both += u64::from((a & b).count_ones());
+            either += u64::from((a | b).count_ones());
+        }
+        if either == 0 {
+            0.0
+        } else {
+            both as f64 / either as f64
+        }
+    }
+}
+
+/// Which way the plant is seen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// Looking along -Z: +X to the right, +Y up.
+    #[default]
+    Front,
+    /// Looking along +X: +Z to the right, +Y up.
+    Side,
+}
+
+impl Side {
+    /// Where a point lands in the picture plane: (right, up).
+    #[inline]
+    fn project(self, p: Vec3) -> Vec2 {
+        match self {
+            Side::Front => Vec2::new(p.x, p.y),
+            Side::Side => Vec2::new(p.z, p.y),
+        }
+    }
+}
+
+/// Why an outline cannot be a target.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum OutlineError {
+    /// No pixel is ink.
+    #[error("the picture has no ink: every pixel is background")]
+    Empty,
+    /// Every pixel is ink.
+    #[error("the picture is ink from edge to edge: no background to tell the outline from")]
+    Full,
+    /// The ink is too small to be an outline.
+    #[error(
+        "the outline is {width} x {height} pixels; a target needs at least {min} pixels each way"
+    )]
+    TooSmall {
+        /// Ink width.
+        width: u32,
+        /// Ink height.
+        height: u32,
+        /// The least of each.
+        min: u32,
+    },
+    /// The ink is much wider than tall.
+    #[error(
+        "the outline is {width} x {height} pixels, more than {CANVAS_ASPECT} times as wide as \
+         tall: not a plant's outline"
+    )]
+    TooWide {
+        /// Ink width.
+        width: u32,
+        /// Ink height.
+        height: u32,
+    },
+}
+
+/// The least width and height, in pixels, of a target's ink.
+pub const MIN_INK: u32 = 8;
+
+/// A target outline, normalised for comparison at one resolution, and the view it is
+/// seen from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outline {
+    side: Side,
+    normalised: Bitmap,
+}
+
+impl Outline {
+    /// The outline of `picture`'s ink seen from `side`, normalised to `rows` pixels tall
+    /// (8 to 1024).
+    pub fn new(picture: &Bitmap, side: Side, rows: u32) -> Result<Outline, OutlineError> {
+        let rows = rows.clamp(8, 1024);
+        let (x0, y0, x1, y1) = picture.ink_bounds().ok_or(OutlineError::Empty)?;
+        if picture.ink() == u64::from(picture.width) * u64::from(picture.height) {
+            return Err(OutlineError::Full);
+        }
+        let (width, height) = (x1 - x0, y1 - y0);
+        if width < MIN_INK || height < MIN_INK {
+            return Err(OutlineError::TooSmall {
+                width,
+                height,
+                min: MIN_INK,
+            });
+        }
+        if width > CANVAS_ASPECT * height {
+            return Err(OutlineError::TooWide { width, height });
+        }
+        // Each canvas pixel is ink when at least half the picture's pixels under it are (the
+        // one under its centre, when enlarging).
+        let mut normalised = Bitmap::new(rows * CANVAS_ASPECT, rows);
+        let scale = f64::from(rows) / f64::from(height);
+        let columns = ((f64::from(width) * scale).round() as u32).clamp(1, rows * CANVAS_ASPECT);
+        let left = (rows * CANVAS_ASPECT - columns) / 2;
+        // The picture's pixels under canvas pixel `c` of a run of `n` over `len` pixels.
+        let under = |c: u32, n: u32, len: u32| {
+            let from = u64::from(c) * u64::from(len) / u64::from(n);
+            let to = (u64::from(c + 1) * u64::from(len)).div_ceil(u64::from(n));
+            (from as u32, (to as u32).max(from as u32 + 1).min(len))
+        };
+        for cy in 0..rows {
+            let (py0, py1) = under(cy, rows, height);
+            for cx in 0..columns {
+                let (px0, px1) = under(cx, columns, width);
+                let mut ink = 0u32;
+                for py in py0..py1 {
+                    for px in px0..px1 {
+                        ink += u32::from(picture.get(x0 + px, y0 + py));
+                    }
+                }
+                if 2 * ink >= (py1 - py0) * (px1 - px0) {
+                    normalised.set(left + cx, cy);
+                }
+            }
+        }
+        Ok(Outline { side, normalised })
+    }
+
+    /// The view the outline is seen from.
+    pub fn side(&self) -> Side {
+        self.side
+    }
+
+    /// Rows of the normalised outline.
+    pub fn rows(&self) -> u32 {
+        self.normalised.height()
+    }
+
+    /// The normalised outline.
+    pub fn normalised(&self) -> &Bitmap {
+        &self.normalised
+    }
+
+    /// Intersection over union of `plant`'s normalised silhouette with this outline, 0 to
+    /// 1; 0 for a plant with nothing above the ground to see. Draws into `scratch`.
+    pub fn iou(&self, plant: &Plant, scratch: &mut Scratch) -> f64 {
+        if !draw_normalised(plant, self.side, self.rows(), scratch) {
+            return 0.0;
+        }
+        scratch.canvas.iou(&self.normalised)
+    }
+}
+
+/// What scoring reuses between plants: the canvas a plant is drawn into.
+#[derive(Debug)]
+pub struct Scratch {
+    canvas: Bitmap,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch {
+            canvas: Bitmap::new(0, 0),
+        }
+    }
+}
+
+impl Scratch {
+    /// The last plant drawn, normalised.
+    pub fn canvas(&self) -> &Bitmap {
+        &self.canvas
+    }
+}
+
+/// Whether the outline draws a segment or organ: roots and root tips are below the ground.
+fn shoot_segment(plant: &Plant, material: sylva_core::plant::MaterialId) -> bool {
+    plant
+        .materials()
+        .get(material.index())
+        .is_none_or(|m| m.kind != MaterialKind::Root)
+}
+
+/// The corners of a segment's band and of an organ's blade, in the picture plane.
+fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
+    let segments = plant
+        .segments()
+        .iter()
+        .filter(|s| shoot_segment(plant, s.material))
+        .map(move |s| {
+            let (a, b) = (side.project(s.start), side.project(s.end));
+            let along = b - a;
+            let normal = if along.length_squared() > 0.0 {
+                along.perp().normalize()
+            } else {
+                Vec2::X
+            };
+            [
+                a + normal * s.start_radius,
+                b + normal * s.end_radius,
+                b - normal * s.end_radius,
+                a - normal * s.start_radius,
+            ]
+        });
+    let organs = plant
+        .organs()
+        .iter()
+        .filter(|o| o.kind != OrganKind::RootTip)
+        .map(move |o| {
+            let half = o.orientation * Vec3::X * (o.size.y * 0.5);
+            let tip = o.orientation * Vec3::Y * o.size.x;
+            let base = o.position;
+            [
+                side.project(base - half),
+                side.project(base - half + tip),
+                side.project(base + half + tip),
+                side.project(base + half),
+            ]
+        });
+    segments.chain(organs)
+}
+
+/// Draws `plant` seen from `side` into `scratch.canvas`, normalised to `rows` rows; `false`
+/// when nothing of it shows.
+fn draw_normalised(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) -> bool {
+    let width = rows * CANVAS_ASPECT;
+    if scratch.canvas.width() != width || scratch.canvas.height() != rows {
+        scratch.canvas = Bitmap::new(width, rows);
+    }
+    scratch.canvas.clear();
+    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    for quad in shapes(plant, side) {
+        for p in quad {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let size = hi - lo;
+    if !(size.y > 0.0 && size.is_finite()) {
+        return false;
+    }
+    // Plant units to pixels: the ink's height fills the rows, its box centred on the canvas.
+    let scale = rows as f32 / size.y;
+    let centre = Vec2::new((lo.x + hi.x) * 0.5, hi.y);
+    let to_pixels = |p: Vec2| {
+        Vec2::new(
+            (p.x - centre.x) * scale + width as f32 * 0.5,
+            (centre.y - p.y) * scale,
+        )
+    };
+    for quad in shapes(plant, side) {
+        fill_quad(&mut scratch.canvas, quad.map(to_pixels));
+    }
+    true
+}
+
+/// Fills a convex quadrilateral (pixel coordinates, rows downwards): every pixel whose
+/// centre it covers, and at least one pixel per row it crosses, so thin stems stay seen.
+fn fill_quad(canvas: &mut Bitmap, quad: [Vec2; 4]) {
+    let (mut top, mut bottom) = (f32::INFINITY, f32::NEG_INFINITY);
+    for p in quad {
+        top = top.min(p.y);
+        bottom = bottom.max(p.y);
+    }
+    let height = canvas.height() as f32;
+    if bottom < 0.0 || top >= height || !(top.is_finite() && bottom.is_finite()) {
+        return;
+    }
+    let first = top.max(0.0).floor() as u32;
+    let last = (bottom.min(height - 1.0)).floor() as u32;
+    for row in first..=last {
+        // The quad's extent across this row's band, from its edges clipped to the band.
+        let (band_top, band_bottom) = (row as f32, row as f32 + 1.0);
+        let (mut left, mut right) = (f32::INFINITY, f32::NEG_INFINITY);
+        for i in 0..4 {
+            let (a, b) = (quad[i], quad[(i + 1) % 4]);
+            let (a, b) = if a.y <= b.y { (a, b) } else { (b, a) };
+            let (y0, y1) = (a.y.max(band_top), b.y.min(band_bottom));
+            if y0 > y1 {
+                continue;
+            }
+            for y in [y0, y1] {
+                let x = if b.y > a.y {
+                    a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y))
+                } else if y == y0 {
+                    a.x
+                } else {
+                    b.x
+                };
+                left = left.min(x);
+                right = right.max(x);
+            }
+        }
+        if left > right {
+            continue;
+        }
+        // Pixels whose centres lie within, and at least the one under the middle.
+        let x0 = (left - 0.5).ceil().max(0.0);
+        let x1 = (right - 0.5).floor() + 1.0;
+        let (x0, x1) = if x1 > x0 {
+            (x0, x1)
+        } else {
+            let mid = ((left + right) * 0.5).floor().max(0.0);
+            (mid, mid + 1.0)
+        };
+        canvas.fill_span(row, x0 as u32, x1.max(0.0) as u32);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sylva_core::PlantMeta;
+
+    fn rectangle(width: u32, height: u32, ink: (u32, u32, u32, u32)) -> Bitmap {
+        let mut b = Bitmap::new(width, height);
+        for y in ink.1..ink.3 {
+            b.fill_span(y, ink.0, ink.2);
+        }
+        b
+    }
+
+    #[test]
+    fn spans_fill_exactly_their_pixels() {
+        let mut b = Bitmap::new(200, 3);
+        b.fill_span(1, 3, 130);
+        assert_eq!(b.ink(), 127);
+        assert!(!b.get(2, 1) && b.get(3, 1) && b.get(129, 1) && !b.get(130, 1));
+        assert_eq!(b.ink_bounds(), Some((3, 1, 130, 2)));
+        b.fill_span(2, 0, 64);
+        assert_eq!(b.ink(), 191);
+        b.fill_span(0, 190, 400);
+        assert_eq!(b.ink_bounds(), Some((0, 0, 200, 3)));
+    }
+
+    #[test]
+    fn outlines_are_normalised_for_place_and_size() {
+        // The same tall box, small in one corner and large in another: the same outline.
+        let small = Outline::new(&rectangle(300, 300, (10, 20, 30, 80)), Side::Front, 64);
+        let large = Outline::new(&rectangle(900, 700, (400, 50, 500, 350)), Side::Front, 64);
+        let (small, large) = (small.unwrap(), large.unwrap());
+        assert_eq!(small.normalised().iou(large.normalised()), 1.0);
+        // 64 rows tall, a third as wide (21 of 192 columns), centred.
+        assert_eq!(small.normalised().ink_bounds(), Some((85, 0, 106, 64)));
+    }
+
+    #[test]
+    fn bad_targets_are_refused() {
+        let side = Side::Front;
+        assert_eq!(
+            Outline::new(&Bitmap::new(50, 50), side, 64),
+            Err(OutlineError::Empty)
+        );
+        assert_eq!(
+            Outline::new(&rectangle(50, 50, (0, 0, 50, 50)), side, 64),
+            Err(OutlineError::Full)
+        );
+        assert!(matches!(
+            Outline::new(&rectangle(50, 50, (1, 1, 4, 40)), side, 64),
+            Err(OutlineError::TooSmall { .. })
+        ));
+        assert!(matches!(
+            Outline::new(&rectangle(500, 50, (0, 10, 400, 30)), side, 64),
+            Err(OutlineError::TooWide { .. })
+        ));
+    }
+
+    /// A trunk 4 m tall and 1 m wide (a box, seen from the front), and a root below.
+    fn stump() -> Plant {
+        let mut plant = Plant::new(PlantMeta::default());
+        plant
+            .add_segment(
+                Vec3::ZERO,
+                Vec3::new(0.0, 4.0, 0.0),
+                (0.5, 0.5),
+                None,
+                false,
+                Plant::BARK,
+            )
+            .unwrap();
+        let root = plant
+            .add_material(sylva_core::plant::Material::of_kind(MaterialKind::Root))
+            .unwrap();
+        plant
+            .add_segment(
+                Vec3::ZERO,
+                Vec3::new(3.0, -2.0, 0.0),
+                (0.5, 0.1),
+                None,
+                false,
+                root,
+            )
+            .unwrap();
+        plant
+    }
+
+    #[test]
+    fn a_plant_matches_its_own_outline_and_not_another() {
+        let mut scratch = Scratch::default();
+        let plant = stump();
+        // The target: a box four times as tall as wide, drawn at another size.
+        let target = rectangle(100, 100, (40, 10, 60, 90));
+        let outline = Outline::new(&target, Side::Front, 64).unwrap();
+        let iou = outline.iou(&plant, &mut scratch);
+        assert!(iou > 0.95, "{iou}");
+        // From the side the trunk is the same box; a squat box is another shape.
+        let squat = Outline::new(&rectangle(100, 100, (10, 40, 90, 80)), Side::Side, 64).unwrap();
+        let iou = squat.iou(&plant, &mut scratch);
+        assert!(iou < 0.3, "{iou}");
+    }
+
+    #[test]
+    fn nothing_above_the_ground_scores_zero() {
+        let outline =
+            Outline::new(&rectangle(100, 100, (40, 10, 60, 90)), Side::Front, 64).unwrap();
+        let plant = Plant::new(PlantMeta::default());
+        assert_eq!(outline.iou(&plant, &mut Scratch::default()), 0.0);
+    }
+}
