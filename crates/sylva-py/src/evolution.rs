@@ -536,3 +536,96 @@ impl Evolution {
         })
     }
 }
+
+/// Evolves a plant whose outline matches a picture and returns the run, as `sylva match`
+/// does: `target` is a PNG or JPEG of the outline seen from the front, `side` the one seen
+/// from the side (the front picture by default); `model` a model's name or `"auto"` (each
+/// model briefly, then on with the best); for `generations` (the same bytes each time) or
+/// `seconds` of breeding (60 by default); `threshold` `"otsu"` or a luminance from 0 to 1.
+/// The best member's `terms["iou"]` is its outline's IoU. Releases the GIL.
+#[pyfunction(name = "match")]
+#[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
+                    population = 100, seed = 1, threshold = None, threads = 0))]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments.
+pub fn match_outline(
+    py: Python<'_>,
+    target: PathBuf,
+    side: Option<PathBuf>,
+    model: &str,
+    generations: Option<u32>,
+    seconds: Option<f64>,
+    population: u32,
+    seed: u64,
+    threshold: Option<&Bound<'_, PyAny>>,
+    threads: u32,
+) -> PyResult<Evolution> {
+    use sylva::evolution::outline::{Limit, match_config, outlines, start_auto};
+    let threshold = match threshold {
+        None => sylva::picture::Threshold::Otsu,
+        Some(t) => serde_json::from_value(from_py(t, "threshold")?)
+            .map_err(|e| bad_value("threshold", e))?,
+    };
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
+    let front = absolute(&target);
+    let outline = sylva::evolution::MatchConfig {
+        side: Some(side.as_deref().map_or_else(|| front.clone(), absolute)),
+        front,
+        threshold,
+        weight: 1.0,
+        beside: false,
+        rows: 64,
+    };
+    outlines(&outline, Path::new("")).py()?;
+    let limit = match (generations, seconds) {
+        (Some(_), Some(_)) => {
+            return Err(bad_value(
+                "seconds",
+                "give `generations` or `seconds`, not both",
+            ));
+        }
+        (Some(n), None) => Limit::Generations(n),
+        (None, s) => match s.unwrap_or(60.0) {
+            s if (1.0..=86_400.0).contains(&s) => Limit::Seconds(s),
+            s => return Err(bad_value("seconds", format!("{s}; expected 1 to 86400"))),
+        },
+    };
+    let run = sylva::RunConfig {
+        generations: match limit {
+            Limit::Generations(n) => n,
+            Limit::Seconds(_) => 1_000_000,
+        },
+        population,
+        seed,
+        threads,
+        ..sylva::RunConfig::default()
+    };
+    let registry = crate::registry();
+    let config = match model {
+        "auto" => None,
+        model => Some(
+            match_config(registry, model, &run, &outline)
+                .map_err(|e| bad_value(e.field, e.message))?,
+        ),
+    };
+    let pool = Evolution::pool(
+        config.as_ref().unwrap_or(&sylva::Config::default()),
+        Some(threads),
+    )?;
+    let evolution = py
+        .detach(|| -> Result<Run, sylva::Error> {
+            let (mut evolution, elsewhere) = match &config {
+                Some(config) => (Run::start(config, Vec::new(), pool)?, 0.0),
+                None => start_auto(registry, &outline, &run, limit, &pool, |_| {})?,
+            };
+            let remaining = limit.remaining(&evolution, elsewhere);
+            let started = std::time::Instant::now();
+            while !remaining.reached(&evolution, started) {
+                evolution.step()?;
+            }
+            Ok(evolution)
+        })
+        .py()?;
+    Ok(Evolution {
+        run: Mutex::new(evolution),
+    })
+}

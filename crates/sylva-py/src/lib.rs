@@ -78,6 +78,7 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
     m.add_class::<evolution::Member>()?;
     m.add_function(wrap_pyfunction!(genome::cross, m)?)?;
     m.add_function(wrap_pyfunction!(genome::models, m)?)?;
+    m.add_function(wrap_pyfunction!(evolution::match_outline, m)?)?;
     m.add_function(wrap_pyfunction!(genome::_rust_grow_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(plant::garden, m)?)?;
     m.add_function(wrap_pyfunction!(plant::scene, m)?)?;

@@ -379,3 +379,23 @@ def test_messages_speak_python():
     with pytest.raises(sylva.InputError) as e:
         sylva.Genome.from_dict({"model": "bintree", "format": 1, "depth": True})
     assert "bool True" in str(e.value) and "i64" not in e.value.detail
+
+
+def test_match_evolves_towards_a_picture(tmp_path):
+    target = EXAMPLES / "match" / "cone.png"
+    run = sylva.match(target, model="bintree", generations=6, population=12, seed=4)
+    assert run.term_names == ["iou"]
+    best = run.best()
+    assert 0.0 < best.terms["iou"] <= 1.0
+    assert best.fitness == best.terms["iou"]
+    again = sylva.match(str(target), model="bintree", generations=6, population=12, seed=4)
+    assert again.best().genome == best.genome
+    # The outline joins the config the run records.
+    assert "[match]" in run.config.to_toml()
+    # A picture that is not one is refused naming the file.
+    text = tmp_path / "notes.png"
+    text.write_text("not a picture")
+    with pytest.raises(sylva.InputError, match="notes.png"):
+        sylva.match(text, generations=1)
+    with pytest.raises(sylva.InputError, match="seconds"):
+        sylva.match(target, generations=1, seconds=5)

@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
-use sylva::evolution::outline::{TERM, match_config, outlines, overlay};
+use sylva::evolution::outline::{
+    Limit, Trial, best_iou, match_config, outlines, overlay, start_auto,
+};
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution, InputError, Registry};
@@ -55,13 +57,6 @@ pub struct MatchArgs {
     /// Continue the run saved in the run directory's checkpoint.
     #[arg(long)]
     resume: bool,
-}
-
-/// How long a run breeds.
-#[derive(Clone, Copy)]
-enum Limit {
-    Generations(u32),
-    Seconds(f64),
 }
 
 fn parse_seconds(text: &str) -> Result<f64, String> {
@@ -132,7 +127,25 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         let evolution = Evolution::resume(&config, &checkpoint, &text, pool.clone())?;
         (evolution, config, 0.0)
     } else if args.model == "auto" {
-        auto(registry, &config_of, limit, &pool)?
+        let (evolution, elsewhere) =
+            start_auto(registry, &target, &run, limit, &pool, |t| match t {
+                Trial::Reached {
+                    model,
+                    iou,
+                    generations,
+                } => eprintln!("auto: {model} reached IoU {iou:.3} in {generations} generations"),
+                Trial::LeftOut {
+                    model,
+                    seconds,
+                    allowance,
+                } => eprintln!(
+                    "auto: {model} left out: a generation may take {} (more than {} of a trial)",
+                    Seconds(*seconds),
+                    Seconds(*allowance)
+                ),
+            })?;
+        let config = evolution.config();
+        (evolution, config, elsewhere)
     } else {
         let config = config_of(&args.model)?;
         let evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
@@ -159,80 +172,6 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The share of a run each model gets in a trial of `--model auto`.
-const TRIAL_SHARE: f64 = 0.1;
-
-/// `--model auto`: a short run of each model whose generations fit the trial, then the
-/// run of the model whose best plant matches the outline best (the first on a tie), and
-/// the seconds spent on the others.
-fn auto(
-    registry: &Registry,
-    config_of: &dyn Fn(&str) -> Result<Config, InputError>,
-    limit: Limit,
-    pool: &sylva::core::par::Pool,
-) -> anyhow::Result<(Evolution, Config, f64)> {
-    let started = Instant::now();
-    let trial = match limit {
-        Limit::Generations(n) => Limit::Generations(((f64::from(n) * TRIAL_SHARE) as u32).max(1)),
-        Limit::Seconds(s) => Limit::Seconds(s * TRIAL_SHARE),
-    };
-    let mut best: Option<(f64, Evolution, Config)> = None;
-    for entry in registry.models() {
-        let config = config_of(entry.name())?;
-        // A model whose generation may take longer than a trial (or, counting generations,
-        // than a tenth of the default minute) is left out: its plants grow slowly.
-        let allowance = match trial {
-            Limit::Seconds(s) => s,
-            Limit::Generations(_) => 60.0 * TRIAL_SHARE,
-        };
-        if let Some(t) = config.generation_time(&[], pool.threads())
-            && t.seconds > allowance
-        {
-            eprintln!(
-                "auto: {} left out: a generation may take {} (more than {} of a trial)",
-                entry.name(),
-                Seconds(t.seconds),
-                Seconds(allowance)
-            );
-            continue;
-        }
-        let mut evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
-        breed_quietly(&mut evolution, trial)?;
-        let iou = best_iou(&evolution);
-        eprintln!(
-            "auto: {} reached IoU {iou:.3} in {} generations",
-            entry.name(),
-            evolution.generation()
-        );
-        if best.as_ref().is_none_or(|(b, _, _)| iou > *b) {
-            best = Some((iou, evolution, config));
-        }
-    }
-    let (_, evolution, config) =
-        best.ok_or_else(|| InputError::new("--model", "no model fits the time given"))?;
-    let own: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
-    let elsewhere = (started.elapsed().as_secs_f64() - own).max(0.0);
-    Ok((evolution, config, elsewhere))
-}
-
-/// The outline IoU of the run's best member.
-fn best_iou(evolution: &Evolution) -> f64 {
-    let at = evolution.term_names().iter().position(|n| n == TERM);
-    let best = evolution.best();
-    match (at, best.fitness) {
-        (Some(at), Some(f)) => f.terms()[at],
-        _ => 0.0,
-    }
-}
-
-fn breed_quietly(evolution: &mut Evolution, limit: Limit) -> anyhow::Result<()> {
-    let started = Instant::now();
-    while !done_from(evolution, limit, started) {
-        evolution.step()?;
-    }
-    Ok(())
-}
-
 /// Breeds until `limit`, showing the best IoU and checkpointing as it goes; `elsewhere`
 /// seconds were spent on other runs (the trials of `--model auto`) and count too.
 fn breed(
@@ -256,6 +195,7 @@ fn breed(
     };
     let started = Instant::now();
     let already = elsewhere + evolution.stats().iter().map(|g| g.seconds).sum::<f64>();
+    let remaining = limit.remaining(evolution, elsewhere);
     let show = |evolution: &Evolution| {
         bar.set_position(match limit {
             Limit::Generations(_) => u64::from(evolution.generation()),
@@ -274,11 +214,7 @@ fn breed(
     show(evolution);
     let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
     let mut last_save = Instant::now();
-    let limit = match limit {
-        Limit::Seconds(s) => Limit::Seconds(s - already),
-        generations => generations,
-    };
-    while !done_from(evolution, limit, started) {
+    while !remaining.reached(evolution, started) {
         evolution.step()?;
         show(evolution);
         if last_save.elapsed() >= every {
@@ -289,12 +225,4 @@ fn breed(
     save(evolution)?;
     bar.finish_and_clear();
     Ok(())
-}
-
-/// Whether this process has bred as long as `limit` asks (seconds counted from `started`).
-fn done_from(evolution: &Evolution, limit: Limit, started: Instant) -> bool {
-    match limit {
-        Limit::Generations(n) => evolution.generation() >= n,
-        Limit::Seconds(s) => started.elapsed().as_secs_f64() >= s,
-    }
 }

@@ -31,6 +31,7 @@ from ._sylva import (
     __version__,
     cross,
     garden,
+    match,
     models,
     scene,
 )
@@ -53,6 +54,7 @@ __all__ = [
     "cross",
     "garden",
     "islands",
+    "match",
     "models",
     "scene",
 ]

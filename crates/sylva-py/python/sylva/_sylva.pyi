@@ -221,6 +221,19 @@ def cross(
 ) -> tuple[Genome, list[int]]:
     """A child of two or more parents of one model, by the model's own crossover."""
 
+def match(
+    target: _Path,
+    side: _Path | None = None,
+    model: str = "auto",
+    generations: int | None = None,
+    seconds: float | None = None,
+    population: int = 100,
+    seed: int = 1,
+    threshold: str | float | None = None,
+    threads: int = 0,
+) -> Evolution:
+    """Evolves a plant whose outline matches a picture (PNG or JPEG); returns the run."""
+
 def models() -> dict[str, str]:
     """The models Sylva knows: name to title."""
 

@@ -5,6 +5,9 @@
 use std::cell::RefCell;
 use std::path::Path;
 use std::sync::Arc;
+use std::time::Instant;
+
+use sylva_core::par::Pool;
 
 use sylva_evolve::{Added, Problem, Term};
 use sylva_fitness::silhouette::{Outline, Scratch, Side};
@@ -16,6 +19,7 @@ use crate::picture;
 use crate::registry::Registry;
 
 use super::config::Config;
+use super::run::Evolution;
 use super::schema::{MatchConfig, RunConfig};
 
 /// The term's name, a column of `stats.csv`.
@@ -141,4 +145,130 @@ pub fn overlay(
         &caption,
     );
     Ok((sylva_render::encode_png(&image)?, iou))
+}
+
+/// How long a match breeds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Limit {
+    /// Until this generation: the same target, seed and generations give the same bytes.
+    Generations(u32),
+    /// For this many seconds of breeding.
+    Seconds(f64),
+}
+
+impl Limit {
+    /// Whether `evolution` has bred as long as asked, counting seconds from `started`.
+    pub fn reached(self, evolution: &Evolution, started: Instant) -> bool {
+        match self {
+            Limit::Generations(n) => evolution.generation() >= n,
+            Limit::Seconds(s) => started.elapsed().as_secs_f64() >= s,
+        }
+    }
+
+    /// What is left of this limit after `evolution`'s bred generations and `elsewhere`
+    /// seconds spent on other runs (a resumed run; the trials of [`start_auto`]).
+    pub fn remaining(self, evolution: &Evolution, elsewhere: f64) -> Limit {
+        match self {
+            Limit::Seconds(s) => {
+                let spent: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
+                Limit::Seconds(s - spent - elsewhere)
+            }
+            generations => generations,
+        }
+    }
+}
+
+/// The share of a match each model's trial gets in [`start_auto`].
+pub const TRIAL_SHARE: f64 = 0.1;
+
+/// The outline IoU of the run's best member (0 for a run without the term).
+pub fn best_iou(evolution: &Evolution) -> f64 {
+    let at = evolution.term_names().iter().position(|n| n == TERM);
+    match (at, evolution.best().fitness) {
+        (Some(at), Some(f)) => f.terms()[at],
+        _ => 0.0,
+    }
+}
+
+/// How one model did in the trials of [`start_auto`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum Trial {
+    /// It bred `generations` generations and reached `iou`.
+    Reached {
+        /// The model.
+        model: &'static str,
+        /// Its best plant's outline IoU.
+        iou: f64,
+        /// Generations bred.
+        generations: u32,
+    },
+    /// It was left out: a generation may take `seconds`, more than a trial allows.
+    LeftOut {
+        /// The model.
+        model: &'static str,
+        /// Seconds a generation may take.
+        seconds: f64,
+        /// Seconds a trial allows a generation.
+        allowance: f64,
+    },
+}
+
+/// A match by the model that matches the outline best: a short run of each model of the
+/// registry (a tenth of `limit`, [`TRIAL_SHARE`]; a model whose generation may take longer
+/// than that, or counting generations longer than a tenth of a minute, is left out), then
+/// the run of the best (the first on a tie), with the seconds spent on the others.
+/// `on_trial` hears how each model did.
+pub fn start_auto(
+    registry: &Registry,
+    target: &MatchConfig,
+    run: &RunConfig,
+    limit: Limit,
+    pool: &Pool,
+    mut on_trial: impl FnMut(&Trial),
+) -> Result<(Evolution, f64), Error> {
+    let started = Instant::now();
+    let (trial, allowance) = match limit {
+        Limit::Generations(n) => (
+            Limit::Generations(((f64::from(n) * TRIAL_SHARE) as u32).max(1)),
+            60.0 * TRIAL_SHARE,
+        ),
+        Limit::Seconds(s) => (Limit::Seconds(s * TRIAL_SHARE), s * TRIAL_SHARE),
+    };
+    let mut best: Option<(f64, Evolution)> = None;
+    for entry in registry.models() {
+        let config = match_config(registry, entry.name(), run, target)
+            .map_err(|e| InputError::new(e.field, e.message))?;
+        if let Some(t) = config.generation_time(&[], pool.threads())
+            && t.seconds > allowance
+        {
+            on_trial(&Trial::LeftOut {
+                model: entry.name(),
+                seconds: t.seconds,
+                allowance,
+            });
+            continue;
+        }
+        let mut evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
+        let begun = Instant::now();
+        while !trial.reached(&evolution, begun) {
+            evolution.step()?;
+        }
+        let iou = best_iou(&evolution);
+        on_trial(&Trial::Reached {
+            model: entry.name(),
+            iou,
+            generations: evolution.generation(),
+        });
+        if best.as_ref().is_none_or(|(b, _)| iou > *b) {
+            best = Some((iou, evolution));
+        }
+    }
+    let (_, evolution) = best.ok_or_else(|| {
+        InputError::new(
+            "model",
+            "no model's generation fits a trial of the time given",
+        )
+    })?;
+    let own: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
+    Ok((evolution, (started.elapsed().as_secs_f64() - own).max(0.0)))
 }
