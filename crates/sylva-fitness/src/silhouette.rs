@@ -9,7 +9,10 @@
 //! A plant is drawn straight into that canvas, without the renderer: each stem segment of
 //! the shoot is a tapered band (a quadrilateral), each leaf and flower its blade's
 //! quadrilateral, filled by scanlines into a bitmap of 64-bit words; roots (root material
-//! and root tips) are left out. Intersection and union are popcounts over the words. Once
+//! and root tips) are left out.
+//!
+//! The term of a run, [`Outline::score`], is the IoU times [`stem_plausibility`]: a plant
+//! whose trunk has grown as wide as the crown it should carry does not pass for a tree. Intersection and union are popcounts over the words. Once
 //! a [`Scratch`] is warm, scoring allocates nothing.
 
 use sylva_core::Plant;
@@ -271,18 +274,26 @@ impl Outline {
         }
         scratch.canvas.iou(&self.normalised)
     }
+
+    /// The outline term: [`Outline::iou`] times [`stem_plausibility`].
+    pub fn score(&self, plant: &Plant, scratch: &mut Scratch) -> f64 {
+        self.iou(plant, scratch) * stem_plausibility(plant)
+    }
 }
 
-/// What scoring reuses between plants: the canvas a plant is drawn into.
+/// What scoring reuses between plants: the canvas a plant is drawn into, and its shapes
+/// projected into the picture plane.
 #[derive(Debug)]
 pub struct Scratch {
     canvas: Bitmap,
+    quads: Vec<[Vec2; 4]>,
 }
 
 impl Default for Scratch {
     fn default() -> Self {
         Scratch {
             canvas: Bitmap::new(0, 0),
+            quads: Vec::new(),
         }
     }
 }
@@ -302,6 +313,48 @@ fn shoot_segment(plant: &Plant, material: sylva_core::plant::MaterialId) -> bool
         .is_none_or(|m| m.kind != MaterialKind::Root)
 }
 
+/// The thickest a stem may be without cost, as a share of the plant's height (a spruce's
+/// trunk is about 2%, an oak's 4%): a plant should match an outline with branches and
+/// leaves, not with a trunk grown as wide as the crown.
+pub const MAX_RADIUS_SHARE: f32 = 0.05;
+
+/// The height of the shoot's skeleton and organs' bases (radii and blades left out).
+fn shoot_height(plant: &Plant) -> f32 {
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    let segments = plant
+        .segments()
+        .iter()
+        .filter(|s| shoot_segment(plant, s.material))
+        .flat_map(|s| [s.start.y, s.end.y]);
+    let organs = plant
+        .organs()
+        .iter()
+        .filter(|o| o.kind != OrganKind::RootTip)
+        .map(|o| o.position.y);
+    for y in segments.chain(organs) {
+        lo = lo.min(y);
+        hi = hi.max(y);
+    }
+    if hi > lo { hi - lo } else { 0.0 }
+}
+
+/// How plausible the plant's stems are, 0 to 1: 1 when none is thicker than
+/// [`MAX_RADIUS_SHARE`] of its height, else that thickness over its thickest stem's.
+pub fn stem_plausibility(plant: &Plant) -> f64 {
+    let allowed = shoot_height(plant) * MAX_RADIUS_SHARE;
+    let thickest = plant
+        .segments()
+        .iter()
+        .filter(|s| shoot_segment(plant, s.material))
+        .map(|s| s.start_radius.max(s.end_radius))
+        .fold(0.0f32, f32::max);
+    if thickest <= allowed {
+        1.0
+    } else {
+        f64::from(allowed / thickest)
+    }
+}
+
 /// The corners of a segment's band and of an organ's blade, in the picture plane.
 fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
     let segments = plant
@@ -309,6 +362,7 @@ fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
         .iter()
         .filter(|s| shoot_segment(plant, s.material))
         .map(move |s| {
+            let (r0, r1) = (s.start_radius, s.end_radius);
             let (a, b) = (side.project(s.start), side.project(s.end));
             let along = b - a;
             let normal = if along.length_squared() > 0.0 {
@@ -317,10 +371,10 @@ fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
                 Vec2::X
             };
             [
-                a + normal * s.start_radius,
-                b + normal * s.end_radius,
-                b - normal * s.end_radius,
-                a - normal * s.start_radius,
+                a + normal * r0,
+                b + normal * r1,
+                b - normal * r1,
+                a - normal * r0,
             ]
         });
     let organs = plant
@@ -349,12 +403,12 @@ fn draw_normalised(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) 
         scratch.canvas = Bitmap::new(width, rows);
     }
     scratch.canvas.clear();
+    scratch.quads.clear();
+    scratch.quads.extend(shapes(plant, side));
     let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-    for quad in shapes(plant, side) {
-        for p in quad {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
+    for p in scratch.quads.iter().flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
     }
     let size = hi - lo;
     if !(size.y > 0.0 && size.is_finite()) {
@@ -369,7 +423,7 @@ fn draw_normalised(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) 
             (centre.y - p.y) * scale,
         )
     };
-    for quad in shapes(plant, side) {
+    for quad in &scratch.quads {
         fill_quad(&mut scratch.canvas, quad.map(to_pixels));
     }
     true
@@ -486,14 +540,14 @@ mod tests {
         ));
     }
 
-    /// A trunk 4 m tall and 1 m wide (a box, seen from the front), and a root below.
-    fn stump() -> Plant {
+    /// A trunk 4 m tall and `2 radius` wide (a box, seen from the front), and a root below.
+    fn stump(radius: f32) -> Plant {
         let mut plant = Plant::new(PlantMeta::default());
         plant
             .add_segment(
                 Vec3::ZERO,
                 Vec3::new(0.0, 4.0, 0.0),
-                (0.5, 0.5),
+                (radius, radius),
                 None,
                 false,
                 Plant::BARK,
@@ -518,16 +572,33 @@ mod tests {
     #[test]
     fn a_plant_matches_its_own_outline_and_not_another() {
         let mut scratch = Scratch::default();
-        let plant = stump();
-        // The target: a box four times as tall as wide, drawn at another size.
-        let target = rectangle(100, 100, (40, 10, 60, 90));
-        let outline = Outline::new(&target, Side::Front, 64).unwrap();
+        let plant = stump(0.15);
+        // The target: a box 13.3 times as tall as wide, drawn at another size.
+        let target = rectangle(300, 300, (141, 20, 159, 260));
+        // At 256 rows the trunk is 19 pixels wide: its edges' pixels count for little.
+        let outline = Outline::new(&target, Side::Front, 256).unwrap();
         let iou = outline.iou(&plant, &mut scratch);
-        assert!(iou > 0.95, "{iou}");
+        assert!(iou > 0.9, "{iou}");
         // From the side the trunk is the same box; a squat box is another shape.
         let squat = Outline::new(&rectangle(100, 100, (10, 40, 90, 80)), Side::Side, 64).unwrap();
         let iou = squat.iou(&plant, &mut scratch);
         assert!(iou < 0.3, "{iou}");
+    }
+
+    #[test]
+    fn a_trunk_as_wide_as_a_crown_does_not_pass_for_one() {
+        // A square target and a stump as wide as tall: its outline matches, its stem does
+        // not pass (a radius of half its height, ten times the 5% allowed).
+        let square = Outline::new(&rectangle(100, 100, (10, 10, 90, 90)), Side::Front, 64);
+        let (square, stump) = (square.unwrap(), stump(2.0));
+        let mut scratch = Scratch::default();
+        assert!(square.iou(&stump, &mut scratch) > 0.95);
+        assert!((stem_plausibility(&stump) - 0.1).abs() < 1e-6);
+        let score = square.score(&stump, &mut scratch);
+        let iou = square.iou(&stump, &mut scratch);
+        assert_eq!(score, iou * stem_plausibility(&stump));
+        // A thin trunk costs nothing.
+        assert_eq!(stem_plausibility(&super::tests::stump(0.15)), 1.0);
     }
 
     #[test]

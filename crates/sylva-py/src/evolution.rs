@@ -542,7 +542,7 @@ impl Evolution {
 /// from the side (the front picture by default); `model` a model's name or `"auto"` (each
 /// model briefly, then on with the best); for `generations` (the same bytes each time) or
 /// `seconds` of breeding (60 by default); `threshold` `"otsu"` or a luminance from 0 to 1.
-/// The best member's `terms["iou"]` is its outline's IoU. Releases the GIL.
+/// The best member's `terms["iou"]` is its outline term (docs/match.md). Releases the GIL.
 #[pyfunction(name = "match")]
 #[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
                     population = 100, seed = 1, threshold = None, threads = 0))]

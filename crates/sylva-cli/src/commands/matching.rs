@@ -127,13 +127,20 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         let evolution = Evolution::resume(&config, &checkpoint, &text, pool.clone())?;
         (evolution, config, 0.0)
     } else if args.model == "auto" {
-        let (evolution, elsewhere) =
-            start_auto(registry, &target, &run, limit, &pool, |t| match t {
+        let (evolution, elsewhere) = start_auto(
+            registry,
+            &target,
+            &run,
+            limit,
+            &pool,
+            |t| match t {
                 Trial::Reached {
                     model,
                     iou,
                     generations,
-                } => eprintln!("auto: {model} reached IoU {iou:.3} in {generations} generations"),
+                } => eprintln!(
+                    "auto: {model} reached an outline score of {iou:.3} in {generations} generations"
+                ),
                 Trial::LeftOut {
                     model,
                     seconds,
@@ -143,7 +150,8 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
                     Seconds(*seconds),
                     Seconds(*allowance)
                 ),
-            })?;
+            },
+        )?;
         let config = evolution.config();
         (evolution, config, elsewhere)
     } else {

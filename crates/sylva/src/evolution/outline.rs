@@ -30,7 +30,8 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// Model `M`'s plants against target outlines: the mean IoU over the views.
+/// Model `M`'s plants against target outlines: the mean over the views of the IoU times
+/// the plant's stem plausibility ([`Outline::score`]).
 struct OutlineTerm<M> {
     model: M,
     outlines: Vec<Outline>,
@@ -50,7 +51,7 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
         };
         SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
-            let sum: f64 = self.outlines.iter().map(|o| o.iou(&plant, scratch)).sum();
+            let sum: f64 = self.outlines.iter().map(|o| o.score(&plant, scratch)).sum();
             sum / self.outlines.len() as f64
         })
     }
