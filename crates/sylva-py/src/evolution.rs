@@ -407,7 +407,9 @@ impl Evolution {
     }
 
     /// Breeds `generations` generations (up to the config's last when left out), calling
-    /// `on_generation(row)` after each when given. Releases the GIL between calls.
+    /// `on_generation(row)` after each when given. Releases the GIL while it breeds. Ctrl-C
+    /// raises `KeyboardInterrupt` when the generation under way ends, leaving the run whole
+    /// at that generation (step it, run it on, or checkpoint it).
     #[pyo3(signature = (generations = None, on_generation = None))]
     fn run(
         &self,
@@ -420,6 +422,7 @@ impl Evolution {
         });
         for _ in 0..todo {
             let row = self.step(py)?;
+            py.check_signals()?;
             if let Some(callback) = &on_generation {
                 callback.call1((row,))?;
             }
@@ -542,7 +545,8 @@ impl Evolution {
 /// from the side (the front picture by default); `model` a model's name or `"auto"` (each
 /// model briefly, then on with the best); for `generations` (the same bytes each time) or
 /// `seconds` of breeding (60 by default); `threshold` `"otsu"` or a luminance from 0 to 1.
-/// The best member's `terms["iou"]` is its outline term (docs/match.md). Releases the GIL.
+/// The best member's `terms["iou"]` is its outline term (docs/match.md). Releases the GIL
+/// while it breeds; Ctrl-C raises `KeyboardInterrupt` between generations.
 #[pyfunction(name = "match")]
 #[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
                     population = 100, seed = 1, threshold = None, threads = 0))]
@@ -611,20 +615,22 @@ pub fn match_outline(
         config.as_ref().unwrap_or(&sylva::Config::default()),
         Some(threads),
     )?;
-    let evolution = py
-        .detach(|| -> Result<Run, sylva::Error> {
-            let (mut evolution, elsewhere) = match &config {
-                Some(config) => (Run::start(config, Vec::new(), pool)?, 0.0),
-                None => start_auto(registry, &outline, &run, limit, &pool, |_| {})?,
-            };
-            let remaining = limit.remaining(&evolution, elsewhere);
-            let started = std::time::Instant::now();
-            while !remaining.reached(&evolution, started) {
-                evolution.step()?;
+    let (mut evolution, elsewhere) = py
+        .detach(|| -> Result<(Run, f64), sylva::Error> {
+            match &config {
+                Some(config) => Ok((Run::start(config, Vec::new(), pool)?, 0.0)),
+                None => start_auto(registry, &outline, &run, limit, &pool, |_| {}),
             }
-            Ok(evolution)
         })
         .py()?;
+    py.check_signals()?;
+    let remaining = limit.remaining(&evolution, elsewhere);
+    let started = std::time::Instant::now();
+    // A generation at a time, so Ctrl-C is heard between them.
+    while !remaining.reached(&evolution, started) {
+        py.detach(|| evolution.step().map(|_| ())).py()?;
+        py.check_signals()?;
+    }
     Ok(Evolution {
         run: Mutex::new(evolution),
     })

@@ -399,3 +399,22 @@ def test_match_evolves_towards_a_picture(tmp_path):
         sylva.match(text, generations=1)
     with pytest.raises(sylva.InputError, match="seconds"):
         sylva.match(target, generations=1, seconds=5)
+
+
+def test_ctrl_c_stops_a_run_between_generations_and_leaves_it_whole():
+    import _thread
+
+    run = sylva.Evolution(CONFIGS["bintree"], threads=1)
+    # Ctrl-C while the run breeds (the main thread is in Rust, the GIL released). Without
+    # it, 100,000 generations would take many minutes.
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run.run(100_000)
+    finally:
+        timer.cancel()
+    stopped = run.generation
+    assert 0 < stopped < 100_000
+    run.step()
+    assert run.generation == stopped + 1
