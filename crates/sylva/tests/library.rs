@@ -89,6 +89,15 @@ fn config_errors_point_at_the_value() {
         ("model = \"oak\"\n", "c.toml:1:9", "unknown model `oak`"),
         ("[output]\nview = \"back\"\n", "c.toml:2:8", "front"),
         ("[run\n", "c.toml:1:", ""),
+        // A section is a table: a list is not read field by field in order.
+        ("run = [5, 10]\n", "c.toml:1:7", "expected a table: `[run]`"),
+        ("run = []\n", "c.toml:1:7", "expected a table"),
+        ("bintree = [\"a\"]\n", "c.toml:1:11", "`[bintree]`"),
+        (
+            "output = 3\n",
+            "c.toml:1:10",
+            "expected a table: `[output]`",
+        ),
         ("[run]\nseed = 18446744073709551616\n", "c.toml:2:8", ""),
         // A section of another model is refused where it stands, not quietly ignored.
         (

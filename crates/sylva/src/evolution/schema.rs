@@ -267,13 +267,53 @@ impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
         while let Some(key) = map.next_key_seed(KeySeed(M::NAME))? {
             match key {
                 Key::Model => map.next_value_seed(NameSeed(M::NAME))?,
-                Key::Run => config.run = map.next_value()?,
-                Key::Settings => config.settings = map.next_value()?,
-                Key::Output => config.output = map.next_value()?,
-                Key::Match => config.outline = Some(map.next_value()?),
+                Key::Run => config.run = map.next_value_seed(Table::new("run"))?,
+                Key::Settings => config.settings = map.next_value_seed(Table::new(M::NAME))?,
+                Key::Output => config.output = map.next_value_seed(Table::new("output"))?,
+                Key::Match => config.outline = Some(map.next_value_seed(Table::new("match"))?),
             }
         }
         Ok(config)
+    }
+}
+
+/// Reads a section (`[run]`, `[output]`, the model's) as a table and nothing else: serde's
+/// derived structs also take a list, field by field in order (`run = [5, 10]` would be
+/// 5 generations of 10), which no one writes on purpose.
+struct Table<T> {
+    name: &'static str,
+    section: PhantomData<T>,
+}
+
+impl<T> Table<T> {
+    fn new(name: &'static str) -> Self {
+        Table {
+            name,
+            section: PhantomData,
+        }
+    }
+}
+
+impl<'de, T: Deserialize<'de>> DeserializeSeed<'de> for Table<T> {
+    type Value = T;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<T, D::Error> {
+        d.deserialize_map(self)
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Visitor<'de> for Table<T> {
+    type Value = T;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "a table: `[{}]` with its fields, or `{} = {{ ... }}`",
+            self.name, self.name
+        )
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+        T::deserialize(de::value::MapAccessDeserializer::new(map))
     }
 }
 
