@@ -57,6 +57,9 @@ const PYTHON_WORDS: &[(&str, &str)] = &[
     ("type: sequence", "type: list"),
     ("type: map", "type: dict"),
     ("unit value", "None"),
+    // The command line's flags, as Python sets the same budgets.
+    ("`--max-memory`", "`sylva.set_max_memory(bytes)`"),
+    ("`--max-time`", "`sylva.set_max_time(seconds)`"),
 ];
 
 /// `message` in Python's words for types and values ([`PYTHON_WORDS`]); a word is replaced
@@ -100,7 +103,8 @@ pub fn input_error(e: &sylva::InputError) -> PyErr {
             return error;
         }
     }
-    raise("InputError", e.to_string(), Some(e))
+    let class = if e.limit { "LimitError" } else { "InputError" };
+    raise(class, e.to_string(), Some(e))
 }
 
 /// Any Sylva error as the Python exception of its kind, its causes in the message: bad input

@@ -82,6 +82,37 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(genome::_rust_grow_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(plant::garden, m)?)?;
     m.add_function(wrap_pyfunction!(plant::scene, m)?)?;
+    m.add_function(wrap_pyfunction!(set_max_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(max_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(set_max_time, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
+
+/// Sets the memory budget of this process in bytes (0 goes back to the default: the least of
+/// the machine's memory and the process's limits). Work whose estimate is over it raises
+/// `LimitError` before it starts, as the command line's `--max-memory` does.
+#[pyfunction]
+fn set_max_memory(bytes: u64) {
+    sylva::core::budget::set_max_memory(bytes);
+}
+
+/// The memory budget in force, in bytes.
+#[pyfunction]
+fn max_memory() -> u64 {
+    sylva::core::budget::max_memory()
+}
+
+/// Sets the time budget of this process in seconds (0 goes back to the default hour). Work
+/// estimated to take longer raises `LimitError` before it starts, as `--max-time` does.
+#[pyfunction]
+fn set_max_time(seconds: f64) -> PyResult<()> {
+    if !(seconds.is_finite() && seconds >= 0.0) {
+        return Err(errors::bad_value(
+            "seconds",
+            format!("{seconds}; expected a number of seconds, 0 or more"),
+        ));
+    }
+    sylva::core::budget::set_max_time(std::time::Duration::from_secs_f64(seconds.min(1e12)));
     Ok(())
 }

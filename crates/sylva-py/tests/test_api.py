@@ -418,3 +418,25 @@ def test_ctrl_c_stops_a_run_between_generations_and_leaves_it_whole():
     assert 0 < stopped < 100_000
     run.step()
     assert run.generation == stopped + 1
+
+
+def test_budgets_are_set_from_python_and_refusals_say_how():
+    default = sylva.max_memory()
+    assert default > 0
+    try:
+        sylva.set_max_memory(1 << 20)
+        assert sylva.max_memory() == 1 << 20
+        config = sylva.Config.load(CONFIGS["bintree"]).with_run(population=100_000)
+        with pytest.raises(sylva.LimitError) as refused:
+            sylva.Evolution(config)
+        message = str(refused.value)
+        assert "sylva.set_max_memory(bytes)" in message and "--max-memory" not in message
+    finally:
+        sylva.set_max_memory(0)
+    assert sylva.max_memory() == default
+    # An L-system population of a million is refused before any of it grows.
+    config = sylva.Config.load(CONFIGS["lsystem"]).with_run(population=1_000_000)
+    with pytest.raises(sylva.LimitError):
+        sylva.Evolution(config)
+    with pytest.raises(sylva.InputError, match="seconds"):
+        sylva.set_max_time(float("nan"))

@@ -107,6 +107,9 @@ pub struct InputError {
     /// permission denied), so front ends can raise their own kind of error (Python's
     /// `FileNotFoundError`).
     pub io: Option<std::io::ErrorKind>,
+    /// Whether it refuses legal input that asks for more than a limit or the memory or time
+    /// budget allows ([`Error::is_limit`]), rather than malformed input.
+    pub limit: bool,
 }
 
 impl InputError {
@@ -120,7 +123,14 @@ impl InputError {
             message: message.to_string(),
             snippet: None,
             io: None,
+            limit: false,
         }
+    }
+
+    /// This error, marked as a limit's refusal ([`InputError::limit`]).
+    pub fn over_limit(mut self) -> Self {
+        self.limit = true;
+        self
     }
 
     /// An error about a whole file, from a library error and its causes.
@@ -169,6 +179,7 @@ impl InputError {
             message,
             snippet: Some(Box::new((Arc::from(text), start..end))),
             io: None,
+            limit: false,
         }
     }
 
@@ -252,7 +263,11 @@ impl Error {
         use sylva_gltf::export::ExportError;
         use sylva_mesh::mesher::MeshError;
         // `Export` is transparent: its source is the export error's source, not itself.
-        if matches!(self, Error::Export(ExportError::TooLarge { .. })) {
+        if matches!(
+            self,
+            Error::Export(ExportError::TooLarge { .. })
+                | Error::Input(InputError { limit: true, .. })
+        ) {
             return true;
         }
         let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(self);
@@ -281,7 +296,7 @@ impl Error {
     /// so it names the file; otherwise unchanged.
     pub fn in_file(self, path: &Path) -> Error {
         if self.is_limit() {
-            Error::Input(InputError::file_error(path, &self))
+            Error::Input(InputError::file_error(path, &self).over_limit())
         } else {
             self
         }

@@ -32,8 +32,11 @@ from ._sylva import (
     cross,
     garden,
     match,
+    max_memory,
     models,
     scene,
+    set_max_memory,
+    set_max_time,
 )
 from .errors import InputError, LimitError, SylvaError
 from .islands import IslandsResult, islands
@@ -55,6 +58,9 @@ __all__ = [
     "garden",
     "islands",
     "match",
+    "max_memory",
     "models",
     "scene",
+    "set_max_memory",
+    "set_max_time",
 ]

@@ -234,6 +234,15 @@ def match(
 ) -> Evolution:
     """Evolves a plant whose outline matches a picture (PNG or JPEG); returns the run."""
 
+def set_max_memory(bytes: int) -> None:
+    """Sets the memory budget in bytes (0: the default); work over it raises LimitError."""
+
+def max_memory() -> int:
+    """The memory budget in force, in bytes."""
+
+def set_max_time(seconds: float) -> None:
+    """Sets the time budget in seconds (0: the default hour); work over it raises LimitError."""
+
 def models() -> dict[str, str]:
     """The models Sylva knows: name to title."""
 

@@ -77,7 +77,7 @@ pub(crate) fn start<M: Evolve + Default>(
         format_args!("a population of {population} (`population`)"),
         "breed a smaller population, or smaller genomes",
     )
-    .map_err(|e| InputError::new(source, e))?;
+    .map_err(|e| InputError::new(source, e).over_limit())?;
     let setup = setup(
         &config.model,
         &config.settings,
@@ -90,7 +90,7 @@ pub(crate) fn start<M: Evolve + Default>(
     // The settings are valid; generation 0 grows as the run is made.
     if let Some(t) = config.generation_time(&start, pool.threads()) {
         sylva_core::budget::check_time(t.seconds, t.what, t.advice)
-            .map_err(|e| InputError::new(source, e))?;
+            .map_err(|e| InputError::new(source, e).over_limit())?;
     }
     let settings = RunSettings {
         seed,
