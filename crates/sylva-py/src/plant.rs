@@ -82,11 +82,11 @@ impl Plant {
         self.grown.plant.height()
     }
 
-    /// Bounds of everything visible: ((min x, y, z), (max x, y, z)), metres (zeros for an
-    /// empty plant).
+    /// Bounds of the plant as meshed, what a scene shows and an exporter writes: ((min x,
+    /// y, z), (max x, y, z)), metres, the mesh's vertices' (zeros for an empty plant).
     #[getter]
     fn bounds(&self) -> ([f32; 3], [f32; 3]) {
-        let b = self.grown.plant.bounds();
+        let b = self.grown.mesh.bounds();
         if b.is_empty() {
             ([0.0; 3], [0.0; 3])
         } else {

@@ -74,6 +74,10 @@ def test_a_plant_grows_meshes_and_exports(model, tmp_path):
     assert all(math.isfinite(v) for v in measures.values())
 
     mesh = plant.mesh
+    # The bounds are the mesh's, what a scene shows (they were the skeleton's, radii
+    # swept round every end: a palm's top 0.4 m above its mesh).
+    assert np.array_equal(low, mesh.positions.min(axis=0))
+    assert np.array_equal(high, mesh.positions.max(axis=0))
     n, t = len(mesh.positions), len(mesh.indices)
     assert mesh.positions.shape == (n, 3) and mesh.positions.dtype == np.float32
     assert mesh.normals.shape == (n, 3) and mesh.uvs.shape == (n, 2)
