@@ -496,6 +496,17 @@ impl Evolution {
         py.detach(|| self.with(|r| r.checkpoint())).py()
     }
 
+    /// Pickled through its checkpoint: unpickled, it resumes exactly where it was
+    /// (`Evolution.resume(config, text=checkpoint)`), for multiprocessing and Ray.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let resume = py.get_type::<Evolution>().getattr("resume")?;
+        let config = self.config();
+        let text = self.checkpoint(py)?;
+        Ok((resume, (config, None::<PathBuf>, text))
+            .into_pyobject(py)?
+            .into_any())
+    }
+
     /// Writes the checkpoint file (atomically).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         py.detach(|| {

@@ -444,3 +444,16 @@ def test_budgets_are_set_from_python_and_refusals_say_how():
         sylva.Evolution(config)
     with pytest.raises(sylva.InputError, match="seconds"):
         sylva.set_max_time(float("nan"))
+
+
+def test_a_run_pickles_through_its_checkpoint():
+    run = sylva.Evolution(CONFIGS["automata"], threads=1)
+    run.run(2)
+    copy = pickle.loads(pickle.dumps(run))
+    assert copy.generation == run.generation == 2
+    assert copy.best().genome == run.best().genome
+    # Both go on alike, as a resumed run does.
+    run.step()
+    copy.step()
+    assert copy.best().genome == run.best().genome
+    assert copy.stats[-1]["best"] == run.stats[-1]["best"]
