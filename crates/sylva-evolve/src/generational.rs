@@ -239,6 +239,19 @@ impl<X, M> Generational<X, M> {
     }
 }
 
+impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::map::Operators<G>
+    for Generational<X, M>
+{
+    type Crossover = X;
+    type Mutation = M;
+    fn crossover(&self) -> &X {
+        &self.crossover
+    }
+    fn mutation(&self) -> &M {
+        &self.mutation
+    }
+}
+
 /// The operator a slot uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Operator {

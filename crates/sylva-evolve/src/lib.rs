@@ -8,6 +8,8 @@
 //! - [`WithTerm`]: a problem with one more [`Term`] (a target outline) beside its own.
 //! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,
 //!   elitism), as Poncin's GP runs used.
+//! - [`MapRun`]: MAP-Elites, a map of the fittest genome of every kind ([`Describe`]
+//!   places genomes; [`Operators`] are a strategy's own, bred from).
 //! - [`Pool`]: the one seam where work goes parallel (serial or rayon), results kept in
 //!   order (from `sylva_core::par`).
 //! - [`Run`]: generations, batches, statistics, a [`Browser`] over the family, and
@@ -55,6 +57,7 @@ pub mod bits;
 pub mod fitness;
 pub mod generational;
 pub mod individual;
+pub mod map;
 pub mod problem;
 pub mod run;
 pub mod strategy;
@@ -64,6 +67,9 @@ pub mod variation;
 pub use fitness::{Fitness, MAX_TERMS};
 pub use generational::{Generational, GenerationalError, GenerationalSettings};
 pub use individual::{Individual, IndividualId, Origin};
+pub use map::{
+    Axis, Describe, Elite, MapCheckpoint, MapError, MapRun, MapSettings, MapStats, Operators,
+};
 pub use problem::Problem;
 pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};
 pub use strategy::{Breeding, MeanReplacement, Strategy, fittest};

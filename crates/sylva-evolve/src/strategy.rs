@@ -204,6 +204,19 @@ where
     }
 }
 
+impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::map::Operators<G>
+    for MeanReplacement<X, M>
+{
+    type Crossover = X;
+    type Mutation = M;
+    fn crossover(&self) -> &X {
+        &self.crossover
+    }
+    fn mutation(&self) -> &M {
+        &self.mutation
+    }
+}
+
 /// Evaluates every member whose fitness is `None`; returns how many were evaluated.
 pub fn evaluate_missing<P: Problem>(
     problem: &P,

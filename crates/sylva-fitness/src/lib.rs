@@ -6,6 +6,9 @@
 //!   thickness, density grid) and their weighted total ([`PoncinFitness`]).
 //! - [`silhouette`]: the outline term: a plant's silhouette against a target outline
 //!   ([`silhouette::Outline`]), as intersection over union.
+//! - [`descriptors`]: behaviour descriptors for quality-diversity search (height to width,
+//!   porosity, lean, asymmetry, branching depth, bare trunk, leaf count, tips), each a
+//!   [`descriptors::Descriptor`] measured on a plant.
 //!
 //! ```
 //! use sylva_fitness::{SusinnoWeights, TreeMeasures};
@@ -19,6 +22,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod descriptors;
 pub mod poncin;
 pub mod silhouette;
 pub mod tree;

@@ -17,7 +17,7 @@
 
 use sylva_core::Plant;
 use sylva_core::glam::{Vec2, Vec3};
-use sylva_core::plant::{MaterialKind, OrganKind};
+use sylva_core::plant::{MaterialKind, Organ, OrganKind};
 
 /// How much wider than tall the comparison canvas is: outlines up to this aspect are
 /// compared whole (a target wider than this is refused as not plant-like).
@@ -86,6 +86,11 @@ impl Bitmap {
             };
             *word |= bits;
         }
+    }
+
+    /// The words of row `y`: pixel `x` is bit `x % 64` of word `x / 64`.
+    pub(crate) fn row(&self, y: u32) -> &[u64] {
+        &self.words[y as usize * self.words_per_row..][..self.words_per_row]
     }
 
     /// Clears every pixel, keeping the size.
@@ -303,6 +308,19 @@ impl Scratch {
     pub fn canvas(&self) -> &Bitmap {
         &self.canvas
     }
+
+    /// Where the buffers are and their capacities: unchanged by a call that allocated
+    /// nothing in them.
+    #[cfg(test)]
+    pub(crate) fn footprint(&self) -> [(usize, usize); 2] {
+        [
+            (
+                self.canvas.words.as_ptr() as usize,
+                self.canvas.words.capacity(),
+            ),
+            (self.quads.as_ptr() as usize, self.quads.capacity()),
+        ]
+    }
 }
 
 /// Whether the outline draws a segment or organ: roots and root tips are below the ground.
@@ -381,23 +399,38 @@ fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
         .organs()
         .iter()
         .filter(|o| o.kind != OrganKind::RootTip)
-        .map(move |o| {
-            let half = o.orientation * Vec3::X * (o.size.y * 0.5);
-            let tip = o.orientation * Vec3::Y * o.size.x;
-            let base = o.position;
-            [
-                side.project(base - half),
-                side.project(base - half + tip),
-                side.project(base + half + tip),
-                side.project(base + half),
-            ]
-        });
+        .map(move |o| blade_corners(o).map(|p| side.project(p)));
     segments.chain(organs)
+}
+
+/// The corners of an organ's blade, in order round it: a rectangle from its base along its
+/// local +Y by its length, as wide as its width along its local X.
+pub(crate) fn blade_corners(o: &Organ) -> [Vec3; 4] {
+    let half = o.orientation * Vec3::X * (o.size.y * 0.5);
+    let tip = o.orientation * Vec3::Y * o.size.x;
+    let base = o.position;
+    [
+        base - half,
+        base - half + tip,
+        base + half + tip,
+        base + half,
+    ]
 }
 
 /// Draws `plant` seen from `side` into `scratch.canvas`, normalised to `rows` rows; `false`
 /// when nothing of it shows.
 fn draw_normalised(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) -> bool {
+    draw(plant, side, rows, false, scratch)
+}
+
+/// Draws `plant` like [`draw_normalised`], but scaled down where it is wider than the canvas
+/// so all of it shows (stood on the bottom row, centred): for measures of the whole plant.
+pub(crate) fn draw_fitted(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) -> bool {
+    draw(plant, side, rows, true, scratch)
+}
+
+/// [`draw_normalised`], or with `fit` [`draw_fitted`].
+fn draw(plant: &Plant, side: Side, rows: u32, fit: bool, scratch: &mut Scratch) -> bool {
     let width = rows * CANVAS_ASPECT;
     if scratch.canvas.width() != width || scratch.canvas.height() != rows {
         scratch.canvas = Bitmap::new(width, rows);
@@ -414,9 +447,18 @@ fn draw_normalised(plant: &Plant, side: Side, rows: u32, scratch: &mut Scratch) 
     if !(size.y > 0.0 && size.is_finite()) {
         return false;
     }
-    // Plant units to pixels: the ink's height fills the rows, its box centred on the canvas.
-    let scale = rows as f32 / size.y;
-    let centre = Vec2::new((lo.x + hi.x) * 0.5, hi.y);
+    // Plant units to pixels: the ink's height fills the rows, its box centred on the canvas
+    // (when fitting, its top drops so its width fits and its foot stays on the bottom row).
+    let mut scale = rows as f32 / size.y;
+    if fit && size.x * scale > width as f32 {
+        scale = width as f32 / size.x;
+    }
+    let top = if fit {
+        lo.y + rows as f32 / scale
+    } else {
+        hi.y
+    };
+    let centre = Vec2::new((lo.x + hi.x) * 0.5, top);
     let to_pixels = |p: Vec2| {
         Vec2::new(
             (p.x - centre.x) * scale + width as f32 * 0.5,

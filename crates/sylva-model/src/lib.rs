@@ -75,7 +75,7 @@ use std::path::PathBuf;
 use rand::Rng;
 use serde::{Serialize, de::DeserializeOwned};
 use sylva_core::{Plant, PlantError, PlantMeta, hash::stable_hash};
-use sylva_evolve::{Problem, Strategy, WithTerm};
+use sylva_evolve::{Operators, Problem, Strategy, WithTerm};
 
 pub use file::{FormatV1, GenomeError};
 
@@ -365,8 +365,13 @@ pub trait Evolve: Model {
     /// The problem the engine solves.
     type Problem: Problem<Genome: Serialize + DeserializeOwned> + Clone + Send + 'static;
     /// How one generation becomes the next: of the problem, and of the problem with one
-    /// more term (a target outline; every generic strategy is both).
-    type Strategy: Strategy<Self::Problem> + Strategy<WithTerm<Self::Problem>> + Send + 'static;
+    /// more term (a target outline; every generic strategy is both). Its variation
+    /// operators also breed MAP-Elites maps ([`Operators`]).
+    type Strategy: Strategy<Self::Problem>
+        + Strategy<WithTerm<Self::Problem>>
+        + Operators<<Self::Problem as Problem>::Genome>
+        + Send
+        + 'static;
 
     /// Genome files the settings name (relative to the config file), read by the caller and
     /// given to [`Evolve::setup`] as `start`.

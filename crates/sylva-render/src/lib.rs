@@ -4,6 +4,7 @@
 //!   [`image::RgbImage`], framed automatically so the whole scene fills the picture.
 //! - [`contact_sheet`] lays out many small captioned renders in a grid.
 //! - [`overlay`] draws two outlines over each other (a plant on its target).
+//! - [`map`] draws a variety map: a thumbnail per filled cell, empty cells left empty.
 //! - [`encode_png`] and [`write_png`] (atomic) save the result.
 //!
 //! How a picture is made: a mild perspective camera looks at the scene from the chosen view
@@ -49,6 +50,7 @@
 //! ```
 
 mod camera;
+pub mod map;
 pub mod overlay;
 mod raster;
 mod shade;

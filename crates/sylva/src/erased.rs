@@ -22,7 +22,7 @@ use sylva_model::{Bred, DevelopError, Evolve, GenomeError, MeshHint, Model, Pare
 
 use crate::error::{Error, FieldError, InputError};
 use crate::evolution::{EvolveConfig, GenerationTime, Member, OutputConfig, RunConfig};
-use crate::evolution::{TypedRun, resume, start};
+use crate::evolution::{MapValue, TypedRun, resume, resume_map, start, start_map};
 use crate::genome::{Genome, Settings, settings_of};
 
 /// A model's genome or config, erased.
@@ -97,6 +97,24 @@ pub(crate) trait DynModel: Send + Sync {
         text: &str,
         pool: Pool,
     ) -> Result<Box<RunValue>, Error>;
+
+    fn start_map(
+        &self,
+        config: &Value,
+        source: &str,
+        base: &Path,
+        start: Vec<Genome>,
+        pool: Pool,
+    ) -> Result<Box<dyn MapValue>, Error>;
+    fn resume_map(
+        &self,
+        config: &Value,
+        source: &str,
+        base: &Path,
+        path: &Path,
+        text: &str,
+        pool: Pool,
+    ) -> Result<Box<dyn MapValue>, Error>;
 
     // Runs.
     fn effective_config(&self, run: &RunValue) -> Box<Value>;
@@ -326,6 +344,29 @@ impl<M: Evolve + Default> DynModel for M {
             text,
             pool,
         )?))
+    }
+
+    fn start_map(
+        &self,
+        c: &Value,
+        source: &str,
+        base: &Path,
+        first: Vec<Genome>,
+        pool: Pool,
+    ) -> Result<Box<dyn MapValue>, Error> {
+        start_map(config::<M>(c), source, base, first, pool)
+    }
+
+    fn resume_map(
+        &self,
+        c: &Value,
+        source: &str,
+        base: &Path,
+        path: &Path,
+        text: &str,
+        pool: Pool,
+    ) -> Result<Box<dyn MapValue>, Error> {
+        resume_map(config::<M>(c), source, base, path, text, pool)
     }
 
     fn effective_config(&self, r: &RunValue) -> Box<Value> {

@@ -58,7 +58,9 @@ pub mod skeleton;
 
 pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, FieldError, InputError};
-pub use evolution::{Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig};
+pub use evolution::{
+    Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig, Varieties, Variety,
+};
 pub use experiment::Experiment;
 pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};

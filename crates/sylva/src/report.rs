@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use plotters::prelude::*;
 use sylva_evolve::GenerationStats;
+use sylva_evolve::map::MapStats;
 use sylva_lsystem::experiments::SimulationOutcome;
 
 /// `stats.csv`: `generation,best,mean,<term...>,evals_per_s`, one row per generation.
@@ -30,6 +31,28 @@ pub fn stats_csv(term_names: &[String], stats: &[GenerationStats]) -> String {
             }
         }
         let _ = writeln!(out, ",{:.0}", s.evals_per_second());
+    }
+    out
+}
+
+/// `stats.csv` of a map run: per generation, the cells filled, coverage, QD-score, best
+/// and mean fitness of the elites, offspring that improved the map, and evaluations.
+pub fn map_stats_csv(stats: &[MapStats]) -> String {
+    let mut out =
+        String::from("generation,filled,coverage,qd_score,best,mean,improved,evaluations\n");
+    for s in stats {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{}",
+            s.generation,
+            s.filled,
+            s.coverage,
+            s.qd_score,
+            s.best,
+            s.mean,
+            s.improved,
+            s.evaluations
+        );
     }
     out
 }

@@ -1,20 +1,23 @@
 //! `sylva evolve`: a run of any model that evolves, with a progress bar, checkpoints while
-//! it runs, and every result file when it ends.
+//! it runs, and every result file when it ends. A config whose `[run] strategy` is
+//! `"map-elites"` fills a map of varieties instead (`varieties.rs`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
+use sylva::core::Plant;
 use sylva::core::budget::Seconds;
 use sylva::core::taper::PipeTaper;
+use sylva::evolution::SearchStrategy;
 use sylva::mesh::SceneNode;
 use sylva::render::{self, SheetCell, SheetOptions};
 use sylva::report::{fitness_svg, stats_csv};
-use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
+use sylva::{Config, Evolution, Genome, GrowOptions, Grown, InputError};
 
 use sylva::files::Outputs;
 
@@ -72,6 +75,14 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
         PathBuf::from(format!("runs/{}-seed{}", config.model(), config.run().seed))
     });
     let pool = super::pool(config.run().threads)?;
+    let base = args
+        .config
+        .as_ref()
+        .and_then(|p| p.parent())
+        .unwrap_or(Path::new("."));
+    if config.run().strategy == SearchStrategy::MapElites {
+        return super::varieties::run(&config, &out, base, args.resume, &pool);
+    }
     let checkpoint = out.join(CHECKPOINT);
     let target = config.run().generations;
     let population = u64::from(config.run().population);
@@ -79,11 +90,6 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
         let text = sylva::files::read_text(&checkpoint)?;
         Evolution::resume(&config, &checkpoint, &text, pool.clone())?
     } else {
-        let base = args
-            .config
-            .as_ref()
-            .and_then(|p| p.parent())
-            .unwrap_or(Path::new("."));
         let start = config.load_start(base)?;
         if let Some(t) = config.generation_time(&start, pool.threads()) {
             super::announce(
@@ -202,21 +208,13 @@ fn breed(evolution: &mut Evolution, config: &Config, checkpoint: &Path) -> anyho
     let population = u64::from(config.run().population);
     let done = evolution.generation().min(target);
     let ticker = Ticker::start(bar(population, target - done, done + 1, target), population);
-    let save = |evolution: &Evolution| -> anyhow::Result<()> {
-        sylva::files::write(checkpoint, evolution.checkpoint()?.as_bytes())?;
-        Ok(())
-    };
-    let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
-    let mut last_save = Instant::now();
+    let mut checkpoints = super::Checkpoints::new(checkpoint, config.run().checkpoint_seconds);
     while evolution.generation() < target {
         let best = evolution.step()?.best;
         ticker.generation(evolution.generation(), best);
-        if last_save.elapsed() >= every {
-            save(evolution)?;
-            last_save = Instant::now();
-        }
+        checkpoints.due(|| evolution.checkpoint())?;
     }
-    save(evolution)?;
+    checkpoints.save(|| evolution.checkpoint())?;
     ticker.finish();
     Ok(())
 }
@@ -245,26 +243,14 @@ pub(super) fn write_results(
         &out.join("fitness.svg"),
         fitness_svg(stats, &title)?.as_bytes(),
     )?;
-    let best = evolution.best();
-    files.add(&out.join("best.json"), best.genome.to_json().as_bytes())?;
-    let taper = config.output().pipe_taper();
-    let options = GrowOptions {
-        taper,
-        wind: config.output().wind_options(),
-        ..GrowOptions::default()
-    };
-    let grown = Grown::grow(best.genome.clone(), &options)?;
-    files.add_scene(&out.join("best.glb"), &grown.scene())?;
-    let guides = evolution.guides().map(|p| guide_mesh(&p)).transpose()?;
-    let mut scene = grown.scene();
-    if let Some(mesh) = &guides {
-        scene.nodes.push(SceneNode::new("guides", mesh));
-    }
-    let size = config.output().image_size;
-    files.add(
-        &out.join("best.png"),
-        &picture(&scene, config.output().view, (size, size))?,
+    let grown = add_best(
+        &mut files,
+        out,
+        &evolution.best().genome,
+        config,
+        evolution.guides(),
     )?;
+    let taper = config.output().pipe_taper();
     let sheet = population_sheet(evolution, config.output().sheet_size as usize, taper, pool)?;
     files.add(&out.join("population.png"), &sheet)?;
     files.commit()?;
@@ -293,6 +279,36 @@ pub(super) fn write_results(
         out.display()
     );
     Ok(())
+}
+
+/// Adds the best plant's files: `best.json`, `best.glb` (with the config's taper and
+/// wind) and `best.png` (with `guides`, if any). Returns the plant grown.
+pub(super) fn add_best(
+    files: &mut Outputs,
+    out: &Path,
+    best: &Genome,
+    config: &Config,
+    guides: Option<Plant>,
+) -> anyhow::Result<Grown> {
+    files.add(&out.join("best.json"), best.to_json().as_bytes())?;
+    let options = GrowOptions {
+        taper: config.output().pipe_taper(),
+        wind: config.output().wind_options(),
+        ..GrowOptions::default()
+    };
+    let grown = Grown::grow(best.clone(), &options)?;
+    files.add_scene(&out.join("best.glb"), &grown.scene())?;
+    let guides = guides.map(|p| guide_mesh(&p)).transpose()?;
+    let mut scene = grown.scene();
+    if let Some(mesh) = &guides {
+        scene.nodes.push(SceneNode::new("guides", mesh));
+    }
+    let size = config.output().image_size;
+    files.add(
+        &out.join("best.png"),
+        &picture(&scene, config.output().view, (size, size))?,
+    )?;
+    Ok(grown)
 }
 
 /// A contact sheet (PNG) of the best `count` members of the current population.

@@ -3,7 +3,7 @@
 //! `sylva evolve` writes and `overlay.png`.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
@@ -215,22 +215,14 @@ fn breed(
             evolution.generation()
         ));
     };
-    let save = |evolution: &Evolution| -> anyhow::Result<()> {
-        sylva::files::write(checkpoint, evolution.checkpoint()?.as_bytes())?;
-        Ok(())
-    };
     show(evolution);
-    let every = Duration::from_secs_f64(config.run().checkpoint_seconds);
-    let mut last_save = Instant::now();
+    let mut checkpoints = super::Checkpoints::new(checkpoint, config.run().checkpoint_seconds);
     while !remaining.reached(evolution, started) {
         evolution.step()?;
         show(evolution);
-        if last_save.elapsed() >= every {
-            save(evolution)?;
-            last_save = Instant::now();
-        }
+        checkpoints.due(|| evolution.checkpoint())?;
     }
-    save(evolution)?;
+    checkpoints.save(|| evolution.checkpoint())?;
     bar.finish_and_clear();
     Ok(())
 }

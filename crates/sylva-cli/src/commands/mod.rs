@@ -9,12 +9,53 @@ pub mod matching;
 pub mod render;
 pub mod simulate;
 pub mod studio;
+pub mod varieties;
 
 use std::fmt::Display;
 use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
+
+/// Writes a run's checkpoint file every `checkpoint_seconds` while it runs, and when it
+/// ends: a run killed at any moment loses at most that much work.
+pub struct Checkpoints<'a> {
+    path: &'a Path,
+    every: std::time::Duration,
+    last: std::time::Instant,
+}
+
+impl<'a> Checkpoints<'a> {
+    /// Checkpoints to `path`, every `seconds`.
+    pub fn new(path: &'a Path, seconds: f64) -> Self {
+        Checkpoints {
+            path,
+            every: std::time::Duration::from_secs_f64(seconds),
+            last: std::time::Instant::now(),
+        }
+    }
+
+    /// Writes the checkpoint `text` makes, if the interval has passed since the last.
+    pub fn due(
+        &mut self,
+        text: impl FnOnce() -> Result<String, sylva::Error>,
+    ) -> anyhow::Result<()> {
+        if self.last.elapsed() >= self.every {
+            self.save(text)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the checkpoint `text` makes.
+    pub fn save(
+        &mut self,
+        text: impl FnOnce() -> Result<String, sylva::Error>,
+    ) -> anyhow::Result<()> {
+        sylva::files::write(self.path, text()?.as_bytes())?;
+        self.last = std::time::Instant::now();
+        Ok(())
+    }
+}
 
 /// Work estimated to take this long or longer is announced before it starts, seconds.
 const ANNOUNCE_SECONDS: f64 = 60.0;

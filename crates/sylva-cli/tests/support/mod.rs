@@ -13,6 +13,19 @@ pub fn sylva(args: &[&str]) -> Output {
         .expect("the sylva binary runs")
 }
 
+/// The standard output of a command that must have succeeded; its exit code and both
+/// streams otherwise.
+pub fn ok(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
 /// A fresh folder for one test: `sylva-<test file>-<process>-<name>` in the temp folder.
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(

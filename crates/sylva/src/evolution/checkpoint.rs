@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use serde::Serialize;
+use serde::de::DeserializeOwned;
 use sylva_evolve::{Checkpoint, Problem};
 use sylva_model::Evolve;
 
@@ -25,24 +26,34 @@ pub(super) struct SavedRun<M: Evolve> {
 }
 
 impl<M: Evolve + Default> SavedRun<M> {
-    /// Reads a checkpoint. Sections of other models in its config (checkpoints of Sylva
-    /// before 0.2 wrote every model's) are passed over.
+    /// Reads a checkpoint.
     pub(super) fn parse(path: &Path, text: &str) -> Result<Self, InputError> {
-        let mut value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
-        let bad = |e: serde_json::Error| InputError::file(path, e);
-        if let Some(config) = value.get_mut("config").and_then(|c| c.as_object_mut()) {
-            config.retain(|k, _| {
-                matches!(k.as_str(), "model" | "run" | "output" | "match") || k == M::NAME
-            });
-        }
-        let config = value.get("config").cloned().unwrap_or_default();
-        let checkpoint = value.get("checkpoint").cloned().unwrap_or_default();
-        Ok(SavedRun {
-            config: serde_json::from_value(config).map_err(bad)?,
-            checkpoint: serde_json::from_value(checkpoint).map_err(bad)?,
-        })
+        let (config, checkpoint) = parse(path, text)?;
+        Ok(SavedRun { config, checkpoint })
     }
+}
+
+/// Reads a checkpoint file: its config and the engine's checkpoint `C`. Sections of other
+/// models in its config (checkpoints of Sylva before 0.2 wrote every model's) are passed
+/// over.
+pub(super) fn parse<M: Evolve + Default, C: DeserializeOwned>(
+    path: &Path,
+    text: &str,
+) -> Result<(EvolveConfig<M>, C), InputError> {
+    let mut value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+    let bad = |e: serde_json::Error| InputError::file(path, e);
+    if let Some(config) = value.get_mut("config").and_then(|c| c.as_object_mut()) {
+        config.retain(|k, _| {
+            matches!(k.as_str(), "model" | "run" | "output" | "match" | "map") || k == M::NAME
+        });
+    }
+    let config = value.get("config").cloned().unwrap_or_default();
+    let checkpoint = value.get("checkpoint").cloned().unwrap_or_default();
+    Ok((
+        serde_json::from_value(config).map_err(bad)?,
+        serde_json::from_value(checkpoint).map_err(bad)?,
+    ))
 }
 
 /// The model a checkpoint's run evolves (its `config.model`), to resume it without its

@@ -14,7 +14,7 @@ use crate::registry::Registry;
 
 use super::checkpoint::SavedRun;
 use super::run::TypedRun;
-use super::schema::{EvolveConfig, OutputConfig, RunConfig};
+use super::schema::{EvolveConfig, OutputConfig, RunConfig, SearchStrategy};
 
 /// An evolution config of any model.
 pub struct Config {
@@ -56,19 +56,15 @@ pub(crate) fn start<M: Evolve + Default>(
     start: Vec<Genome>,
     pool: Pool,
 ) -> Result<TypedRun<M>, Error> {
-    let mut typed = Vec::with_capacity(start.len());
-    for (i, g) in start.iter().enumerate() {
-        typed.push(g.get::<M>().cloned().ok_or_else(|| {
-            InputError::new(
-                format!("start genome {}", i + 1),
-                format!(
-                    "this run evolves `{}` genomes; this is a `{}` genome",
-                    M::NAME,
-                    g.model()
-                ),
-            )
-        })?);
+    if config.run.strategy == SearchStrategy::MapElites {
+        return Err(InputError::new(
+            source,
+            "`[run] strategy = \"map-elites\"` fills a map of varieties: run it with `sylva \
+             evolve`, or as varieties (sylva.varieties in Python), not as one population",
+        )
+        .into());
     }
+    let typed = typed_start::<M>(&start)?;
     let (seed, population) = (config.run.seed, config.run.population as usize);
     // A population and its offspring, each genome at the settings' bounds.
     let genome = config.model.genome_bytes(&config.settings);
@@ -103,6 +99,26 @@ pub(crate) fn start<M: Evolve + Default>(
         config: config.clone(),
         run,
     })
+}
+
+/// The start genomes as model `M`'s; another model's is refused.
+pub(super) fn typed_start<M: Evolve>(start: &[Genome]) -> Result<Vec<M::Genome>, InputError> {
+    start
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            g.get::<M>().cloned().ok_or_else(|| {
+                InputError::new(
+                    format!("start genome {}", i + 1),
+                    format!(
+                        "this run evolves `{}` genomes; this is a `{}` genome",
+                        M::NAME,
+                        g.model()
+                    ),
+                )
+            })
+        })
+        .collect()
 }
 
 /// Resumes the run of `config` saved in a checkpoint's `text` (read from `path`).
@@ -163,7 +179,7 @@ impl<M: Evolve + Default> EvolveConfig<M> {
 
 /// The model's problem with the config's `[match]` term, if it has one, its pictures read
 /// relative to `base`.
-fn with_term<M: Evolve>(
+pub(super) fn with_term<M: Evolve>(
     config: &EvolveConfig<M>,
     problem: M::Problem,
     base: &Path,
@@ -178,7 +194,7 @@ fn with_term<M: Evolve>(
 
 /// The model's problem and strategy for `settings`; a refusal names the config (`source`)
 /// and the model's section.
-fn setup<M: Evolve>(
+pub(super) fn setup<M: Evolve>(
     model: &M,
     settings: &M::Settings,
     start: Vec<M::Genome>,

@@ -40,16 +40,24 @@
 //! Each holds its model's handle (`erased.rs`) beside the typed value.
 //! - `checkpoint.rs`: the checkpoint file a run resumes from.
 //! - `outline.rs`: the `[match]` term, a plant's silhouette against target pictures.
+//! - `varieties.rs`: [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
+//!   "map-elites"` and `[map]`): a map of the fittest plant of every kind.
 
 mod checkpoint;
 mod config;
 pub mod outline;
 mod run;
 mod schema;
+mod varieties;
 
 pub use checkpoint::checkpoint_model;
 pub use config::{Config, GenerationTime, evaluations_done};
 pub(crate) use config::{resume, start};
 pub(crate) use run::TypedRun;
 pub use run::{Evolution, Member};
-pub use schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig, WindConfig};
+pub use schema::{
+    AxisConfig, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy,
+    WindConfig,
+};
+pub(crate) use varieties::{MapValue, resume_map, start_map};
+pub use varieties::{Varieties, Variety};

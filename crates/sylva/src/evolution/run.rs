@@ -36,6 +36,20 @@ impl Member {
     }
 }
 
+/// Individual `ind` of a run of `model` solving `problem`, its genome as a genome file.
+pub(super) fn member_of<M: Evolve + Default>(
+    model: &M,
+    problem: &M::Problem,
+    ind: &sylva_evolve::Individual<<M::Problem as Problem>::Genome>,
+) -> Member {
+    Member {
+        id: ind.id,
+        genome: Genome::new(model.clone(), model.genome_file(problem, &ind.genome)),
+        fitness: ind.fitness,
+        origin: ind.origin.clone(),
+    }
+}
+
 /// An evolution run of any model.
 pub struct Evolution {
     model: Arc<dyn DynModel>,
@@ -54,16 +68,7 @@ impl<M: Evolve + Default> TypedRun<M> {
         &self,
         ind: &sylva_evolve::Individual<<M::Problem as Problem>::Genome>,
     ) -> Member {
-        let model = &self.config.model;
-        Member {
-            id: ind.id,
-            genome: Genome::new(
-                model.clone(),
-                model.genome_file(&self.run.problem().problem, &ind.genome),
-            ),
-            fitness: ind.fitness,
-            origin: ind.origin.clone(),
-        }
+        member_of(&self.config.model, &self.run.problem().problem, ind)
     }
 
     pub(crate) fn population(&self) -> Vec<Member> {

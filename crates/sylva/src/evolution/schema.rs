@@ -12,6 +12,8 @@ use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
 use sylva_render::View;
 
+use sylva_fitness::descriptors::Descriptor;
+
 use crate::error::InputError;
 use crate::picture::Threshold;
 
@@ -34,6 +36,29 @@ pub struct RunConfig {
     /// checkpoints when it ends.
     #[serde(deserialize_with = "checkpoint_seconds")]
     pub checkpoint_seconds: f64,
+    /// How the run searches: `"model"`, the model's own generation step (the default), or
+    /// `"map-elites"`, a map of the fittest plant of every kind (`[map]`;
+    /// [docs/varieties.md]). A map breeds `[map] batch` offspring a generation;
+    /// `population` is not used.
+    #[serde(skip_serializing_if = "is_own")]
+    pub strategy: SearchStrategy,
+}
+
+/// How a run searches (`[run] strategy`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SearchStrategy {
+    /// The model's own generation step.
+    #[default]
+    #[serde(rename = "model")]
+    Model,
+    /// MAP-Elites, over the `[map]` section's descriptors.
+    #[serde(rename = "map-elites")]
+    MapElites,
+}
+
+// The default stays out of written configs, so those keep their bytes.
+fn is_own(s: &SearchStrategy) -> bool {
+    *s == SearchStrategy::Model
 }
 
 impl Default for RunConfig {
@@ -44,6 +69,7 @@ impl Default for RunConfig {
             seed: 1,
             threads: 0,
             checkpoint_seconds: 2.0,
+            strategy: SearchStrategy::Model,
         }
     }
 }
@@ -132,6 +158,125 @@ pub struct MatchConfig {
     pub rows: u32,
 }
 
+/// `[map]`: the map of a MAP-Elites run (`[run] strategy = "map-elites"`): its
+/// descriptors, and how it is filled ([docs/varieties.md]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapConfig {
+    /// The map's axes, 1 to 3, at most 100,000 cells in all. Default: `height_to_width`
+    /// and `porosity`, 10 cells each.
+    #[serde(deserialize_with = "map_axes")]
+    pub descriptors: Vec<AxisConfig>,
+    /// Genomes of generation 0 (start genomes, then random), 1 to 1,000,000. Default 200.
+    #[serde(deserialize_with = "map_initial")]
+    pub initial: u32,
+    /// Offspring bred from the map each generation, 1 to 1,000,000. Default 100.
+    #[serde(deserialize_with = "map_batch")]
+    pub batch: u32,
+    /// Share of offspring crossed from two elites before mutating, 0 to 1; the rest are
+    /// mutants of one. Default 0.5.
+    #[serde(deserialize_with = "map_crossover")]
+    pub crossover: f64,
+    /// Subtracted from each elite's fitness in the QD-score (set it below every fitness
+    /// the model gives, so that filling a cell always raises the score), -1e12 to 1e12.
+    /// Default 0.
+    #[serde(deserialize_with = "map_qd_offset")]
+    pub qd_offset: f64,
+}
+
+/// One axis of the map: a descriptor, its range and its cells.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisConfig {
+    /// The descriptor (see [`Descriptor`]).
+    pub name: Descriptor,
+    /// Its range, `[low, high]`; values outside fall in the end cells. Default: the
+    /// descriptor's own range.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<[f64; 2]>,
+    /// Cells across the range, 1 to 1000. Default 10.
+    #[serde(default = "ten", deserialize_with = "axis_cells")]
+    pub cells: u32,
+}
+
+impl AxisConfig {
+    /// `name` over its own range in `cells` cells.
+    pub fn new(name: Descriptor, cells: u32) -> AxisConfig {
+        AxisConfig {
+            name,
+            range: None,
+            cells,
+        }
+    }
+
+    /// The range: the one given, or the descriptor's own.
+    pub fn bounds(&self) -> (f64, f64) {
+        self.range.map_or(self.name.range(), |[lo, hi]| (lo, hi))
+    }
+}
+
+impl Default for MapConfig {
+    fn default() -> Self {
+        MapConfig {
+            descriptors: vec![
+                AxisConfig::new(Descriptor::HeightToWidth, 10),
+                AxisConfig::new(Descriptor::Porosity, 10),
+            ],
+            initial: 200,
+            batch: 100,
+            crossover: 0.5,
+            qd_offset: 0.0,
+        }
+    }
+}
+
+fn ten() -> u32 {
+    10
+}
+
+sylva_core::ranged!(map_initial: u32, "initial", 1, 1_000_000);
+sylva_core::ranged!(map_batch: u32, "batch", 1, 1_000_000);
+sylva_core::ranged!(map_crossover: f64, "crossover", 0.0, 1.0);
+sylva_core::ranged!(map_qd_offset: f64, "qd_offset", -1e12, 1e12);
+sylva_core::ranged!(axis_cells: u32, "cells", 1, 1000);
+
+/// Reads `descriptors`: 1 to 3 axes, each range finite and rising, each descriptor once,
+/// at most 100,000 cells in all.
+fn map_axes<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<AxisConfig>, D::Error> {
+    let axes = Vec::<AxisConfig>::deserialize(d)?;
+    let max = sylva_evolve::map::MAX_DESCRIPTORS;
+    if axes.is_empty() || axes.len() > max {
+        return Err(de::Error::custom(format!(
+            "`descriptors` must list 1 to {max} descriptors, got {}",
+            axes.len()
+        )));
+    }
+    for (i, axis) in axes.iter().enumerate() {
+        if let Some([lo, hi]) = axis.range
+            && !(lo.is_finite() && hi.is_finite() && lo < hi)
+        {
+            return Err(de::Error::custom(format!(
+                "`range` of `{}` must be two finite numbers, low then high, got [{lo}, {hi}]",
+                axis.name.name()
+            )));
+        }
+        if axes[..i].iter().any(|a| a.name == axis.name) {
+            return Err(de::Error::custom(format!(
+                "`descriptors` names `{}` twice",
+                axis.name.name()
+            )));
+        }
+    }
+    let cells: u64 = axes.iter().map(|a| u64::from(a.cells)).product();
+    let most = sylva_evolve::map::MAX_CELLS;
+    if cells > most as u64 {
+        return Err(de::Error::custom(format!(
+            "the map would have {cells} cells; at most {most} (fewer `cells` per descriptor)"
+        )));
+    }
+    Ok(axes)
+}
+
 fn one() -> f64 {
     1.0
 }
@@ -213,6 +358,8 @@ pub struct EvolveConfig<M: Evolve> {
     pub output: OutputConfig,
     /// A target outline to match, if any (`[match]`).
     pub outline: Option<MatchConfig>,
+    /// The map of a MAP-Elites run, if one is given (`[map]`).
+    pub map: Option<MapConfig>,
 }
 
 impl<M: Evolve> PartialEq for EvolveConfig<M> {
@@ -221,6 +368,7 @@ impl<M: Evolve> PartialEq for EvolveConfig<M> {
             && self.settings == other.settings
             && self.output == other.output
             && self.outline == other.outline
+            && self.map == other.map
     }
 }
 
@@ -233,6 +381,9 @@ impl<M: Evolve> Serialize for EvolveConfig<M> {
         st.serialize_field("output", &self.output)?;
         if let Some(outline) = &self.outline {
             st.serialize_field("match", outline)?;
+        }
+        if let Some(map) = &self.map {
+            st.serialize_field("map", map)?;
         }
         st.end()
     }
@@ -253,6 +404,7 @@ enum Key {
     Settings,
     Output,
     Match,
+    Map,
 }
 
 impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
@@ -271,7 +423,14 @@ impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
                 Key::Settings => config.settings = map.next_value_seed(Table::new(M::NAME))?,
                 Key::Output => config.output = map.next_value_seed(Table::new("output"))?,
                 Key::Match => config.outline = Some(map.next_value_seed(Table::new("match"))?),
+                Key::Map => config.map = Some(map.next_value_seed(Table::new("map"))?),
             }
+        }
+        if config.map.is_some() && config.run.strategy != SearchStrategy::MapElites {
+            return Err(de::Error::custom(
+                "a `[map]` is drawn by a MAP-Elites run: add `strategy = \"map-elites\"` to \
+                 `[run]`, or leave `[map]` out",
+            ));
         }
         Ok(config)
     }
@@ -330,10 +489,11 @@ impl<'de> DeserializeSeed<'de> for KeySeed {
             "run" => Ok(Key::Run),
             "output" => Ok(Key::Output),
             "match" => Ok(Key::Match),
+            "map" => Ok(Key::Map),
             k if k == self.0 => Ok(Key::Settings),
             k => Err(de::Error::custom(format!(
                 "unknown field `{k}`: this config evolves `{}` (set `model` to evolve another \
-                 model); expected `model`, `run`, `{}`, `output` or `match`",
+                 model); expected `model`, `run`, `{}`, `output`, `match` or `map`",
                 self.0, self.0
             ))),
         }

@@ -1,0 +1,425 @@
+//! A MAP-Elites run of any model ([`Varieties`]): a map of the fittest plant of every kind
+//! ([`sylva_evolve::map`]), placed by descriptors measured on the grown plant
+//! ([`sylva_fitness::descriptors`]) and scored by the model's own terms, with the
+//! `[match]` outline if the config has one.
+
+use std::cell::RefCell;
+use std::path::Path;
+use std::sync::Arc;
+
+use serde::Serialize;
+use sylva_core::Plant;
+use sylva_core::par::Pool;
+use sylva_evolve::map::{Axis, Describe, MapCheckpoint, MapRun, MapSettings, MapStats};
+use sylva_evolve::{Problem, WithTerm};
+use sylva_fitness::descriptors::{self, Descriptor, Scratch};
+use sylva_model::Evolve;
+
+use crate::erased::{DynModel, Value};
+use crate::error::{Error, InputError};
+use crate::genome::Genome;
+
+use super::checkpoint;
+use super::config::{Config, setup, typed_start, with_term};
+use super::run::{Member, member_of};
+use super::schema::{EvolveConfig, MapConfig, SearchStrategy};
+
+thread_local! {
+    /// Per-thread measuring buffers; they carry nothing between plants.
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Places model `M`'s genomes by descriptors of the plant each grows (with its own seed).
+struct PlantDescriber<M> {
+    model: M,
+    descriptors: Vec<Descriptor>,
+}
+
+impl<M: Evolve> Describe<WithTerm<M::Problem>> for PlantDescriber<M> {
+    /// A genome that fails to grow is not described.
+    fn describe(
+        &self,
+        problem: &WithTerm<M::Problem>,
+        evolved: &<M::Problem as Problem>::Genome,
+        out: &mut [f64],
+    ) -> bool {
+        let genome = self.model.genome_file(&problem.problem, evolved);
+        let seed = self.model.default_seed(&genome);
+        let Ok(plant) = self.model.develop(&genome, seed) else {
+            return false;
+        };
+        SCRATCH.with(|scratch| {
+            descriptors::measure(&plant, &self.descriptors, &mut scratch.borrow_mut(), out);
+        });
+        true
+    }
+}
+
+/// One filled cell of a map: where it is, and its elite.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variety {
+    /// The cell, row-major over the axes (the first slowest).
+    pub cell: usize,
+    /// The cell's place along each axis.
+    pub coordinates: Vec<u32>,
+    /// The elite's descriptors, one per axis.
+    pub descriptors: Vec<f64>,
+    /// The elite.
+    pub member: Member,
+}
+
+/// What the library does with a model's map run, object-safe.
+pub(crate) trait MapValue: Send {
+    fn config(&self) -> Box<Value>;
+    fn step(&mut self) -> &MapStats;
+    fn stats(&self) -> &[MapStats];
+    fn term_names(&self) -> &[String];
+    fn settings(&self) -> &MapSettings;
+    fn descriptors(&self) -> &[Descriptor];
+    fn varieties(&self) -> Vec<Variety>;
+    fn variety(&self, cell: usize) -> Option<Variety>;
+    fn checkpoint(&self) -> Result<String, Error>;
+    fn guides(&self) -> Option<Plant>;
+}
+
+/// A map run of model `M`, with the config it follows (its `[map]` filled in).
+struct TypedMap<M: Evolve> {
+    config: EvolveConfig<M>,
+    descriptors: Vec<Descriptor>,
+    run: MapRun<WithTerm<M::Problem>, M::Strategy>,
+}
+
+/// The checkpoint file of a map run: the effective config and the engine's checkpoint.
+#[derive(Serialize)]
+#[serde(bound = "")]
+struct SavedMapRef<'a, M: Evolve> {
+    config: &'a EvolveConfig<M>,
+    checkpoint: MapCheckpoint<<M::Problem as Problem>::Genome>,
+}
+
+impl<M: Evolve + Default> TypedMap<M> {
+    fn variety_of(&self, cell: usize) -> Option<Variety> {
+        let elite = self.run.elite(cell)?;
+        Some(Variety {
+            cell,
+            coordinates: self.run.settings().coordinates(cell),
+            descriptors: elite.descriptors.clone(),
+            member: member_of(
+                &self.config.model,
+                &self.run.problem().problem,
+                &elite.individual,
+            ),
+        })
+    }
+}
+
+impl<M: Evolve + Default> MapValue for TypedMap<M> {
+    fn config(&self) -> Box<Value> {
+        Box::new(self.config.clone())
+    }
+
+    fn step(&mut self) -> &MapStats {
+        self.run.step()
+    }
+
+    fn stats(&self) -> &[MapStats] {
+        self.run.stats()
+    }
+
+    fn term_names(&self) -> &[String] {
+        self.run.term_names()
+    }
+
+    fn settings(&self) -> &MapSettings {
+        self.run.settings()
+    }
+
+    fn descriptors(&self) -> &[Descriptor] {
+        &self.descriptors
+    }
+
+    fn varieties(&self) -> Vec<Variety> {
+        self.run
+            .filled()
+            .iter()
+            .filter_map(|&cell| self.variety_of(cell))
+            .collect()
+    }
+
+    fn variety(&self, cell: usize) -> Option<Variety> {
+        self.variety_of(cell)
+    }
+
+    fn checkpoint(&self) -> Result<String, Error> {
+        let saved = SavedMapRef::<M> {
+            config: &self.config,
+            checkpoint: self.run.checkpoint(),
+        };
+        serde_json::to_string(&saved)
+            .map_err(|e| InputError::new("checkpoint", e))
+            .map_err(Error::from)
+    }
+
+    fn guides(&self) -> Option<Plant> {
+        self.config.model.guides(&self.run.problem().problem)
+    }
+}
+
+/// `config` as a map run's: the strategy set and `[map]` filled in with its defaults.
+fn as_map<M: Evolve>(config: &EvolveConfig<M>) -> EvolveConfig<M> {
+    let mut config = config.clone();
+    config.run.strategy = SearchStrategy::MapElites;
+    config.map.get_or_insert_with(MapConfig::default);
+    config
+}
+
+/// The engine's settings of a map run of `config` (a map run's, see [`as_map`]).
+fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings, Vec<Descriptor>) {
+    let map = config.map.clone().unwrap_or_default();
+    let axes = map
+        .descriptors
+        .iter()
+        .map(|a| {
+            let (min, max) = a.bounds();
+            Axis {
+                min,
+                max,
+                cells: a.cells,
+            }
+        })
+        .collect();
+    let settings = MapSettings {
+        seed: config.run.seed,
+        axes,
+        initial: map.initial as usize,
+        batch: map.batch as usize,
+        crossover: map.crossover,
+        qd_offset: map.qd_offset,
+    };
+    (settings, map.descriptors.iter().map(|a| a.name).collect())
+}
+
+/// Starts a map run of `config`: generation 0 made, evaluated and placed. A refusal names
+/// the config (`source`).
+pub(crate) fn start_map<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    source: &str,
+    base: &Path,
+    start: Vec<Genome>,
+    pool: Pool,
+) -> Result<Box<dyn MapValue>, Error> {
+    let config = as_map(config);
+    let (settings, descriptors) = map_settings(&config);
+    let typed = typed_start::<M>(&start)?;
+    // Every cell's elite and a generation of offspring, each at the settings' bounds.
+    let held = (settings.cells() + settings.batch.max(settings.initial)) as u64;
+    let genome = config.model.genome_bytes(&config.settings);
+    sylva_core::budget::check(
+        held.saturating_mul(genome).saturating_mul(2),
+        format_args!(
+            "a map of {} cells and generations of {} (`[map]`)",
+            settings.cells(),
+            settings.batch.max(settings.initial)
+        ),
+        "draw a map of fewer cells, or breed smaller batches or smaller genomes",
+    )
+    .map_err(|e| InputError::new(source, e).over_limit())?;
+    // A generation grows up to `initial` or `batch` genomes.
+    let mut timed = config.clone();
+    timed.run.population = settings.batch.max(settings.initial) as u32;
+    if let Some(t) = timed.generation_time(&start, pool.threads()) {
+        sylva_core::budget::check_time(t.seconds, t.what, t.advice)
+            .map_err(|e| InputError::new(source, e).over_limit())?;
+    }
+    let setup = setup(
+        &config.model,
+        &config.settings,
+        typed,
+        config.run.seed,
+        settings.initial,
+        source,
+    )?;
+    let problem = with_term(&config, setup.problem, base)?;
+    let describer = Arc::new(PlantDescriber {
+        model: config.model.clone(),
+        descriptors: descriptors.clone(),
+    });
+    let run = MapRun::new(
+        problem,
+        setup.strategy,
+        describer,
+        pool,
+        settings,
+        setup.first,
+    )
+    .map_err(|e| InputError::new("[map]", e))?;
+    Ok(Box::new(TypedMap {
+        config,
+        descriptors,
+        run,
+    }))
+}
+
+/// Resumes the map run of `config` saved in a checkpoint's `text` (read from `path`).
+pub(crate) fn resume_map<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    source: &str,
+    base: &Path,
+    path: &Path,
+    text: &str,
+    pool: Pool,
+) -> Result<Box<dyn MapValue>, Error> {
+    let config = as_map(config);
+    let (saved, engine): (EvolveConfig<M>, MapCheckpoint<_>) = checkpoint::parse(path, text)?;
+    if saved.resumable() != config.resumable() {
+        return Err(InputError::file(
+            path,
+            "the checkpoint was written by a different config (only `generations`, \
+             `threads` and `checkpoint_seconds` may change when resuming)",
+        )
+        .into());
+    }
+    let (settings, descriptors) = map_settings(&config);
+    if engine.settings != settings {
+        return Err(InputError::file(path, "the checkpoint's map differs from its config").into());
+    }
+    let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
+    let problem = with_term(&config, setup.problem, base)?;
+    let describer = Arc::new(PlantDescriber {
+        model: config.model.clone(),
+        descriptors: descriptors.clone(),
+    });
+    let run = MapRun::resume(problem, setup.strategy, describer, pool, engine)
+        .map_err(|e| InputError::file(path, e))?;
+    Ok(Box::new(TypedMap {
+        config,
+        descriptors,
+        run,
+    }))
+}
+
+/// A MAP-Elites run of any model: a map of the fittest plant of every kind
+/// ([docs/varieties.md]).
+pub struct Varieties {
+    model: Arc<dyn DynModel>,
+    run: Box<dyn MapValue>,
+}
+
+impl std::fmt::Debug for Varieties {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Varieties")
+            .field("model", &self.model.title())
+            .field("generation", &self.generation())
+            .field("filled", &self.stats().last().map(|s| s.filled))
+            .finish()
+    }
+}
+
+impl Varieties {
+    /// Starts a map run of `config` (whatever its `[run] strategy`; its `[map]`, or the
+    /// default map): generation 0 made, evaluated and placed. `start` holds the first
+    /// genomes (of the config's model); the rest are random.
+    pub fn start(config: &Config, start: Vec<Genome>, pool: Pool) -> Result<Varieties, Error> {
+        let (model, typed) = config.parts();
+        let run = model.start_map(typed, &config.source(), &config.base(), start, pool)?;
+        Ok(Varieties {
+            model: model.clone(),
+            run,
+        })
+    }
+
+    /// Resumes the map run saved in a checkpoint's `text` (read from `path`), which must
+    /// have been written by the same config (but for the run's length, threads and
+    /// checkpoint interval). The run continues exactly as if it had never stopped.
+    pub fn resume(
+        config: &Config,
+        path: &Path,
+        text: &str,
+        pool: Pool,
+    ) -> Result<Varieties, Error> {
+        let (model, typed) = config.parts();
+        let run = model.resume_map(typed, &config.source(), &config.base(), path, text, pool)?;
+        Ok(Varieties {
+            model: model.clone(),
+            run,
+        })
+    }
+
+    /// The effective config (its `[map]` filled in).
+    pub fn config(&self) -> Config {
+        Config::erased(self.model.clone(), self.run.config())
+    }
+
+    /// The model's title, for plots.
+    pub fn title(&self) -> &'static str {
+        self.model.title()
+    }
+
+    /// Breeds one generation, offers it to the map, and returns its statistics.
+    pub fn step(&mut self) -> &MapStats {
+        self.run.step()
+    }
+
+    /// The last completed generation.
+    pub fn generation(&self) -> u32 {
+        self.stats().last().map_or(0, |s| s.generation)
+    }
+
+    /// Statistics of every generation so far, one row each.
+    pub fn stats(&self) -> &[MapStats] {
+        self.run.stats()
+    }
+
+    /// Names of the fitness terms, in the order of each member's terms.
+    pub fn term_names(&self) -> &[String] {
+        self.run.term_names()
+    }
+
+    /// The map's descriptors, one per axis.
+    pub fn descriptors(&self) -> &[Descriptor] {
+        self.run.descriptors()
+    }
+
+    /// The map's axes: each descriptor's range and cells.
+    pub fn axes(&self) -> &[Axis] {
+        &self.run.settings().axes
+    }
+
+    /// Cells in the map.
+    pub fn cells(&self) -> usize {
+        self.run.settings().cells()
+    }
+
+    /// The filled cells' elites, in cell order.
+    pub fn varieties(&self) -> Vec<Variety> {
+        self.run.varieties()
+    }
+
+    /// The elite of `cell`, if it is filled.
+    pub fn variety(&self, cell: usize) -> Option<Variety> {
+        self.run.variety(cell)
+    }
+
+    /// The fittest elite (ties go to the lower cell), if the map holds any.
+    pub fn best(&self) -> Option<Variety> {
+        self.varieties().into_iter().reduce(|best, v| {
+            if v.member.total() > best.member.total() {
+                v
+            } else {
+                best
+            }
+        })
+    }
+
+    /// The checkpoint file's text (JSON): the effective config and everything needed to
+    /// resume.
+    pub fn checkpoint(&self) -> Result<String, Error> {
+        self.run.checkpoint()
+    }
+
+    /// Guides drawn beside plants in pictures (a target surface, forbidden cells), if the
+    /// model's fitness has any.
+    pub fn guides(&self) -> Option<Plant> {
+        self.run.guides()
+    }
+}
