@@ -151,8 +151,22 @@ pub fn map_picture(
         });
 
     let mut image = RgbImage::from_pixel(width, height, Rgb(PAPER));
-    let title = fit_text(&picture.title, width.saturating_sub(12), 2);
-    draw_text(&mut image, 6, 6, &title, 2, INK);
+    // Double size if the whole title fits so, else single size in the same bar.
+    let room = width.saturating_sub(12);
+    let scale = if text_width(&picture.title, 2) <= room {
+        2
+    } else {
+        1
+    };
+    let title = fit_text(&picture.title, room, scale);
+    draw_text(
+        &mut image,
+        6,
+        6 + (2 - scale) * GLYPH / 2,
+        &title,
+        scale,
+        INK,
+    );
     let origin = |x: u32, y: u32| (LEFT + x * c, TITLE + (rows - 1 - y) * c);
     for y in 0..rows {
         for x in 0..columns {

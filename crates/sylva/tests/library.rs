@@ -42,6 +42,11 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "automata/pine.toml",
         "plantmaker/evolve.toml",
         "lsystem/evolve.toml",
+        "bintree/varieties.toml",
+        "automata/varieties.toml",
+        "plantmaker/varieties.toml",
+        "lsystem/varieties.toml",
+        "match/varieties.toml",
     ] {
         let c = Config::load(&example(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         // What a run records reads back as the same config.

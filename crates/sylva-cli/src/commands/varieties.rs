@@ -161,8 +161,10 @@ fn archive_png(
             shown[at] = Some(v);
         }
     }
+    // Roots are below the ground: a thumbnail framed on them shows a small shoot.
     let options = GrowOptions {
         taper: config.output().pipe_taper(),
+        roots: false,
         ..GrowOptions::default()
     };
     let grown: Vec<Option<Grown>> = shown
