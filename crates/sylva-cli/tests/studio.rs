@@ -889,10 +889,10 @@ fn models_say_which_modes_hold_their_plants() {
             .cloned()
             .unwrap_or_else(|| panic!("{name} is listed: {models}"))
     };
-    assert_eq!(of("plantmaker")["modes"], json!(["breed"]));
-    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden"]));
-    assert_eq!(of("bintree")["modes"], json!(["breed", "family"]));
-    assert_eq!(of("automata")["modes"], json!(["breed", "design"]));
+    assert_eq!(of("plantmaker")["modes"], json!(["breed", "map"]));
+    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden", "map"]));
+    assert_eq!(of("bintree")["modes"], json!(["breed", "family", "map"]));
+    assert_eq!(of("automata")["modes"], json!(["breed", "design", "map"]));
     let defaults: Vec<&Value> = models
         .as_array()
         .unwrap()
@@ -1526,4 +1526,167 @@ fn a_design_run_killed_mid_evolution_resumes_to_the_same_bytes() {
     let after = get(&server, &format!("/api/sessions/{s}/run"));
     assert_eq!(after["status"], "stopped");
     assert!(after["generation"].as_u64().unwrap() <= stopped["generation"].as_u64().unwrap() + 1);
+}
+
+/// Waits until a map has had `generation` generations (or ended); its view.
+fn wait_map(server: &Server, session: i64, generation: u64) -> Value {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    loop {
+        let map = get(server, &format!("/api/sessions/{session}/map"));
+        if map["generation"].as_u64().unwrap() >= generation || map["status"] != "running" {
+            return map;
+        }
+        assert!(Instant::now() < deadline, "the map is stuck: {map}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_map_fills_in_the_background_survives_a_kill_and_its_plants_branch_and_export() {
+    let map = json!({"mode": "map", "map": {
+        "model": "bintree", "generations": 1500, "seed": 3,
+        "x": {"name": "height_to_width", "cells": 5},
+        "y": {"name": "porosity", "cells": 4, "range": [0.0, 0.8]},
+    }});
+    // Uninterrupted.
+    let whole_dir = temp_dir("map-whole");
+    let whole = start(&whole_dir, "127.0.0.1");
+    let s = post(&whole, "/api/sessions", map.clone())["id"]
+        .as_i64()
+        .unwrap();
+    let done = wait_map(&whole, s, u64::MAX);
+    assert_eq!(done["status"], "done", "{done}");
+    assert_eq!(done["generation"], 1500);
+    assert_eq!(
+        done["axes"][1],
+        json!({"name": "porosity", "min": 0.0, "max": 0.8, "cells": 4})
+    );
+    let cells = |map: &Value| -> Vec<(Value, Value, Value)> {
+        map["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                (
+                    c["cell"].clone(),
+                    c["fitness"].clone(),
+                    c["descriptors"].clone(),
+                )
+            })
+            .collect()
+    };
+    let filled = cells(&done).len();
+    assert!(filled > 5 && filled <= 20, "{done}");
+    let last = done["rows"].as_array().unwrap().last().unwrap().clone();
+    assert_eq!(last["generation"], 1500);
+    assert_eq!(last["filled"], filled as f64);
+
+    // Killed in the middle, started again.
+    let dir = temp_dir("map-killed");
+    let mut server = start(&dir, "127.0.0.1");
+    let s = post(&server, "/api/sessions", map)["id"].as_i64().unwrap();
+    wait_map(&server, s, 200);
+    drop(server);
+    server = start(&dir, "127.0.0.1");
+    let resumed = wait_map(&server, s, u64::MAX);
+    assert_eq!(resumed["status"], "done", "{resumed}");
+    assert_eq!(cells(&resumed), cells(&done));
+    let genome = |server: &Server, plant: &Value| {
+        request(
+            server,
+            "GET",
+            &format!("/api/plants/{plant}/genome.json"),
+            b"",
+            true,
+        )
+        .1
+    };
+    for (a, b) in resumed["cells"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(done["cells"].as_array().unwrap())
+    {
+        assert_eq!(genome(&server, &a["plant"]), genome(&whole, &b["plant"]));
+    }
+
+    // A cell's plant branches into breeding, and exports with wind and levels of detail.
+    let plant = resumed["cells"][0]["plant"].as_i64().unwrap();
+    let info = get(&server, &format!("/api/plants/{plant}"));
+    assert_eq!(info["operator"], "map");
+    let branched = post(&server, &format!("/api/plants/{plant}/branch"), json!({}));
+    assert_eq!(branched["mode"], "breed");
+    let (status, glb) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{plant}/plant.glb?wind=true&lod=3"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&glb));
+    let text = String::from_utf8_lossy(&glb);
+    assert!(glb.starts_with(b"glTF") && text.contains("_LOD2") && text.contains("\"wind\""));
+    let (status, _) = request(
+        &server,
+        "GET",
+        &format!("/api/plants/{plant}/plant.glb?lod=9"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 400);
+
+    // Stop and resume: a stop is kept across a kill, and resume goes on.
+    post(
+        &server,
+        &format!("/api/sessions/{s}/map/resume"),
+        json!({"generations": 100000}),
+    );
+    wait_map(&server, s, 1600);
+    post(&server, &format!("/api/sessions/{s}/map/stop"), json!({}));
+    let stopped = wait_map(&server, s, 0);
+    assert_eq!(stopped["status"], "stopped");
+    drop(server);
+    let server = start(&dir, "127.0.0.1");
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(
+        get(&server, &format!("/api/sessions/{s}/map"))["status"],
+        "stopped"
+    );
+
+    // A bad map names its field.
+    for (body, field) in [
+        (
+            json!({"model": "bintree", "x": {"name": "leafiness"}}),
+            "map.x.name",
+        ),
+        (
+            json!({"model": "bintree", "x": {"name": "lean", "cells": 0}}),
+            "map.x.cells",
+        ),
+        (
+            json!({"model": "bintree", "x": {"name": "lean"}, "y": {"name": "lean"}}),
+            "map.y.name",
+        ),
+        (json!({"model": "oak", "x": {"name": "lean"}}), "map.model"),
+        (
+            json!({"model": "bintree", "x": {"name": "lean", "range": [1, 0]}}),
+            "map.x.range",
+        ),
+        (
+            json!({"model": "bintree", "x": {"name": "lean"}, "generations": 0}),
+            "map.generations",
+        ),
+    ] {
+        let sent = json!({"mode": "map", "map": body});
+        let answer = request(
+            &server,
+            "POST",
+            "/api/sessions",
+            sent.to_string().as_bytes(),
+            true,
+        );
+        assert_refused(&sent.to_string(), answer, 400, field);
+    }
+    let descriptors = get(&server, "/api/descriptors");
+    assert_eq!(descriptors.as_array().unwrap().len(), 8);
 }

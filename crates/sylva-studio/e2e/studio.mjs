@@ -629,6 +629,44 @@ async function main() {
     await shot("design-running");
   });
 
+  // ---- Map ----
+  await step("map: a variety map fills; a cell opens its plant, exports with wind and LOD, and branches into breeding", async () => {
+    await byTestId("mode-map").click();
+    await byTestId("map-form").waitFor();
+    await byTestId("map-model").selectOption("bintree");
+    await byTestId("map-x-cells").fill("5");
+    await byTestId("map-y-cells").fill("4");
+    await byTestId("map-generations").fill("200");
+    await byTestId("map-start").click();
+    await page.waitForFunction(() => window.sylvaStudio.session() && window.sylvaStudio.session().mode === "map");
+    const id = await page.evaluate(() => window.sylvaStudio.session().id);
+    await page.waitForFunction(() => document.querySelector('[data-testid="map-status"]').dataset.status === "done", null, { timeout: 90_000 });
+    const map = await api(`/api/sessions/${id}/map`);
+    check(map.status === "done" && map.generation === 200, `the map ended as ${map.status} at generation ${map.generation}`);
+    const all = await page.locator('[data-testid="map-cell"]').count();
+    check(all === 20, `the map shows ${all} cells, not 5 × 4`);
+    const filled = await page.locator('[data-testid="map-cell"].filled').count();
+    check(filled === map.cells.length && filled >= 4, `the page shows ${filled} filled cells, the map has ${map.cells.length}`);
+    for (const c of map.cells) {
+      const plant = await page.locator(`[data-testid="map-cell"][data-cell="${c.cell}"]`).getAttribute("data-plant");
+      check(plant === String(c.plant), `cell ${c.cell} shows plant ${plant}, the map has ${c.plant}`);
+    }
+    await page.waitForFunction(() => [...document.querySelectorAll('[data-testid="map-cell"].filled img')].every((i) => i.complete && i.naturalWidth > 0), null, { timeout: 60_000 });
+    await noError("map");
+    await shot("map");
+    await page.locator('[data-testid="map-cell"].filled').first().click();
+    await byTestId("plant-detail").waitFor({ state: "visible" });
+    await page.waitForFunction(() => document.querySelector('[data-testid="detail-operator"]')?.textContent === "map");
+    const href = await byTestId("export-glb-lod").getAttribute("href");
+    const glb = await fetch(`${base}${href}`);
+    const bytes = Buffer.from(await glb.arrayBuffer());
+    check(glb.ok && bytes.subarray(0, 4).toString() === "glTF" && bytes.includes("_LOD3") && bytes.includes('"wind"'), `the LOD export answered ${glb.status}`);
+    await byTestId("branch").click();
+    await page.waitForFunction(() => window.sylvaStudio.session().mode === "breed");
+    await waitGridLoaded();
+    await noError("map branch");
+  });
+
   // ---- restart ----
   await step("the archive survives a killed server (and the running design run resumes)", async () => {
     const before = await api(`/api/sessions/${breedId}`);

@@ -13,7 +13,8 @@ use rusqlite::{Connection, OptionalExtension, Transaction, params};
 use serde::Serialize;
 
 /// Ordered schema steps: step `i` takes a file from version `i` to `i + 1`.
-const MIGRATIONS: &[&str] = &[r#"
+const MIGRATIONS: &[&str] = &[
+    r#"
 CREATE TABLE sessions (
     id INTEGER PRIMARY KEY,
     mode TEXT NOT NULL,
@@ -86,7 +87,18 @@ CREATE TABLE run_checkpoints (
     checkpoint TEXT NOT NULL,
     PRIMARY KEY (run, generation)
 );
-"#];
+"#,
+    r#"
+CREATE TABLE map_cells (
+    run INTEGER NOT NULL REFERENCES runs(id),
+    cell INTEGER NOT NULL,
+    plant INTEGER NOT NULL REFERENCES plants(id),
+    fitness REAL NOT NULL,
+    descriptors TEXT NOT NULL,
+    PRIMARY KEY (run, cell)
+);
+"#,
+];
 
 /// Why the archive failed.
 #[derive(Debug, thiserror::Error)]
@@ -153,15 +165,18 @@ pub enum ModeName {
     Family,
     /// The GP designer.
     Design,
+    /// A variety map.
+    Map,
 }
 
 impl ModeName {
     /// Every mode, in the order the page lists them.
-    pub const ALL: [ModeName; 4] = [
+    pub const ALL: [ModeName; 5] = [
         ModeName::Breed,
         ModeName::Garden,
         ModeName::Family,
         ModeName::Design,
+        ModeName::Map,
     ];
 
     /// Its name.
@@ -171,6 +186,7 @@ impl ModeName {
             ModeName::Garden => "garden",
             ModeName::Family => "family",
             ModeName::Design => "design",
+            ModeName::Map => "map",
         }
     }
 
@@ -179,7 +195,7 @@ impl ModeName {
         ModeName::ALL.into_iter().find(|m| m.as_str() == name)
     }
 
-    /// The names, for an error: `breed, garden, family or design`.
+    /// The names, for an error: `breed, garden, family, design or map`.
     pub fn expected() -> String {
         let names: Vec<&str> = ModeName::ALL.iter().map(|m| m.as_str()).collect();
         let (last, rest) = names.split_last().unwrap_or((&"", &[]));
@@ -210,6 +226,8 @@ pub enum Operator {
     Family,
     /// A member of a design run.
     Design,
+    /// An elite of a variety map.
+    Map,
     /// Empty rules, the biomorph garden's start.
     Empty,
     /// An archived plant, again, at the start of a new session.
@@ -230,6 +248,7 @@ impl Operator {
             Operator::Mother => "mother",
             Operator::Family => "family",
             Operator::Design => "design",
+            Operator::Map => "map",
             Operator::Empty => "empty",
             Operator::Branch => "branch",
         }
@@ -753,6 +772,55 @@ pub fn runs_with_status(c: &Connection, status: &str) -> rusqlite::Result<Vec<Ru
         "SELECT {RUN_COLUMNS} FROM runs WHERE status = ?1 ORDER BY id"
     ))?;
     stmt.query_map([status], run_row)?.collect()
+}
+
+/// Runs of sessions of `mode` with a status.
+pub fn runs_of_mode(c: &Connection, mode: ModeName, status: &str) -> rusqlite::Result<Vec<RunRow>> {
+    let columns: Vec<String> = RUN_COLUMNS
+        .split(", ")
+        .map(|c| format!("runs.{c}"))
+        .collect();
+    let mut stmt = c.prepare(&format!(
+        "SELECT {} FROM runs JOIN sessions ON sessions.id = runs.session
+         WHERE runs.status = ?1 AND sessions.mode = ?2 ORDER BY runs.id",
+        columns.join(", ")
+    ))?;
+    stmt.query_map(params![status, mode.as_str()], run_row)?
+        .collect()
+}
+
+/// Puts a plant in a map's cell: `{cell, plant, fitness, descriptors}`.
+pub fn set_map_cell(c: &Connection, run: i64, cell: &serde_json::Value) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO map_cells (run, cell, plant, fitness, descriptors)
+         VALUES (?1, ?2, ?3, ?4, ?5)",
+        params![
+            run,
+            cell["cell"].as_i64(),
+            cell["plant"].as_i64(),
+            cell["fitness"].as_f64().unwrap_or(0.0),
+            cell["descriptors"].to_string()
+        ],
+    )?;
+    Ok(())
+}
+
+/// A map's filled cells, in cell order: `{cell, plant, fitness, descriptors}` each.
+pub fn map_cells(c: &Connection, run: i64) -> rusqlite::Result<Vec<serde_json::Value>> {
+    let mut stmt = c.prepare_cached(
+        "SELECT cell, plant, fitness, descriptors FROM map_cells WHERE run = ?1 ORDER BY cell",
+    )?;
+    stmt.query_map([run], |r| {
+        let descriptors: String = r.get(3)?;
+        Ok(serde_json::json!({
+            "cell": r.get::<_, i64>(0)?,
+            "plant": r.get::<_, i64>(1)?,
+            "fitness": r.get::<_, f64>(2)?,
+            "descriptors": serde_json::from_str::<serde_json::Value>(&descriptors)
+                .unwrap_or_default(),
+        }))
+    })?
+    .collect()
 }
 
 /// Saves a run's progress: its checkpoint, generation and status.

@@ -4,7 +4,8 @@
 //! - [`archive`]: the SQLite archive ([`Archive`]): sessions, plants, parentage, steps, runs.
 //! - [`modes`]: the modes behind one seam ([`modes::Mode`]): breed (PlantMaker's main
 //!   window, for any model), garden (the biomorph loop of L-system plants), family (the
-//!   binary-tree population) and design (the GP designer's runs); sessions start, branch,
+//!   binary-tree population), design (the GP designer's runs) and map (variety maps of any
+//!   model); sessions start, branch,
 //!   undo and redo through it.
 //! - [`sessions`]: sessions as stored and viewed, examples, step seeds.
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
@@ -39,7 +40,7 @@ pub mod plants;
 pub mod runs;
 pub mod sessions;
 
-use modes::{design, family};
+use modes::{design, family, map};
 
 use std::collections::HashMap;
 use std::net::SocketAddr;
@@ -137,7 +138,7 @@ pub struct Inner {
     locks: Mutex<HashMap<i64, Arc<tokio::sync::Mutex<()>>>>,
     /// Family runs in memory.
     pub families: family::Families,
-    /// Design runs going on.
+    /// Design runs and maps going on.
     pub runs: design::Runs,
     /// The channels of the pages watching sessions.
     pub events: events::Events,
@@ -262,6 +263,7 @@ pub fn serve(options: Options) -> Result<(), StartError> {
             })?;
         let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
         design::resume_all(&studio);
+        map::resume_all(&studio);
         warm_textures();
         let query = token.map(|t| format!("?token={t}")).unwrap_or_default();
         // Written, not printed: a closed stdout must not stop the server.

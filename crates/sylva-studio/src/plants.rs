@@ -18,7 +18,7 @@ use sylva::assets::Origin;
 use sylva::core::Plant;
 use sylva::mesh::SceneNode;
 use sylva::render::View;
-use sylva::{Genome, GrowOptions, Grown, Preview, Registry};
+use sylva::{Genome, GrowOptions, Grown, LodAssets, Preview, Registry};
 
 use crate::Studio;
 use crate::archive::{self, ParentRow, PlantRow};
@@ -213,16 +213,64 @@ fn glb_response(glb: &[u8]) -> Response {
 pub(crate) struct GlbQuery {
     #[serde(default)]
     roots: bool,
+    /// A wind skin and its looping clip, as `sylva grow --wind`.
+    #[serde(default)]
+    wind: bool,
+    /// Levels of detail, 2 to 8, as `sylva grow --lod N`: one scene of sibling nodes
+    /// `NAME_LOD0`, `NAME_LOD1`, … with each level's screen coverage in its extras.
+    lod: Option<usize>,
 }
 
-/// `GET /api/plants/{id}/plant.glb`.
+/// `GET /api/plants/{id}/plant.glb[?roots=true][&wind=true][&lod=N]`: the plant in full,
+/// for exports; with wind or levels of detail, the game asset `sylva grow` writes.
 pub(crate) async fn glb(
     State(studio): State<Studio>,
     Path(id): Path<i64>,
     Query(q): Query<GlbQuery>,
 ) -> Result<Response, ApiError> {
-    let glb = tokio::task::spawn_blocking(move || plant_glb(&studio, id, q.roots)).await??;
+    if let Some(n) = q.lod
+        && !(2..=sylva::gltf::lod::MAX_LEVELS).contains(&n)
+    {
+        return Err(ApiError::bad(
+            "lod",
+            format!(
+                "expected 2 to {} levels, got {n}",
+                sylva::gltf::lod::MAX_LEVELS
+            ),
+        ));
+    }
+    let glb = tokio::task::spawn_blocking(move || {
+        if q.wind || q.lod.is_some() {
+            asset_glb(&studio, id, &q).map(Arc::new)
+        } else {
+            plant_glb(&studio, id, q.roots)
+        }
+    })
+    .await??;
     Ok(glb_response(&glb))
+}
+
+/// A plant grown again with wind or levels of detail (not kept in memory: exports are
+/// rare, and each asks its own).
+fn asset_glb(studio: &Studio, id: i64, q: &GlbQuery) -> Result<Vec<u8>, ApiError> {
+    let row = plant_row(studio, id)?;
+    let genome = genome_of(&studio.registry, &row)?;
+    let options = GrowOptions {
+        seed: Some(row.seed),
+        roots: q.roots,
+        wind: q.wind.then(sylva::mesh::wind::WindOptions::default),
+        lod: q.lod,
+        ..GrowOptions::default()
+    };
+    let failed = |e: sylva::Error| ApiError::library("genome", e);
+    let grown = Grown::grow(genome, &options).map_err(failed)?;
+    let glb = if options.lod.is_some() {
+        let chain = LodAssets::new(grown, &options).map_err(failed)?;
+        sylva::gltf::export::to_glb(&chain.group_scene(&row.model))
+    } else {
+        sylva::gltf::export::to_glb(&grown.scene())
+    };
+    glb.map_err(|e| ApiError::library("genome", e.into()))
 }
 
 #[derive(Deserialize)]

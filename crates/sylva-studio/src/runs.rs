@@ -1,5 +1,5 @@
-//! Evolution runs kept in the archive, shared by the modes that run them (family and
-//! design): a generation's figures as a row, and a run's members archived as plants.
+//! Evolution runs kept in the archive, shared by the modes that run them (family, design
+//! and map): a generation's figures as a row, and a run's members archived as plants.
 
 use serde_json::json;
 use sylva::{Evolution, Member};
@@ -25,7 +25,8 @@ pub fn generation_row(run: &Evolution) -> GenerationRow {
     }
 }
 
-/// Archives a run's member as a plant, once (found again by run and member id).
+/// Archives a run's member as a plant, once (found again by run and member id), with
+/// `extra` fields in its settings (a map's cell).
 pub fn archive_member(
     studio: &Studio,
     session: i64,
@@ -33,15 +34,21 @@ pub fn archive_member(
     generation: u32,
     member: &Member,
     operator: Operator,
+    extra: Option<serde_json::Value>,
 ) -> Result<i64, ApiError> {
     let text = member.genome.to_json();
     let seed = member.genome.default_seed();
-    let settings = json!({
+    let mut settings = json!({
         "run": run,
         "generation": generation,
         "member": member.id.0,
         "fitness": finite(member.total()),
     });
+    if let Some(serde_json::Value::Object(extra)) = extra {
+        for (k, v) in extra {
+            settings[k] = v;
+        }
+    }
     studio.archive.transaction(|c| -> Result<_, ApiError> {
         let found: Option<i64> = c
             .query_row(

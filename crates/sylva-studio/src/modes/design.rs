@@ -91,7 +91,7 @@ pub fn status_event(studio: &Studio, session: i64) -> Result<SessionEvent, ApiEr
     Ok(SessionEvent { name, data })
 }
 
-/// The runs going on.
+/// The runs going on (design runs and maps).
 #[derive(Default)]
 pub struct Runs {
     stops: Mutex<HashMap<i64, Arc<AtomicBool>>>,
@@ -111,11 +111,43 @@ impl Runs {
         }
     }
 
-    fn is_running(&self, run: i64) -> bool {
+    pub(crate) fn is_running(&self, run: i64) -> bool {
         self.stops
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .contains_key(&run)
+    }
+
+    /// Marks `run` as going, with the flag that asks it to stop; `None` if it is going
+    /// already.
+    pub(crate) fn begin(&self, run: i64) -> Option<Arc<AtomicBool>> {
+        let mut stops = self.stops.lock().unwrap_or_else(|p| p.into_inner());
+        if stops.contains_key(&run) {
+            return None;
+        }
+        let stop = Arc::new(AtomicBool::new(false));
+        stops.insert(run, stop.clone());
+        Some(stop)
+    }
+
+    /// `run`'s thread has ended.
+    pub(crate) fn end(&self, run: i64) {
+        self.stops
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .remove(&run);
+    }
+
+    /// Asks `run` to stop at its next generation, if it is going.
+    pub(crate) fn stop(&self, run: i64) {
+        if let Some(stop) = self
+            .stops
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .get(&run)
+        {
+            stop.store(true, Ordering::SeqCst);
+        }
     }
 }
 
@@ -382,25 +414,15 @@ fn run_row(studio: &Studio, run: i64) -> Result<RunRow, ApiError> {
 
 /// Starts (or resumes) a run's thread, unless it is going already.
 fn spawn(studio: &Studio, run: i64) -> Result<(), ApiError> {
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let mut stops = studio.runs.stops.lock().unwrap_or_else(|p| p.into_inner());
-        if stops.contains_key(&run) {
-            return Ok(());
-        }
-        stops.insert(run, stop.clone());
-    }
+    let Some(stop) = studio.runs.begin(run) else {
+        return Ok(());
+    };
     let worker = studio.clone();
     let spawned = std::thread::Builder::new()
         .name(format!("sylva-run-{run}"))
         .spawn(move || {
             let result = drive(&worker, run, &stop);
-            worker
-                .runs
-                .stops
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .remove(&run);
+            worker.runs.end(run);
             if let Err(e) = result {
                 let _ = worker.archive.transaction(|c| -> Result<(), ApiError> {
                     let row = archive::run(c, run)?;
@@ -421,12 +443,7 @@ fn spawn(studio: &Studio, run: i64) -> Result<(), ApiError> {
             }
         });
     if let Err(e) = spawned {
-        studio
-            .runs
-            .stops
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .remove(&run);
+        studio.runs.end(run);
         return Err(ApiError::internal(format!("starting a run: {e}")));
     }
     Ok(())
@@ -493,6 +510,7 @@ fn save_generation(
         evolution.generation(),
         &best,
         Operator::Design,
+        None,
     )?;
     let checkpoint = evolution
         .checkpoint()
@@ -531,15 +549,7 @@ fn save_generation(
 /// Stops a run: marked stopped now (so a restart does not resume it), and its thread ends
 /// after the generation it is making.
 fn stop_run(studio: &Studio, run: i64) -> Result<(), ApiError> {
-    if let Some(stop) = studio
-        .runs
-        .stops
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .get(&run)
-    {
-        stop.store(true, Ordering::SeqCst);
-    }
+    studio.runs.stop(run);
     studio.archive.transaction(|c| -> Result<_, ApiError> {
         let row = archive::run(c, run)?.ok_or_else(|| ApiError::not_found(format!("run {run}")))?;
         if row.status == "running" {
@@ -657,7 +667,7 @@ pub(crate) async fn run(
 pub fn resume_all(studio: &Studio) {
     let Ok(runs) = studio
         .archive
-        .read(|c| archive::runs_with_status(c, "running"))
+        .read(|c| archive::runs_of_mode(c, ModeName::Design, "running"))
     else {
         return;
     };

@@ -399,6 +399,7 @@ pub(crate) async fn member(
         state.generation,
         &member,
         Operator::Family,
+        None,
     )?;
     Ok(Json(MemberPlant {
         plant,

@@ -7,6 +7,7 @@
 //! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
 //! - [`family`]: the deciduous-evolution viewer's binary-tree population.
 //! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
+//! - [`map`]: variety maps (MAP-Elites) of any model, filled in the background.
 //!
 //! A new mode is a module implementing [`Mode`], a [`ModeName`], and one arm in each of the
 //! dispatches below.
@@ -15,6 +16,7 @@ pub mod breed;
 pub mod design;
 pub mod family;
 pub mod garden;
+pub mod map;
 
 use std::future::Future;
 
@@ -106,6 +108,10 @@ macro_rules! with_mode {
             }
             ModeName::Design => {
                 type $M = design::DesignMode;
+                $body
+            }
+            ModeName::Map => {
+                type $M = map::MapMode;
                 $body
             }
         }

@@ -180,6 +180,11 @@ export const api = {
   run: (id) => get(`/api/sessions/${enc(id)}/run`),
   eventsUrl: (id) => `/api/sessions/${enc(id)}/events`,
 
+  descriptors: () => get("/api/descriptors"),
+  map: (id) => get(`/api/sessions/${enc(id)}/map`),
+  mapStop: (id) => post(`/api/sessions/${enc(id)}/map/stop`),
+  mapResume: (id, generations) => post(`/api/sessions/${enc(id)}/map/resume`, { generations }),
+
   plants: (session, offset = 0, limit = 100) =>
     get(`/api/plants?session=${enc(session)}&offset=${offset}&limit=${limit}`),
   plant: (id) => get(`/api/plants/${enc(id)}`),

@@ -81,6 +81,8 @@ export function createDetail(ctx, panel) {
       h("h3", {}, "Export"),
       h("div", { class: "buttons exports" },
         exportLink("plant.glb", "GLB", "export-glb", `plant-${p.id}.glb`),
+        exportLink("plant.glb?wind=true", "GLB + wind", "export-glb-wind", `plant-${p.id}-wind.glb`),
+        exportLink("plant.glb?wind=true&lod=4", "GLB + wind + LOD", "export-glb-lod", `plant-${p.id}-lod.glb`),
         exportLink("plant.zip", "OBJ (zip)", "export-obj", `plant-${p.id}.zip`),
         exportLink("plant.stl", "STL", "export-stl", `plant-${p.id}.stl`),
         h("a", { href: `/api/plants/${enc}/plant.png?view=iso&size=1024x1024`, download: `plant-${p.id}.png`, testid: "export-png", class: "button" }, "PNG"),

@@ -9,10 +9,11 @@ import { createBreedMode } from "./breed.js";
 import { createGardenMode } from "./garden.js";
 import { createFamilyMode } from "./family.js";
 import { createDesignMode } from "./design.js";
+import { createMapMode } from "./map.js";
 import { createDetail } from "./detail.js";
 import { createLineage } from "./lineage.js";
 
-const MODES = ["breed", "garden", "family", "design"];
+const MODES = ["breed", "garden", "family", "design", "map"];
 const $ = (id) => document.getElementById(id);
 
 const ui = {
@@ -104,6 +105,7 @@ const modes = {
   garden: createGardenMode(ctx, $("view-garden")),
   family: createFamilyMode(ctx, $("view-family")),
   design: createDesignMode(ctx, $("view-design")),
+  map: createMapMode(ctx, $("view-map")),
 };
 const detail = createDetail(ctx, $("detail"));
 const lineage = createLineage(ctx, $("lineage"));

@@ -59,5 +59,6 @@ pub use schema::{
     AxisConfig, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy,
     WindConfig,
 };
+pub use sylva_fitness::descriptors::Descriptor;
 pub(crate) use varieties::{MapValue, resume_map, start_map};
 pub use varieties::{Varieties, Variety};
