@@ -141,3 +141,51 @@ fn bad_pictures_are_refused_naming_the_file_and_nothing_is_written() {
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("luminance"));
 }
+
+#[test]
+fn height_scales_the_best_plants_assets_and_is_recorded() {
+    let dir = temp_dir("height");
+    let out = dir.join("run");
+    let target = target();
+    let args = [
+        "match",
+        s(&target),
+        "--model",
+        "bintree",
+        "--generations",
+        "2",
+        "--population",
+        "8",
+        "--height",
+        "7",
+        "--out",
+        s(&out),
+    ];
+    ok(&sylva(&args));
+    let config = fs::read_to_string(out.join("config.toml")).unwrap();
+    assert!(config.contains("height = 7.0"), "{config}");
+    let glb = fs::read(out.join("best.glb")).unwrap();
+    assert!(String::from_utf8_lossy(&glb).contains("\"height\":7.0"));
+    // The genome is the plant as evolved; only its assets are scaled.
+    let grown = dir.join("grown.glb");
+    let best = out.join("best.json");
+    ok(&sylva(&[
+        "grow",
+        s(&best),
+        "-o",
+        s(&grown),
+        "--height",
+        "7",
+    ]));
+    assert_eq!(fs::read(&grown).unwrap(), glb);
+    for bad in ["0", "-1", "nan", "1e9"] {
+        let flag = format!("--height={bad}");
+        let refused = sylva(&["grow", s(&best), "-o", s(&grown), &flag]);
+        assert_eq!(refused.status.code(), Some(2), "{bad}");
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert!(
+            stderr.contains("--height") && stderr.contains("0.01 to 1000"),
+            "{stderr}"
+        );
+    }
+}

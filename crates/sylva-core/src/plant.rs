@@ -591,6 +591,45 @@ impl Plant {
         plant
     }
 
+    /// Scales the plant about its origin by `factor` (positive): every point, radius and
+    /// blade, so that it keeps its shape at another size. Refused, and the plant left as it
+    /// was, when the factor is not a positive finite number or a point would go beyond
+    /// [`MAX_COORD`].
+    pub fn scale(&mut self, factor: f32) -> Result<(), PlantError> {
+        if !factor.is_finite() {
+            return Err(PlantError::NotFinite { what: "scale" });
+        }
+        if factor <= 0.0 {
+            return Err(PlantError::Negative {
+                what: "scale",
+                value: factor,
+            });
+        }
+        let far = self
+            .segments
+            .iter()
+            .flat_map(|s| [s.start.abs().max_element(), s.end.abs().max_element()])
+            .chain(self.organs.iter().map(|o| o.position.abs().max_element()))
+            .fold(0.0f32, f32::max);
+        if far * factor > MAX_COORD {
+            return Err(PlantError::TooFar {
+                what: "scaled point",
+                value: far * factor,
+            });
+        }
+        for s in &mut self.segments {
+            s.start *= factor;
+            s.end *= factor;
+            s.start_radius *= factor;
+            s.end_radius *= factor;
+        }
+        for o in &mut self.organs {
+            o.position *= factor;
+            o.size *= factor;
+        }
+        Ok(())
+    }
+
     /// A segment by id.
     #[inline]
     pub fn segment(&self, id: SegmentId) -> &Segment {
@@ -679,6 +718,34 @@ mod tests {
         assert_eq!(shoot.segments.len(), 2);
         assert_eq!(shoot.segments[1].parent, Some(SegmentId(0)));
         assert_eq!(p.without(MaterialKind::Leaf), p);
+    }
+
+    #[test]
+    fn scaling_keeps_the_shape_at_another_size() {
+        let mut p = Plant::new(PlantMeta::default());
+        let a = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.2, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        p.add_organ(Organ {
+            kind: OrganKind::Leaf,
+            position: Vec3::new(0.5, 1.0, 0.0),
+            orientation: Quat::IDENTITY,
+            size: Vec2::new(0.3, 0.1),
+            material: Plant::LEAF,
+            parent: Some(a),
+        })
+        .unwrap();
+        let before = p.clone();
+        p.scale(3.0).unwrap();
+        assert_eq!(p.segments[0].end, Vec3::Y * 3.0);
+        assert_eq!(p.segments[0].start_radius, 0.6f32);
+        assert_eq!(p.organs[0].position, Vec3::new(1.5, 3.0, 0.0));
+        assert!((p.organs[0].size - Vec2::new(0.9, 0.3)).abs().max_element() < 1e-6);
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e13] {
+            let mut q = before.clone();
+            assert!(q.scale(bad).is_err(), "{bad}");
+            assert_eq!(q, before, "a refused scale changes nothing");
+        }
     }
 
     #[test]

@@ -95,6 +95,9 @@ pub struct GrowOptions {
     /// Positions and normals stored as integers in GLB files (`--quantize`,
     /// `KHR_mesh_quantization`). Default false.
     pub quantize: bool,
+    /// The plant scaled about its foot so that its highest point stands this many metres
+    /// above the ground (`--height`). Default none: the model's own scale.
+    pub height: Option<f32>,
 }
 
 impl Default for GrowOptions {
@@ -106,6 +109,7 @@ impl Default for GrowOptions {
             wind: None,
             lod: None,
             quantize: false,
+            height: None,
         }
     }
 }
@@ -136,6 +140,8 @@ pub struct Grown {
     pub roots: bool,
     /// The wind skin and clip, if asked for ([`GrowOptions::wind`]).
     pub rig: Option<Rig>,
+    /// The height it was scaled to, if any ([`GrowOptions::height`]).
+    pub height: Option<f32>,
 }
 
 impl Grown {
@@ -145,7 +151,10 @@ impl Grown {
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
         let seed = options.seed.unwrap_or_else(|| genome.default_seed());
         let (roots, taper) = (options.roots, options.taper);
-        let plant = grow_plant(&genome, seed, roots, taper)?;
+        let mut plant = grow_plant(&genome, seed, roots, taper)?;
+        if let Some(height) = options.height {
+            scale_to_height(&mut plant, height)?;
+        }
         let mut mesher = Mesher::new(mesh_options(genome.mesh_hint()))?;
         let (mesh, rig) = match &options.wind {
             None => (mesher.mesh(&plant)?, None),
@@ -163,6 +172,7 @@ impl Grown {
             taper,
             roots,
             rig,
+            height: options.height,
         })
     }
 
@@ -173,6 +183,9 @@ impl Grown {
         let mut extras = Origin::of(&self.genome, self.seed).extras();
         if let Some(taper) = self.taper {
             extras["taper"] = json!({ "pipe_exponent": taper.exponent });
+        }
+        if let Some(height) = self.height {
+            extras["height"] = json!(height);
         }
         if let Some(rig) = &self.rig {
             extras["wind"] = wind_extras(rig);
@@ -200,6 +213,31 @@ pub fn grow_plant(
         taper.apply(&mut plant);
     }
     Ok(plant)
+}
+
+/// Lowest and highest height a plant is scaled to (`--height`), metres.
+pub const HEIGHTS: (f32, f32) = (0.01, 1000.0);
+
+/// Scales `plant` about its foot so that its highest visible point stands `height` metres
+/// above the ground.
+pub fn scale_to_height(plant: &mut Plant, height: f32) -> Result<(), InputError> {
+    let (lo, hi) = HEIGHTS;
+    if !(lo..=hi).contains(&height) {
+        return Err(InputError::new(
+            "--height",
+            format!("expected {lo} to {hi} metres, got {height}"),
+        ));
+    }
+    let top = plant.bounds().max.y;
+    if !(top.is_finite() && top > 0.0) {
+        return Err(InputError::new(
+            "--height",
+            "the plant has nothing above the ground to scale to a height",
+        ));
+    }
+    plant
+        .scale(height / top)
+        .map_err(|e| InputError::new("--height", e))
 }
 
 /// What a wind GLB's extras say of its rig: the clip, its period and the joints.

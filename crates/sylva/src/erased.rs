@@ -72,6 +72,7 @@ pub(crate) trait DynModel: Send + Sync {
     fn run_settings<'a>(&self, config: &'a Value) -> &'a RunConfig;
     fn run_settings_mut<'a>(&self, config: &'a mut Value) -> &'a mut RunConfig;
     fn output<'a>(&self, config: &'a Value) -> &'a OutputConfig;
+    fn output_mut<'a>(&self, config: &'a mut Value) -> &'a mut OutputConfig;
     fn to_toml(&self, config: &Value) -> String;
     fn start_files(&self, config: &Value) -> Vec<PathBuf>;
     fn generation_time(
@@ -296,6 +297,10 @@ impl<M: Evolve + Default> DynModel for M {
 
     fn output<'a>(&self, c: &'a Value) -> &'a OutputConfig {
         &config::<M>(c).output
+    }
+
+    fn output_mut<'a>(&self, c: &'a mut Value) -> &'a mut OutputConfig {
+        &mut config_mut::<M>(c).output
     }
 
     fn to_toml(&self, c: &Value) -> String {

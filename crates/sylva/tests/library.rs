@@ -476,6 +476,36 @@ fn a_run_that_cannot_score_stops_with_an_error() {
 }
 
 #[test]
+fn a_height_scales_the_plant_to_it_and_travels_with_the_asset() {
+    for file in [
+        "plantmaker/palm.json",
+        "bintree/oak.json",
+        "lsystem/tree.json",
+    ] {
+        let genome = load_genome(&example(file)).unwrap();
+        let options = GrowOptions {
+            height: Some(7.5),
+            ..seeded(0)
+        };
+        let grown = Grown::grow(genome.clone(), &options).unwrap();
+        let top = grown.plant.bounds().max.y;
+        assert!((top - 7.5).abs() < 1e-3, "{file}: {top}");
+        let mesh_top = grown.mesh.bounds().max.y;
+        assert!(mesh_top > 7.0 && mesh_top < 7.6, "{file}: {mesh_top}");
+        let extras = grown.scene().nodes[0].extras.clone().unwrap();
+        assert_eq!(extras["height"], 7.5, "{file}");
+        for bad in [0.0, -2.0, f32::NAN, 5000.0] {
+            let options = GrowOptions {
+                height: Some(bad),
+                ..seeded(0)
+            };
+            let e = Grown::grow(genome.clone(), &options).err().unwrap();
+            assert!(e.to_string().contains("--height"), "{e}");
+        }
+    }
+}
+
+#[test]
 fn the_pipe_taper_keeps_the_pipes_and_travels_with_the_asset() {
     let e = 2.5;
     let taper = sylva_core::taper::PipeTaper::new(e).unwrap();

@@ -281,8 +281,8 @@ pub(super) fn write_results(
     Ok(())
 }
 
-/// Adds the best plant's files: `best.json`, `best.glb` (with the config's taper and
-/// wind) and `best.png` (with `guides`, if any). Returns the plant grown.
+/// Adds the best plant's files: `best.json`, `best.glb` (with the config's taper, wind and
+/// height) and `best.png` (with `guides`, if any). Returns the plant grown.
 pub(super) fn add_best(
     files: &mut Outputs,
     out: &Path,
@@ -294,6 +294,7 @@ pub(super) fn add_best(
     let options = GrowOptions {
         taper: config.output().pipe_taper(),
         wind: config.output().wind_options(),
+        height: config.output().height,
         ..GrowOptions::default()
     };
     let grown = Grown::grow(best.clone(), &options)?;

@@ -37,6 +37,10 @@ pub struct GrowArgs {
     /// every level as a sibling node (NAME_LOD0, …) carrying its screen coverage.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=8))]
     lod: Option<u32>,
+    /// Scale the plant so that its highest point stands this many metres above the
+    /// ground, 0.01 to 1000 [default: the model's own scale].
+    #[arg(long, value_name = "METRES", value_parser = super::parse_height)]
+    height: Option<f32>,
     #[command(flatten)]
     wind: super::WindArgs,
     #[command(flatten)]
@@ -54,6 +58,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         quantize: args.quantize.check(&args.output, wind.is_some())?,
         lod: args.lod.map(|n| n as usize),
         wind,
+        height: args.height,
     };
     let glb = options.glb_options();
     if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {

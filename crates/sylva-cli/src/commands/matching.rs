@@ -54,6 +54,11 @@ pub struct MatchArgs {
     /// Run directory [default: runs/match-<target>-seed<seed>].
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Scale the best plant's assets so that its highest point stands this many metres
+    /// above the ground, 0.01 to 1000 [default: the model's own scale]; the outline is
+    /// matched whatever the size.
+    #[arg(long, value_name = "METRES", value_parser = super::parse_height)]
+    height: Option<f32>,
     /// Continue the run saved in the run directory's checkpoint.
     #[arg(long)]
     resume: bool,
@@ -167,6 +172,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
     // The config written is the run's: its generations are the ones bred.
     let mut config = evolution.config();
     config.run_mut().generations = evolution.generation();
+    config.output_mut().height = args.height;
     let best = evolution.best();
     let (picture, iou) = overlay(&target, Path::new(""), &best.genome)?;
     write_results(

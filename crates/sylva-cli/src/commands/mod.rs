@@ -57,6 +57,15 @@ impl<'a> Checkpoints<'a> {
     }
 }
 
+/// Reads `--height`: metres from 0.01 to 1000.
+pub fn parse_height(text: &str) -> Result<f32, String> {
+    let (lo, hi) = sylva::assets::HEIGHTS;
+    match text.trim().parse::<f32>() {
+        Ok(m) if (lo..=hi).contains(&m) => Ok(m),
+        _ => Err(format!("expected metres from {lo} to {hi}; got {text:?}")),
+    }
+}
+
 /// Work estimated to take this long or longer is announced before it starts, seconds.
 const ANNOUNCE_SECONDS: f64 = 60.0;
 

@@ -331,6 +331,11 @@ impl Config {
         self.model.output(&*self.config)
     }
 
+    /// What a run writes, to change (`sylva match --height` does).
+    pub fn output_mut(&mut self) -> &mut OutputConfig {
+        self.model.output_mut(&mut *self.config)
+    }
+
     /// The config as TOML.
     pub fn to_toml(&self) -> String {
         self.model.to_toml(&*self.config)

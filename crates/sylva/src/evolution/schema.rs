@@ -101,6 +101,24 @@ pub struct OutputConfig {
     /// defaults, or `wind = { strength = 2.0, period = 3.0 }`. Default none.
     #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "wind")]
     pub wind: Option<WindConfig>,
+    /// The best plant's assets scaled so that its highest point stands this many metres
+    /// above the ground, 0.01 to 1000, as `sylva grow --height`. Default none: the model's
+    /// own scale (evolution scores the plants as grown).
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "height")]
+    pub height: Option<f32>,
+}
+
+/// Reads `height`, checked to lie in 0.01..=1000 metres.
+fn height<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    let metres = f32::deserialize(d)?;
+    let (lo, hi) = crate::assets::HEIGHTS;
+    if (lo..=hi).contains(&metres) {
+        Ok(Some(metres))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "`height` must be a number from {lo} to {hi} m, got {metres}"
+        )))
+    }
 }
 
 /// `[output] wind`: the wind of `best.glb`.
@@ -313,6 +331,7 @@ impl Default for OutputConfig {
             sheet_size: 48,
             taper: None,
             wind: None,
+            height: None,
         }
     }
 }
