@@ -889,10 +889,10 @@ fn models_say_which_modes_hold_their_plants() {
             .cloned()
             .unwrap_or_else(|| panic!("{name} is listed: {models}"))
     };
-    assert_eq!(of("plantmaker")["modes"], json!(["breed", "map"]));
-    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden", "map"]));
-    assert_eq!(of("bintree")["modes"], json!(["breed", "family", "map"]));
-    assert_eq!(of("automata")["modes"], json!(["breed", "design", "map"]));
+    assert_eq!(of("plantmaker")["modes"], json!(["breed", "match", "map"]));
+    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden", "match", "map"]));
+    assert_eq!(of("bintree")["modes"], json!(["breed", "family", "match", "map"]));
+    assert_eq!(of("automata")["modes"], json!(["breed", "design", "match", "map"]));
     let defaults: Vec<&Value> = models
         .as_array()
         .unwrap()
@@ -1689,4 +1689,160 @@ fn a_map_fills_in_the_background_survives_a_kill_and_its_plants_branch_and_expor
     }
     let descriptors = get(&server, "/api/descriptors");
     assert_eq!(descriptors.as_array().unwrap().len(), 8);
+}
+
+/// Waits until a match has made `generation` generations (or ended); its run's view.
+fn wait_match(server: &Server, session: i64, generation: u64) -> Value {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    loop {
+        let run = get(server, &format!("/api/sessions/{session}/match/run"));
+        if run["generation"].as_u64().unwrap() >= generation || run["status"] != "running" {
+            return run;
+        }
+        assert!(Instant::now() < deadline, "the match is stuck: {run}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
+    use base64::Engine;
+    let round =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/match/round.png"))
+            .unwrap();
+    let picture = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&round)
+    );
+    let request_of = |model: &str, generations: u32| {
+        json!({"mode": "match", "match": {
+            "picture": picture, "model": model, "generations": generations,
+            "population": 16, "seed": 2,
+        }})
+    };
+    // Uninterrupted.
+    let whole_dir = temp_dir("match-whole");
+    let whole = start(&whole_dir, "127.0.0.1");
+    let s = post(&whole, "/api/sessions", request_of("bintree", 40))["id"]
+        .as_i64()
+        .unwrap();
+    let done = wait_match(&whole, s, u64::MAX);
+    assert_eq!(done["status"], "done", "{done}");
+    assert_eq!(done["terms"], json!(["iou"]));
+    let rows = done["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 41);
+    let last = rows.last().unwrap();
+    let iou = last["best_terms"][0].as_f64().unwrap();
+    assert!(iou > 0.3 && iou <= 1.0, "{last}");
+    assert!(last["best"].as_f64().unwrap() >= rows[0]["best"].as_f64().unwrap());
+    // The target as given, and the best plant's outline over it.
+    let (status, bytes) = request(
+        &whole,
+        "GET",
+        &format!("/api/sessions/{s}/match/picture"),
+        b"",
+        true,
+    );
+    assert_eq!((status, bytes), (200, round.clone()));
+    let plant = last["plant"].as_i64().unwrap();
+    let (status, png) = request(
+        &whole,
+        "GET",
+        &format!("/api/sessions/{s}/match/overlay.png?plant={plant}"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 200);
+    assert!(png.starts_with(b"\x89PNG"));
+    assert_eq!(
+        get(&whole, &format!("/api/plants/{plant}"))["operator"],
+        "match"
+    );
+
+    // Killed in the middle, started again: the same run.
+    let dir = temp_dir("match-killed");
+    let mut server = start(&dir, "127.0.0.1");
+    let k = post(&server, "/api/sessions", request_of("bintree", 40))["id"]
+        .as_i64()
+        .unwrap();
+    wait_match(&server, k, 10);
+    drop(server);
+    server = start(&dir, "127.0.0.1");
+    let resumed = wait_match(&server, k, u64::MAX);
+    assert_eq!(resumed["status"], "done", "{resumed}");
+    let figures = |run: &Value| -> Vec<(Value, Value)> {
+        run["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| (r["best"].clone(), r["best_terms"].clone()))
+            .collect()
+    };
+    assert_eq!(figures(&resumed), figures(&done));
+    let genome = |server: &Server, run: &Value| {
+        let plant = run["rows"].as_array().unwrap().last().unwrap()["plant"].clone();
+        request(
+            server,
+            "GET",
+            &format!("/api/plants/{plant}/genome.json"),
+            b"",
+            true,
+        )
+        .1
+    };
+    assert_eq!(genome(&server, &resumed), genome(&whole, &done));
+    // Its pictures came back from the archive: the overlay still draws.
+    let plant = resumed["rows"].as_array().unwrap().last().unwrap()["plant"].clone();
+    let (status, _) = request(
+        &server,
+        "GET",
+        &format!("/api/sessions/{k}/match/overlay.png?plant={plant}"),
+        b"",
+        true,
+    );
+    assert_eq!(status, 200);
+
+    // Auto tries each model and goes on with the best; the session says which.
+    let a = post(&server, "/api/sessions", request_of("auto", 10))["id"]
+        .as_i64()
+        .unwrap();
+    let auto = wait_match(&server, a, u64::MAX);
+    assert_eq!(auto["status"], "done", "{auto}");
+    let session = get(&server, &format!("/api/sessions/{a}"));
+    assert!(
+        ["bintree", "automata", "plantmaker", "lsystem"]
+            .contains(&session["model"].as_str().unwrap())
+    );
+
+    // Bad pictures and numbers are refused naming their fields, and keep nothing.
+    let sessions = get(&server, "/api/sessions").as_array().unwrap().len();
+    let text = base64::engine::general_purpose::STANDARD.encode(b"not a picture at all");
+    for (body, field) in [
+        (json!({"picture": text}), "match.picture"),
+        (json!({"picture": "%%%"}), "match.picture"),
+        (json!({"picture": picture, "side": text}), "match.side"),
+        (json!({"picture": picture, "model": "oak"}), "match.model"),
+        (
+            json!({"picture": picture, "generations": 0}),
+            "match.generations",
+        ),
+        (
+            json!({"picture": picture, "population": 1}),
+            "match.population",
+        ),
+    ] {
+        let sent = json!({"mode": "match", "match": body});
+        let answer = request(
+            &server,
+            "POST",
+            "/api/sessions",
+            sent.to_string().as_bytes(),
+            true,
+        );
+        assert_refused(field, answer, 400, field);
+    }
+    assert_eq!(
+        get(&server, "/api/sessions").as_array().unwrap().len(),
+        sessions
+    );
 }

@@ -667,6 +667,38 @@ async function main() {
     await noError("map branch");
   });
 
+  // ---- Match ----
+  await step("match: a picture in, the best plant's outline over it live, the best opened", async () => {
+    await byTestId("mode-match").click();
+    await byTestId("match-form").waitFor();
+    await byTestId("match-file").setInputFiles(path.join(repo, "examples/match/round.png"));
+    await page.waitForFunction(() => !document.querySelector('[data-testid="match-preview"]').hidden);
+    await byTestId("match-model").selectOption("bintree");
+    await byTestId("match-generations").fill("15");
+    await byTestId("match-population").fill("20");
+    await byTestId("match-start").click();
+    await page.waitForFunction(() => window.sylvaStudio.session() && window.sylvaStudio.session().mode === "match");
+    const id = await page.evaluate(() => window.sylvaStudio.session().id);
+    await page.waitForFunction(() => document.querySelector('[data-testid="match-status"]').dataset.status === "done", null, { timeout: 90_000 });
+    const run = await api(`/api/sessions/${id}/match/run`);
+    check(run.status === "done" && run.rows.length === 16, `the match ended as ${run.status} with ${run.rows.length} rows`);
+    const last = run.rows[run.rows.length - 1];
+    await page.waitForFunction((plant) => {
+      const img = document.querySelector('[data-testid="match-overlay"]');
+      return img.dataset.plant === String(plant) && img.complete && img.naturalWidth > 0;
+    }, last.plant, { timeout: 60_000 });
+    await page.waitForFunction(() => {
+      const img = document.querySelector('[data-testid="match-target"]');
+      return img.complete && img.naturalWidth > 0;
+    });
+    await noError("match");
+    await shot("match");
+    await byTestId("match-open-best").click();
+    await byTestId("plant-detail").waitFor({ state: "visible" });
+    await page.waitForFunction(() => document.querySelector('[data-testid="detail-operator"]')?.textContent === "match");
+    await noError("match: the best opened");
+  });
+
   // ---- restart ----
   await step("the archive survives a killed server (and the running design run resumes)", async () => {
     const before = await api(`/api/sessions/${breedId}`);

@@ -98,6 +98,14 @@ CREATE TABLE map_cells (
     PRIMARY KEY (run, cell)
 );
 "#,
+    r#"
+CREATE TABLE pictures (
+    session INTEGER NOT NULL REFERENCES sessions(id),
+    view TEXT NOT NULL,
+    bytes BLOB NOT NULL,
+    PRIMARY KEY (session, view)
+);
+"#,
 ];
 
 /// Why the archive failed.
@@ -167,15 +175,18 @@ pub enum ModeName {
     Design,
     /// A variety map.
     Map,
+    /// Design from a picture.
+    Match,
 }
 
 impl ModeName {
     /// Every mode, in the order the page lists them.
-    pub const ALL: [ModeName; 5] = [
+    pub const ALL: [ModeName; 6] = [
         ModeName::Breed,
         ModeName::Garden,
         ModeName::Family,
         ModeName::Design,
+        ModeName::Match,
         ModeName::Map,
     ];
 
@@ -187,6 +198,7 @@ impl ModeName {
             ModeName::Family => "family",
             ModeName::Design => "design",
             ModeName::Map => "map",
+            ModeName::Match => "match",
         }
     }
 
@@ -195,7 +207,7 @@ impl ModeName {
         ModeName::ALL.into_iter().find(|m| m.as_str() == name)
     }
 
-    /// The names, for an error: `breed, garden, family, design or map`.
+    /// The names, for an error: `breed, garden, family, design, match or map`.
     pub fn expected() -> String {
         let names: Vec<&str> = ModeName::ALL.iter().map(|m| m.as_str()).collect();
         let (last, rest) = names.split_last().unwrap_or((&"", &[]));
@@ -228,6 +240,8 @@ pub enum Operator {
     Design,
     /// An elite of a variety map.
     Map,
+    /// A generation's best of a match to a picture.
+    Match,
     /// Empty rules, the biomorph garden's start.
     Empty,
     /// An archived plant, again, at the start of a new session.
@@ -249,6 +263,7 @@ impl Operator {
             Operator::Family => "family",
             Operator::Design => "design",
             Operator::Map => "map",
+            Operator::Match => "match",
             Operator::Empty => "empty",
             Operator::Branch => "branch",
         }
@@ -787,6 +802,48 @@ pub fn runs_of_mode(c: &Connection, mode: ModeName, status: &str) -> rusqlite::R
     ))?;
     stmt.query_map(params![status, mode.as_str()], run_row)?
         .collect()
+}
+
+/// Keeps a session's target picture of `view` (`front`, `side`).
+pub fn insert_picture(
+    c: &Connection,
+    session: i64,
+    view: &str,
+    bytes: &[u8],
+) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO pictures (session, view, bytes) VALUES (?1, ?2, ?3)",
+        params![session, view, bytes],
+    )?;
+    Ok(())
+}
+
+/// A session's target picture of `view`.
+pub fn picture(c: &Connection, session: i64, view: &str) -> rusqlite::Result<Option<Vec<u8>>> {
+    c.query_row(
+        "SELECT bytes FROM pictures WHERE session = ?1 AND view = ?2",
+        params![session, view],
+        |r| r.get(0),
+    )
+    .optional()
+}
+
+/// Sets a run's config (a match's, once its trials chose the model).
+pub fn set_run_config(c: &Connection, id: i64, config: &str) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE runs SET config = ?2 WHERE id = ?1",
+        params![id, config],
+    )?;
+    Ok(())
+}
+
+/// Sets a session's model (a match's, once its trials chose it).
+pub fn set_session_model(c: &Connection, id: i64, model: &str) -> rusqlite::Result<()> {
+    c.execute(
+        "UPDATE sessions SET model = ?2 WHERE id = ?1",
+        params![id, model],
+    )?;
+    Ok(())
 }
 
 /// Puts a plant in a map's cell: `{cell, plant, fitness, descriptors}`.

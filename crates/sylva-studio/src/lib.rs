@@ -4,8 +4,8 @@
 //! - [`archive`]: the SQLite archive ([`Archive`]): sessions, plants, parentage, steps, runs.
 //! - [`modes`]: the modes behind one seam ([`modes::Mode`]): breed (PlantMaker's main
 //!   window, for any model), garden (the biomorph loop of L-system plants), family (the
-//!   binary-tree population), design (the GP designer's runs) and map (variety maps of any
-//!   model); sessions start, branch,
+//!   binary-tree population), design (the GP designer's runs), match (design from a
+//!   picture) and map (variety maps of any model); sessions start, branch,
 //!   undo and redo through it.
 //! - [`sessions`]: sessions as stored and viewed, examples, step seeds.
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
@@ -40,7 +40,7 @@ pub mod plants;
 pub mod runs;
 pub mod sessions;
 
-use modes::{design, family, map};
+use modes::{design, family, map, matching};
 
 use std::collections::HashMap;
 use std::net::SocketAddr;
@@ -139,7 +139,7 @@ pub struct Inner {
     /// Family runs in memory.
     pub families: family::Families,
     /// Design runs and maps going on.
-    pub runs: design::Runs,
+    pub runs: runs::Runs,
     /// The channels of the pages watching sessions.
     pub events: events::Events,
 }
@@ -168,7 +168,7 @@ impl Studio {
             pool: sylva::core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
             families: family::Families::default(),
-            runs: design::Runs::default(),
+            runs: runs::Runs::default(),
             events: events::Events::default(),
         }))
     }
@@ -264,6 +264,7 @@ pub fn serve(options: Options) -> Result<(), StartError> {
         let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
         design::resume_all(&studio);
         map::resume_all(&studio);
+        matching::resume_all(&studio);
         warm_textures();
         let query = token.map(|t| format!("?token={t}")).unwrap_or_default();
         // Written, not printed: a closed stdout must not stop the server.

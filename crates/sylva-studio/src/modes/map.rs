@@ -29,7 +29,7 @@ use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
 use crate::modes::Mode;
-use crate::runs::{archive_member, finite};
+use crate::runs::{self, archive_member, finite};
 use crate::sessions::{SessionView, example, session_of, view};
 
 /// The example maps, built into the binary: each model's base.
@@ -461,41 +461,8 @@ pub(crate) async fn resume(
     Body(request): Body<ResumeRequest>,
 ) -> Result<Json<SessionView>, ApiError> {
     let state = map_state(&studio, id)?;
-    let row = run_row(&studio, state.run)?;
-    let generations = request.generations.unwrap_or(row.generations);
-    if !(1..=MAX_GENERATIONS).contains(&generations) {
-        return Err(ApiError::bad(
-            "generations",
-            format!("expected 1 to {MAX_GENERATIONS}, got {generations}"),
-        ));
-    }
-    if row.status == "failed" {
-        return Err(ApiError::conflict(format!(
-            "the run failed ({}); start a new map",
-            row.error.unwrap_or_default()
-        )));
-    }
-    if studio.runs.is_running(row.id) && row.status == "running" {
-        return Err(ApiError::conflict("the map is filling"));
-    }
-    if row.generation >= generations {
-        return Err(ApiError::conflict(format!(
-            "the map has had its {generations} generations; ask for more with `generations`"
-        )));
-    }
-    // A run still finishing its generation after a stop ends first.
-    for _ in 0..600 {
-        if !studio.runs.is_running(row.id) {
-            break;
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-    studio.archive.transaction(|c| -> Result<_, ApiError> {
-        archive::set_run_generations(c, row.id, generations)?;
-        archive::set_run_status(c, row.id, "running")?;
-        Ok(())
-    })?;
-    spawn(&studio, row.id)?;
+    runs::ready_to_resume(&studio, state.run, request.generations, MAX_GENERATIONS).await?;
+    spawn(&studio, state.run)?;
     Ok(Json(view(&studio, id)?))
 }
 

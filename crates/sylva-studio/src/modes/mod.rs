@@ -7,6 +7,8 @@
 //! - [`garden`]: the biomorph loop of L-system plants grown together in a voxel world.
 //! - [`family`]: the deciduous-evolution viewer's binary-tree population.
 //! - [`design`]: the GP designer's evolutions of automata trees, run in the background.
+//! - [`matching`]: design from a picture: an evolution of any model towards a target
+//!   outline, run in the background.
 //! - [`map`]: variety maps (MAP-Elites) of any model, filled in the background.
 //!
 //! A new mode is a module implementing [`Mode`], a [`ModeName`], and one arm in each of the
@@ -17,6 +19,7 @@ pub mod design;
 pub mod family;
 pub mod garden;
 pub mod map;
+pub mod matching;
 
 use std::future::Future;
 
@@ -112,6 +115,10 @@ macro_rules! with_mode {
             }
             ModeName::Map => {
                 type $M = map::MapMode;
+                $body
+            }
+            ModeName::Match => {
+                type $M = matching::MatchMode;
                 $body
             }
         }

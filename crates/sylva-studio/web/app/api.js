@@ -180,6 +180,12 @@ export const api = {
   run: (id) => get(`/api/sessions/${enc(id)}/run`),
   eventsUrl: (id) => `/api/sessions/${enc(id)}/events`,
 
+  matchRun: (id) => get(`/api/sessions/${enc(id)}/match/run`),
+  matchStop: (id) => post(`/api/sessions/${enc(id)}/match/stop`),
+  matchResume: (id, generations) => post(`/api/sessions/${enc(id)}/match/resume`, { generations }),
+  matchPictureUrl: (id, view = "front") => `/api/sessions/${enc(id)}/match/picture?view=${view}`,
+  matchOverlayUrl: (id, plant) => `/api/sessions/${enc(id)}/match/overlay.png?plant=${enc(plant)}`,
+
   descriptors: () => get("/api/descriptors"),
   map: (id) => get(`/api/sessions/${enc(id)}/map`),
   mapStop: (id) => post(`/api/sessions/${enc(id)}/map/stop`),

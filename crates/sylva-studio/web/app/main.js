@@ -10,10 +10,11 @@ import { createGardenMode } from "./garden.js";
 import { createFamilyMode } from "./family.js";
 import { createDesignMode } from "./design.js";
 import { createMapMode } from "./map.js";
+import { createMatchMode } from "./match.js";
 import { createDetail } from "./detail.js";
 import { createLineage } from "./lineage.js";
 
-const MODES = ["breed", "garden", "family", "design", "map"];
+const MODES = ["breed", "garden", "family", "design", "match", "map"];
 const $ = (id) => document.getElementById(id);
 
 const ui = {
@@ -105,6 +106,7 @@ const modes = {
   garden: createGardenMode(ctx, $("view-garden")),
   family: createFamilyMode(ctx, $("view-family")),
   design: createDesignMode(ctx, $("view-design")),
+  match: createMatchMode(ctx, $("view-match")),
   map: createMapMode(ctx, $("view-map")),
 };
 const detail = createDetail(ctx, $("detail"));

@@ -7,6 +7,7 @@
 import { api, seedValue } from "./api.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { drawChart } from "./chart.js";
+import { follow } from "./follow.js";
 
 const RUNNING = "running";
 const THUMB = 72;
@@ -210,39 +211,22 @@ export function createMapMode(ctx, root) {
     if (es && esSession === id && es.readyState !== EventSource.CLOSED) return;
     closeEvents();
     esSession = id;
-    es = new EventSource(api.eventsUrl(id));
-    es.addEventListener("map", (e) => {
-      let g;
-      try {
-        g = JSON.parse(e.data);
-      } catch {
-        ctx.showError(new Error(`a map event that is not JSON: ${String(e.data).slice(0, 120)}`));
-        return;
-      }
-      if (!session || session.id !== id || !view) return;
-      for (const c of g.cells || []) updateCell(c);
-      if (g.filled !== undefined) rows.set(g.generation, g);
-      drawChart_();
-      setStatus(g.status || RUNNING, g.generation, view.generations, null);
-      ctx.refreshPopulation();
-    });
-    es.addEventListener("status", async (e) => {
-      let st = {};
-      try {
-        st = JSON.parse(e.data);
-      } catch {
-        st = { status: String(e.data) };
-      }
-      if (!session || session.id !== id) return;
-      if (st.status && st.status !== RUNNING) closeEvents();
-      const m = await ctx.act(() => api.map(id));
-      if (m && session && session.id === id) applyMap(m);
-    });
-    es.addEventListener("error", () => {
-      if (es && es.readyState === EventSource.CLOSED) {
-        ctx.showError(new Error(`lost the progress stream of session #${id}; reload to follow the map again`));
-      }
-    });
+    es = follow(ctx, api.eventsUrl(id), id, {
+      map: (g) => {
+        if (!session || session.id !== id || !view) return;
+        for (const c of g.cells || []) updateCell(c);
+        if (g.filled !== undefined) rows.set(g.generation, g);
+        drawChart_();
+        setStatus(g.status || RUNNING, g.generation, view.generations, null);
+        ctx.refreshPopulation();
+      },
+      status: async (st) => {
+        if (!session || session.id !== id) return;
+        if (st.status && st.status !== RUNNING) closeEvents();
+        const m = await ctx.act(() => api.map(id));
+        if (m && session && session.id === id) applyMap(m);
+      },
+    }, "map");
   }
 
   function closeEvents() {

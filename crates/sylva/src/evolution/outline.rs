@@ -218,10 +218,25 @@ pub enum Trial {
 /// registry (a tenth of `limit`, [`TRIAL_SHARE`]; a model whose generation may take longer
 /// than that, or counting generations longer than a tenth of a minute, is left out), then
 /// the run of the best (the first on a tie), with the seconds spent on the others.
-/// `on_trial` hears how each model did.
+/// `on_trial` hears how each model did. The target's pictures are found as their paths say
+/// (relative ones from the current folder; [`start_auto_at`] finds them elsewhere).
 pub fn start_auto(
     registry: &Registry,
     target: &MatchConfig,
+    run: &RunConfig,
+    limit: Limit,
+    pool: &Pool,
+    on_trial: impl FnMut(&Trial),
+) -> Result<(Evolution, f64), Error> {
+    start_auto_at(registry, target, Path::new(""), run, limit, pool, on_trial)
+}
+
+/// [`start_auto`], the target's relative paths found in `base` (the studio keeps its
+/// pictures in a folder of its own).
+pub fn start_auto_at(
+    registry: &Registry,
+    target: &MatchConfig,
+    base: &Path,
     run: &RunConfig,
     limit: Limit,
     pool: &Pool,
@@ -237,8 +252,9 @@ pub fn start_auto(
     };
     let mut best: Option<(f64, Evolution)> = None;
     for entry in registry.models() {
-        let config = match_config(registry, entry.name(), run, target)
+        let mut config = match_config(registry, entry.name(), run, target)
             .map_err(|e| InputError::new(e.field, e.message))?;
+        config.set_base(base);
         if let Some(t) = config.generation_time(&[], pool.threads())
             && t.seconds > allowance
         {

@@ -1,0 +1,438 @@
+//! Match mode, design from a picture (docs/match.md): drop a picture of the tree a scene
+//! needs and watch an evolution of any model (or of the model that matches it best) bring
+//! its best plant's outline over it, generation by generation, in the background.
+//!
+//! The pictures are kept in the archive; a run finds them in a folder of the studio's own
+//! (written again from the archive whenever it is missing, as after a restart). The run goes
+//! on as [`runs`](crate::runs) keeps background runs: checkpointed every generation,
+//! resumed after a kill to the bytes of a run never stopped. Each generation's best is
+//! archived as a plant, to open, branch into breeding and export.
+
+use std::path::{Path as FilePath, PathBuf};
+
+use axum::Json;
+use axum::extract::{Path, Query, State};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use base64::Engine;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use sylva::evolution::outline::{Limit, match_config, outlines, overlay, start_auto_at};
+use sylva::evolution::{MatchConfig, RunConfig};
+use sylva::picture::Threshold;
+use sylva::{Config, Evolution};
+
+use crate::Studio;
+use crate::archive::{self, ModeName, Operator, RunRow};
+use crate::error::ApiError;
+use crate::events::SessionEvent;
+use crate::http::Body;
+use crate::modes::Mode;
+use crate::plants::{genome_of, plant_row};
+use crate::runs::{self, Background};
+use crate::sessions::{SessionView, session_of, view};
+
+/// Most generations a match is asked for.
+const MAX_GENERATIONS: u32 = 10_000;
+
+/// The model that tries every model first.
+const AUTO: &str = "auto";
+
+/// A match as the person sets it.
+#[derive(Deserialize, Serialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct MatchDesign {
+    /// The target seen from the front: a PNG or JPEG, base64 (bare, or a `data:` URL).
+    #[serde(skip_serializing)]
+    picture: String,
+    /// The target seen from the side, the same way. Default: the front picture (a tree looks
+    /// much alike from every side).
+    #[serde(default, skip_serializing)]
+    side: Option<String>,
+    /// The model, or `auto`: each model briefly, then on with the best. Default auto.
+    model: Option<String>,
+    /// What is ink: `"otsu"` (the default) or a luminance 0 to 1 that ink is darker than.
+    threshold: Option<Threshold>,
+    /// Generations, 1 to 10,000. Default 100.
+    generations: Option<u32>,
+    /// Individuals per generation, 2 to 5000. Default 100.
+    population: Option<u32>,
+    /// The run's seed. Default 1.
+    seed: Option<u64>,
+}
+
+/// `POST /api/sessions` in match mode.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    #[serde(rename = "match")]
+    target: MatchDesign,
+}
+
+/// A match session's state: its run and the match as asked (the pictures are in the
+/// archive's `pictures`).
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct MatchState {
+    /// The run.
+    pub run: i64,
+    /// The match as asked, less its pictures.
+    pub design: serde_json::Value,
+    /// Whether the model was chosen by trials (`auto`).
+    pub auto: bool,
+}
+
+/// The two views a match keeps pictures of, as files in its folder.
+const VIEWS: [&str; 2] = ["front", "side"];
+
+/// A picture's bytes from base64 (bare or a `data:` URL), naming `field` when it is not.
+fn picture_bytes(text: &str, field: &str) -> Result<Vec<u8>, ApiError> {
+    let data = match text.split_once(";base64,") {
+        Some((head, data)) if head.starts_with("data:") => data,
+        _ => text,
+    };
+    base64::engine::general_purpose::STANDARD
+        .decode(data.trim())
+        .map_err(|e| ApiError::bad(field, format!("expected a PNG or JPEG as base64: {e}")))
+}
+
+/// The target a match's config carries: its pictures by name, in the match's folder.
+fn target(threshold: Threshold) -> MatchConfig {
+    MatchConfig {
+        front: PathBuf::from("front"),
+        side: Some(PathBuf::from("side")),
+        threshold,
+        weight: 1.0,
+        beside: false,
+        rows: 64,
+    }
+}
+
+/// The folder a session's pictures are found in by its run: written from the archive when
+/// a file is missing.
+fn picture_dir(studio: &Studio, session: i64) -> Result<PathBuf, ApiError> {
+    let dir = std::env::temp_dir()
+        .join(format!("sylva-studio-{}", std::process::id()))
+        .join(format!("match-{session}"));
+    let failed = |e: std::io::Error| ApiError::internal(format!("the pictures' folder: {e}"));
+    if VIEWS.iter().all(|v| dir.join(v).is_file()) {
+        return Ok(dir);
+    }
+    std::fs::create_dir_all(&dir).map_err(failed)?;
+    for v in VIEWS {
+        let bytes = studio
+            .archive
+            .read(|c| archive::picture(c, session, v))?
+            .ok_or_else(|| ApiError::internal(format!("session {session} has no {v} picture")))?;
+        std::fs::write(dir.join(v), bytes).map_err(failed)?;
+    }
+    Ok(dir)
+}
+
+/// Checks a match's numbers, naming their fields; its run's size.
+fn run_of(design: &MatchDesign) -> Result<RunConfig, ApiError> {
+    let generations = design.generations.unwrap_or(100);
+    if !(1..=MAX_GENERATIONS).contains(&generations) {
+        return Err(ApiError::bad(
+            "match.generations",
+            format!("expected 1 to {MAX_GENERATIONS}, got {generations}"),
+        ));
+    }
+    let population = design.population.unwrap_or(100);
+    if !(2..=5000).contains(&population) {
+        return Err(ApiError::bad(
+            "match.population",
+            format!("expected 2 to 5000, got {population}"),
+        ));
+    }
+    Ok(RunConfig {
+        generations,
+        population,
+        seed: design.seed.unwrap_or(1),
+        ..RunConfig::default()
+    })
+}
+
+/// The config of a match of `model`, its pictures in the session's folder.
+fn config_for(
+    studio: &Studio,
+    model: &str,
+    run: &RunConfig,
+    threshold: Threshold,
+) -> Result<Config, ApiError> {
+    match_config(&studio.registry, model, run, &target(threshold)).map_err(|e| {
+        match e.field.as_str() {
+            "model" => ApiError::bad("match.model", e.message),
+            field => ApiError::unprocessable(format!("match ({field})"), e.message),
+        }
+    })
+}
+
+/// Creates a match session, keeps its pictures and starts its run.
+async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+    let design = start.target;
+    let front = picture_bytes(&design.picture, "match.picture")?;
+    let side = match &design.side {
+        Some(text) => picture_bytes(text, "match.side")?,
+        None => front.clone(),
+    };
+    let run = run_of(&design)?;
+    let threshold = design.threshold.unwrap_or_default();
+    let model = design.model.clone().unwrap_or_else(|| AUTO.to_owned());
+    let auto = model == AUTO;
+    // An auto match's config is its first model's until the trials choose.
+    let first = studio
+        .registry
+        .models()
+        .first()
+        .map(|m| m.name())
+        .unwrap_or(AUTO);
+    let config = config_for(studio, if auto { first } else { &model }, &run, threshold)?;
+    // The pictures are read before anything is kept: a bad one is refused naming its field.
+    let check = tempfile_dir()?;
+    for (view, bytes, field) in [
+        ("front", &front, "match.picture"),
+        ("side", &side, "match.side"),
+    ] {
+        std::fs::write(check.join(view), bytes)
+            .map_err(|e| ApiError::internal(format!("checking the picture: {e}")))?;
+        let one = MatchConfig {
+            side: None,
+            front: PathBuf::from(view),
+            ..target(threshold)
+        };
+        outlines(&one, &check).map_err(|e| ApiError::bad(field, e.message))?;
+    }
+    let _ = std::fs::remove_dir_all(&check);
+    let generations = run.generations;
+    let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
+        let id = archive::insert_session(c, ModeName::Match, config.model(), "Match", &json!({}))?;
+        archive::insert_picture(c, id, "front", &front)?;
+        archive::insert_picture(c, id, "side", &side)?;
+        let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
+        let state = MatchState {
+            run,
+            design: json!(design),
+            auto,
+        };
+        archive::set_state(c, id, &json!(state))?;
+        Ok((id, run))
+    })?;
+    runs::spawn::<MatchMode>(studio, run)?;
+    Ok(id)
+}
+
+/// A fresh folder to check pictures in.
+fn tempfile_dir() -> Result<PathBuf, ApiError> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "sylva-studio-{}-check-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| ApiError::internal(format!("checking the picture: {e}")))?;
+    Ok(dir)
+}
+
+fn match_state(studio: &Studio, id: i64) -> Result<MatchState, ApiError> {
+    let row = session_of(studio, id, ModeName::Match)?;
+    serde_json::from_value(row.state)
+        .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
+}
+
+/// The threshold a session's match asked for.
+fn threshold_of(state: &MatchState) -> Threshold {
+    serde_json::from_value(state.design["threshold"].clone()).unwrap_or_default()
+}
+
+impl Background for MatchMode {
+    const OPERATOR: Operator = Operator::Match;
+
+    fn config(studio: &Studio, row: &RunRow) -> Result<Config, ApiError> {
+        let mut config = studio
+            .registry
+            .parse_config(FilePath::new("match"), &row.config)
+            .map_err(|e| ApiError::internal(e.to_string()))?;
+        config.set_base(picture_dir(studio, row.session)?);
+        Ok(config)
+    }
+
+    /// Auto: each model briefly, then on with the best, whose config the run keeps.
+    fn start(studio: &Studio, row: &RunRow, config: &Config) -> Result<Evolution, ApiError> {
+        let state = match_state(studio, row.session)?;
+        let failed = |e: sylva::Error| ApiError::internal(sylva::error::chain(&e));
+        if !state.auto {
+            return Evolution::start(config, Vec::new(), studio.pool.clone()).map_err(failed);
+        }
+        let run = config.run().clone();
+        let threshold = threshold_of(&state);
+        let dir = picture_dir(studio, row.session)?;
+        let (evolution, _) = start_auto_at(
+            &studio.registry,
+            &target(threshold),
+            &dir,
+            &run,
+            Limit::Generations(run.generations),
+            &studio.pool,
+            |_| {},
+        )
+        .map_err(failed)?;
+        let chosen = config_for(studio, evolution.config().model(), &run, threshold)?;
+        studio.archive.transaction(|c| -> Result<_, ApiError> {
+            archive::set_run_config(c, row.id, &chosen.to_toml())?;
+            archive::set_session_model(c, row.session, chosen.model())?;
+            Ok(())
+        })?;
+        Ok(evolution)
+    }
+}
+
+/// `POST /api/sessions/{id}/match/stop`.
+pub(crate) async fn stop(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<SessionView>, ApiError> {
+    let state = match_state(&studio, id)?;
+    runs::stop_run(&studio, state.run)?;
+    Ok(Json(view(&studio, id)?))
+}
+
+/// `POST /api/sessions/{id}/match/resume`.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ResumeRequest {
+    /// Run to this many generations in all (more than asked at first, to go on).
+    generations: Option<u32>,
+}
+
+/// `POST /api/sessions/{id}/match/resume`: a stopped (or done) match goes on.
+pub(crate) async fn resume(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Body(request): Body<ResumeRequest>,
+) -> Result<Json<SessionView>, ApiError> {
+    let state = match_state(&studio, id)?;
+    runs::resume_run::<MatchMode>(&studio, state.run, request.generations, MAX_GENERATIONS).await?;
+    Ok(Json(view(&studio, id)?))
+}
+
+/// `GET /api/sessions/{id}/match/run`: the run and its figures (`best` is the outline score,
+/// `best_terms` the IoU).
+pub(crate) async fn run(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+) -> Result<Json<runs::RunView>, ApiError> {
+    let state = match_state(&studio, id)?;
+    Ok(Json(runs::run_view(&studio, state.run)?))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PictureQuery {
+    view: Option<String>,
+}
+
+/// The view a query names: `front` (the default) or `side`.
+fn view_of(q: &PictureQuery) -> Result<&'static str, ApiError> {
+    match q.view.as_deref() {
+        None | Some("front") => Ok("front"),
+        Some("side") => Ok("side"),
+        Some(other) => Err(ApiError::bad(
+            "view",
+            format!("expected front or side, got {other:?}"),
+        )),
+    }
+}
+
+/// `GET /api/sessions/{id}/match/picture?view=front|side`: a target picture as given.
+pub(crate) async fn picture(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<PictureQuery>,
+) -> Result<Response, ApiError> {
+    match_state(&studio, id)?;
+    let view = view_of(&q)?;
+    let bytes = studio
+        .archive
+        .read(|c| archive::picture(c, id, view))?
+        .ok_or_else(|| ApiError::not_found(format!("session {id}'s {view} picture")))?;
+    let kind = if bytes.starts_with(b"\x89PNG") {
+        "image/png"
+    } else {
+        "image/jpeg"
+    };
+    Ok(([(header::CONTENT_TYPE, kind)], bytes).into_response())
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct OverlayQuery {
+    plant: i64,
+}
+
+/// `GET /api/sessions/{id}/match/overlay.png?plant=ID`: the front target and the plant's
+/// outline over each other (blue the target, orange the plant, green both), with their IoU
+/// in its caption and in the `X-Sylva-IoU` header.
+pub(crate) async fn overlay_png(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<OverlayQuery>,
+) -> Result<Response, ApiError> {
+    let state = match_state(&studio, id)?;
+    let (png, iou) = tokio::task::spawn_blocking(move || -> Result<_, ApiError> {
+        let row = plant_row(&studio, q.plant)?;
+        let genome = genome_of(&studio.registry, &row)?;
+        let dir = picture_dir(&studio, id)?;
+        overlay(&target(threshold_of(&state)), &dir, &genome)
+            .map_err(|e| ApiError::library("plant", e))
+    })
+    .await??;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "image/png".to_owned()),
+            (
+                header::HeaderName::from_static("x-sylva-iou"),
+                format!("{iou:.4}"),
+            ),
+        ],
+        png,
+    )
+        .into_response())
+}
+
+/// Resumes every match that was running when the studio stopped (or was killed).
+pub fn resume_all(studio: &Studio) {
+    runs::resume_all::<MatchMode>(studio, ModeName::Match);
+}
+
+/// Match mode, behind the studio's mode seam.
+pub struct MatchMode;
+
+impl Mode for MatchMode {
+    const NAME: ModeName = ModeName::Match;
+    type Start = Start;
+
+    fn models(registry: &sylva::Registry) -> Vec<&'static str> {
+        registry.models().iter().map(|m| m.name()).collect()
+    }
+
+    async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
+        create(studio, start).await
+    }
+
+    fn routes() -> axum::Router<Studio> {
+        use axum::routing::{get, post};
+        axum::Router::new()
+            .route("/sessions/{id}/match/stop", post(stop))
+            .route("/sessions/{id}/match/resume", post(resume))
+            .route("/sessions/{id}/match/run", get(run))
+            .route("/sessions/{id}/match/picture", get(picture))
+            .route("/sessions/{id}/match/overlay.png", get(overlay_png))
+    }
+
+    fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
+        let state = match_state(studio, session)?;
+        runs::status_event(studio, state.run).map(Some)
+    }
+}
