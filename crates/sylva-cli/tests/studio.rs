@@ -890,9 +890,18 @@ fn models_say_which_modes_hold_their_plants() {
             .unwrap_or_else(|| panic!("{name} is listed: {models}"))
     };
     assert_eq!(of("plantmaker")["modes"], json!(["breed", "match", "map"]));
-    assert_eq!(of("lsystem")["modes"], json!(["breed", "garden", "match", "map"]));
-    assert_eq!(of("bintree")["modes"], json!(["breed", "family", "match", "map"]));
-    assert_eq!(of("automata")["modes"], json!(["breed", "design", "match", "map"]));
+    assert_eq!(
+        of("lsystem")["modes"],
+        json!(["breed", "garden", "match", "map"])
+    );
+    assert_eq!(
+        of("bintree")["modes"],
+        json!(["breed", "family", "match", "map"])
+    );
+    assert_eq!(
+        of("automata")["modes"],
+        json!(["breed", "design", "match", "map"])
+    );
     let defaults: Vec<&Value> = models
         .as_array()
         .unwrap()

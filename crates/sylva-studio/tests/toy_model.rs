@@ -86,7 +86,7 @@ fn a_studio_of_a_users_registry_breeds_its_models() {
         .cloned()
         .unwrap_or_else(|| panic!("listed: {models}"));
     assert_eq!(cylinder["title"], "Cylinders");
-    assert_eq!(cylinder["modes"], json!(["breed"]));
+    assert_eq!(cylinder["modes"], json!(["breed", "match", "map"]));
     // Started at random, crossed and mutated.
     let session = json_of(
         &studio,
@@ -137,6 +137,38 @@ fn a_studio_of_a_users_registry_breeds_its_models() {
     );
     assert_eq!(status, StatusCode::OK);
     assert!(String::from_utf8_lossy(&file).contains(r#""model": "cylinder""#));
+    // A map of its plants (it has no example map: its own settings and the default map).
+    let map = json_of(
+        &studio,
+        "POST",
+        "/api/sessions",
+        Some(json!({"mode": "map", "map": {
+            "model": "cylinder", "x": {"name": "height_to_width", "cells": 4}, "generations": 5,
+        }})),
+    );
+    let m = map["id"].as_i64().unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(300);
+    let done = loop {
+        let view = json_of(&studio, "GET", &format!("/api/sessions/{m}/map"), None);
+        if view["status"] != "running" {
+            break view;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the map is stuck: {view}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert_eq!(done["status"], "done", "{done}");
+    let cells = done["cells"].as_array().unwrap();
+    assert!(!cells.is_empty(), "{done}");
+    let elite = json_of(
+        &studio,
+        "GET",
+        &format!("/api/plants/{}", cells[0]["plant"]),
+        None,
+    );
+    assert_eq!(elite["model"], "cylinder");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
