@@ -296,6 +296,20 @@ fn angles_of_axis(axis: [f64; 3]) -> (f64, f64) {
     (azimuth, v.y.clamp(-1.0, 1.0).asin().to_degrees())
 }
 
+/// The bit string of `values` (one per field, see [`BinTree::values`]) in `geometry`'s
+/// layout: each value's nearest code, values outside a field's range clamped to it.
+pub fn encode_values(values: &[f64; 11], geometry: Geometry) -> Bits {
+    let layout = geometry.layout();
+    let mut bits = Bits::zeros(bits_of(layout)).expect("the layout fits in two words");
+    let mut offset = 0;
+    for (v, f) in values.iter().zip(layout) {
+        let width = usize::from(f.code.bits);
+        bits.write(offset, width, f.code.encode(*v));
+        offset += width;
+    }
+    bits
+}
+
 impl BinTree {
     /// Decodes a GA bit string (see [`LAYOUT`]); `min_radius` comes from the run.
     pub fn decode(bits: &Bits, min_radius: f64) -> BinTree {
@@ -336,7 +350,13 @@ impl BinTree {
 
     /// The nearest bit string (values outside the GA's ranges are clamped to them).
     pub fn encode(&self) -> Bits {
-        let values = [
+        encode_values(&self.values(), self.geometry)
+    }
+
+    /// The genome's value of each field of the GA's layout, in the layout's order (each
+    /// rotation's axis as its azimuth and elevation, degrees).
+    pub fn values(&self) -> [f64; 11] {
+        [
             f64::from(self.depth),
             self.lower_radius,
             self.upper_radius,
@@ -348,16 +368,7 @@ impl BinTree {
             self.rotation2.angle,
             angles_of_axis(self.rotation2.axis).0,
             angles_of_axis(self.rotation2.axis).1,
-        ];
-        let layout = self.geometry.layout();
-        let mut bits = Bits::zeros(bits_of(layout)).expect("the layout fits in two words");
-        let mut offset = 0;
-        for (v, f) in values.iter().zip(layout) {
-            let width = usize::from(f.code.bits);
-            bits.write(offset, width, f.code.encode(*v));
-            offset += width;
-        }
-        bits
+        ]
     }
 
     /// Number of cylinders, `2^depth - 1`.

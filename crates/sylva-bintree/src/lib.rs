@@ -12,6 +12,7 @@
 //!   and the bit layout of the genetic algorithm ([`LAYOUT`]).
 //! - [`problem`]: the genetic algorithm as an evolution problem: the model's settings (the
 //!   `[bintree]` config), Susinno's weighted fitness and his mean-replacement step.
+//! - [`vector`]: genomes as vectors of the layout's fields, for optimisers outside Sylva.
 //! - [`BinTreeModel`]: the model as Sylva's [`Model`] and [`Evolve`].
 //!
 //! ```
@@ -25,6 +26,7 @@
 
 pub mod genome;
 pub mod problem;
+pub mod vector;
 
 pub use genome::{
     BITS, BinTree, Bits, Field, Geometry, LAYOUT, MAX_DEPTH, MODEL, PAPER_BITS, PAPER_LAYOUT,
@@ -41,7 +43,7 @@ use sylva_evolve::bits::BitFlip;
 use sylva_evolve::{Crossover, Mutate};
 use sylva_model::{
     Bred, ConfigError, CrossLevel, DevelopError, Evolve, Knobs, Model, Parent, Setup,
-    VariationError, two_most_dominant,
+    VariationError, VectorCoding, two_most_dominant,
 };
 
 /// Susinno's binary tree as a Sylva model.
@@ -131,5 +133,14 @@ impl Evolve for BinTreeModel {
 
     fn genome_file(&self, problem: &BinTreeProblem, bits: &Bits) -> BinTree {
         problem.decode(bits)
+    }
+
+    /// The layout's fields, each in its own unit ([`vector::FieldCoding`]).
+    fn vector_coding(
+        &self,
+        problem: &BinTreeProblem,
+        _seed: u64,
+    ) -> Option<Box<dyn VectorCoding<Self>>> {
+        Some(Box::new(vector::FieldCoding::new(problem)))
     }
 }

@@ -12,6 +12,9 @@
 //! crate) keeps the one registry that lists them.
 //!
 //! - [`file`](mod@file): genome files ([`GenomeError`], [`FormatV1`], [`model_tag!`]).
+//! - [`VectorCoding`]: a model's genomes as fixed vectors of parameters, for optimisers
+//!   outside Sylva ([`Evolve::vector_coding`]; the library decodes any model's vectors
+//!   otherwise).
 //!
 //! ```
 //! use rand::{Rng, RngExt};
@@ -420,6 +423,38 @@ pub trait Evolve: Model {
     ) -> Option<EvaluationTime> {
         None
     }
+
+    /// The problem's genomes as vectors of numbers, for a model whose evolved genome is
+    /// naturally a fixed list of parameters (the binary tree's fields, PlantMaker's codes),
+    /// so that an optimiser outside Sylva (CMA-ES, pyribs) can search them. `seed` is what
+    /// a decoded genome takes for any part the vector does not hold (a genome's own growth
+    /// seed). `None`, the default, for genomes of varying structure (programs, rule sets):
+    /// the library then decodes vectors as the random draws of
+    /// [`Problem::random_genome`], which every model has.
+    fn vector_coding(
+        &self,
+        _problem: &Self::Problem,
+        _seed: u64,
+    ) -> Option<Box<dyn VectorCoding<Self>>> {
+        None
+    }
+}
+
+/// A model's genomes as fixed-length vectors of numbers ([`Evolve::vector_coding`]): one
+/// entry per parameter, each within its bounds, so that nearby vectors are similar genomes.
+pub trait VectorCoding<M: Evolve>: Send + Sync {
+    /// Each entry's lower and upper bound (lower ≤ upper).
+    fn bounds(&self) -> &[[f64; 2]];
+
+    /// The evolved genome of `x`: one entry per bound, each finite and within its bounds
+    /// (the caller checks and clamps). Every such vector decodes to a legal genome.
+    fn decode(&self, x: &[f64]) -> <M::Problem as Problem>::Genome;
+
+    /// The vector of `genome` (a genome file of the model), each entry within its bounds:
+    /// the nearest the coding holds, so `decode(encode(g))` is `g` for a genome the coding
+    /// can express, or the nearest one it can; `Err` says why a genome has no vector here
+    /// (another shape than the problem's genomes), naming what differs.
+    fn encode(&self, genome: &M::Genome) -> Result<Vec<f64>, String>;
 }
 
 /// How long one evaluation may take ([`Evolve::evaluation_time`]).

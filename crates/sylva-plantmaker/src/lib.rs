@@ -18,6 +18,7 @@
 //! - [`garden`]: many plants of one or more genomes placed on a plot without overlapping.
 //! - [`problem`]: evolution without a person: the model's settings (the `[plantmaker]`
 //!   config), Poncin's shared terms over the grown plant, generational breeding.
+//! - [`vector`]: genomes as vectors of their codes, for optimisers outside Sylva.
 //! - [`PlantMakerModel`]: the model as Sylva's [`Model`](sylva_model::Model) and
 //!   [`Evolve`](sylva_model::Evolve).
 //!
@@ -39,6 +40,7 @@ pub mod genes;
 pub mod packed;
 pub mod problem;
 pub mod variation;
+pub mod vector;
 
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
@@ -515,6 +517,22 @@ impl sylva_model::Evolve for PlantMakerModel {
 
     fn genome_file(&self, _problem: &PlantMakerProblem, genome: &PlantMaker) -> PlantMaker {
         genome.clone()
+    }
+
+    /// The tables' codes at the settings' segment counts ([`vector::CodeCoding`]); decoded
+    /// genomes grow with `seed`.
+    fn vector_coding(
+        &self,
+        problem: &PlantMakerProblem,
+        seed: u64,
+    ) -> Option<Box<dyn sylva_model::VectorCoding<Self>>> {
+        let s = &problem.settings;
+        Some(Box::new(vector::CodeCoding::new(
+            s.branches as usize,
+            s.fans as usize,
+            s.inflorescences as usize,
+            seed,
+        )))
     }
 }
 

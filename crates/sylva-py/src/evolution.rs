@@ -78,11 +78,34 @@ fn field_error(e: sylva::InputError, text: &str) -> sylva::InputError {
     sylva::InputError::new(format!("{DICT} `{field}`"), e.message)
 }
 
+impl Config {
+    /// A config given as Python code gives one: a `Config`, a dict shaped like the file,
+    /// or the path of a config file.
+    pub fn from_any(config: &Bound<'_, PyAny>) -> PyResult<Config> {
+        if let Ok(config) = config.cast::<Config>() {
+            Ok(config.borrow().clone())
+        } else if config.is_instance_of::<pyo3::types::PyDict>() {
+            Config::from_dict(config, None)
+        } else {
+            let path: PathBuf = config.extract().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "expected a Config, a dict or the path of a config file, got {}",
+                    config
+                        .get_type()
+                        .name()
+                        .map_or_else(|_| "?".into(), |n| n.to_string())
+                ))
+            })?;
+            Config::load(path)
+        }
+    }
+}
+
 #[pymethods]
 impl Config {
     /// Reads a config file; genome files it names are found next to it.
     #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Config> {
+    pub(crate) fn load(path: PathBuf) -> PyResult<Config> {
         let inner = crate::registry().load_config(&path).py()?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(Config { inner, base })
@@ -100,7 +123,7 @@ impl Config {
     /// {"population": 500}, "automata": {...}}`. Errors name the field.
     #[staticmethod]
     #[pyo3(signature = (data, base = None))]
-    fn from_dict(data: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<Config> {
+    pub(crate) fn from_dict(data: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<Config> {
         let value = from_py(data, "config dict")?;
         let text =
             toml::to_string(&value).map_err(|e| bad_value(DICT, format!("not a config: {e}")))?;
@@ -268,7 +291,10 @@ impl Evolution {
         f(&mut run)
     }
 
-    fn pool(config: &sylva::Config, threads: Option<u32>) -> PyResult<sylva::core::par::Pool> {
+    pub(crate) fn pool(
+        config: &sylva::Config,
+        threads: Option<u32>,
+    ) -> PyResult<sylva::core::par::Pool> {
         let threads = threads.unwrap_or(config.run().threads);
         if threads > 1024 {
             return Err(bad_value(
@@ -315,26 +341,7 @@ impl Evolution {
         start: Option<Vec<Genome>>,
         threads: Option<u32>,
     ) -> PyResult<Evolution> {
-        let given;
-        let config: &Config = if let Ok(config) = config.cast::<Config>() {
-            given = config.borrow().clone();
-            &given
-        } else if config.is_instance_of::<pyo3::types::PyDict>() {
-            given = Config::from_dict(config, None)?;
-            &given
-        } else {
-            let path: PathBuf = config.extract().map_err(|_| {
-                pyo3::exceptions::PyTypeError::new_err(format!(
-                    "expected a Config, a dict or the path of a config file, got {}",
-                    config
-                        .get_type()
-                        .name()
-                        .map_or_else(|_| "?".into(), |n| n.to_string())
-                ))
-            })?;
-            given = Config::load(path)?;
-            &given
-        };
+        let config = &Config::from_any(config)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
             None => config.inner.load_start(&config.base).py()?,
@@ -358,14 +365,7 @@ impl Evolution {
         text: Option<String>,
         threads: Option<u32>,
     ) -> PyResult<Evolution> {
-        let (path, text) = match (path, text) {
-            (Some(path), None) => {
-                let text = sylva::files::read_text(&path).py()?;
-                (path, text)
-            }
-            (None, Some(text)) => (PathBuf::from("<checkpoint>"), text),
-            _ => return Err(bad_value("resume", "give either `path` or `text`")),
-        };
+        let (path, text) = checkpoint_text(path, text)?;
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
         let run = py.detach(|| Run::resume(inner, &path, &text, pool)).py()?;
@@ -645,4 +645,20 @@ pub fn match_outline(
     Ok(Evolution {
         run: Mutex::new(evolution),
     })
+}
+
+/// A checkpoint to resume from: the file at `path`, or `text` (named `<checkpoint>` in
+/// errors); exactly one of them.
+pub(crate) fn checkpoint_text(
+    path: Option<PathBuf>,
+    text: Option<String>,
+) -> PyResult<(PathBuf, String)> {
+    match (path, text) {
+        (Some(path), None) => {
+            let text = sylva::files::read_text(&path).py()?;
+            Ok((path, text))
+        }
+        (None, Some(text)) => Ok((PathBuf::from("<checkpoint>"), text)),
+        _ => Err(bad_value("resume", "give either `path` or `text`")),
+    }
 }

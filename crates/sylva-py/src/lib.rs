@@ -7,6 +7,9 @@
 //! - [`genome`]: `Genome` (load, fields, grow, mutate), `cross`, `models`;
 //! - [`plant`]: `Plant` (measures, export, render), `Mesh` (numpy arrays), `Scene`, `garden`;
 //! - [`evolution`]: `Config`, `Evolution` (step, browse, checkpoint, migrants), `Member`;
+//! - [`varieties`]: `Varieties` (maps of varieties: step, archive, checkpoint), `Variety`,
+//!   `Archive`;
+//! - [`space`]: `GenomeSpace`, genomes as numpy vectors for optimisers outside Sylva;
 //! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`.
 //!
 //! The module reads and makes genomes and configs with the models it was made with
@@ -21,6 +24,8 @@ mod genome;
 mod json;
 mod pair;
 mod plant;
+mod space;
+mod varieties;
 
 use std::sync::OnceLock;
 
@@ -76,6 +81,11 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
     m.add_class::<evolution::Config>()?;
     m.add_class::<evolution::Evolution>()?;
     m.add_class::<evolution::Member>()?;
+    m.add_class::<varieties::Varieties>()?;
+    m.add_class::<varieties::Variety>()?;
+    m.add_class::<varieties::Archive>()?;
+    m.add_class::<space::GenomeSpace>()?;
+    m.add_function(wrap_pyfunction!(varieties::varieties, m)?)?;
     m.add_function(wrap_pyfunction!(genome::cross, m)?)?;
     m.add_function(wrap_pyfunction!(genome::models, m)?)?;
     m.add_function(wrap_pyfunction!(evolution::match_outline, m)?)?;

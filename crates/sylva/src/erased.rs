@@ -23,6 +23,7 @@ use sylva_model::{Bred, DevelopError, Evolve, GenomeError, MeshHint, Model, Pare
 use crate::error::{Error, FieldError, InputError};
 use crate::evolution::{EvolveConfig, GenerationTime, Member, OutputConfig, RunConfig};
 use crate::evolution::{MapValue, TypedRun, resume, resume_map, start, start_map};
+use crate::evolution::{SpaceOptions, SpaceValue, new_space};
 use crate::genome::{Genome, Settings, settings_of};
 
 /// A model's genome or config, erased.
@@ -116,6 +117,14 @@ pub(crate) trait DynModel: Send + Sync {
         text: &str,
         pool: Pool,
     ) -> Result<Box<dyn MapValue>, Error>;
+    fn space(
+        &self,
+        config: &Value,
+        source: &str,
+        base: &Path,
+        start: Vec<Genome>,
+        options: &SpaceOptions,
+    ) -> Result<Box<dyn SpaceValue>, Error>;
 
     // Runs.
     fn effective_config(&self, run: &RunValue) -> Box<Value>;
@@ -372,6 +381,17 @@ impl<M: Evolve + Default> DynModel for M {
         pool: Pool,
     ) -> Result<Box<dyn MapValue>, Error> {
         resume_map(config::<M>(c), source, base, path, text, pool)
+    }
+
+    fn space(
+        &self,
+        c: &Value,
+        source: &str,
+        base: &Path,
+        start: Vec<Genome>,
+        options: &SpaceOptions,
+    ) -> Result<Box<dyn SpaceValue>, Error> {
+        new_space(config::<M>(c), source, base, start, options)
     }
 
     fn effective_config(&self, r: &RunValue) -> Box<Value> {

@@ -18,7 +18,8 @@
 //! - [`garden`]: PlantMaker gardens and forests, planned, estimated, grown and meshed or
 //!   streamed as a GLB.
 //! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
-//!   step, browse, checkpoint, resume.
+//!   step, browse, checkpoint, resume; maps of varieties ([`Varieties`]) and genomes as
+//!   vectors for optimisers outside Sylva ([`GenomeSpace`]).
 //! - [`report`]: `stats.csv`, `fitness.svg` and experiment reports.
 //! - [`files`]: reading input with limits, writing output atomically.
 //! - [`error`]: typed errors; [`InputError`] names the file, line, column and what was
@@ -59,14 +60,15 @@ pub mod skeleton;
 pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, FieldError, InputError};
 pub use evolution::{
-    Config, Evolution, EvolveConfig, Member, OutputConfig, RunConfig, Varieties, Variety,
+    Config, Evolution, EvolveConfig, GenomeSpace, Member, OutputConfig, RunConfig, Varieties,
+    Variety,
 };
 pub use experiment::Experiment;
 pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;
-pub use sylva_evolve::{GenerationStats, IndividualId};
+pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
 pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 

@@ -14,20 +14,26 @@ Genomes of the four models (``bintree``, ``automata``, ``plantmaker``, ``lsystem
 :class:`Genome`; a grown one is a :class:`Plant`; many plants make a :class:`Scene`
 (:func:`garden`, :func:`scene`). :class:`Config` and :class:`Evolution` run evolutions;
 :func:`islands` runs several populations at once, on Ray when it is installed and on a
-local process pool otherwise. Errors are :class:`SylvaError`, :class:`InputError` (bad
+local process pool otherwise. :func:`varieties` fills a map of the fittest plant of every
+kind (MAP-Elites, :class:`Varieties`); :class:`GenomeSpace` hands any model's genomes to an
+optimiser outside Sylva (pyribs, CMA-ES) as numpy vectors. Errors are :class:`SylvaError`, :class:`InputError` (bad
 input, with its file, line and column) and :class:`LimitError`.
 """
 
 from __future__ import annotations
 
 from ._sylva import (
+    Archive,
     Config,
     Evolution,
     Genome,
+    GenomeSpace,
     Member,
     Mesh,
     Plant,
     Scene,
+    Varieties,
+    Variety,
     __version__,
     cross,
     garden,
@@ -37,14 +43,17 @@ from ._sylva import (
     scene,
     set_max_memory,
     set_max_time,
+    varieties,
 )
 from .errors import InputError, LimitError, SylvaError
 from .islands import IslandsResult, islands
 
 __all__ = [
+    "Archive",
     "Config",
     "Evolution",
     "Genome",
+    "GenomeSpace",
     "InputError",
     "IslandsResult",
     "LimitError",
@@ -53,6 +62,8 @@ __all__ = [
     "Plant",
     "Scene",
     "SylvaError",
+    "Varieties",
+    "Variety",
     "__version__",
     "cross",
     "garden",
@@ -63,4 +74,5 @@ __all__ = [
     "scene",
     "set_max_memory",
     "set_max_time",
+    "varieties",
 ]

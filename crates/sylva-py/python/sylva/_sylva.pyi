@@ -177,7 +177,10 @@ class Evolution:
     """An evolution run of any model."""
 
     def __init__(
-        self, config: Config, start: Sequence[Genome] | None = None, threads: int | None = None
+        self,
+        config: Config | dict[str, Any] | _Path,
+        start: Sequence[Genome] | None = None,
+        threads: int | None = None,
     ) -> None: ...
     @staticmethod
     def resume(
@@ -212,6 +215,140 @@ class Evolution:
     def save(self, path: _Path) -> None: ...
     def emigrants(self, count: int) -> list[bytes]: ...
     def immigrate(self, migrants: Sequence[bytes]) -> list[int]: ...
+
+class Variety:
+    """One filled cell of a map: where it is, and its elite."""
+
+    cell: int
+    """The cell, row-major over the axes (the first slowest)."""
+    coordinates: list[int]
+    """The cell's place along each axis."""
+    descriptors: list[float]
+    """The elite's descriptors, one per axis."""
+    genome: Genome
+    fitness: float
+    terms: dict[str, float]
+    id: int
+    generation: int
+    operator: str
+    parents: list[int]
+
+class Archive:
+    """A map's filled cells, in cell order, as numpy arrays (n elites, k axes, t terms)."""
+
+    cells: npt.NDArray[np.int64]
+    """(n,) each elite's cell, row-major over the axes."""
+    coordinates: npt.NDArray[np.int64]
+    """(n, k) each elite's cell along each axis."""
+    descriptors: npt.NDArray[np.float64]
+    """(n, k) each elite's descriptors."""
+    fitness: npt.NDArray[np.float64]
+    """(n,) each elite's total fitness."""
+    terms: npt.NDArray[np.float64]
+    """(n, t) each elite's fitness terms, columns named by ``term_names``."""
+    term_names: list[str]
+    ids: npt.NDArray[np.int64]
+    """(n,) each elite's run-wide id."""
+    genomes: list[Genome]
+    def __len__(self) -> int: ...
+    def data(self) -> dict[str, Any]:
+        """The columns under pyribs' names: ``index``, ``objective``, ``measures``, ``solution``."""
+
+class Varieties:
+    """A MAP-Elites run of any model: a map of the fittest plant of every kind."""
+
+    def __init__(
+        self,
+        config: Config | dict[str, Any] | _Path,
+        start: Sequence[Genome] | None = None,
+        threads: int | None = None,
+    ) -> None: ...
+    @staticmethod
+    def resume(
+        config: Config | dict[str, Any] | _Path,
+        path: _Path | None = None,
+        text: str | None = None,
+        threads: int | None = None,
+    ) -> Varieties: ...
+    @property
+    def config(self) -> Config: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def generation(self) -> int: ...
+    @property
+    def cells(self) -> int: ...
+    @property
+    def descriptors(self) -> list[str]: ...
+    @property
+    def axes(self) -> list[tuple[str, float, float, int]]:
+        """(descriptor, low, high, cells) of each axis."""
+    @property
+    def term_names(self) -> list[str]: ...
+    def step(self) -> dict[str, Any]:
+        """Breeds one generation; returns its statistics row."""
+    def run(
+        self,
+        generations: int | None = None,
+        on_generation: Callable[[dict[str, Any]], Any] | None = None,
+    ) -> None: ...
+    @property
+    def stats(self) -> list[dict[str, Any]]:
+        """generation, filled, coverage, qd_score, best, mean, best_id, improved,
+        evaluations, seconds: one dict per generation."""
+    def archive(self) -> Archive: ...
+    def variety(self, cell: int) -> Variety | None: ...
+    def best(self) -> Variety | None: ...
+    def checkpoint(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+class GenomeSpace:
+    """A model's genomes as vectors of numbers, decoded and scored as a map run scores them."""
+
+    def __init__(
+        self,
+        config: Config | dict[str, Any] | _Path,
+        dim: int | None = None,
+        *,
+        coding: str | None = None,
+        seed: int | None = None,
+        threads: int | None = None,
+    ) -> None: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def coding(self) -> str:
+        """"direct" or "codons"."""
+    @property
+    def dim(self) -> int: ...
+    @property
+    def lower(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def upper(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def descriptors(self) -> list[str]: ...
+    @property
+    def term_names(self) -> list[str]: ...
+    def decode(self, x: npt.ArrayLike) -> Genome:
+        """The genome of a (dim,) vector (entries clamped to the bounds)."""
+    def decode_many(self, X: npt.ArrayLike) -> list[Genome]:
+        """The genomes of the rows of an (n, dim) array."""
+    def encode(self, genome: Genome) -> npt.NDArray[np.float64]:
+        """The (dim,) vector of a genome, for a direct coding."""
+    def evaluate(
+        self, X: npt.ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(objective (n,), descriptors (n, k)) of the rows of an (n, dim) array."""
+
+def varieties(
+    config: Config | dict[str, Any] | _Path,
+    *,
+    threads: int | None = None,
+    start: Sequence[Genome] | None = None,
+) -> Varieties:
+    """Starts a map of varieties (MAP-Elites) of ``config``."""
 
 def cross(
     parents: Sequence[Genome],

@@ -42,12 +42,15 @@
 //! - `outline.rs`: the `[match]` term, a plant's silhouette against target pictures.
 //! - `varieties.rs`: [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
 //!   "map-elites"` and `[map]`): a map of the fittest plant of every kind.
+//! - `space.rs`: [`GenomeSpace`], any model's genomes as vectors of numbers, decoded and
+//!   scored as a map run scores them, for optimisers outside Sylva.
 
 mod checkpoint;
 mod config;
 pub mod outline;
 mod run;
 mod schema;
+mod space;
 mod varieties;
 
 pub use checkpoint::checkpoint_model;
@@ -59,6 +62,8 @@ pub use schema::{
     AxisConfig, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy,
     WindConfig,
 };
+pub use space::{Coding, Codons, GenomeSpace, MAX_DIM, Scores, SpaceOptions};
+pub(crate) use space::{SpaceValue, new_space};
 pub use sylva_fitness::descriptors::Descriptor;
 pub(crate) use varieties::{MapValue, resume_map, start_map};
 pub use varieties::{Varieties, Variety};

@@ -30,9 +30,9 @@ thread_local! {
 }
 
 /// Places model `M`'s genomes by descriptors of the plant each grows (with its own seed).
-struct PlantDescriber<M> {
-    model: M,
-    descriptors: Vec<Descriptor>,
+pub(super) struct PlantDescriber<M> {
+    pub(super) model: M,
+    pub(super) descriptors: Vec<Descriptor>,
 }
 
 impl<M: Evolve> Describe<WithTerm<M::Problem>> for PlantDescriber<M> {
@@ -166,7 +166,7 @@ impl<M: Evolve + Default> MapValue for TypedMap<M> {
 }
 
 /// `config` as a map run's: the strategy set and `[map]` filled in with its defaults.
-fn as_map<M: Evolve>(config: &EvolveConfig<M>) -> EvolveConfig<M> {
+pub(super) fn as_map<M: Evolve>(config: &EvolveConfig<M>) -> EvolveConfig<M> {
     let mut config = config.clone();
     config.run.strategy = SearchStrategy::MapElites;
     config.map.get_or_insert_with(MapConfig::default);
@@ -174,7 +174,7 @@ fn as_map<M: Evolve>(config: &EvolveConfig<M>) -> EvolveConfig<M> {
 }
 
 /// The engine's settings of a map run of `config` (a map run's, see [`as_map`]).
-fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings, Vec<Descriptor>) {
+pub(super) fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings, Vec<Descriptor>) {
     let map = config.map.clone().unwrap_or_default();
     let axes = map
         .descriptors

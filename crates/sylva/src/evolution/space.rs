@@ -1,0 +1,693 @@
+//! Genomes as vectors of numbers ([`GenomeSpace`]), so that an optimiser outside Sylva
+//! (CMA-ES, pyribs, a loop of one's own) can drive any model: it asks for vectors within
+//! the space's bounds, the space decodes them into genomes and scores them, with the
+//! config's own fitness (the model's terms and the `[match]` outline, if any) and the
+//! descriptors of its `[map]`, exactly as a MAP-Elites run of the config scores its
+//! offspring ([`Varieties`](super::Varieties)).
+//!
+//! Two codings ([`Coding`]):
+//!
+//! - **Direct**, for a model whose evolved genome is naturally a fixed list of parameters
+//!   ([`Evolve::vector_coding`]: the binary tree's fields, PlantMaker's codes): an entry
+//!   per parameter, within the parameter's range, so nearby vectors are similar plants and
+//!   a genome has a vector ([`GenomeSpace::encode`]).
+//! - **Codons**, for every model (the default for those of varying structure: automata
+//!   programs, L-system rules): the vector's entries, each from 0 to 1, are the random
+//!   draws the model's own random genome generator ([`Problem::random_genome`]) makes, one
+//!   entry per 32- or 64-bit draw, read in order ([`Codons`]); draws past the vector's end
+//!   come from a fixed stream of the space's seed, so a vector always decodes, and always to
+//!   the same genome. This is grammatical evolution's decoder (a codon picks a production)
+//!   with the model's generator as the grammar. Its default length is the most draws any
+//!   of 64 random genomes of the config took.
+//!
+//! Everything is a pure function of the vector, the config and the seed: a batch is scored
+//! in parallel with results in row order, the same for any number of threads.
+
+use std::convert::Infallible;
+use std::path::Path;
+use std::sync::Arc;
+
+use rand::TryRng;
+use sylva_core::par::Pool;
+use sylva_core::rng::{self, ChaCha8Rng};
+use sylva_evolve::map::Describe;
+use sylva_evolve::{Problem, WithTerm};
+use sylva_fitness::descriptors::Descriptor;
+use sylva_model::{Evolve, VectorCoding};
+
+use crate::erased::{DynModel, Value};
+use crate::error::{Error, InputError};
+use crate::genome::Genome;
+
+use super::config::{Config, setup, typed_start, with_term};
+use super::schema::EvolveConfig;
+use super::varieties::{PlantDescriber, as_map, map_settings};
+
+/// Most entries a codon vector has.
+pub const MAX_DIM: usize = 1_000_000;
+
+/// Random genomes whose draws set a codon space's default length.
+const DIM_SAMPLES: u32 = 64;
+
+/// How a space turns vectors into genomes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Coding {
+    /// An entry per parameter of the model's genome, within its range
+    /// ([`Evolve::vector_coding`]: the binary tree's fields, PlantMaker's codes): nearby
+    /// vectors are similar plants, and a genome has a vector ([`GenomeSpace::encode`]).
+    Direct,
+    /// Entries from 0 to 1, read in order as the random draws the model's own random genome
+    /// generator makes ([`Codons`]), draws past the end from a fixed stream of the space's
+    /// seed: grammatical evolution's decoder, the generator standing for the grammar. Every
+    /// model has it; it is the only coding of genomes whose structure varies.
+    Codons,
+}
+
+impl Coding {
+    /// Its name: `direct` or `codons`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Coding::Direct => "direct",
+            Coding::Codons => "codons",
+        }
+    }
+
+    /// The coding named `name`.
+    pub fn from_name(name: &str) -> Option<Coding> {
+        match name {
+            "direct" => Some(Coding::Direct),
+            "codons" => Some(Coding::Codons),
+            _ => None,
+        }
+    }
+}
+
+/// How a [`GenomeSpace`] is made; every field's default is documented.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpaceOptions {
+    /// The coding; default (`None`): direct where the model has one, else codons.
+    pub coding: Option<Coding>,
+    /// Entries per vector: a direct coding's is the model's and may only be restated; a
+    /// codon space's is 1 to [`MAX_DIM`], by default the most draws any of 64 random
+    /// genomes of the config took.
+    pub dim: Option<usize>,
+    /// What decoded genomes take for anything the vector does not hold (a PlantMaker
+    /// genome's growth seed; a codon vector's draws past its end). Default: the config's
+    /// `[run] seed`.
+    pub seed: Option<u64>,
+}
+
+/// A random number generator that yields a vector's entries ([`Coding::Codons`]): each
+/// entry `e` (0 to 1) is one draw, `e · 2⁶⁴` as a 64-bit word (saturating at 1), the upper
+/// half of it for a 32-bit draw. Draws past the end come from `rest`.
+///
+/// Since `rand` draws a number in a range from the high bits of a word, and a probability
+/// test compares a word with the probability, an entry is near enough "where in the range"
+/// and "how likely": a small change to an entry is a small change to the draw. (An entry
+/// within 2⁻³² of a range's cell edge makes `rand` read the next one as well, to stay
+/// unbiased.)
+#[derive(Clone, Debug)]
+pub struct Codons<'a> {
+    entries: &'a [f64],
+    drawn: usize,
+    rest: ChaCha8Rng,
+}
+
+impl<'a> Codons<'a> {
+    /// A generator that yields `entries`, then `rest`.
+    pub fn new(entries: &'a [f64], rest: ChaCha8Rng) -> Codons<'a> {
+        Codons {
+            entries,
+            drawn: 0,
+            rest,
+        }
+    }
+
+    /// Draws made so far (entries, then words of `rest`).
+    pub fn drawn(&self) -> usize {
+        self.drawn
+    }
+
+    fn word(&mut self) -> u64 {
+        let at = self.drawn;
+        self.drawn += 1;
+        match self.entries.get(at) {
+            // 2⁶⁴ · e saturates to u64::MAX at 1 and to 0 below 0 (NaN too, which callers
+            // refuse before decoding).
+            Some(e) => (e * 18_446_744_073_709_551_616.0) as u64,
+            None => rand::Rng::next_u64(&mut self.rest),
+        }
+    }
+}
+
+impl TryRng for Codons<'_> {
+    type Error = Infallible;
+
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        Ok((self.word() >> 32) as u32)
+    }
+
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        Ok(self.word())
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        for chunk in dst.chunks_mut(8) {
+            let bytes = self.word().to_le_bytes();
+            chunk.copy_from_slice(&bytes[..chunk.len()]);
+        }
+        Ok(())
+    }
+}
+
+/// Scores of a batch of vectors, in row order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scores {
+    /// Each vector's total fitness, as the native run's (not finite for a genome the
+    /// model cannot score: an L-system world that cannot be built).
+    pub fitness: Vec<f64>,
+    /// Each vector's descriptors, row by row (one per axis of the map); NaN for a genome
+    /// that cannot be grown and measured, which a native map leaves out.
+    pub descriptors: Vec<f64>,
+}
+
+/// What the library does with a model's space, object-safe.
+pub(crate) trait SpaceValue: Send + Sync {
+    fn coding(&self) -> Coding;
+    fn bounds(&self) -> &[[f64; 2]];
+    fn seed(&self) -> u64;
+    fn term_names(&self) -> &[String];
+    fn descriptors(&self) -> &[Descriptor];
+    /// The genome file of `x` (of the space's length, finite, clamped to the bounds).
+    fn decode(&self, x: &[f64]) -> Box<Value>;
+    fn encode(&self, genome: &Genome) -> Result<Vec<f64>, InputError>;
+    /// Scores rows of `dim` entries each (finite, clamped).
+    fn evaluate(&self, xs: &[f64], pool: &Pool) -> Scores;
+    /// Refuses scoring `rows` genomes on `threads` that would take longer than the time
+    /// budget.
+    fn check_time(&self, rows: usize, threads: usize) -> Result<(), InputError>;
+}
+
+/// The space of model `M`'s genomes under a config.
+struct TypedSpace<M: Evolve> {
+    config: EvolveConfig<M>,
+    source: String,
+    problem: WithTerm<M::Problem>,
+    describer: PlantDescriber<M>,
+    direct: Option<Box<dyn VectorCoding<M>>>,
+    bounds: Vec<[f64; 2]>,
+    seed: u64,
+    term_names: Vec<String>,
+}
+
+impl<M: Evolve + Default> TypedSpace<M> {
+    /// The evolved genome of `x`.
+    fn evolved(&self, x: &[f64]) -> <M::Problem as Problem>::Genome {
+        match &self.direct {
+            Some(coding) => coding.decode(x),
+            None => {
+                let mut codons = Codons::new(x, rng::seeded(self.seed));
+                self.problem.random_genome(&mut codons)
+            }
+        }
+    }
+}
+
+impl<M: Evolve + Default> SpaceValue for TypedSpace<M> {
+    fn coding(&self) -> Coding {
+        match self.direct {
+            Some(_) => Coding::Direct,
+            None => Coding::Codons,
+        }
+    }
+
+    fn bounds(&self) -> &[[f64; 2]] {
+        &self.bounds
+    }
+
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    fn term_names(&self) -> &[String] {
+        &self.term_names
+    }
+
+    fn descriptors(&self) -> &[Descriptor] {
+        &self.describer.descriptors
+    }
+
+    fn decode(&self, x: &[f64]) -> Box<Value> {
+        let evolved = self.evolved(x);
+        Box::new(
+            self.config
+                .model
+                .genome_file(&self.problem.problem, &evolved),
+        )
+    }
+
+    fn encode(&self, genome: &Genome) -> Result<Vec<f64>, InputError> {
+        let Some(coding) = &self.direct else {
+            return Err(InputError::new(
+                "genome",
+                format!(
+                    "a codon space has no vector for a genome (its vectors are the random \
+                     draws that make one); `{}` genomes have a direct coding only if the \
+                     model gives one",
+                    M::NAME
+                ),
+            ));
+        };
+        let typed = genome.get::<M>().ok_or_else(|| {
+            InputError::new(
+                "genome",
+                format!(
+                    "this space holds `{}` genomes; this is a `{}` genome",
+                    M::NAME,
+                    genome.model()
+                ),
+            )
+        })?;
+        coding
+            .encode(typed)
+            .map_err(|why| InputError::new("genome", why))
+    }
+
+    fn evaluate(&self, xs: &[f64], pool: &Pool) -> Scores {
+        let dim = self.bounds.len();
+        let axes = self.describer.descriptors.len();
+        let rows = xs.len() / dim;
+        let scored = pool.map(rows, |i| {
+            let genome = self.evolved(&xs[i * dim..(i + 1) * dim]);
+            let fitness = sylva_evolve::problem::evaluate(&self.problem, &genome).total();
+            let mut descriptors = vec![f64::NAN; axes];
+            if !self
+                .describer
+                .describe(&self.problem, &genome, &mut descriptors)
+            {
+                descriptors.fill(f64::NAN);
+            }
+            (fitness, descriptors)
+        });
+        let mut out = Scores {
+            fitness: Vec::with_capacity(rows),
+            descriptors: Vec::with_capacity(rows * axes),
+        };
+        for (fitness, descriptors) in scored {
+            out.fitness.push(fitness);
+            out.descriptors.extend(descriptors);
+        }
+        out
+    }
+
+    fn check_time(&self, rows: usize, threads: usize) -> Result<(), InputError> {
+        let mut timed = self.config.clone();
+        timed.run.population = u32::try_from(rows).unwrap_or(u32::MAX);
+        match timed.generation_time(&[], threads) {
+            Some(t) => sylva_core::budget::check_time(t.seconds, t.what, t.advice)
+                .map_err(|e| InputError::new(&self.source, e).over_limit()),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The space of `config`'s genomes (its `[map]`, or the default map, for descriptors),
+/// set up with `start` genomes as a run of it is. A refusal names the config (`source`)
+/// or the option.
+pub(crate) fn new_space<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    source: &str,
+    base: &Path,
+    start: Vec<Genome>,
+    options: &SpaceOptions,
+) -> Result<Box<dyn SpaceValue>, Error> {
+    let config = as_map(config);
+    let (_, descriptors) = map_settings(&config);
+    let seed = options.seed.unwrap_or(config.run.seed);
+    let typed = typed_start::<M>(&start)?;
+    let setup = setup(&config.model, &config.settings, typed, seed, 0, source)?;
+    let problem = with_term(&config, setup.problem, base)?;
+    let direct = match options.coding {
+        Some(Coding::Codons) => None,
+        Some(Coding::Direct) => Some(
+            config
+                .model
+                .vector_coding(&problem.problem, seed)
+                .ok_or_else(|| {
+                    InputError::new(
+                        "coding",
+                        format!(
+                            "`{}` genomes have no direct coding (their structure varies); \
+                             use codons",
+                            M::NAME
+                        ),
+                    )
+                })?,
+        ),
+        None => config.model.vector_coding(&problem.problem, seed),
+    };
+    let dim = match (&direct, options.dim) {
+        (Some(coding), Some(dim)) if dim != coding.bounds().len() => {
+            return Err(InputError::new(
+                "dim",
+                format!(
+                    "the direct coding of `{}` genomes has {} entries, got {dim} (leave \
+                     `dim` out, or use codons)",
+                    M::NAME,
+                    coding.bounds().len()
+                ),
+            )
+            .into());
+        }
+        (Some(coding), _) => coding.bounds().len(),
+        (None, Some(dim)) if !(1..=MAX_DIM).contains(&dim) => {
+            return Err(InputError::new(
+                "dim",
+                format!("a codon vector has 1 to {MAX_DIM} entries, got {dim}"),
+            )
+            .into());
+        }
+        (None, Some(dim)) => dim,
+        (None, None) => (0..DIM_SAMPLES)
+            .map(|k| {
+                let mut codons = Codons::new(&[], rng::stream(seed, 0, k));
+                problem.random_genome(&mut codons);
+                codons.drawn()
+            })
+            .max()
+            .unwrap_or(1)
+            .clamp(1, MAX_DIM),
+    };
+    let bounds = match &direct {
+        Some(coding) => coding.bounds().to_vec(),
+        None => vec![[0.0, 1.0]; dim],
+    };
+    let term_names = problem.term_names();
+    Ok(Box::new(TypedSpace {
+        describer: PlantDescriber {
+            model: config.model.clone(),
+            descriptors,
+        },
+        source: source.to_owned(),
+        config,
+        problem,
+        direct,
+        bounds,
+        seed,
+        term_names,
+    }))
+}
+
+/// A model's genomes as vectors of numbers under a config: decoded, encoded and scored as
+/// the config's MAP-Elites run scores them, with a direct coding or codons ([`Coding`]).
+pub struct GenomeSpace {
+    model: Arc<dyn DynModel>,
+    space: Box<dyn SpaceValue>,
+}
+
+impl std::fmt::Debug for GenomeSpace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GenomeSpace")
+            .field("model", &self.model.name())
+            .field("coding", &self.coding())
+            .field("dim", &self.dim())
+            .finish()
+    }
+}
+
+impl GenomeSpace {
+    /// The space of `config`'s genomes, scored with its fitness and measured with its
+    /// `[map]`'s descriptors (the default map's if it has none). `start` holds the genomes
+    /// the config's `start` files name (see [`Config::load_start`]), which some models'
+    /// random genomes grow from (an L-system run's mutants of its start genome).
+    pub fn new(
+        config: &Config,
+        start: Vec<Genome>,
+        options: &SpaceOptions,
+    ) -> Result<GenomeSpace, Error> {
+        let (model, typed) = config.parts();
+        let space = model.space(typed, &config.source(), &config.base(), start, options)?;
+        Ok(GenomeSpace {
+            model: model.clone(),
+            space,
+        })
+    }
+
+    /// The model's name.
+    pub fn model(&self) -> &'static str {
+        self.model.name()
+    }
+
+    /// How vectors become genomes.
+    pub fn coding(&self) -> Coding {
+        self.space.coding()
+    }
+
+    /// Entries per vector.
+    pub fn dim(&self) -> usize {
+        self.space.bounds().len()
+    }
+
+    /// Each entry's lower and upper bound.
+    pub fn bounds(&self) -> &[[f64; 2]] {
+        self.space.bounds()
+    }
+
+    /// The seed decoded genomes take for what the vector does not hold.
+    pub fn seed(&self) -> u64 {
+        self.space.seed()
+    }
+
+    /// Names of the fitness terms the config scores.
+    pub fn term_names(&self) -> &[String] {
+        self.space.term_names()
+    }
+
+    /// The descriptors measured, one per axis of the config's map.
+    pub fn descriptors(&self) -> &[Descriptor] {
+        self.space.descriptors()
+    }
+
+    /// `xs` (rows of [`GenomeSpace::dim`] entries, named `name` in errors) checked and
+    /// clamped to the bounds: a length that is not whole rows, or an entry that is not
+    /// finite, is refused naming the row and entry.
+    fn clamped(&self, name: &str, xs: &[f64]) -> Result<Vec<f64>, InputError> {
+        let dim = self.dim();
+        if !xs.len().is_multiple_of(dim) {
+            return Err(InputError::new(
+                name,
+                format!(
+                    "{} entries are not whole vectors of {dim} (this space's `dim`)",
+                    xs.len()
+                ),
+            ));
+        }
+        let bounds = self.bounds();
+        xs.iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                if !x.is_finite() {
+                    let at = if xs.len() == dim {
+                        format!("entry {i}")
+                    } else {
+                        format!("row {}, entry {}", i / dim, i % dim)
+                    };
+                    return Err(InputError::new(
+                        name,
+                        format!("{at} is {x}; every entry must be a finite number"),
+                    ));
+                }
+                let [lo, hi] = bounds[i % dim];
+                Ok(x.clamp(lo, hi))
+            })
+            .collect()
+    }
+
+    /// The genome of vector `x` (named `x` in errors): [`GenomeSpace::dim`] finite entries,
+    /// each clamped to its bounds first.
+    pub fn decode(&self, x: &[f64]) -> Result<Genome, InputError> {
+        if x.len() != self.dim() {
+            return Err(InputError::new(
+                "x",
+                format!(
+                    "a vector of this space has {} entries, got {}",
+                    self.dim(),
+                    x.len()
+                ),
+            ));
+        }
+        let x = self.clamped("x", x)?;
+        Ok(Genome::erased(self.model.clone(), self.space.decode(&x)))
+    }
+
+    /// The genomes of the rows of `xs` (row-major, named `X` in errors), in order, decoded
+    /// on `pool`.
+    pub fn decode_many(&self, xs: &[f64], pool: &Pool) -> Result<Vec<Genome>, InputError> {
+        let xs = self.clamped("X", xs)?;
+        let dim = self.dim();
+        let genomes = pool.map(xs.len() / dim, |i| {
+            self.space.decode(&xs[i * dim..(i + 1) * dim])
+        });
+        Ok(genomes
+            .into_iter()
+            .map(|g| Genome::erased(self.model.clone(), g))
+            .collect())
+    }
+
+    /// The vector of `genome`, for a direct coding; a codon space, a genome of another
+    /// model, or one of another shape (PlantMaker's segment counts) is refused naming
+    /// `genome`.
+    pub fn encode(&self, genome: &Genome) -> Result<Vec<f64>, InputError> {
+        self.space.encode(genome)
+    }
+
+    /// Scores the rows of `xs` (row-major, named `X` in errors) on `pool`: each row's
+    /// fitness and descriptors, exactly as the config's MAP-Elites run scores a genome.
+    /// Work estimated to take longer than the time budget (L-system plants) is refused
+    /// before it starts.
+    pub fn evaluate(&self, xs: &[f64], pool: &Pool) -> Result<Scores, Error> {
+        let xs = self.clamped("X", xs)?;
+        self.space
+            .check_time(xs.len() / self.dim(), pool.threads())?;
+        Ok(self.space.evaluate(&xs, pool))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::RngExt;
+
+    #[test]
+    fn codons_are_the_draws_then_the_stream() {
+        let entries = [0.0, 0.5, 1.0, 0.25];
+        let mut codons = Codons::new(&entries, rng::seeded(3));
+        let mut r = || rand::Rng::next_u64(&mut codons);
+        assert_eq!([r(), r(), r(), r()], [0, 1 << 63, u64::MAX, 1 << 62]);
+        let mut stream = rng::seeded(3);
+        assert_eq!(r(), rand::Rng::next_u64(&mut stream));
+        // A 32-bit draw is the upper half; a range draw lands where the entry says. (An
+        // entry at a cell's very edge, as 0.3 · 10 is in binary, reads the next one too:
+        // rand's unbiased ranges.)
+        let mut codons = Codons::new(&[0.75, 0.35, 0.99, 0.1, 0.6], rng::seeded(3));
+        assert_eq!(rand::Rng::next_u32(&mut codons), 3 << 30);
+        assert_eq!(codons.random_range(0..10u32), 3);
+        assert_eq!(codons.random_range(0..10u32), 9);
+        assert!(codons.random_bool(0.2));
+        assert!(!codons.random_bool(0.5));
+        assert_eq!(codons.drawn(), 5);
+    }
+
+    fn config(toml: &str) -> Config {
+        Config::parse(Path::new("space.toml"), toml).expect("a valid config")
+    }
+
+    #[test]
+    fn every_model_decodes_any_vector_into_a_plant() {
+        for model in ["bintree", "automata", "plantmaker", "lsystem"] {
+            let config = config(&format!("model = \"{model}\"\n"));
+            let space = GenomeSpace::new(&config, Vec::new(), &SpaceOptions::default()).unwrap();
+            let direct = matches!(model, "bintree" | "plantmaker");
+            assert_eq!(space.coding() == Coding::Direct, direct, "{model}");
+            let low: Vec<f64> = space.bounds().iter().map(|b| b[0]).collect();
+            let high: Vec<f64> = space.bounds().iter().map(|b| b[1]).collect();
+            let mut rng = rng::seeded(5);
+            let middle: Vec<f64> = space
+                .bounds()
+                .iter()
+                .map(|[lo, hi]| rng.random_range(*lo..=*hi))
+                .collect();
+            for x in [&low, &high, &middle] {
+                let genome = space.decode(x).unwrap();
+                assert_eq!(genome.model(), model);
+                // Same vector, same genome.
+                assert_eq!(genome, space.decode(x).unwrap());
+                genome.develop(genome.default_seed()).unwrap();
+            }
+        }
+    }
+
+    #[test]
+    fn scores_are_the_maps_and_do_not_depend_on_threads() {
+        let config = config(
+            "model = \"bintree\"\n[run]\nstrategy = \"map-elites\"\nseed = 4\n[map]\n\
+             initial = 12\nbatch = 4\n",
+        );
+        let space = GenomeSpace::new(&config, Vec::new(), &SpaceOptions::default()).unwrap();
+        let map = crate::Varieties::start(&config, Vec::new(), Pool::Serial).unwrap();
+        let elites = map.varieties();
+        assert!(!elites.is_empty());
+        let mut xs = Vec::new();
+        for v in &elites {
+            xs.extend(space.encode(&v.member.genome).unwrap());
+        }
+        let serial = space.evaluate(&xs, &Pool::Serial).unwrap();
+        let parallel = space
+            .evaluate(&xs, &Pool::with_threads(3).unwrap())
+            .unwrap();
+        assert_eq!(serial, parallel);
+        for (i, v) in elites.iter().enumerate() {
+            assert_eq!(serial.fitness[i], v.member.total());
+            assert_eq!(serial.descriptors[2 * i..2 * i + 2], v.descriptors[..]);
+        }
+    }
+
+    #[test]
+    fn bad_vectors_and_options_are_refused_by_name() {
+        let config = config("model = \"automata\"\n");
+        let space = GenomeSpace::new(
+            &config,
+            Vec::new(),
+            &SpaceOptions {
+                dim: Some(40),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!((space.coding(), space.dim()), (Coding::Codons, 40));
+        let e = space.decode(&[0.5; 39]).unwrap_err();
+        assert!(e.location == "x" && e.message.contains("40 entries"), "{e}");
+        let mut xs = vec![0.5; 80];
+        xs[43] = f64::NAN;
+        let e = space.evaluate(&xs, &Pool::Serial).unwrap_err().to_string();
+        assert!(
+            e.contains("X") && e.contains("row 1, entry 3 is NaN"),
+            "{e}"
+        );
+        let e = space.decode_many(&xs[..79], &Pool::Serial).unwrap_err();
+        assert!(
+            e.location == "X" && e.message.contains("whole vectors"),
+            "{e}"
+        );
+        let g = space.decode(&[0.5; 40]).unwrap();
+        assert_eq!(space.encode(&g).unwrap_err().location, "genome");
+        let direct = SpaceOptions {
+            coding: Some(Coding::Direct),
+            ..Default::default()
+        };
+        let e = GenomeSpace::new(&config, Vec::new(), &direct)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("coding") && e.contains("no direct coding"),
+            "{e}"
+        );
+        let bintree = self::config("model = \"bintree\"\n");
+        let e = GenomeSpace::new(
+            &bintree,
+            Vec::new(),
+            &SpaceOptions {
+                dim: Some(65),
+                ..Default::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("dim") && e.contains("11 entries"), "{e}");
+        // Entries outside the bounds are clamped to them.
+        let space = GenomeSpace::new(&bintree, Vec::new(), &SpaceOptions::default()).unwrap();
+        let low: Vec<f64> = space.bounds().iter().map(|b| b[0]).collect();
+        let below: Vec<f64> = low.iter().map(|v| v - 100.0).collect();
+        assert_eq!(space.decode(&below).unwrap(), space.decode(&low).unwrap());
+    }
+}
