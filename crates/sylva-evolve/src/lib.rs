@@ -9,7 +9,8 @@
 //! - [`Generational`]: lilgp's tournament breeding (crossover, reproduction, mutation,
 //!   elitism), as Poncin's GP runs used.
 //! - [`MapRun`]: MAP-Elites, a map of the fittest genome of every kind ([`Describe`]
-//!   places genomes; [`Operators`] are a strategy's own, bred from).
+//!   places genomes; [`Operators`] are a strategy's own, bred from), or CMA-ME where the
+//!   genomes have a [`Coding`] as vectors ([`Emitter`], [`cma::SepCma`]).
 //! - [`Pool`]: the one seam where work goes parallel (serial or rayon), results kept in
 //!   order (from `sylva_core::par`).
 //! - [`Run`]: generations, batches, statistics, a [`Browser`] over the family, and
@@ -54,6 +55,7 @@
 //! ```
 
 pub mod bits;
+pub mod cma;
 pub mod fitness;
 pub mod generational;
 pub mod individual;
@@ -68,7 +70,8 @@ pub use fitness::{Fitness, MAX_TERMS};
 pub use generational::{Generational, GenerationalError, GenerationalSettings};
 pub use individual::{Individual, IndividualId, Origin};
 pub use map::{
-    Axis, Describe, Elite, MapCheckpoint, MapError, MapRun, MapSettings, MapStats, Operators,
+    Axis, Coding, Describe, Elite, Emitter, MapCheckpoint, MapError, MapRun, MapSettings, MapStats,
+    Operators,
 };
 pub use problem::Problem;
 pub use run::{Browser, Checkpoint, EvolveError, GenerationStats, Run, RunSettings};

@@ -16,12 +16,22 @@
 //! the map does not depend on the number of threads. A genome whose fitness is not finite,
 //! or that cannot be described, stays out of the map.
 //!
+//! Where a model's genomes have a [`Coding`] as vectors of numbers, offspring can instead
+//! come from CMA-ME emitters ([`Emitter::CmaMe`], Fontaine et al. 2020): each emitter is an
+//! evolution strategy ([`SepCma`]) that samples vectors around its mean, ranks its samples
+//! by what they did to the map (new cells first, by fitness; then improved cells, by the
+//! gain; then the rest, by how far they fell short) and moves towards the best, starting
+//! again from a random elite when a generation of its samples changes nothing or the
+//! strategy collapses. Emitter `e` (re)starts at the end of generation `g` from stream
+//! `(seed, g, n + e)`, `n` being the generation's size, so emitters too are deterministic.
+//!
 //! A generation's figures ([`MapStats`]) are the map's coverage (share of cells filled)
 //! and its QD-score (the sum over elites of their fitness less
 //! [`MapSettings::qd_offset`], so that filling a cell never lowers it when the offset is
 //! below every fitness), as pyribs reports them. A [`MapCheckpoint`] resumes a run exactly.
 
 use std::borrow::Cow;
+use std::ops::Range;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -30,6 +40,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::Pool;
+use crate::cma::SepCma;
 use crate::fitness::{Fitness, MAX_TERMS};
 use crate::individual::{Individual, IndividualId, Origin};
 use crate::problem::{Problem, evaluate};
@@ -69,6 +80,43 @@ pub trait Operators<G> {
     fn crossover(&self) -> &Self::Crossover;
     /// The mutation.
     fn mutation(&self) -> &Self::Mutation;
+}
+
+/// A problem's genomes as vectors of numbers, each entry within its bounds: what a CMA-ME
+/// emitter searches.
+pub trait Coding<P: Problem>: Send + Sync {
+    /// Each entry's lower and upper bound (lower ≤ upper); at least one entry.
+    fn bounds(&self) -> &[[f64; 2]];
+    /// The genome of `x`, one entry per bound, each within its bounds.
+    fn decode(&self, x: &[f64]) -> P::Genome;
+    /// The vector of `genome`, or `None` if the coding cannot hold it (an emitter then
+    /// starts from a random vector instead).
+    fn encode(&self, problem: &P, genome: &P::Genome) -> Option<Vec<f64>>;
+}
+
+/// Where a map's offspring come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Emitter {
+    /// The model's own operators on elites chosen uniformly (MAP-Elites).
+    #[default]
+    Operators,
+    /// CMA-ME: `emitters` evolution strategies share each batch, each starting from an
+    /// elite's vector with step size `sigma` (a share of each entry's range). Needs a
+    /// [`Coding`].
+    CmaMe {
+        /// Strategies, 1 to half the batch (each needs two samples a generation).
+        emitters: u32,
+        /// First step size, as a share of each entry's range, above 0 to 1.
+        sigma: f64,
+    },
+}
+
+impl Emitter {
+    /// Whether this is the default, the model's operators.
+    pub fn is_operators(&self) -> bool {
+        *self == Emitter::Operators
+    }
 }
 
 /// One descriptor's range, cut into equal cells.
@@ -111,6 +159,9 @@ pub struct MapSettings {
     pub crossover: f64,
     /// Subtracted from each elite's fitness in the QD-score.
     pub qd_offset: f64,
+    /// Where offspring come from.
+    #[serde(default, skip_serializing_if = "Emitter::is_operators")]
+    pub emitter: Emitter,
 }
 
 /// Why map settings are refused.
@@ -154,6 +205,9 @@ pub enum MapError {
     /// A checkpoint that does not fit.
     #[error("checkpoint does not fit this run: {0}")]
     BadCheckpoint(String),
+    /// CMA-ME asked of genomes that have no coding as vectors.
+    #[error("CMA-ME emitters search genomes as vectors, and these genomes have no such coding")]
+    NoCoding,
 }
 
 impl MapSettings {
@@ -196,6 +250,22 @@ impl MapSettings {
                 expected: "a finite number",
                 value: self.qd_offset,
             });
+        }
+        if let Emitter::CmaMe { emitters, sigma } = self.emitter {
+            if emitters == 0 || emitters as usize > self.batch / 2 {
+                return Err(MapError::Number {
+                    name: "emitters",
+                    expected: "1 to half the batch (two samples each a generation)",
+                    value: f64::from(emitters),
+                });
+            }
+            if !(sigma > 0.0 && sigma <= 1.0) {
+                return Err(MapError::Number {
+                    name: "sigma",
+                    expected: "above 0 to 1 (a share of each entry's range)",
+                    value: sigma,
+                });
+            }
         }
         Ok(())
     }
@@ -282,6 +352,9 @@ pub struct MapCheckpoint<G> {
     pub elites: Vec<Individual<G>>,
     /// Statistics of generations 0 to `generation`.
     pub stats: Vec<MapStats>,
+    /// The CMA-ME emitters' strategies (none for the model's operators).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub emitters: Vec<SepCma>,
 }
 
 /// An offspring, scored and described.
@@ -291,7 +364,14 @@ struct Offered<G> {
     descriptors: Option<Descriptors>,
     operator: &'static str,
     parents: Vec<IndividualId>,
+    /// The normal draws a CMA-ME emitter sampled it from.
+    draws: Option<Vec<f64>>,
 }
+
+/// What offering a genome did to the map, as CMA-ME ranks it: `(rank, value)`, compared
+/// in that order, higher first. New cells (rank 3) by fitness, improved cells (2) by the
+/// gain, the rest (1) by the (negative) margin to the elite, the undescribable last (0).
+type Placement = (u8, f64);
 
 /// A MAP-Elites run over problem `P`, bred with the operators of `S`.
 pub struct MapRun<P: Problem, S> {
@@ -307,20 +387,24 @@ pub struct MapRun<P: Problem, S> {
     /// The filled cells, ascending: where parents are drawn from.
     filled: Vec<usize>,
     stats: Vec<MapStats>,
+    coding: Option<Arc<dyn Coding<P>>>,
+    emitters: Vec<SepCma>,
 }
 
 impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
     /// Starts a run: `genomes` (extra ones are ignored) and random genomes up to
     /// [`MapSettings::initial`], evaluated and placed.
+    /// `coding` is what CMA-ME emitters search ([`Emitter::CmaMe`]; the operators need none).
     pub fn new(
         problem: P,
         operators: S,
         describer: Arc<dyn Describe<P>>,
+        coding: Option<Arc<dyn Coding<P>>>,
         evaluator: Pool,
         settings: MapSettings,
         genomes: Vec<P::Genome>,
     ) -> Result<Self, MapError> {
-        let mut run = Self::empty(problem, operators, describer, evaluator, settings)?;
+        let mut run = Self::empty(problem, operators, describer, coding, evaluator, settings)?;
         let start = Instant::now();
         let seed = run.settings.seed;
         let given = genomes.len().min(run.settings.initial);
@@ -330,18 +414,29 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         let offered = {
             let (problem, describer) = (&run.problem, &*run.describer);
             let axes = run.settings.axes.len();
+            // CMA-ME searches the coding, so it starts from random vectors of it.
+            let coding = (!run.settings.emitter.is_operators())
+                .then_some(run.coding.as_deref())
+                .flatten();
             run.evaluator.map(genomes.len(), |k| {
-                let (genome, operator) = match &genomes[k] {
-                    Some(g) => (g.clone(), "given"),
-                    None => (
-                        problem.random_genome(&mut rng::stream(seed, 0, k as u32)),
-                        "random",
-                    ),
+                let mut rng = rng::stream(seed, 0, k as u32);
+                let (genome, operator) = match (&genomes[k], coding) {
+                    (Some(g), _) => (g.clone(), "given"),
+                    (None, Some(coding)) => (random_vector(coding, &mut rng), "random"),
+                    (None, None) => (problem.random_genome(&mut rng), "random"),
                 };
-                score(problem, describer, axes, genome, operator, Vec::new())
+                score(problem, describer, axes, genome, operator, Vec::new(), None)
             })
         };
-        let improved = run.offer(offered);
+        let (improved, _) = run.offer(offered);
+        if let Emitter::CmaMe { emitters, .. } = run.settings.emitter {
+            // Every emitter starts at the best genome found, as CMA-ME's do, and later
+            // restarts at a random elite.
+            for e in 0..emitters as usize {
+                let strategy = run.restart(e, run.settings.initial, true);
+                run.emitters.push(strategy);
+            }
+        }
         run.record(improved, run.settings.initial as u64, start);
         Ok(run)
     }
@@ -352,6 +447,7 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         problem: P,
         operators: S,
         describer: Arc<dyn Describe<P>>,
+        coding: Option<Arc<dyn Coding<P>>>,
         evaluator: Pool,
         checkpoint: MapCheckpoint<P::Genome>,
     ) -> Result<Self, MapError> {
@@ -380,9 +476,27 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
             problem,
             operators,
             describer,
+            coding,
             evaluator,
             checkpoint.settings,
         )?;
+        let wanted = match run.settings.emitter {
+            Emitter::CmaMe { emitters, .. } => emitters as usize,
+            Emitter::Operators => 0,
+        };
+        let dim = run.coding.as_ref().map_or(0, |c| c.bounds().len());
+        let fits = |es: &SepCma| {
+            [&es.mean, &es.variances, &es.sigma_path, &es.covariance_path]
+                .iter()
+                .all(|v| v.len() == dim)
+        };
+        if checkpoint.emitters.len() != wanted || !checkpoint.emitters.iter().all(fits) {
+            return bad(format!(
+                "{} emitters saved for {wanted} of {dim} entries",
+                checkpoint.emitters.len()
+            ));
+        }
+        run.emitters = checkpoint.emitters;
         if checkpoint.elites.len() > run.cells.len() {
             return bad(format!(
                 "{} elites saved for a map of {} cells",
@@ -406,6 +520,7 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
                     elites[k].genome.clone(),
                     "",
                     Vec::new(),
+                    None,
                 )
             })
         };
@@ -419,10 +534,15 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         problem: P,
         operators: S,
         describer: Arc<dyn Describe<P>>,
+        coding: Option<Arc<dyn Coding<P>>>,
         evaluator: Pool,
         settings: MapSettings,
     ) -> Result<Self, MapError> {
         settings.validate()?;
+        let coded = coding.as_ref().is_some_and(|c| !c.bounds().is_empty());
+        if !settings.emitter.is_operators() && !coded {
+            return Err(MapError::NoCoding);
+        }
         let term_names = problem.term_names();
         if term_names.len() > MAX_TERMS {
             return Err(MapError::TooManyTerms(term_names.len()));
@@ -441,6 +561,8 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
             cells,
             filled: Vec::new(),
             stats: Vec::new(),
+            coding,
+            emitters: Vec::new(),
         })
     }
 
@@ -448,38 +570,21 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
     pub fn step(&mut self) -> &MapStats {
         let start = Instant::now();
         self.generation = (self.generation + 1).min(crate::run::MAX_GENERATION);
-        let (seed, generation) = (self.settings.seed, self.generation);
-        let offered = {
-            let (problem, describer, cells, filled) =
-                (&self.problem, &*self.describer, &self.cells, &self.filled);
-            let (crossover, mutation) = (self.operators.crossover(), self.operators.mutation());
-            let axes = self.settings.axes.len();
-            let rate = self.settings.crossover;
-            let elite = |i: usize| {
-                &cells[filled[i]]
-                    .as_ref()
-                    .expect("filled cells hold elites")
-                    .individual
-            };
-            self.evaluator.map(self.settings.batch, |k| {
-                let mut rng = rng::stream(seed, generation, k as u32);
-                if filled.is_empty() {
-                    let genome = problem.random_genome(&mut rng);
-                    return score(problem, describer, axes, genome, "random", Vec::new());
-                }
-                let a = elite(rng.random_range(0..filled.len()));
-                let (mut genome, operator, parents) = if rng.random::<f64>() < rate {
-                    let b = elite(rng.random_range(0..filled.len()));
-                    let child = crossover.crossover(&a.genome, &b.genome, &mut rng);
-                    (child, "crossover+mutation", vec![a.id, b.id])
-                } else {
-                    (a.genome.clone(), "mutation", vec![a.id])
-                };
-                mutation.mutate(&mut genome, &mut rng);
-                score(problem, describer, axes, genome, operator, parents)
-            })
+        let improved = match self.settings.emitter {
+            Emitter::Operators => {
+                let offered = self.breed();
+                self.offer(offered).0
+            }
+            Emitter::CmaMe { .. } => {
+                let mut offered = self.sample();
+                let draws: Vec<Vec<f64>> = (offered.iter_mut())
+                    .map(|o| o.draws.take().unwrap_or_default())
+                    .collect();
+                let (improved, placements) = self.offer(offered);
+                self.adapt(&draws, &placements);
+                improved
+            }
         };
-        let improved = self.offer(offered);
         self.record(improved, self.settings.batch as u64, start);
         self.stats.last().expect("record pushed a row")
     }
@@ -491,42 +596,169 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         }
     }
 
-    /// Offers scored offspring to the map in order; returns how many improved it.
-    fn offer(&mut self, offered: Vec<Offered<P::Genome>>) -> usize {
-        let mut improved = 0;
-        for offer in offered {
-            let id = IndividualId(self.next_id);
-            self.next_id += 1;
-            let origin = Origin {
-                generation: self.generation,
-                operator: Cow::Borrowed(offer.operator),
-                parents: offer.parents.clone(),
+    /// A generation bred with the model's operators from elites chosen uniformly.
+    fn breed(&self) -> Vec<Offered<P::Genome>> {
+        let (seed, generation) = (self.settings.seed, self.generation);
+        let (problem, describer, cells, filled) =
+            (&self.problem, &*self.describer, &self.cells, &self.filled);
+        let (crossover, mutation) = (self.operators.crossover(), self.operators.mutation());
+        let axes = self.settings.axes.len();
+        let rate = self.settings.crossover;
+        let elite = |i: usize| {
+            &cells[filled[i]]
+                .as_ref()
+                .expect("filled cells hold elites")
+                .individual
+        };
+        self.evaluator.map(self.settings.batch, |k| {
+            let mut rng = rng::stream(seed, generation, k as u32);
+            if filled.is_empty() {
+                let genome = problem.random_genome(&mut rng);
+                return score(problem, describer, axes, genome, "random", Vec::new(), None);
+            }
+            let a = elite(rng.random_range(0..filled.len()));
+            let (mut genome, operator, parents) = if rng.random::<f64>() < rate {
+                let b = elite(rng.random_range(0..filled.len()));
+                let child = crossover.crossover(&a.genome, &b.genome, &mut rng);
+                (child, "crossover+mutation", vec![a.id, b.id])
+            } else {
+                (a.genome.clone(), "mutation", vec![a.id])
             };
-            improved += usize::from(self.place(id, offer, origin));
+            mutation.mutate(&mut genome, &mut rng);
+            score(problem, describer, axes, genome, operator, parents, None)
+        })
+    }
+
+    /// A generation sampled by the CMA-ME emitters, each from its share of the slots.
+    fn sample(&self) -> Vec<Offered<P::Genome>> {
+        let (seed, generation) = (self.settings.seed, self.generation);
+        let coding = self.coding.as_deref().expect("CMA-ME runs have a coding");
+        let bounds = coding.bounds();
+        let owner: Vec<usize> = emitter_slots(self.settings.batch, self.emitters.len())
+            .enumerate()
+            .flat_map(|(e, slots)| slots.map(move |_| e))
+            .collect();
+        let (problem, describer, emitters) = (&self.problem, &*self.describer, &self.emitters);
+        let axes = self.settings.axes.len();
+        self.evaluator.map(self.settings.batch, |k| {
+            let (mut draws, mut unit) = (vec![0.0; bounds.len()], vec![0.0; bounds.len()]);
+            let mut rng = rng::stream(seed, generation, k as u32);
+            emitters[owner[k]].sample(&mut rng, &mut draws, &mut unit);
+            // The strategy samples the whole space; what leaves the bounds is clamped onto
+            // them (its draws still teach the strategy), as pyribs' unbounded emitters do.
+            let x: Vec<f64> = (unit.iter().zip(bounds))
+                .map(|(u, [lo, hi])| lo + u.clamp(0.0, 1.0) * (hi - lo))
+                .collect();
+            let genome = coding.decode(&x);
+            score(
+                problem,
+                describer,
+                axes,
+                genome,
+                "cma-me",
+                Vec::new(),
+                Some(draws),
+            )
+        })
+    }
+
+    /// Moves each emitter towards its samples that did most for the map, or starts it
+    /// again if none changed the map or its strategy collapsed.
+    fn adapt(&mut self, draws: &[Vec<f64>], placements: &[Placement]) {
+        let batch = self.settings.batch;
+        for (e, slots) in emitter_slots(batch, self.emitters.len()).enumerate() {
+            if slots.clone().all(|k| placements[k].0 < 2) {
+                self.emitters[e] = self.restart(e, batch, false);
+                continue;
+            }
+            let mut ranked: Vec<usize> = slots.collect();
+            // Stable: ties keep slot order.
+            ranked.sort_by(|&a, &b| {
+                let (pa, pb) = (placements[a], placements[b]);
+                pb.0.cmp(&pa.0).then(pb.1.total_cmp(&pa.1))
+            });
+            let ranked: Vec<&[f64]> = ranked.iter().map(|&k| &draws[k][..]).collect();
+            self.emitters[e].update(&ranked);
+            if self.emitters[e].degenerate() {
+                self.emitters[e] = self.restart(e, batch, false);
+            }
         }
-        improved
+    }
+
+    /// Emitter `e`'s strategy started afresh at the vector of the best elite or a random
+    /// one (a random vector if the map is empty or the coding cannot hold the elite),
+    /// drawn from stream `(seed, generation, size + e)`, `size` being the generation's.
+    fn restart(&self, e: usize, size: usize, best: bool) -> SepCma {
+        let Emitter::CmaMe { sigma, .. } = self.settings.emitter else {
+            unreachable!("only CMA-ME runs have emitters")
+        };
+        let coding = self.coding.as_deref().expect("CMA-ME runs have a coding");
+        let bounds = coding.bounds();
+        let slot = u32::try_from(size + e).unwrap_or(u32::MAX);
+        let mut rng = rng::stream(self.settings.seed, self.generation, slot);
+        let elite = match best {
+            true => self.best(),
+            false if self.filled.is_empty() => None,
+            false => self.cells[self.filled[rng.random_range(0..self.filled.len())]].as_ref(),
+        };
+        let elite = elite.map(|elite| coding.encode(&self.problem, &elite.individual.genome));
+        let mean = match elite.flatten() {
+            Some(x) if x.len() == bounds.len() => (x.iter().zip(bounds))
+                .map(|(x, [lo, hi])| {
+                    let unit = (x - lo) / (hi - lo);
+                    if unit.is_finite() {
+                        unit.clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            _ => (0..bounds.len()).map(|_| rng.random::<f64>()).collect(),
+        };
+        SepCma::new(mean, sigma)
+    }
+
+    /// Offers scored offspring to the map in order; returns how many improved it, and
+    /// what each did.
+    fn offer(&mut self, offered: Vec<Offered<P::Genome>>) -> (usize, Vec<Placement>) {
+        let placements: Vec<Placement> = offered
+            .into_iter()
+            .map(|offer| {
+                let id = IndividualId(self.next_id);
+                self.next_id += 1;
+                let origin = Origin {
+                    generation: self.generation,
+                    operator: Cow::Borrowed(offer.operator),
+                    parents: offer.parents.clone(),
+                };
+                self.place(id, offer, origin)
+            })
+            .collect();
+        let improved = placements.iter().filter(|p| p.0 >= 2).count();
+        (improved, placements)
     }
 
     /// Puts an offspring in its cell if the cell is empty or it beats the elite there;
-    /// whether it did.
-    fn place(&mut self, id: IndividualId, offer: Offered<P::Genome>, origin: Origin) -> bool {
-        let Some(descriptors) = offer.descriptors else {
-            return false;
+    /// what it did.
+    fn place(&mut self, id: IndividualId, offer: Offered<P::Genome>, origin: Origin) -> Placement {
+        let fitness = offer.fitness.total();
+        let Some(descriptors) = offer.descriptors.filter(|_| fitness.is_finite()) else {
+            return (0, f64::NEG_INFINITY);
         };
-        if !offer.fitness.total().is_finite() {
-            return false;
-        }
         let axes = self.settings.axes.len();
         let cell = self.settings.cell(&descriptors[..axes]);
         let slot = &mut self.cells[cell];
-        match slot {
-            Some(elite) if elite.individual.total() >= offer.fitness.total() => return false,
-            Some(_) => {}
+        let placement = match slot {
+            Some(elite) if elite.individual.total() >= fitness => {
+                return (1, fitness - elite.individual.total());
+            }
+            Some(elite) => (2, fitness - elite.individual.total()),
             None => {
                 let at = self.filled.partition_point(|&c| c < cell);
                 self.filled.insert(at, cell);
+                (3, fitness)
             }
-        }
+        };
         *slot = Some(Elite {
             individual: Individual {
                 id,
@@ -536,7 +768,7 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
             },
             descriptors: descriptors[..axes].to_vec(),
         });
-        true
+        placement
     }
 
     fn record(&mut self, improved: usize, evaluations: u64, start: Instant) {
@@ -629,8 +861,30 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
             next_id: self.next_id,
             elites: self.elites().map(|e| e.individual.clone()).collect(),
             stats: self.stats.clone(),
+            emitters: self.emitters.clone(),
         }
     }
+}
+
+/// The genome of a vector drawn uniformly within `coding`'s bounds.
+fn random_vector<P: Problem, R: rand::Rng + ?Sized>(
+    coding: &dyn Coding<P>,
+    rng: &mut R,
+) -> P::Genome {
+    let x: Vec<f64> = (coding.bounds().iter())
+        .map(|[lo, hi]| lo + rng.random::<f64>() * (hi - lo))
+        .collect();
+    coding.decode(&x)
+}
+
+/// The slots of a generation of `batch` that each of `emitters` emitters samples: equal
+/// shares in order, the first ones taking one more while the remainder lasts.
+fn emitter_slots(batch: usize, emitters: usize) -> impl Iterator<Item = Range<usize>> {
+    let (share, extra) = (batch / emitters.max(1), batch % emitters.max(1));
+    (0..emitters).map(move |e| {
+        let start = e * share + e.min(extra);
+        start..start + share + usize::from(e < extra)
+    })
 }
 
 /// Evaluates and describes an offspring.
@@ -641,6 +895,7 @@ fn score<P: Problem>(
     genome: P::Genome,
     operator: &'static str,
     parents: Vec<IndividualId>,
+    draws: Option<Vec<f64>>,
 ) -> Offered<P::Genome> {
     let fitness = evaluate(problem, &genome);
     let mut descriptors = [0.0; MAX_DESCRIPTORS];
@@ -652,6 +907,7 @@ fn score<P: Problem>(
         descriptors: described.then_some(descriptors),
         operator,
         parents,
+        draws,
     }
 }
 
@@ -711,12 +967,22 @@ mod tests {
             batch: 30,
             crossover: 0.5,
             qd_offset: -40.0,
+            emitter: Emitter::Operators,
         }
     }
 
     fn run(pool: Pool) -> MapRun<Halves, Ops> {
         let ops = Ops(OnePoint, BitFlip { rate: 0.05 });
-        MapRun::new(Halves, ops, Arc::new(Halves), pool, settings(), Vec::new()).unwrap()
+        MapRun::new(
+            Halves,
+            ops,
+            Arc::new(Halves),
+            None,
+            pool,
+            settings(),
+            Vec::new(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -792,8 +1058,15 @@ mod tests {
         let saved = serde_json::to_string(&parallel.checkpoint()).unwrap();
         let ops = Ops(OnePoint, BitFlip { rate: 0.05 });
         let checkpoint = serde_json::from_str(&saved).unwrap();
-        let mut resumed =
-            MapRun::resume(Halves, ops, Arc::new(Halves), Pool::Serial, checkpoint).unwrap();
+        let mut resumed = MapRun::resume(
+            Halves,
+            ops,
+            Arc::new(Halves),
+            None,
+            Pool::Serial,
+            checkpoint,
+        )
+        .unwrap();
         resumed.run_batch(6, |_| {});
         let strip = |c: MapCheckpoint<BitString<1>>| {
             let mut c = c;
@@ -801,5 +1074,186 @@ mod tests {
             c
         };
         assert_eq!(strip(serial.checkpoint()), strip(resumed.checkpoint()));
+    }
+
+    /// Ten numbers in 0..1 scored by their closeness to 0.3, placed by the mean of each
+    /// half: a real-valued problem for CMA-ME.
+    struct Reals;
+
+    impl Problem for Reals {
+        type Genome = Vec<f64>;
+        fn term_names(&self) -> Vec<String> {
+            vec!["closeness".into()]
+        }
+        fn evaluate(&self, g: &Vec<f64>) -> Fitness {
+            let d: f64 = g.iter().map(|x| (x - 0.3).powi(2)).sum();
+            Fitness::new(-d, &[-d])
+        }
+        fn random_genome<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
+            (0..10).map(|_| rng.random::<f64>()).collect()
+        }
+    }
+
+    impl Describe<Reals> for Reals {
+        fn describe(&self, _: &Reals, g: &Vec<f64>, out: &mut [f64]) -> bool {
+            out[0] = g[..5].iter().sum::<f64>() / 5.0;
+            out[1] = g[5..].iter().sum::<f64>() / 5.0;
+            true
+        }
+    }
+
+    struct Unit([[f64; 2]; 10]);
+
+    impl Coding<Reals> for Unit {
+        fn bounds(&self) -> &[[f64; 2]] {
+            &self.0
+        }
+        fn decode(&self, x: &[f64]) -> Vec<f64> {
+            x.to_vec()
+        }
+        fn encode(&self, _: &Reals, g: &Vec<f64>) -> Option<Vec<f64>> {
+            Some(g.clone())
+        }
+    }
+
+    /// Nudges one number (the operators a CMA-ME run carries but does not use).
+    struct Nudge;
+
+    impl Mutate<Vec<f64>> for Nudge {
+        fn mutate<R: rand::Rng + ?Sized>(&self, g: &mut Vec<f64>, rng: &mut R) {
+            let i = rng.random_range(0..g.len());
+            g[i] = (g[i] + rng.random_range(-0.1..0.1)).clamp(0.0, 1.0);
+        }
+    }
+
+    impl Crossover<Vec<f64>> for Nudge {
+        fn crossover<R: rand::Rng + ?Sized>(
+            &self,
+            a: &Vec<f64>,
+            _: &Vec<f64>,
+            _: &mut R,
+        ) -> Vec<f64> {
+            a.clone()
+        }
+    }
+
+    impl Operators<Vec<f64>> for Nudge {
+        type Crossover = Nudge;
+        type Mutation = Nudge;
+        fn crossover(&self) -> &Nudge {
+            self
+        }
+        fn mutation(&self) -> &Nudge {
+            self
+        }
+    }
+
+    fn cma_settings() -> MapSettings {
+        let axis = Axis {
+            min: 0.0,
+            max: 1.0,
+            cells: 10,
+        };
+        MapSettings {
+            seed: 5,
+            axes: vec![axis, axis],
+            initial: 20,
+            batch: 25,
+            crossover: 0.0,
+            qd_offset: -10.0,
+            emitter: Emitter::CmaMe {
+                emitters: 3,
+                sigma: 0.2,
+            },
+        }
+    }
+
+    fn cma_run(pool: Pool) -> MapRun<Reals, Nudge> {
+        let coding: Arc<dyn Coding<Reals>> = Arc::new(Unit([[0.0, 1.0]; 10]));
+        MapRun::new(
+            Reals,
+            Nudge,
+            Arc::new(Reals),
+            Some(coding),
+            pool,
+            cma_settings(),
+            Vec::new(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn cma_me_emitters_fill_the_map_and_resume_exactly() {
+        let mut serial = cma_run(Pool::Serial);
+        assert_eq!(serial.checkpoint().emitters.len(), 3);
+        let first = serial.stats()[0].clone();
+        let mut last = first.clone();
+        serial.run_batch(40, |s| {
+            assert!(s.filled >= last.filled && s.qd_score >= last.qd_score);
+            last = s.clone();
+        });
+        assert!(last.filled > 2 * first.filled, "{first:?} {last:?}");
+        let operators: Vec<_> = (serial.elites())
+            .map(|e| e.individual.origin.operator.clone())
+            .collect();
+        assert!(operators.iter().any(|o| o == "cma-me"), "{operators:?}");
+        // Samples outside the bounds were clamped onto them.
+        for e in serial.elites() {
+            assert!(e.individual.genome.iter().all(|x| (0.0..=1.0).contains(x)));
+        }
+        let mut parallel = cma_run(Pool::with_threads(3).unwrap());
+        parallel.run_batch(15, |_| {});
+        let saved = serde_json::to_string(&parallel.checkpoint()).unwrap();
+        let coding: Arc<dyn Coding<Reals>> = Arc::new(Unit([[0.0, 1.0]; 10]));
+        let checkpoint = serde_json::from_str(&saved).unwrap();
+        let mut resumed = MapRun::resume(
+            Reals,
+            Nudge,
+            Arc::new(Reals),
+            Some(coding),
+            Pool::Serial,
+            checkpoint,
+        )
+        .unwrap();
+        resumed.run_batch(25, |_| {});
+        let strip = |c: MapCheckpoint<Vec<f64>>| {
+            let mut c = c;
+            c.stats.iter_mut().for_each(|s| s.seconds = 0.0);
+            c
+        };
+        assert_eq!(strip(serial.checkpoint()), strip(resumed.checkpoint()));
+    }
+
+    #[test]
+    fn cma_me_needs_a_coding_and_sound_emitters() {
+        let no_coding = MapRun::new(
+            Reals,
+            Nudge,
+            Arc::new(Reals),
+            None,
+            Pool::Serial,
+            cma_settings(),
+            vec![],
+        );
+        assert_eq!(no_coding.err(), Some(MapError::NoCoding));
+        for (emitters, sigma, name) in [
+            (0, 0.2, "emitters"),
+            (13, 0.2, "emitters"),
+            (3, 0.0, "sigma"),
+            (3, f64::NAN, "sigma"),
+            (3, 1.5, "sigma"),
+        ] {
+            let mut s = cma_settings();
+            s.emitter = Emitter::CmaMe { emitters, sigma };
+            assert!(
+                matches!(s.validate(), Err(MapError::Number { name: n, .. }) if n == name),
+                "{emitters} {sigma}"
+            );
+        }
+        // The operators' settings and checkpoints keep their bytes: no emitter field.
+        let text = serde_json::to_string(&settings()).unwrap();
+        assert!(!text.contains("emitter"), "{text}");
+        let back: MapSettings = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.emitter, Emitter::Operators);
     }
 }

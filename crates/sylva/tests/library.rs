@@ -45,6 +45,7 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "bintree/varieties.toml",
         "automata/varieties.toml",
         "plantmaker/varieties.toml",
+        "plantmaker/varieties-cma-me.toml",
         "lsystem/varieties.toml",
         "match/varieties.toml",
     ] {

@@ -161,6 +161,26 @@ fn bad_maps_are_refused_naming_the_field() {
         (format!("{run}[map]\nbatch = -3\n"), "`batch` must be", 5),
         (format!("{run}[map]\ncrossover = 1.5\n"), "`crossover`", 5),
         (
+            format!("{run}[map]\nemitter = \"cma\"\n"),
+            "expected `operators` or `cma-me`",
+            5,
+        ),
+        (
+            format!("{run}[map]\nemitter = \"cma-me\"\nsigma = 0\n"),
+            "`sigma` must be",
+            6,
+        ),
+        (
+            format!("{run}[map]\nemitter = \"cma-me\"\nemitters = 0\n"),
+            "`emitters` must be",
+            6,
+        ),
+        (
+            format!("{run}[map]\nsigma = 0.2\n"),
+            "emitter = \"cma-me\"",
+            0,
+        ),
+        (
             format!("{run}[map]\ncolour = 1\n"),
             "unknown field `colour`",
             5,
@@ -197,4 +217,50 @@ fn a_map_is_not_run_as_one_population() {
     let names: Vec<&str> = run.descriptors().iter().map(|d| d.name()).collect();
     assert_eq!(names, ["height_to_width", "porosity"]);
     assert_eq!(run.cells(), 100);
+}
+
+#[test]
+fn cma_me_emitters_fill_a_plantmaker_map_and_resume_exactly() {
+    let map = "emitter = \"cma-me\"\nemitters = 2\nsigma = 0.2\n\
+               descriptors = [{ name = \"leaf_count\", range = [0, 600], cells = 4 }, \
+               { name = \"porosity\", range = [0.2, 1], cells = 4 }]\n";
+    let config = config("plantmaker", map);
+    let mut serial = Varieties::start(&config, Vec::new(), Pool::Serial).unwrap();
+    for _ in 0..5 {
+        serial.step();
+    }
+    let stats = serial.stats();
+    assert!(stats[5].filled > stats[0].filled, "{stats:?}");
+    assert!(
+        (serial.varieties().iter()).any(|v| v.member.origin.operator == "cma-me"),
+        "an emitter's sample made an elite"
+    );
+    let toml = serial.config().to_toml();
+    assert!(toml.contains("emitter = \"cma-me\""), "{toml}");
+    let mut parallel =
+        Varieties::start(&config, Vec::new(), Pool::with_threads(3).unwrap()).unwrap();
+    parallel.step();
+    parallel.step();
+    let saved = parallel.checkpoint().unwrap();
+    assert!(saved.contains("\"emitters\""), "the strategies are saved");
+    let mut resumed =
+        Varieties::resume(&config, Path::new("checkpoint.json"), &saved, Pool::Serial).unwrap();
+    for _ in 0..3 {
+        resumed.step();
+    }
+    assert_eq!(bytes(&serial), bytes(&resumed));
+}
+
+#[test]
+fn cma_me_is_refused_for_genomes_of_varying_structure() {
+    for model in ["automata", "lsystem"] {
+        let config = config(model, "emitter = \"cma-me\"\n");
+        let e = Varieties::start(&config, Vec::new(), Pool::Serial)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("test.toml") && e.contains(model) && e.contains("emitter = \"operators\""),
+            "{e}"
+        );
+    }
 }

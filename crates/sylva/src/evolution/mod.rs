@@ -59,8 +59,8 @@ pub(crate) use config::{resume, start};
 pub(crate) use run::TypedRun;
 pub use run::{Evolution, Member};
 pub use schema::{
-    AxisConfig, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy,
-    WindConfig,
+    AxisConfig, EmitterKind, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig,
+    SearchStrategy, WindConfig,
 };
 pub use space::{Coding, Codons, GenomeSpace, MAX_DIM, Scores, SpaceOptions};
 pub(crate) use space::{SpaceValue, new_space};

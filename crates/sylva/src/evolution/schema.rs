@@ -200,6 +200,50 @@ pub struct MapConfig {
     /// Default 0.
     #[serde(deserialize_with = "map_qd_offset")]
     pub qd_offset: f64,
+    /// Where offspring come from: `"operators"` (the model's own crossover and mutation
+    /// of elites chosen uniformly; the default) or `"cma-me"` (CMA-ME emitters searching
+    /// the genomes as vectors, for models that have a direct coding: PlantMaker and binary
+    /// trees).
+    #[serde(skip_serializing_if = "EmitterKind::is_operators")]
+    pub emitter: EmitterKind,
+    /// CMA-ME: evolution strategies sharing each batch, 1 to half the batch. Default 5.
+    #[serde(
+        deserialize_with = "map_emitters",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub emitters: Option<u32>,
+    /// CMA-ME: each strategy's first step size, as a share of each genome entry's range,
+    /// 0.001 to 1. Default 0.1.
+    #[serde(
+        deserialize_with = "map_sigma",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub sigma: Option<f64>,
+}
+
+/// `[map] emitter`: where a map's offspring come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EmitterKind {
+    /// The model's own operators.
+    #[default]
+    Operators,
+    /// CMA-ME emitters over the genomes as vectors.
+    CmaMe,
+}
+
+impl EmitterKind {
+    /// Whether this is the default, the model's operators.
+    pub fn is_operators(&self) -> bool {
+        *self == EmitterKind::Operators
+    }
+}
+
+impl MapConfig {
+    /// CMA-ME's strategies when none are given.
+    pub const EMITTERS: u32 = 5;
+    /// CMA-ME's first step size when none is given.
+    pub const SIGMA: f64 = 0.1;
 }
 
 /// One axis of the map: a descriptor, its range and its cells.
@@ -244,6 +288,9 @@ impl Default for MapConfig {
             batch: 100,
             crossover: 0.5,
             qd_offset: 0.0,
+            emitter: EmitterKind::Operators,
+            emitters: None,
+            sigma: None,
         }
     }
 }
@@ -257,6 +304,16 @@ sylva_core::ranged!(map_batch: u32, "batch", 1, 1_000_000);
 sylva_core::ranged!(map_crossover: f64, "crossover", 0.0, 1.0);
 sylva_core::ranged!(map_qd_offset: f64, "qd_offset", -1e12, 1e12);
 sylva_core::ranged!(axis_cells: u32, "cells", 1, 1000);
+sylva_core::ranged!(emitters_value: u32, "emitters", 1, 500_000);
+sylva_core::ranged!(sigma_value: f64, "sigma", 0.001, 1.0);
+
+fn map_emitters<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    emitters_value(d).map(Some)
+}
+
+fn map_sigma<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    sigma_value(d).map(Some)
+}
 
 /// Reads `descriptors`: 1 to 3 axes, each range finite and rising, each descriptor once,
 /// at most 100,000 cells in all.
@@ -449,6 +506,15 @@ impl<'de, M: Evolve + Default> Visitor<'de> for ConfigVisitor<M> {
             return Err(de::Error::custom(
                 "a `[map]` is drawn by a MAP-Elites run: add `strategy = \"map-elites\"` to \
                  `[run]`, or leave `[map]` out",
+            ));
+        }
+        if let Some(map) = &config.map
+            && map.emitter.is_operators()
+            && (map.emitters.is_some() || map.sigma.is_some())
+        {
+            return Err(de::Error::custom(
+                "`[map]` `emitters` and `sigma` tune CMA-ME: add `emitter = \"cma-me\"` to \
+                 `[map]`, or leave them out",
             ));
         }
         Ok(config)

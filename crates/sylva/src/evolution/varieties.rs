@@ -10,10 +10,10 @@ use std::sync::Arc;
 use serde::Serialize;
 use sylva_core::Plant;
 use sylva_core::par::Pool;
-use sylva_evolve::map::{Axis, Describe, MapCheckpoint, MapRun, MapSettings, MapStats};
+use sylva_evolve::map::{Axis, Describe, Emitter, MapCheckpoint, MapRun, MapSettings, MapStats};
 use sylva_evolve::{Problem, WithTerm};
 use sylva_fitness::descriptors::{self, Descriptor, Scratch};
-use sylva_model::Evolve;
+use sylva_model::{Evolve, VectorCoding};
 
 use crate::erased::{DynModel, Value};
 use crate::error::{Error, InputError};
@@ -22,7 +22,7 @@ use crate::genome::Genome;
 use super::checkpoint;
 use super::config::{Config, setup, typed_start, with_term};
 use super::run::{Member, member_of};
-use super::schema::{EvolveConfig, MapConfig, SearchStrategy};
+use super::schema::{EmitterKind, EvolveConfig, MapConfig, SearchStrategy};
 
 thread_local! {
     /// Per-thread measuring buffers; they carry nothing between plants.
@@ -53,6 +53,66 @@ impl<M: Evolve> Describe<WithTerm<M::Problem>> for PlantDescriber<M> {
         });
         true
     }
+}
+
+/// A model's direct coding ([`Evolve::vector_coding`]) as CMA-ME emitters search it.
+struct DirectCoding<M: Evolve> {
+    model: M,
+    coding: Box<dyn VectorCoding<M>>,
+}
+
+impl<M: Evolve> sylva_evolve::Coding<WithTerm<M::Problem>> for DirectCoding<M> {
+    fn bounds(&self) -> &[[f64; 2]] {
+        self.coding.bounds()
+    }
+
+    fn decode(&self, x: &[f64]) -> <M::Problem as Problem>::Genome {
+        self.coding.decode(x)
+    }
+
+    fn encode(
+        &self,
+        problem: &WithTerm<M::Problem>,
+        genome: &<M::Problem as Problem>::Genome,
+    ) -> Option<Vec<f64>> {
+        let file = self.model.genome_file(&problem.problem, genome);
+        self.coding.encode(&file).ok()
+    }
+}
+
+/// What CMA-ME emitters search, for model `M`.
+type EngineCoding<M> = Arc<dyn sylva_evolve::Coding<WithTerm<<M as Evolve>::Problem>>>;
+
+/// The coding CMA-ME emitters search, if `config` asks for them; refused, naming the
+/// config (`source`), for a model whose genomes have none.
+fn emitter_coding<M: Evolve>(
+    config: &EvolveConfig<M>,
+    problem: &WithTerm<M::Problem>,
+    source: &str,
+) -> Result<Option<EngineCoding<M>>, Error> {
+    let map = config.map.as_ref();
+    if map.is_none_or(|m| m.emitter == EmitterKind::Operators) {
+        return Ok(None);
+    }
+    let Some(coding) = config
+        .model
+        .vector_coding(&problem.problem, config.run.seed)
+    else {
+        return Err(InputError::new(
+            source,
+            format!(
+                "`[map] emitter = \"cma-me\"` searches genomes as vectors of numbers, and \
+                 `{}` genomes have none (their structure varies): CMA-ME searches PlantMaker \
+                 and binary trees; use `emitter = \"operators\"`",
+                M::NAME
+            ),
+        )
+        .into());
+    };
+    Ok(Some(Arc::new(DirectCoding {
+        model: config.model.clone(),
+        coding,
+    })))
 }
 
 /// One filled cell of a map: where it is, and its elite.
@@ -195,6 +255,13 @@ pub(super) fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings,
         batch: map.batch as usize,
         crossover: map.crossover,
         qd_offset: map.qd_offset,
+        emitter: match map.emitter {
+            EmitterKind::Operators => Emitter::Operators,
+            EmitterKind::CmaMe => Emitter::CmaMe {
+                emitters: map.emitters.unwrap_or(MapConfig::EMITTERS),
+                sigma: map.sigma.unwrap_or(MapConfig::SIGMA),
+            },
+        },
     };
     (settings, map.descriptors.iter().map(|a| a.name).collect())
 }
@@ -240,6 +307,7 @@ pub(crate) fn start_map<M: Evolve + Default>(
         source,
     )?;
     let problem = with_term(&config, setup.problem, base)?;
+    let coding = emitter_coding(&config, &problem, source)?;
     let describer = Arc::new(PlantDescriber {
         model: config.model.clone(),
         descriptors: descriptors.clone(),
@@ -248,6 +316,7 @@ pub(crate) fn start_map<M: Evolve + Default>(
         problem,
         setup.strategy,
         describer,
+        coding,
         pool,
         settings,
         setup.first,
@@ -285,11 +354,12 @@ pub(crate) fn resume_map<M: Evolve + Default>(
     }
     let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
     let problem = with_term(&config, setup.problem, base)?;
+    let coding = emitter_coding(&config, &problem, source)?;
     let describer = Arc::new(PlantDescriber {
         model: config.model.clone(),
         descriptors: descriptors.clone(),
     });
-    let run = MapRun::resume(problem, setup.strategy, describer, pool, engine)
+    let run = MapRun::resume(problem, setup.strategy, describer, coding, pool, engine)
         .map_err(|e| InputError::file(path, e))?;
     Ok(Box::new(TypedMap {
         config,
