@@ -589,6 +589,7 @@ pub fn match_outline(
         weight: 1.0,
         beside: false,
         rows: 64,
+        closeness: 0.0,
     };
     outlines(&outline, Path::new("")).py()?;
     let limit = match (generations, seconds) {

@@ -72,6 +72,23 @@ fn bad_match_sections_name_the_field_or_file() {
         .err()
         .unwrap();
     assert!(e.message.contains("rows"), "{e}");
+    let e = config("model = \"bintree\"\n[match]\nfront = \"round.png\"\ncloseness = 11\n")
+        .err()
+        .unwrap();
+    assert!(
+        e.message.contains("`closeness` must be") && e.line == 4,
+        "{e}"
+    );
+    // Closeness is left out of a config that does not set it, and kept where it is set.
+    let plain = config("model = \"bintree\"\n[match]\nfront = \"round.png\"\n").unwrap();
+    assert!(!plain.to_toml().contains("closeness"));
+    let close =
+        config("model = \"bintree\"\n[match]\nfront = \"round.png\"\ncloseness = 0.5\n").unwrap();
+    assert!(
+        close.to_toml().contains("closeness = 0.5"),
+        "{}",
+        close.to_toml()
+    );
     // A picture that is not there is named when the run starts.
     let config = config("model = \"bintree\"\n[match]\nfront = \"nowhere.png\"\n").unwrap();
     let e = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap_err();

@@ -48,6 +48,10 @@ pub struct MatchArgs {
     /// What is ink: `otsu` (the default) or a luminance from 0 to 1 that ink is darker than.
     #[arg(long, default_value = "otsu", value_parser = parse_threshold)]
     threshold: Threshold,
+    /// Weight of closeness (a distance transform's) beside the IoU, 0 to 10 (`[match]
+    /// closeness`, docs/match.md).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_closeness)]
+    closeness: f64,
     /// Worker threads; 0 means one per core. Results do not depend on it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
     threads: u32,
@@ -68,6 +72,13 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(s) if (1.0..=86_400.0).contains(&s) => Ok(s),
         _ => Err(format!("expected seconds from 1 to 86400; got {text:?}")),
+    }
+}
+
+fn parse_closeness(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(w) if (0.0..=10.0).contains(&w) => Ok(w),
+        _ => Err(format!("expected a number from 0 to 10, got `{text}`")),
     }
 }
 
@@ -93,6 +104,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         weight: 1.0,
         beside: false,
         rows: 64,
+        closeness: args.closeness,
     };
     // The pictures are read first: a bad one is refused before anything is written.
     outlines(&target, Path::new(""))?;

@@ -104,6 +104,7 @@ fn target(threshold: Threshold) -> MatchConfig {
         weight: 1.0,
         beside: false,
         rows: 64,
+        closeness: 0.0,
     }
 }
 

@@ -35,6 +35,8 @@ thread_local! {
 struct OutlineTerm<M> {
     model: M,
     outlines: Vec<Outline>,
+    /// Weight of closeness beside the IoU (`[match] closeness`).
+    closeness: f64,
 }
 
 impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
@@ -51,7 +53,9 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
         };
         SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
-            let sum: f64 = self.outlines.iter().map(|o| o.score(&plant, scratch)).sum();
+            let sum: f64 = (self.outlines.iter())
+                .map(|o| o.score_with_closeness(&plant, self.closeness, scratch))
+                .sum();
             sum / self.outlines.len() as f64
         })
     }
@@ -84,6 +88,7 @@ pub(super) fn added<M: Evolve>(
         term: Arc::new(OutlineTerm {
             model: model.clone(),
             outlines: outlines(config, base)?,
+            closeness: config.closeness,
         }),
         weight: config.weight,
         beside: config.beside,

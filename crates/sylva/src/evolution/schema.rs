@@ -174,6 +174,19 @@ pub struct MatchConfig {
     /// Rows the outlines are compared at, 16 to 512. Default 64.
     #[serde(default = "sixty_four", deserialize_with = "match_rows")]
     pub rows: u32,
+    /// Weight of closeness beside the IoU, 0 to 10: how near the silhouette lies to the
+    /// outline by a distance transform, which keeps rising as a plant that misses the
+    /// outline moves towards it (docs/match.md). Default 0: the IoU alone.
+    #[serde(
+        default,
+        deserialize_with = "match_closeness",
+        skip_serializing_if = "is_zero"
+    )]
+    pub closeness: f64,
+}
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 /// `[map]`: the map of a MAP-Elites run (`[run] strategy = "map-elites"`): its
@@ -366,6 +379,7 @@ fn sixty_four() -> u32 {
 
 sylva_core::ranged!(match_weight: f64, "weight", 0.0, 1_000_000.0);
 sylva_core::ranged!(match_rows: u32, "rows", 16, 512);
+sylva_core::ranged!(match_closeness: f64, "closeness", 0.0, 10.0);
 
 impl OutputConfig {
     /// The taper the outputs are grown with, if any.
