@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import os
 import pickle
+import signal
 import struct
 import subprocess
 import sys
@@ -119,7 +120,12 @@ def _serve() -> None:
     """A local worker (``python -m sylva._worker``): serves calls to one island, read from
     standard input, until its input closes. An island that could not start answers every
     call with the reason. Standard output is kept for replies: anything printed goes to
-    standard error."""
+    standard error.
+
+    Ctrl-C is the driver's to handle: a terminal sends it to the whole process group, and a
+    worker that took it would end with a traceback of its own; the driver ends its workers
+    instead (:func:`islands`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     calls = os.fdopen(os.dup(0), "rb")
     replies = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)
@@ -178,7 +184,11 @@ class _LocalBackend:
             out.append(value)
         return out
 
-    def stop(self, worker: Any) -> None:
+    def stop(self, worker: Any, now: bool = False) -> None:
+        """Ends a worker: it exits when its input closes, after the call under way; ``now``
+        ends it at once (SIGTERM: no traceback, nothing more written)."""
+        if now and worker.poll() is None:
+            worker.terminate()
         for stream in (worker.stdin, worker.stdout):
             try:
                 stream.close()
@@ -191,6 +201,39 @@ class _LocalBackend:
             worker.wait()
 
 
+def _connect(ray: Any) -> None:
+    """``ray.init()``: joins the cluster at ``RAY_ADDRESS`` when it is set, else starts a
+    local Ray. A cluster that asks for a token this process does not send (Ray 2.52 and
+    later: ``RAY_AUTH_MODE=token`` on the cluster, not here) is refused by Ray with a
+    ``ConnectionError`` after 20 seconds of retries; that one is raised as a
+    :class:`SylvaError` that says what to set."""
+    try:
+        ray.init()
+    except ConnectionError as e:
+        if not _refused_for_token(e):
+            raise
+        address = os.environ.get("RAY_ADDRESS", "the Ray cluster")
+        raise SylvaError(
+            f"{address} refused this process: the cluster uses token authentication "
+            f"(RAY_AUTH_MODE=token) and this process sent no token or the wrong one. Run it "
+            f"with RAY_AUTH_MODE=token and the cluster's token in ~/.ray/auth_token (or in "
+            f"RAY_AUTH_TOKEN), as every node of the cluster has it; see 'On a real Ray "
+            f"cluster' in Sylva's docs/python.md"
+        ) from e
+
+
+def _refused_for_token(error: BaseException) -> bool:
+    """Whether ``error`` or one of its causes is Ray's refusal of a missing or wrong token."""
+    seen: set[int] = set()
+    cause: BaseException | None = error
+    while cause is not None and id(cause) not in seen:
+        seen.add(id(cause))
+        if type(cause).__name__ == "AuthenticationError" or "InvalidAuthToken" in str(cause):
+            return True
+        cause = cause.__cause__ or cause.__context__
+    return False
+
+
 class _RayBackend:
     """Islands as Ray actors, spread over the cluster's nodes."""
 
@@ -200,7 +243,7 @@ class _RayBackend:
         import ray
 
         if not ray.is_initialized():
-            ray.init()  # connects to RAY_ADDRESS when set, else starts a local Ray
+            _connect(ray)
         self.ray = ray
         cpus = ray.cluster_resources().get("CPU", 1.0)
         # An island asks for its share of the cluster, so that all of them are placed.
@@ -225,7 +268,7 @@ class _RayBackend:
                 raise _Lost(str(e)) from e
         return out
 
-    def stop(self, worker: Any) -> None:
+    def stop(self, worker: Any, now: bool = False) -> None:
         self.ray.kill(worker)
 
 
@@ -310,7 +353,9 @@ def islands(
         generations: generations bred after the first (the config's when left out).
         threads: worker threads per island (results do not depend on it).
         backend: ``"ray"``, ``"local"`` (worker processes on this machine), or ``"auto"``
-            (Ray when it is installed).
+            (Ray when it is installed). Ray is started with ``ray.init()`` unless it is
+            already initialised: it joins the cluster at ``RAY_ADDRESS`` when that is set,
+            else starts a Ray on this machine.
         checkpoint: a file the driver writes after every round; if it exists when the run
             starts, the run resumes from it.
         max_restarts: restarts allowed per island per round before the run gives up.
@@ -320,6 +365,9 @@ def islands(
 
     Returns:
         An :class:`IslandsResult`.
+
+    Ctrl-C raises ``KeyboardInterrupt`` in the caller alone: the workers end at once, without
+    tracebacks of their own, and with ``checkpoint`` the run resumes from its last round.
     """
     config = _as_config(config)
     _check("islands", islands, 1, 1024)
@@ -362,6 +410,7 @@ def islands(
     restarts = 0
     rounds = 0
     round_seconds: list[float] = []
+    interrupted = False
     try:
         while generation < total:
             round_start = time.perf_counter()
@@ -403,10 +452,15 @@ def islands(
                                ([], 0, 0), max_restarts)
             restarts += states.pop()
             states = [s["checkpoint"] for s in states]
+    except KeyboardInterrupt:
+        # Ctrl-C: the workers end at once, and the run resumes from the last round's
+        # checkpoint (``checkpoint=``).
+        interrupted = True
+        raise
     finally:
         for w in workers:
             try:
-                runner.stop(w)
+                runner.stop(w, now=interrupted)
             except Exception:  # noqa: BLE001 (a lost worker needs no stopping)
                 pass
     seconds = time.perf_counter() - started
