@@ -14,8 +14,14 @@
 //! assert_eq!(squares, vec![0, 1, 4, 9, 16]);
 //! # Ok::<(), rayon::ThreadPoolBuildError>(())
 //! ```
+//!
+//! Long work (a generation of a large population) can be cut short between jobs: under
+//! [`Stop::watch`], every job of every map made from the watching thread first checks the
+//! [`Stop`], so a front end's Ctrl-C ends the work within one job rather than one generation.
 
+use std::cell::RefCell;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -58,8 +64,18 @@ impl Pool {
         T: Send,
         F: Fn(usize) -> T + Sync + Send,
     {
+        let stop = watched();
+        let job = |i| {
+            check(stop.as_ref());
+            job(i)
+        };
         match self {
             Pool::Serial => (0..jobs).map(job).collect(),
+            // Watched, the first job to stop halts the others: without the fuse, every job
+            // left would start, and unwind, in turn.
+            Pool::Parallel(pool) if stop.is_some() => {
+                pool.install(|| (0..jobs).into_par_iter().panic_fuse().map(job).collect())
+            }
             Pool::Parallel(pool) => pool.install(|| (0..jobs).into_par_iter().map(job).collect()),
         }
     }
@@ -72,11 +88,23 @@ impl Pool {
         I: Fn() -> S + Sync + Send,
         F: Fn(&mut S, usize) -> T + Sync + Send,
     {
+        let stop = watched();
+        let job = |state: &mut S, i| {
+            check(stop.as_ref());
+            job(state, i)
+        };
         match self {
             Pool::Serial => {
                 let mut state = init();
                 (0..jobs).map(|i| job(&mut state, i)).collect()
             }
+            Pool::Parallel(pool) if stop.is_some() => pool.install(|| {
+                (0..jobs)
+                    .into_par_iter()
+                    .panic_fuse()
+                    .map_init(init, job)
+                    .collect()
+            }),
             Pool::Parallel(pool) => {
                 pool.install(|| (0..jobs).into_par_iter().map_init(init, job).collect())
             }
@@ -90,9 +118,87 @@ impl Pool {
         U: Send,
         F: Fn(&mut T) -> U + Sync + Send,
     {
+        let stop = watched();
+        let job = |item: &mut T| {
+            check(stop.as_ref());
+            job(item)
+        };
         match self {
             Pool::Serial => items.iter_mut().map(job).collect(),
+            Pool::Parallel(pool) if stop.is_some() => {
+                pool.install(|| items.par_iter_mut().panic_fuse().map(job).collect())
+            }
             Pool::Parallel(pool) => pool.install(|| items.par_iter_mut().map(job).collect()),
+        }
+    }
+}
+
+/// A flag that cuts work short between jobs ([`Stop::watch`]); clones share it, so a front
+/// end keeps one and sets it from another thread (on Ctrl-C).
+#[derive(Clone, Debug, Default)]
+pub struct Stop(Arc<AtomicBool>);
+
+/// Work ended by its [`Stop`] before it finished.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("stopped before it finished")]
+pub struct Stopped;
+
+thread_local! {
+    /// The stop watched by the work running on this thread, if any ([`Stop::watch`]).
+    static WATCHED: RefCell<Option<Stop>> = const { RefCell::new(None) };
+}
+
+/// The stop the calling thread's work is watched by, for a map's jobs to check (they may run
+/// on other threads).
+fn watched() -> Option<Stop> {
+    WATCHED.with(|w| w.borrow().clone())
+}
+
+/// Ends the job under way if its stop is set: the job unwinds, without the panic hook (no
+/// message is printed), to [`Stop::watch`], which returns [`Stopped`].
+fn check(stop: Option<&Stop>) {
+    if stop.is_some_and(Stop::is_stopped) {
+        std::panic::resume_unwind(Box::new(Stopped));
+    }
+}
+
+impl Stop {
+    /// A flag, not set.
+    pub fn new() -> Stop {
+        Stop::default()
+    }
+
+    /// Sets the flag: watched work ends at its next job.
+    pub fn stop(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the flag is set.
+    pub fn is_stopped(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// Clears the flag, for the next piece of work.
+    pub fn reset(&self) {
+        self.0.store(false, Ordering::Relaxed);
+    }
+
+    /// Runs `work` on this thread so that every job of every [`Pool`] map it makes from this
+    /// thread (on whichever thread the job runs) first checks this flag, and once it is set
+    /// ends there. Returns `Err(Stopped)` if the work was cut short: whatever it was changing
+    /// may be half changed, so the caller throws that away or puts it back as it was. Jobs
+    /// under way finish; maps made from a pool's own threads (maps within a job) are not
+    /// watched. A panic that is not a stop goes on as a panic.
+    pub fn watch<T>(&self, work: impl FnOnce() -> T) -> Result<T, Stopped> {
+        let outer = WATCHED.with(|w| w.replace(Some(self.clone())));
+        // Unwinding is the one way out of a map that is not ours to change (the evolution
+        // engine's); `Stopped` is its only payload here, and the caller restores any state.
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work));
+        WATCHED.with(|w| *w.borrow_mut() = outer);
+        match result {
+            Ok(value) => Ok(value),
+            Err(payload) if payload.is::<Stopped>() => Err(Stopped),
+            Err(payload) => std::panic::resume_unwind(payload),
         }
     }
 }
@@ -100,6 +206,53 @@ impl Pool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stop_ends_watched_maps_between_jobs() {
+        for pool in [Pool::Serial, Pool::with_threads(2).unwrap()] {
+            let stop = Stop::new();
+            let ran = std::sync::atomic::AtomicUsize::new(0);
+            let result = stop.watch(|| {
+                pool.map(10_000, |i| {
+                    if ran.fetch_add(1, Ordering::Relaxed) == 10 {
+                        stop.stop();
+                    }
+                    i
+                })
+            });
+            assert_eq!(result, Err(Stopped));
+            // The jobs under way when it was set finish; no other starts.
+            assert!(
+                ran.load(Ordering::Relaxed) < 100,
+                "{}",
+                ran.load(Ordering::Relaxed)
+            );
+            // Unwatched work, and watched work once the flag is cleared, run whole.
+            assert_eq!(pool.map(3, |i| i), [0, 1, 2]);
+            stop.reset();
+            assert_eq!(stop.watch(|| pool.map(3, |i| i)), Ok(vec![0, 1, 2]));
+            let mut items = [1, 2, 3];
+            stop.stop();
+            assert_eq!(
+                stop.watch(|| pool.map_mut(&mut items, |x| *x)),
+                Err(Stopped)
+            );
+            assert_eq!(
+                stop.watch(|| pool.map_init(3, || 0, |_, i| i)),
+                Err(Stopped)
+            );
+            // Outside a map, the flag does nothing.
+            assert_eq!(stop.watch(|| 7), Ok(7));
+        }
+    }
+
+    #[test]
+    fn a_panic_is_not_a_stop() {
+        let stop = Stop::new();
+        let caught =
+            std::panic::catch_unwind(|| stop.watch(|| Pool::Serial.map(1, |_| panic!("bug"))));
+        assert!(caught.is_err());
+    }
 
     #[test]
     fn every_pool_gives_the_same_order() {

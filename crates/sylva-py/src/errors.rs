@@ -108,11 +108,20 @@ pub fn input_error(e: &sylva::InputError) -> PyErr {
 }
 
 /// Any Sylva error as the Python exception of its kind, its causes in the message: bad input
-/// is an `InputError`, a refusal of work that does not fit a `LimitError`, anything else a
+/// is an `InputError`, a refusal of work that does not fit a `LimitError`, an exception of the
+/// run's own fitness function that exception, a stop `KeyboardInterrupt`, anything else a
 /// `SylvaError`.
 pub fn error(e: sylva::Error) -> PyErr {
     match e {
         sylva::Error::Input(input) => input_error(&input),
+        // The run's own fitness function's exception, raised again as it was.
+        sylva::Error::Scorer(inner) => match inner.downcast::<PyErr>() {
+            Ok(e) => *e,
+            Err(other) => raise("SylvaError", sylva::error::chain(&*other), None),
+        },
+        sylva::Error::Stopped(_) => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err("stopped before it finished")
+        }
         e if e.is_limit() => raise("LimitError", sylva::error::chain(&e), None),
         e => raise("SylvaError", sylva::error::chain(&e), None),
     }

@@ -2,16 +2,18 @@
 //! migrants islands exchange.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, TryLockError};
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
+use sylva::evolution::Stop;
 use sylva::{Evolution as Run, Member as RunMember};
 use sylva::{GenerationStats, IndividualId};
 
 use crate::errors::{IntoPy, bad_value, input_error};
 use crate::genome::Genome;
 use crate::json::{from_py, to_py};
+use crate::work::{PyFitness, Serving, work};
 
 /// An evolution config of any model that evolves: read from a TOML file (`Config.load`),
 /// TOML text (`Config.from_toml`) or a dict shaped like the file (`Config.from_dict`).
@@ -265,6 +267,59 @@ impl Member {
 
 #[pymethods]
 impl Member {
+    /// A member of these fields (`Member._restore`, as a member unpickles).
+    #[staticmethod]
+    #[allow(clippy::too_many_arguments)] // One per field.
+    fn _restore(
+        id: u64,
+        genome: Genome,
+        fitness: Option<f64>,
+        terms: Bound<'_, PyDict>,
+        generation: u32,
+        operator: String,
+        parents: Vec<u64>,
+    ) -> Member {
+        Member {
+            id,
+            genome,
+            fitness,
+            terms: terms.into_any().unbind(),
+            generation,
+            operator,
+            parents,
+        }
+    }
+
+    /// Pickled as its fields.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let restore = py.get_type::<Member>().getattr("_restore")?;
+        let args = (
+            self.id,
+            self.genome.clone(),
+            self.fitness,
+            self.terms.bind(py),
+            self.generation,
+            self.operator.clone(),
+            self.parents.clone(),
+        );
+        Ok((restore, args).into_pyobject(py)?.into_any())
+    }
+
+    /// Members are equal when every field is.
+    fn __eq__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        let Ok(other) = other.cast::<Member>() else {
+            return Ok(false);
+        };
+        let o = other.get();
+        Ok(self.id == o.id
+            && self.genome.inner == o.genome.inner
+            && self.fitness.map(f64::to_bits) == o.fitness.map(f64::to_bits)
+            && self.generation == o.generation
+            && self.operator == o.operator
+            && self.parents == o.parents
+            && self.terms.bind(py).eq(o.terms.bind(py))?)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<sylva.Member {} fitness {}>",
@@ -274,21 +329,144 @@ impl Member {
     }
 }
 
+/// How a Python fitness function joins a run (`Evolution(config, fitness=f, ...)`).
+#[derive(Clone)]
+struct Fitness {
+    scorer: Arc<PyFitness>,
+    weight: f64,
+    /// "add" (beside the model's terms) or "replace" (alone).
+    mode: &'static str,
+    batch: usize,
+}
+
+/// The name of a Python fitness function's term.
+const PYTHON_TERM: &str = "python";
+
+impl Fitness {
+    /// The function and its settings, checked; none without a function.
+    fn of(
+        function: Option<Bound<'_, PyAny>>,
+        weight: f64,
+        mode: &str,
+        batch: usize,
+    ) -> PyResult<Option<Fitness>> {
+        let Some(function) = function else {
+            return Ok(None);
+        };
+        if !function.is_callable() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "`fitness` must be a function taking a list of plants, got {}",
+                function
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".into(), |n| n.to_string())
+            )));
+        }
+        let mode = match mode {
+            "add" => "add",
+            "replace" => "replace",
+            other => {
+                return Err(bad_value(
+                    "fitness_mode",
+                    format!(
+                        "{other:?}; expected \"add\" (beside the model's terms) or \"replace\" \
+                         (in their place)"
+                    ),
+                ));
+            }
+        };
+        Ok(Some(Fitness {
+            scorer: Arc::new(PyFitness::new(function.unbind())),
+            weight,
+            mode,
+            batch,
+        }))
+    }
+
+    fn term(&self) -> sylva::OwnTerm {
+        sylva::OwnTerm {
+            name: PYTHON_TERM.to_owned(),
+            scorer: self.scorer.clone(),
+            weight: self.weight,
+            beside: self.mode == "add",
+            batch: self.batch,
+        }
+    }
+}
+
 /// An evolution run of any model. `Evolution(config)` makes and scores generation 0
 /// (with the config's `start` genomes, or `start` given here); `step` breeds one
 /// generation, `run` a batch; `stats`, `population`, `best`, `fittest` and `family` read
-/// it; `checkpoint`/`save` and `Evolution.resume` stop and go on exactly. Long calls
-/// release the GIL.
+/// it; `checkpoint`/`save` and `Evolution.resume` stop and go on exactly. `fitness=f` adds
+/// a Python fitness function: `f(plants)` gets a list of grown `Plant`s and returns one
+/// number per plant, a term named "python" weighted `fitness_weight`, beside the model's
+/// terms (`fitness_mode="add"`) or in their place (`"replace"`), `fitness_batch` plants per
+/// call at most. Long calls release the GIL, and Ctrl-C stops them within one member's
+/// evaluation, leaving the run as it was before the generation under way.
 #[pyclass(module = "sylva", name = "Evolution")]
 pub struct Evolution {
     run: Mutex<Run>,
+    /// Set on Ctrl-C while the run works.
+    stop: Stop,
+    fitness: Option<Fitness>,
+    serving: Serving,
 }
 
 impl Evolution {
-    fn with<T>(&self, f: impl FnOnce(&mut Run) -> T) -> T {
-        // A panic inside a step would poison the lock; the run's state is still whole.
-        let mut run = self.run.lock().unwrap_or_else(|e| e.into_inner());
-        f(&mut run)
+    /// `f` on the run: at once when it is free, else after waiting for it with the GIL
+    /// released (another thread's call holds it). From the run's own fitness function, whose
+    /// run is at work, an error.
+    fn with<T: Send>(&self, py: Python<'_>, f: impl FnOnce(&mut Run) -> T + Send) -> PyResult<T> {
+        match self.run.try_lock() {
+            Ok(mut run) => Ok(f(&mut run)),
+            // A panic inside a step would poison the lock; the run's state is still whole.
+            Err(TryLockError::Poisoned(e)) => Ok(f(&mut e.into_inner())),
+            Err(TryLockError::WouldBlock) if self.serving.here() => {
+                Err(pyo3::exceptions::PyRuntimeError::new_err(
+                    "the run is breeding: its own fitness function cannot read it (score the \
+                     plants it is given)",
+                ))
+            }
+            Err(TryLockError::WouldBlock) => Ok(py.detach(|| {
+                let mut run = self.run.lock().unwrap_or_else(|e| e.into_inner());
+                f(&mut run)
+            })),
+        }
+    }
+
+    /// `job` on the run, off this thread, with Ctrl-C heard and the fitness function served
+    /// ([`work`]).
+    fn work<T: Send>(&self, py: Python<'_>, job: impl FnOnce(&mut Run) -> T + Send) -> PyResult<T> {
+        let scorer = self.fitness.as_ref().map(|f| &f.scorer);
+        work(py, &self.stop, scorer, &self.serving, || {
+            let mut run = self.run.lock().unwrap_or_else(|e| e.into_inner());
+            job(&mut run)
+        })
+    }
+
+    fn made(run: Run, stop: Stop, fitness: Option<Fitness>) -> Evolution {
+        Evolution {
+            run: Mutex::new(run),
+            stop,
+            fitness,
+            serving: Serving::default(),
+        }
+    }
+
+    /// Makes a run with `stop` and `fitness` hooked in, by `make`, off this thread.
+    fn make(
+        py: Python<'_>,
+        fitness: Option<Fitness>,
+        make: impl FnOnce(sylva::RunHooks) -> Result<Run, sylva::Error> + Send,
+    ) -> PyResult<Evolution> {
+        let stop = Stop::new();
+        let hooks = sylva::RunHooks {
+            stop: Some(stop.clone()),
+            term: fitness.as_ref().map(Fitness::term),
+        };
+        let scorer = fitness.as_ref().map(|f| &f.scorer);
+        let run = work(py, &stop, scorer, &Serving::default(), || make(hooks))?.py()?;
+        Ok(Evolution::made(run, stop, fitness))
     }
 
     pub(crate) fn pool(
@@ -305,6 +483,10 @@ impl Evolution {
         sylva::core::par::Pool::with_threads(threads as usize)
             .map_err(sylva::Error::from)
             .py()
+    }
+
+    fn names(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.with(py, |r| r.term_names().to_vec())
     }
 }
 
@@ -333,83 +515,119 @@ impl Evolution {
     /// Starts a run: generation 0 made and scored. `config` is a `Config`, a dict, or the
     /// path of a config file (as `islands()` takes it). `start` genomes are its first
     /// members (the config's `start` files when left out); `threads` overrides the config's.
+    /// `fitness`, `fitness_weight`, `fitness_mode` and `fitness_batch`: a Python fitness
+    /// function and how it joins the model's terms (see the class). Ctrl-C while generation
+    /// 0 is made raises `KeyboardInterrupt` (within one member's evaluation), and makes
+    /// nothing.
     #[new]
-    #[pyo3(signature = (config, start = None, threads = None))]
+    #[pyo3(signature = (config, start = None, threads = None, *, fitness = None,
+                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = 16))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn new(
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
         threads: Option<u32>,
+        fitness: Option<Bound<'_, PyAny>>,
+        fitness_weight: f64,
+        fitness_mode: &str,
+        fitness_batch: usize,
     ) -> PyResult<Evolution> {
         let config = &Config::from_any(config)?;
+        let fitness = Fitness::of(fitness, fitness_weight, fitness_mode, fitness_batch)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
             None => config.inner.load_start(&config.base).py()?,
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
-        let run = py.detach(|| Run::start(inner, start, pool)).py()?;
-        Ok(Evolution {
-            run: Mutex::new(run),
+        Evolution::make(py, fitness, |hooks| {
+            Run::start_with(inner, start, pool, hooks)
         })
     }
 
     /// Resumes a run from a checkpoint file (`path`) or its text (`text`), written by the
-    /// same config (only generations, threads and the checkpoint interval may change).
+    /// same config (only generations, threads and the checkpoint interval may change). A run
+    /// with a Python fitness function is resumed with it again (`fitness=f` and the same
+    /// `fitness_weight` and `fitness_mode`): a checkpoint holds its settings, not the
+    /// function.
     #[staticmethod]
-    #[pyo3(signature = (config, path = None, text = None, threads = None))]
+    #[pyo3(signature = (config, path = None, text = None, threads = None, *, fitness = None,
+                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = 16))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn resume(
         py: Python<'_>,
         config: &Config,
         path: Option<PathBuf>,
         text: Option<String>,
         threads: Option<u32>,
+        fitness: Option<Bound<'_, PyAny>>,
+        fitness_weight: f64,
+        fitness_mode: &str,
+        fitness_batch: usize,
     ) -> PyResult<Evolution> {
+        let fitness = Fitness::of(fitness, fitness_weight, fitness_mode, fitness_batch)?;
         let (path, text) = checkpoint_text(path, text)?;
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
-        let run = py.detach(|| Run::resume(inner, &path, &text, pool)).py()?;
-        Ok(Evolution {
-            run: Mutex::new(run),
+        Evolution::make(py, fitness, |hooks| {
+            Run::resume_with(inner, &path, &text, pool, hooks)
         })
     }
 
     /// The effective config.
     #[getter]
-    fn config(&self) -> Config {
-        Config {
-            inner: self.with(|r| r.config()),
+    fn config(&self, py: Python<'_>) -> PyResult<Config> {
+        Ok(Config {
+            inner: self.with(py, |r| r.config())?,
             base: PathBuf::new(),
-        }
+        })
     }
 
     /// The last completed generation.
     #[getter]
-    fn generation(&self) -> u32 {
-        self.with(|r| r.generation())
+    fn generation(&self, py: Python<'_>) -> PyResult<u32> {
+        self.with(py, |r| r.generation())
     }
 
     /// Names of the fitness terms.
     #[getter]
-    fn term_names(&self) -> Vec<String> {
-        self.with(|r| r.term_names().to_vec())
+    fn term_names(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.names(py)
     }
 
-    /// Breeds one generation; returns its statistics row. Releases the GIL.
+    /// The Python fitness function, if the run has one.
+    #[getter]
+    fn fitness(&self, py: Python<'_>) -> Option<Py<PyAny>> {
+        self.fitness
+            .as_ref()
+            .map(|f| f.scorer.function().clone_ref(py))
+    }
+
+    /// Calls of the Python fitness function so far, the plants they scored, the seconds the
+    /// calls took (the function's own work included) and the seconds dropping the plants
+    /// after took: what `benches/fitness_overhead.py` reads. None without a function.
+    #[getter]
+    fn _fitness_calls(&self) -> Option<(u64, u64, f64, f64)> {
+        self.fitness.as_ref().map(|f| f.scorer.spent())
+    }
+
+    /// Breeds one generation; returns its statistics row. Runs with the GIL released (but
+    /// while the fitness function runs). Ctrl-C raises `KeyboardInterrupt` within one
+    /// member's evaluation and leaves the run as it was before the generation: the next step
+    /// scores that population again first (as resuming would), then breeds.
     fn step<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (stats, names) = py.detach(|| {
-            self.with(|r| {
-                let stats = r.step().cloned();
-                (stats, r.term_names().to_vec())
-            })
-        });
+        let (stats, names) = self.work(py, |r| {
+            let stats = r.step().cloned();
+            (stats, r.term_names().to_vec())
+        })?;
         row(py, &stats.py()?, &names)
     }
 
     /// Breeds `generations` generations (up to the config's last when left out), calling
-    /// `on_generation(row)` after each when given. Releases the GIL while it breeds. Ctrl-C
-    /// raises `KeyboardInterrupt` when the generation under way ends, leaving the run whole
-    /// at that generation (step it, run it on, or checkpoint it).
+    /// `on_generation(row)` after each when given. Ctrl-C raises `KeyboardInterrupt` within
+    /// one member's evaluation, leaving the run whole at the last generation it finished
+    /// (step it, run it on, or checkpoint it).
     #[pyo3(signature = (generations = None, on_generation = None))]
     fn run(
         &self,
@@ -417,12 +635,14 @@ impl Evolution {
         generations: Option<u32>,
         on_generation: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let todo = generations.unwrap_or_else(|| {
-            self.with(|r| r.config().run().generations.saturating_sub(r.generation()))
-        });
+        let todo = match generations {
+            Some(n) => n,
+            None => self.with(py, |r| {
+                r.config().run().generations.saturating_sub(r.generation())
+            })?,
+        };
         for _ in 0..todo {
             let row = self.step(py)?;
-            py.check_signals()?;
             if let Some(callback) = &on_generation {
                 callback.call1((row,))?;
             }
@@ -433,13 +653,13 @@ impl Evolution {
     /// Statistics of every generation so far: one dict per generation (see `step`).
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let (stats, names) = self.with(|r| (r.stats().to_vec(), r.term_names().to_vec()));
+        let (stats, names) = self.with(py, |r| (r.stats().to_vec(), r.term_names().to_vec()))?;
         stats.iter().map(|s| row(py, s, &names)).collect()
     }
 
     /// The current population, in slot order.
     fn population(&self, py: Python<'_>) -> PyResult<Vec<Member>> {
-        let (members, names) = self.with(|r| (r.population(), r.term_names().to_vec()));
+        let (members, names) = self.with(py, |r| (r.population(), r.term_names().to_vec()))?;
         members
             .into_iter()
             .map(|m| Member::of(py, m, &names))
@@ -448,13 +668,13 @@ impl Evolution {
 
     /// The best member of the current population.
     fn best(&self, py: Python<'_>) -> PyResult<Member> {
-        let (best, names) = self.with(|r| (r.best(), r.term_names().to_vec()));
+        let (best, names) = self.with(py, |r| (r.best(), r.term_names().to_vec()))?;
         Member::of(py, best, &names)
     }
 
     /// The `count` fittest members, fittest first.
     fn fittest(&self, py: Python<'_>, count: usize) -> PyResult<Vec<Member>> {
-        let (members, names) = self.with(|r| (r.fittest(count), r.term_names().to_vec()));
+        let (members, names) = self.with(py, |r| (r.fittest(count), r.term_names().to_vec()))?;
         members
             .into_iter()
             .map(|m| Member::of(py, m, &names))
@@ -463,14 +683,18 @@ impl Evolution {
 
     /// A member by id, from the current population or a kept generation (None if gone).
     fn member(&self, py: Python<'_>, id: u64) -> PyResult<Option<Member>> {
-        let (member, names) = self.with(|r| (r.member(IndividualId(id)), r.term_names().to_vec()));
+        let (member, names) = self.with(py, |r| {
+            (r.member(IndividualId(id)), r.term_names().to_vec())
+        })?;
         member.map(|m| Member::of(py, m, &names)).transpose()
     }
 
     /// A member's family as far as kept generations reach: the member, its parents, theirs,
     /// each once, nearest first. Call `keep_history` before stepping to keep generations.
     fn family(&self, py: Python<'_>, id: u64) -> PyResult<Vec<Member>> {
-        let (members, names) = self.with(|r| (r.family(IndividualId(id)), r.term_names().to_vec()));
+        let (members, names) = self.with(py, |r| {
+            (r.family(IndividualId(id)), r.term_names().to_vec())
+        })?;
         members
             .into_iter()
             .map(|m| Member::of(py, m, &names))
@@ -479,28 +703,41 @@ impl Evolution {
 
     /// The population of `generation`, if it is the current one or still kept.
     fn generation_members(&self, py: Python<'_>, generation: u32) -> PyResult<Option<Vec<Member>>> {
-        let (members, names) =
-            self.with(|r| (r.generation_members(generation), r.term_names().to_vec()));
+        let (members, names) = self.with(py, |r| {
+            (r.generation_members(generation), r.term_names().to_vec())
+        })?;
         members
             .map(|ms| ms.into_iter().map(|m| Member::of(py, m, &names)).collect())
             .transpose()
     }
 
     /// Keeps the last `generations` generations for browsing (0 keeps only the current).
-    fn keep_history(&self, generations: usize) {
-        self.with(|r| r.keep_history(generations));
+    fn keep_history(&self, py: Python<'_>, generations: usize) -> PyResult<()> {
+        self.with(py, |r| r.keep_history(generations))
     }
 
     /// The checkpoint's text (JSON): everything needed to resume exactly.
     fn checkpoint(&self, py: Python<'_>) -> PyResult<String> {
-        py.detach(|| self.with(|r| r.checkpoint())).py()
+        self.with(py, |r| r.checkpoint())?.py()
     }
 
     /// Pickled through its checkpoint: unpickled, it resumes exactly where it was
-    /// (`Evolution.resume(config, text=checkpoint)`), for multiprocessing and Ray.
+    /// (`Evolution.resume(config, text=checkpoint)`), for multiprocessing and Ray. A run with
+    /// a Python fitness function pickles it too (by reference: a module-level function).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let resume = py.get_type::<Evolution>().getattr("resume")?;
-        let config = self.config();
+        let mut resume = py.get_type::<Evolution>().getattr("resume")?;
+        if let Some(f) = &self.fitness {
+            let kwargs = PyDict::new(py);
+            kwargs.set_item("fitness", f.scorer.function().bind(py))?;
+            kwargs.set_item("fitness_weight", f.weight)?;
+            kwargs.set_item("fitness_mode", f.mode)?;
+            kwargs.set_item("fitness_batch", f.batch)?;
+            resume = py
+                .import("functools")?
+                .getattr("partial")?
+                .call((resume,), Some(&kwargs))?;
+        }
+        let config = self.config(py)?;
         let text = self.checkpoint(py)?;
         Ok((resume, (config, None::<PathBuf>, text))
             .into_pyobject(py)?
@@ -509,20 +746,19 @@ impl Evolution {
 
     /// Writes the checkpoint file (atomically).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| {
-            let text = self.with(|r| r.checkpoint())?;
-            sylva::files::write(&path, text.as_bytes())
-        })
-        .py()
+        let text = self.checkpoint(py)?;
+        py.detach(|| sylva::files::write(&path, text.as_bytes()))
+            .py()
     }
 
     /// The `count` fittest genomes as the engine evolves them (bytes each): what an island
     /// sends its neighbours.
-    fn emigrants<'py>(&self, py: Python<'py>, count: usize) -> Vec<Bound<'py, PyBytes>> {
-        self.with(|r| r.emigrants(count))
+    fn emigrants<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Vec<Bound<'py, PyBytes>>> {
+        Ok(self
+            .with(py, |r| r.emigrants(count))?
             .iter()
             .map(|m| PyBytes::new(py, m.as_bytes()))
-            .collect()
+            .collect())
     }
 
     /// Puts migrants (from `emigrants` of a run of the same config) in the places of the
@@ -536,12 +772,12 @@ impl Evolution {
                     .map_err(|_| bad_value(format!("migrant {}", i + 1), "not UTF-8 text"))
             })
             .collect::<PyResult<Vec<String>>>()?;
-        let ids = py.detach(|| self.with(|r| r.immigrate(&texts))).py()?;
+        let ids = self.work(py, |r| r.immigrate(&texts))?.py()?;
         Ok(ids.into_iter().map(|id| id.0).collect())
     }
 
-    fn __repr__(&self) -> String {
-        self.with(|r| {
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        self.with(py, |r| {
             format!(
                 "<sylva.Evolution {} generation {}>",
                 r.title(),
@@ -552,20 +788,22 @@ impl Evolution {
 }
 
 /// Evolves a plant whose outline matches a picture and returns the run, as `sylva match`
-/// does: `target` is a PNG or JPEG of the outline seen from the front, `side` the one seen
-/// from the side (the front picture by default); `model` a model's name or `"auto"` (each
-/// model briefly, then on with the best); for `generations` (the same bytes each time) or
-/// `seconds` of breeding (60 by default); `threshold` `"otsu"` or a luminance from 0 to 1.
-/// The best member's `terms["iou"]` is its outline term (docs/match.md). Releases the GIL
-/// while it breeds; Ctrl-C raises `KeyboardInterrupt` between generations.
+/// does: `target` is the outline seen from the front and `side` the one seen from the side
+/// (the front one by default), each a PNG or JPEG file or a numpy array (a 2-D mask, ink
+/// True or nonzero; or a uint8 image, grey (h, w), RGB or RGBA (h, w, 3 or 4), read as its
+/// PNG file would be); `model` a model's name or `"auto"` (each model briefly, then on with
+/// the best); for `generations` (the same bytes each time) or `seconds` of breeding (60 by
+/// default); `threshold` `"otsu"` or a luminance from 0 to 1. The best member's
+/// `terms["iou"]` is its outline term (docs/match.md). Releases the GIL while it breeds;
+/// Ctrl-C raises `KeyboardInterrupt` within one member's evaluation.
 #[pyfunction(name = "match")]
 #[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
                     population = 100, seed = 1, threshold = None, threads = 0))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
 pub fn match_outline(
     py: Python<'_>,
-    target: PathBuf,
-    side: Option<PathBuf>,
+    target: &Bound<'_, PyAny>,
+    side: Option<&Bound<'_, PyAny>>,
     model: &str,
     generations: Option<u32>,
     seconds: Option<f64>,
@@ -581,9 +819,13 @@ pub fn match_outline(
             .map_err(|e| bad_value("threshold", e))?,
     };
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
-    let front = absolute(&target);
+    let front = absolute(&crate::mask::picture_path(py, target, "target")?);
+    let side = match side {
+        Some(side) => absolute(&crate::mask::picture_path(py, side, "side")?),
+        None => front.clone(),
+    };
     let outline = sylva::evolution::MatchConfig {
-        side: Some(side.as_deref().map_or_else(|| front.clone(), absolute)),
+        side: Some(side),
         front,
         threshold,
         weight: 1.0,
@@ -627,25 +869,37 @@ pub fn match_outline(
         config.as_ref().unwrap_or(&sylva::Config::default()),
         Some(threads),
     )?;
-    let (mut evolution, elsewhere) = py
-        .detach(|| -> Result<(Run, f64), sylva::Error> {
-            match &config {
-                Some(config) => Ok((Run::start(config, Vec::new(), pool)?, 0.0)),
-                None => start_auto(registry, &outline, &run, limit, &pool, |_| {}),
+    let stop = Stop::new();
+    let (evolution, elsewhere) = work(py, &stop, None, &Serving::default(), || {
+        match &config {
+            Some(config) => {
+                let hooks = sylva::RunHooks {
+                    stop: Some(stop.clone()),
+                    term: None,
+                };
+                Ok((Run::start_with(config, Vec::new(), pool, hooks)?, 0.0))
             }
-        })
-        .py()?;
-    py.check_signals()?;
+            // The trials are thrown away if stopped.
+            None => {
+                let (mut run, elsewhere) =
+                    stop.watch(|| start_auto(registry, &outline, &run, limit, &pool, |_| {}))??;
+                run.set_stop(Some(stop.clone()));
+                Ok::<_, sylva::Error>((run, elsewhere))
+            }
+        }
+    })?
+    .py()?;
     let remaining = limit.remaining(&evolution, elsewhere);
+    let evolution = Evolution::made(evolution, stop, None);
     let started = std::time::Instant::now();
-    // A generation at a time, so Ctrl-C is heard between them.
-    while !remaining.reached(&evolution, started) {
-        py.detach(|| evolution.step().map(|_| ())).py()?;
-        py.check_signals()?;
+    loop {
+        let reached = evolution.with(py, |r| remaining.reached(r, started))?;
+        if reached {
+            break;
+        }
+        evolution.work(py, |r| r.step().map(|_| ()))?.py()?;
     }
-    Ok(Evolution {
-        run: Mutex::new(evolution),
-    })
+    Ok(evolution)
 }
 
 /// A checkpoint to resume from: the file at `path`, or `text` (named `<checkpoint>` in

@@ -209,6 +209,12 @@ impl Genome {
             .is_ok_and(|o| o.borrow().inner == self.inner)
     }
 
+    /// The hash of its genome file's text: equal genomes hash alike, so genomes are set
+    /// members and dict keys (do not set a field of one while it is).
+    fn __hash__(&self) -> u64 {
+        sylva::core::hash::stable_hash(self.inner.to_json().as_bytes())
+    }
+
     fn __repr__(&self) -> String {
         let hash = sylva::core::hash::stable_hash(self.inner.to_json().as_bytes());
         format!("<sylva.Genome {} {hash:016x}>", self.inner.model())

@@ -10,22 +10,27 @@
 //! - [`varieties`]: `Varieties` (maps of varieties: step, archive, checkpoint), `Variety`,
 //!   `Archive`;
 //! - [`space`]: `GenomeSpace`, genomes as numpy vectors for optimisers outside Sylva;
-//! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`.
+//! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`;
+//! - [`work`]: long calls off the calling thread, so Ctrl-C is heard and a Python fitness
+//!   function is served; [`mask`]: numpy masks as match targets.
 //!
 //! The module reads and makes genomes and configs with the models it was made with
 //! ([`init`]): Sylva's four, or a registry of a crate's own.
 //!
-//! Calls that grow, mesh, render, write or breed release the GIL. The pure-Python half
+//! Calls that grow, mesh, render, write or breed release the GIL; runs stop on Ctrl-C within
+//! one member's evaluation. The pure-Python half
 //! (`python/sylva`) adds island evolution on Ray or a local process pool.
 
 mod errors;
 mod evolution;
 mod genome;
 mod json;
+mod mask;
 mod pair;
 mod plant;
 mod space;
 mod varieties;
+mod work;
 
 use std::sync::OnceLock;
 

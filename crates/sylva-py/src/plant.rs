@@ -187,6 +187,55 @@ impl Plant {
         render(py, &self.grown.scene(), path, view, size.into())
     }
 
+    /// The plant grown again from what it grew from (`Plant._regrow`): the same genome,
+    /// seed, roots, taper and height give the same bytes.
+    #[staticmethod]
+    #[pyo3(signature = (genome, seed, roots, taper, height = None))]
+    fn _regrow(
+        py: Python<'_>,
+        genome: &Genome,
+        seed: u64,
+        roots: bool,
+        taper: Option<f64>,
+        height: Option<f32>,
+    ) -> PyResult<Plant> {
+        let taper = taper
+            .map(sylva::core::taper::PipeTaper::new)
+            .transpose()
+            .map_err(|e| bad_value("taper", e))?;
+        let options = sylva::GrowOptions {
+            seed: Some(seed),
+            roots,
+            taper,
+            height,
+            ..sylva::GrowOptions::default()
+        };
+        let genome = genome.inner.clone();
+        let grown = py.detach(|| sylva::Grown::grow(genome, &options)).py()?;
+        Ok(Plant::new(grown))
+    }
+
+    /// Pickled as what it grew from (genome, seed, roots, taper), so it grows again to the
+    /// same bytes when unpickled: a few bytes for multiprocessing and Ray rather than its
+    /// mesh.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        if self.grown.rig.is_some() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(
+                "a plant grown with wind does not pickle",
+            ));
+        }
+        let regrow = py.get_type::<Plant>().getattr("_regrow")?;
+        let g = &self.grown;
+        let args = (
+            self.genome(),
+            g.seed,
+            g.roots,
+            g.taper.map(|t| t.exponent),
+            g.height,
+        );
+        Ok((regrow, args).into_pyobject(py)?.into_any())
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<sylva.Plant {} seed {}: {} segments, {} organs, {} triangles>",
@@ -302,6 +351,50 @@ impl Mesh {
 
 #[pymethods]
 impl Mesh {
+    /// A mesh of these arrays (`Mesh._from_arrays`, as a mesh unpickles): they are made
+    /// read-only, as a plant's are.
+    #[staticmethod]
+    fn _from_arrays(
+        positions: Bound<'_, PyArray2<f32>>,
+        normals: Bound<'_, PyArray2<f32>>,
+        uvs: Bound<'_, PyArray2<f32>>,
+        indices: Bound<'_, PyArray2<u32>>,
+        triangle_materials: Bound<'_, PyArray1<u32>>,
+        materials: Bound<'_, PyList>,
+    ) -> PyResult<Mesh> {
+        for array in [
+            positions.as_any(),
+            normals.as_any(),
+            uvs.as_any(),
+            indices.as_any(),
+            triangle_materials.as_any(),
+        ] {
+            array.call_method1("setflags", (false,))?;
+        }
+        Ok(Mesh {
+            positions: positions.unbind(),
+            normals: normals.unbind(),
+            uvs: uvs.unbind(),
+            indices: indices.unbind(),
+            triangle_materials: triangle_materials.unbind(),
+            materials: materials.into_any().unbind(),
+        })
+    }
+
+    /// Pickled as its arrays (copied: an unpickled mesh owns its memory, read-only).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let make = py.get_type::<Mesh>().getattr("_from_arrays")?;
+        let args = (
+            self.positions.bind(py),
+            self.normals.bind(py),
+            self.uvs.bind(py),
+            self.indices.bind(py),
+            self.triangle_materials.bind(py),
+            self.materials.bind(py),
+        );
+        Ok((make, args).into_pyobject(py)?.into_any())
+    }
+
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "<sylva.Mesh {} vertices, {} triangles>",

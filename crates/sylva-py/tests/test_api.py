@@ -6,7 +6,9 @@ from __future__ import annotations
 import gc
 import json
 import math
+import os
 import pickle
+import signal
 import struct
 import threading
 import time
@@ -385,6 +387,59 @@ def test_messages_speak_python():
     assert "bool True" in str(e.value) and "i64" not in e.value.detail
 
 
+def png(path: Path, pixels: np.ndarray) -> Path:
+    """Writes an 8-bit grey (h, w) or RGB (h, w, 3) PNG file, without a picture library."""
+    import zlib
+
+    height, width = pixels.shape[:2]
+    kind = 0 if pixels.ndim == 2 else 2
+    raw = b"".join(b"\x00" + row.tobytes() for row in pixels.astype(np.uint8))
+
+    def chunk(name: bytes, data: bytes) -> bytes:
+        body = name + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, kind, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+                     + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+    return path
+
+
+def test_match_takes_numpy_masks_as_it_takes_pictures(tmp_path):
+    # A cone: ink (True) widening downwards, on a 48 x 64 canvas.
+    y, x = np.mgrid[0:64, 0:48]
+    mask = (np.abs(x - 24) < (y - 4) * 0.35) & (y > 4) & (y < 60)
+    trunk = (np.abs(x - 24) < 2) & (y >= 56)
+    mask |= trunk
+    side = np.abs(x - 24) < (y - 4) * 0.25
+    ink = np.where(mask, 0, 255).astype(np.uint8)
+    files = png(tmp_path / "cone.png", ink), png(tmp_path / "side.png", np.where(side, 0, 255))
+    kwargs = dict(model="bintree", generations=3, population=10, seed=4)
+
+    def result(run):
+        return run.best().genome, [{k: v for k, v in r.items() if k != "seconds"} for r in run.stats]
+
+    from_files = result(sylva.match(files[0], side=files[1], **kwargs))
+    assert result(sylva.match(mask, side=side, **kwargs)) == from_files
+    # Any numbers (ink: nonzero), and a uint8 picture read as its PNG file is.
+    assert result(sylva.match(mask * 0.5, side=side.astype(np.int32), **kwargs)) == from_files
+    rgb = np.repeat(ink[:, :, None], 3, axis=2)
+    png(tmp_path / "rgb.png", rgb)
+    assert result(sylva.match(rgb, side=side, **kwargs)) == result(
+        sylva.match(tmp_path / "rgb.png", side=side, **kwargs))
+    # What a mask cannot be is refused naming the argument.
+    with pytest.raises(sylva.InputError, match="astype\\(bool\\)"):
+        sylva.match(mask.astype(np.uint8), **kwargs)
+    with pytest.raises(sylva.InputError, match="side"):
+        sylva.match(mask, side=np.zeros((4, 4, 4)), **kwargs)
+    with pytest.raises(TypeError, match="target"):
+        sylva.match(np.array([["a"]]), **kwargs)
+    with pytest.raises(TypeError, match="target"):
+        sylva.match(42, **kwargs)
+    with pytest.raises(sylva.InputError):
+        sylva.match(np.zeros((64, 48), bool), **kwargs)  # no ink: no outline
+
+
 def test_match_evolves_towards_a_picture(tmp_path):
     target = EXAMPLES / "match" / "cone.png"
     run = sylva.match(target, model="bintree", generations=6, population=12, seed=4)
@@ -405,7 +460,7 @@ def test_match_evolves_towards_a_picture(tmp_path):
         sylva.match(target, generations=1, seconds=5)
 
 
-def test_ctrl_c_stops_a_run_between_generations_and_leaves_it_whole():
+def test_ctrl_c_stops_a_run_and_leaves_it_whole():
     import _thread
 
     run = sylva.Evolution(CONFIGS["bintree"], threads=1)
@@ -422,6 +477,49 @@ def test_ctrl_c_stops_a_run_between_generations_and_leaves_it_whole():
     assert 0 < stopped < 100_000
     run.step()
     assert run.generation == stopped + 1
+
+
+def sigint_after(seconds: float) -> threading.Timer:
+    """A real SIGINT to this process (what Ctrl-C sends) after `seconds`."""
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_making_a_huge_population():
+    # 400 L-system plants, each grown for 150 steps in a voxel world: about 50 s on two
+    # threads uninterrupted. Ctrl-C is heard within one plant's growth.
+    config = sylva.Config.load(CONFIGS["lsystem"]).with_run(population=400)
+    timer = sigint_after(0.3)
+    started = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sylva.Evolution(config, threads=2)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - started < 10
+
+
+def test_ctrl_c_stops_a_long_generation_and_leaves_the_run_as_it_was():
+    config = sylva.Config.load(CONFIGS["lsystem"]).with_run(population=16, seed=3)
+    run = sylva.Evolution(config, threads=2)
+    before = run.checkpoint()
+    best = run.best()
+    # One generation of these 16 plants takes seconds: it is under way when the signal comes.
+    timer = sigint_after(0.1)
+    started = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run.step()
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - started < 10
+    # The run reads, checkpoints and pickles as it was before the generation (the library's
+    # tests step it on, exactly as if it had not been stopped).
+    assert run.generation == 0 and len(run.stats) == 1
+    assert run.checkpoint() == before
+    assert run.best() == best
+    assert pickle.loads(pickle.dumps(run)).checkpoint() == before
 
 
 def test_budgets_are_set_from_python_and_refusals_say_how():
@@ -444,6 +542,56 @@ def test_budgets_are_set_from_python_and_refusals_say_how():
         sylva.Evolution(config)
     with pytest.raises(sylva.InputError, match="seconds"):
         sylva.set_max_time(float("nan"))
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_plants_meshes_and_members_pickle_exactly(model):
+    genome = sylva.Genome.load(GENOMES[model])
+    plants = [genome.grow(seed=3), genome.grow(seed=4, roots=False, taper=2.5)]
+    for plant in plants:
+        copy = pickle.loads(pickle.dumps(plant))
+        assert (copy.genome, copy.seed) == (plant.genome, plant.seed)
+        assert copy.glb() == plant.glb(), "it grows again to the same bytes"
+        assert copy.skeleton_json() == plant.skeleton_json()
+    mesh = plants[0].mesh
+    copy = pickle.loads(pickle.dumps(mesh))
+    for name in ["positions", "normals", "uvs", "indices", "triangle_materials"]:
+        a, b = getattr(mesh, name), getattr(copy, name)
+        assert a.dtype == b.dtype and np.array_equal(a, b), name
+        assert not b.flags.writeable, name
+    assert copy.materials == mesh.materials
+    run = sylva.Evolution(sylva.Config.load(CONFIGS[model]).with_run(population=6, seed=2),
+                          threads=1)
+    for member in run.population():
+        copy = pickle.loads(pickle.dumps(member))
+        assert copy == member
+        assert (copy.id, copy.genome, copy.fitness, copy.terms, copy.operator, copy.parents) == (
+            member.id, member.genome, member.fitness, member.terms, member.operator,
+            member.parents)
+
+
+def test_genomes_are_hashable():
+    oak = sylva.Genome.load(GENOMES["bintree"])
+    same = sylva.Genome.from_json(oak.to_json())
+    other = oak.mutate(seed=3)
+    assert hash(oak) == hash(same) and {oak, same, other} == {oak, other}
+    assert {oak: 1}[same] == 1
+
+
+def test_plants_meshes_and_members_cross_processes():
+    import concurrent.futures
+    import copy
+    import multiprocessing
+
+    plant = sylva.Genome.load(GENOMES["plantmaker"]).grow(seed=2)
+    member = sylva.Evolution(CONFIGS["bintree"], threads=1).best()
+    # A fresh interpreter (spawn) unpickles each, copies it, and sends it back.
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(1, mp_context=context) as pool:
+        back = list(pool.map(copy.copy, [plant, plant.mesh, member, member.genome]))
+    assert back[0].glb() == plant.glb()
+    assert np.array_equal(back[1].positions, plant.mesh.positions)
+    assert back[2] == member and back[3] == member.genome
 
 
 def test_a_run_pickles_through_its_checkpoint():

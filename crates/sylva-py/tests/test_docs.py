@@ -22,4 +22,9 @@ def test_the_walk_through_runs_as_written(tmp_path, monkeypatch):
     for written in ["tulip.glb", "tulip.png", "run.checkpoint.json", "garden.glb", "best-island.glb"]:
         assert (tmp_path / written).stat().st_size > 0, written
     assert namespace["again"].generation == namespace["run"].generation
+    # The fitness function of one's own: crowns under the height cap, in place of the model's.
+    shaped, crown = namespace["shaped"], namespace["crown"]
+    assert shaped.term_names == ["python"] and crown.terms["python"] > 0
+    assert crown.genome.grow().mesh.positions[:, 1].max() <= 4.0
+    assert shaped.stats[-1]["best"] >= shaped.stats[0]["best"]
     assert os.path.getsize(tmp_path / "tulip.png") == len(namespace["png"])

@@ -99,6 +99,50 @@ def test_a_stopped_driver_resumes_from_its_checkpoint(local, tmp_path):
         sylva.islands(small_sphere(), backend="local", checkpoint=path, **dict(RUN, migrants=1))
 
 
+CTRL_C_SCRIPT = """
+import sys, sylva
+config = sylva.Config.load(sys.argv[1]).with_run(population=200, generations=400)
+def on_round(info):
+    print("round", info["round"], *info["pids"], flush=True)
+try:
+    sylva.islands(config, islands=2, migrate_every=2, seed=3, backend="local",
+                  checkpoint=sys.argv[2], on_round=on_round)
+except KeyboardInterrupt:
+    print("stopped", flush=True)
+    sys.exit(130)
+"""
+
+
+def test_ctrl_c_stops_local_islands_without_tracebacks_from_workers(tmp_path):
+    import subprocess
+    import sys
+
+    # The driver in a process group of its own, with its workers: the terminal's Ctrl-C
+    # goes to the whole group.
+    driver = subprocess.Popen(
+        [sys.executable, "-c", CTRL_C_SCRIPT, str(EXAMPLES / "automata" / "sphere.toml"),
+         str(tmp_path / "islands.json")],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )
+    try:
+        first = driver.stdout.readline().split()
+        assert first[:2] == ["round", "1"], first
+        os.killpg(driver.pid, signal.SIGINT)
+        out, err = driver.communicate(timeout=60)
+    finally:
+        if driver.poll() is None:
+            driver.kill()
+    assert driver.returncode == 130 and out.strip().endswith("stopped"), (out, err)
+    # Only the driver heard it: no worker wrote a traceback, and none is left.
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    for pid in map(int, first[2:]):
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+    # The run resumes from its last round.
+    saved = __import__("json").loads((tmp_path / "islands.json").read_text())
+    assert saved["round"] >= 1
+
+
 @pytest.mark.parametrize(
     "change, field",
     [

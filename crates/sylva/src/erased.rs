@@ -23,7 +23,7 @@ use sylva_model::{Bred, DevelopError, Evolve, GenomeError, MeshHint, Model, Pare
 use crate::error::{Error, FieldError, InputError};
 use crate::evolution::{EvolveConfig, GenerationTime, Member, OutputConfig, RunConfig};
 use crate::evolution::{MapValue, TypedRun, resume, resume_map, start, start_map};
-use crate::evolution::{SpaceOptions, SpaceValue, new_space};
+use crate::evolution::{RunHooks, SpaceOptions, SpaceValue, Stop, new_space};
 use crate::genome::{Genome, Settings, settings_of};
 
 /// A model's genome or config, erased.
@@ -89,7 +89,9 @@ pub(crate) trait DynModel: Send + Sync {
         base: &Path,
         start: Vec<Genome>,
         pool: Pool,
+        hooks: RunHooks,
     ) -> Result<Box<RunValue>, Error>;
+    #[allow(clippy::too_many_arguments)] // What resuming takes, one argument each.
     fn resume(
         &self,
         config: &Value,
@@ -98,6 +100,7 @@ pub(crate) trait DynModel: Send + Sync {
         path: &Path,
         text: &str,
         pool: Pool,
+        hooks: RunHooks,
     ) -> Result<Box<RunValue>, Error>;
 
     fn start_map(
@@ -128,7 +131,8 @@ pub(crate) trait DynModel: Send + Sync {
 
     // Runs.
     fn effective_config(&self, run: &RunValue) -> Box<Value>;
-    fn step<'a>(&self, run: &'a mut RunValue) -> &'a GenerationStats;
+    fn step(&self, run: &mut RunValue) -> Result<(), Error>;
+    fn set_stop(&self, run: &mut RunValue, stop: Option<Stop>);
     fn generation(&self, run: &RunValue) -> u32;
     fn stats<'a>(&self, run: &'a RunValue) -> &'a [GenerationStats];
     fn term_names<'a>(&self, run: &'a RunValue) -> &'a [String];
@@ -145,7 +149,7 @@ pub(crate) trait DynModel: Send + Sync {
         &self,
         run: &mut RunValue,
         migrants: &[String],
-    ) -> Result<Vec<IndividualId>, InputError>;
+    ) -> Result<Vec<IndividualId>, Error>;
 }
 
 /// The typed genome in `value`, held with its own model.
@@ -337,8 +341,16 @@ impl<M: Evolve + Default> DynModel for M {
         base: &Path,
         first: Vec<Genome>,
         pool: Pool,
+        hooks: RunHooks,
     ) -> Result<Box<RunValue>, Error> {
-        Ok(Box::new(start(config::<M>(c), source, base, first, pool)?))
+        Ok(Box::new(start(
+            config::<M>(c),
+            source,
+            base,
+            first,
+            pool,
+            hooks,
+        )?))
     }
 
     fn resume(
@@ -349,6 +361,7 @@ impl<M: Evolve + Default> DynModel for M {
         path: &Path,
         text: &str,
         pool: Pool,
+        hooks: RunHooks,
     ) -> Result<Box<RunValue>, Error> {
         Ok(Box::new(resume(
             config::<M>(c),
@@ -357,6 +370,7 @@ impl<M: Evolve + Default> DynModel for M {
             path,
             text,
             pool,
+            hooks,
         )?))
     }
 
@@ -398,16 +412,20 @@ impl<M: Evolve + Default> DynModel for M {
         Box::new(run::<M>(r).config.clone())
     }
 
-    fn step<'a>(&self, r: &'a mut RunValue) -> &'a GenerationStats {
-        run_mut::<M>(r).run.step()
+    fn step(&self, r: &mut RunValue) -> Result<(), Error> {
+        run_mut::<M>(r).step()
+    }
+
+    fn set_stop(&self, r: &mut RunValue, stop: Option<Stop>) {
+        run_mut::<M>(r).hooked.stop = stop;
     }
 
     fn generation(&self, r: &RunValue) -> u32 {
-        run::<M>(r).run.generation()
+        run::<M>(r).generation()
     }
 
     fn stats<'a>(&self, r: &'a RunValue) -> &'a [GenerationStats] {
-        run::<M>(r).run.stats()
+        run::<M>(r).stats()
     }
 
     fn term_names<'a>(&self, r: &'a RunValue) -> &'a [String] {
@@ -423,23 +441,19 @@ impl<M: Evolve + Default> DynModel for M {
     }
 
     fn best(&self, r: &RunValue) -> Member {
-        let r = run::<M>(r);
-        r.member(r.run.best())
+        run::<M>(r).best()
     }
 
     fn member(&self, r: &RunValue, id: IndividualId) -> Option<Member> {
-        let r = run::<M>(r);
-        r.run.find(id).map(|i| r.member(i))
+        run::<M>(r).find(id)
     }
 
     fn generation_members(&self, r: &RunValue, generation: u32) -> Option<Vec<Member>> {
-        let r = run::<M>(r);
-        let population = r.run.generation_population(generation)?;
-        Some(population.iter().map(|i| r.member(i)).collect())
+        run::<M>(r).generation_members(generation)
     }
 
     fn keep_history(&self, r: &mut RunValue, generations: usize) {
-        run_mut::<M>(r).run.set_keep_history(generations);
+        run_mut::<M>(r).keep_history(generations);
     }
 
     fn checkpoint(&self, r: &RunValue) -> Result<String, Error> {
@@ -449,7 +463,9 @@ impl<M: Evolve + Default> DynModel for M {
     fn guides(&self, r: &RunValue) -> Option<Plant> {
         let r = run::<M>(r);
         // The model's own guides mean nothing when its terms do not count.
-        if r.config.outline.as_ref().is_some_and(|o| !o.beside) {
+        if r.config.outline.as_ref().is_some_and(|o| !o.beside)
+            || r.run.problem().added.as_ref().is_some_and(|a| !a.beside)
+        {
             return None;
         }
         Evolve::guides(&r.config.model, &r.run.problem().problem)
@@ -459,11 +475,7 @@ impl<M: Evolve + Default> DynModel for M {
         run::<M>(r).emigrants(count)
     }
 
-    fn immigrate(
-        &self,
-        r: &mut RunValue,
-        migrants: &[String],
-    ) -> Result<Vec<IndividualId>, InputError> {
+    fn immigrate(&self, r: &mut RunValue, migrants: &[String]) -> Result<Vec<IndividualId>, Error> {
         run_mut::<M>(r).immigrate(migrants)
     }
 }

@@ -247,6 +247,13 @@ pub enum Error {
     /// The worker threads could not start.
     #[error("starting the worker threads")]
     Threads(#[from] sylva_core::par::ThreadPoolBuildError),
+    /// Work was cut short by its [`Stop`](sylva_core::par::Stop) (a front end's Ctrl-C).
+    #[error(transparent)]
+    Stopped(#[from] sylva_core::par::Stopped),
+    /// A run's own fitness function (a front end's code,
+    /// [`PlantScorer`](crate::evolution::PlantScorer)) failed; its error is kept whole.
+    #[error("scoring plants with the run's own fitness function")]
+    Scorer(#[source] crate::evolution::ScorerError),
 }
 
 impl Error {

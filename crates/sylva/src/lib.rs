@@ -60,8 +60,8 @@ pub mod skeleton;
 pub use assets::{GrowOptions, Grown, Origin, Placed, SceneAssets};
 pub use error::{Error, FieldError, InputError};
 pub use evolution::{
-    Config, Evolution, EvolveConfig, GenomeSpace, Member, OutputConfig, RunConfig, Varieties,
-    Variety,
+    Config, Evolution, EvolveConfig, GenomeSpace, Member, OutputConfig, OwnTerm, PlantScorer,
+    RunConfig, RunHooks, Varieties, Variety,
 };
 pub use experiment::Experiment;
 pub use genome::{Genome, Settings, load_genome, parse_genome};

@@ -133,6 +133,43 @@ pub fn decode_target(
     Ok(ink)
 }
 
+/// A picture held in memory (8-bit pixels, `channels` to a pixel: 1 grey, 3 RGB, 4 RGBA;
+/// rows top first) as PNG bytes, for what reads targets from files: a front end's picture
+/// in memory (Python's numpy mask) becomes the file a config can name. `name` names it in
+/// errors.
+pub fn encode_png(
+    name: &str,
+    width: u32,
+    height: u32,
+    channels: u8,
+    pixels: Vec<u8>,
+) -> Result<Vec<u8>, InputError> {
+    let bad = |message: String| InputError::new(name, message);
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(bad(format!(
+            "{width} x {height} pixels; expected 1 to {MAX_SIDE} on each side"
+        )));
+    }
+    let wrong = || bad("the pixels do not fill the picture".to_owned());
+    let image = match channels {
+        1 => DynamicImage::ImageLuma8(
+            ImageBuffer::from_raw(width, height, pixels).ok_or_else(wrong)?,
+        ),
+        3 => {
+            DynamicImage::ImageRgb8(ImageBuffer::from_raw(width, height, pixels).ok_or_else(wrong)?)
+        }
+        4 => DynamicImage::ImageRgba8(
+            ImageBuffer::from_raw(width, height, pixels).ok_or_else(wrong)?,
+        ),
+        n => return Err(bad(format!("{n} channels; expected 1, 3 or 4"))),
+    };
+    let mut png = Cursor::new(Vec::new());
+    image
+        .write_to(&mut png, ImageFormat::Png)
+        .map_err(|e| bad(e.to_string()))?;
+    Ok(png.into_inner())
+}
+
 /// Otsu's threshold of a 256-bin luminance histogram, as a level 0..=1: the split into a dark
 /// class (the bins below the level) and a light one with the greatest variance between
 /// their means. When a run of empty bins separates the classes, the level is in the middle

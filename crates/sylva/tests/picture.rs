@@ -354,3 +354,32 @@ fn a_level_outside_zero_to_one_is_refused() {
         );
     }
 }
+
+#[test]
+fn pictures_held_in_memory_encode_to_pngs_read_back_exactly() {
+    // A mask drawn black on white, as Python's numpy masks are written.
+    let grey: Vec<u8> = (0..H)
+        .flat_map(|y| (0..W).map(move |x| if is_tree(x, y) { 0 } else { 255 }))
+        .collect();
+    let png = sylva::picture::encode_png("target", W, H, 1, grey.clone()).unwrap();
+    for threshold in [
+        Threshold::Otsu,
+        Threshold::Level(0.1),
+        Threshold::Level(1.0),
+    ] {
+        let ink = decode_target(Path::new("mask.png"), &png, threshold).unwrap();
+        for (x, y) in (0..H).flat_map(|y| (0..W).map(move |x| (x, y))) {
+            assert_eq!(ink.get(x, y), is_tree(x, y), "({x}, {y}) {threshold:?}");
+        }
+    }
+    // RGB and RGBA pictures read as their files would be.
+    let rgb: Vec<u8> = grey.iter().flat_map(|&g| [g, g, g]).collect();
+    let png = sylva::picture::encode_png("target", W, H, 3, rgb).unwrap();
+    let ink = decode_target(Path::new("rgb.png"), &png, Threshold::Otsu).unwrap();
+    assert!(ink.get(24, 22) && !ink.get(0, 0));
+    // Bad shapes are refused naming the picture.
+    for (w, h, channels, len) in [(0, 4, 1, 0), (W, H, 2, (W * H * 2) as usize), (W, H, 1, 5)] {
+        let e = sylva::picture::encode_png("side", w, h, channels, vec![0; len]).unwrap_err();
+        assert_eq!(e.location, "side", "{e}");
+    }
+}

@@ -12,7 +12,8 @@ stands on); long calls release the GIL.
 
 Genomes of the four models (``bintree``, ``automata``, ``plantmaker``, ``lsystem``) are
 :class:`Genome`; a grown one is a :class:`Plant`; many plants make a :class:`Scene`
-(:func:`garden`, :func:`scene`). :class:`Config` and :class:`Evolution` run evolutions;
+(:func:`garden`, :func:`scene`). :class:`Config` and :class:`Evolution` run evolutions (scored
+by a Python function of your own too: ``Evolution(config, fitness=f)``);
 :func:`islands` runs several populations at once, on Ray when it is installed and on a
 local process pool otherwise. :func:`varieties` fills a map of the fittest plant of every
 kind (MAP-Elites, :class:`Varieties`); :class:`GenomeSpace` hands any model's genomes to an

@@ -58,6 +58,8 @@ class Genome:
     def mutate(self, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A mutated copy, made by the model's own mutation."""
     def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int:
+        """The hash of its genome file's text (do not set a field of a genome in a set)."""
 
 class Mesh:
     """A triangle mesh as read-only numpy arrays that view the plant's memory (no copy);
@@ -75,6 +77,8 @@ class Mesh:
     """(t,) index into ``materials`` of each triangle."""
     materials: list[dict[str, Any]]
     """Each material: ``name``, ``kind`` (bark, leaf, flower, root), ``color``, ``texture``."""
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its arrays; unpickled, it owns them, read-only."""
 
 class Plant:
     """A grown genome: measures, mesh, exports and pictures."""
@@ -115,6 +119,9 @@ class Plant:
         self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (800, 800)
     ) -> bytes:
         """PNG bytes of a picture, also written to ``path`` when given."""
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its genome, seed, roots and taper; unpickled, it grows again to the
+        same bytes."""
 
 class Scene:
     """Many plants in one scene."""
@@ -172,31 +179,57 @@ class Member:
     generation: int
     operator: str
     parents: list[int]
+    def __eq__(self, other: object) -> bool:
+        """Equal when every field is."""
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its fields."""
+
+Fitness = Callable[[list[Plant]], Sequence[float] | npt.NDArray[np.floating[Any]]]
+"""A Python fitness function: a list of grown plants in, one number per plant out."""
 
 class Evolution:
-    """An evolution run of any model."""
+    """An evolution run of any model; ``fitness=f`` adds a Python fitness function."""
 
     def __init__(
         self,
         config: Config | dict[str, Any] | _Path,
         start: Sequence[Genome] | None = None,
         threads: int | None = None,
-    ) -> None: ...
+        *,
+        fitness: Fitness | None = None,
+        fitness_weight: float = 1.0,
+        fitness_mode: str = "add",
+        fitness_batch: int = 16,
+    ) -> None:
+        """Generation 0 made and scored. ``fitness(plants)`` scores a list of at most
+        ``fitness_batch`` grown plants, a term named "python" weighted ``fitness_weight``,
+        beside the model's terms (``fitness_mode="add"``) or in their place (``"replace"``).
+        Ctrl-C raises KeyboardInterrupt within one member's evaluation."""
     @staticmethod
     def resume(
         config: Config,
         path: _Path | None = None,
         text: str | None = None,
         threads: int | None = None,
-    ) -> Evolution: ...
+        *,
+        fitness: Fitness | None = None,
+        fitness_weight: float = 1.0,
+        fitness_mode: str = "add",
+        fitness_batch: int = 16,
+    ) -> Evolution:
+        """Resumes from a checkpoint; a run with a fitness function is given it again."""
     @property
     def config(self) -> Config: ...
     @property
     def generation(self) -> int: ...
     @property
     def term_names(self) -> list[str]: ...
+    @property
+    def fitness(self) -> Fitness | None:
+        """The Python fitness function, if the run has one."""
     def step(self) -> dict[str, Any]:
-        """Breeds one generation; returns its statistics row."""
+        """Breeds one generation; returns its statistics row. Ctrl-C raises
+        KeyboardInterrupt within one member's evaluation and leaves the run as it was."""
     def run(
         self,
         generations: int | None = None,
@@ -359,8 +392,8 @@ def cross(
     """A child of two or more parents of one model, by the model's own crossover."""
 
 def match(
-    target: _Path,
-    side: _Path | None = None,
+    target: _Path | npt.NDArray[Any],
+    side: _Path | npt.NDArray[Any] | None = None,
     model: str = "auto",
     generations: int | None = None,
     seconds: float | None = None,
@@ -369,7 +402,8 @@ def match(
     threshold: str | float | None = None,
     threads: int = 0,
 ) -> Evolution:
-    """Evolves a plant whose outline matches a picture (PNG or JPEG); returns the run."""
+    """Evolves a plant whose outline matches a picture (a PNG or JPEG file, or a numpy
+    mask or uint8 image); returns the run."""
 
 def set_max_memory(bytes: int) -> None:
     """Sets the memory budget in bytes (0: the default); work over it raises LimitError."""

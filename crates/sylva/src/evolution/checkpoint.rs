@@ -10,6 +10,7 @@ use sylva_model::Evolve;
 
 use crate::error::InputError;
 
+use super::hooks::OwnRecord;
 use super::schema::EvolveConfig;
 
 /// The checkpoint file: the effective config and the engine's checkpoint.
@@ -18,18 +19,44 @@ use super::schema::EvolveConfig;
 pub(super) struct SavedRunRef<'a, M: Evolve> {
     pub(super) config: &'a EvolveConfig<M>,
     pub(super) checkpoint: Checkpoint<<M::Problem as Problem>::Genome>,
+    /// The run's own fitness term, if it has one (written only then, so checkpoints of
+    /// other runs keep their bytes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) own_term: Option<OwnRecord>,
 }
 
 pub(super) struct SavedRun<M: Evolve> {
     pub(super) config: EvolveConfig<M>,
     pub(super) checkpoint: Checkpoint<<M::Problem as Problem>::Genome>,
+    pub(super) own_term: Option<OwnRecord>,
 }
 
 impl<M: Evolve + Default> SavedRun<M> {
     /// Reads a checkpoint.
     pub(super) fn parse(path: &Path, text: &str) -> Result<Self, InputError> {
         let (config, checkpoint) = parse(path, text)?;
-        Ok(SavedRun { config, checkpoint })
+        let own_term = own_term(path, text)?;
+        Ok(SavedRun {
+            config,
+            checkpoint,
+            own_term,
+        })
+    }
+}
+
+/// The own fitness term a checkpoint records, if any.
+fn own_term(path: &Path, text: &str) -> Result<Option<OwnRecord>, InputError> {
+    // Most checkpoints have none: they are not read twice for it.
+    if !text.contains("\"own_term\"") {
+        return Ok(None);
+    }
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+    match value.get("own_term") {
+        None => Ok(None),
+        Some(term) => serde_json::from_value(term.clone())
+            .map(Some)
+            .map_err(|e| InputError::file(path, format!("`own_term`: {e}"))),
     }
 }
 

@@ -13,7 +13,8 @@ use crate::genome::Genome;
 use crate::registry::Registry;
 
 use super::checkpoint::SavedRun;
-use super::run::TypedRun;
+use super::hooks::{RunHooks, Scored, check_resumed, check_term, first_generation};
+use super::run::{Hooked, TypedRun};
 use super::schema::{EvolveConfig, OutputConfig, RunConfig, SearchStrategy};
 
 /// An evolution config of any model.
@@ -55,6 +56,7 @@ pub(crate) fn start<M: Evolve + Default>(
     base: &Path,
     start: Vec<Genome>,
     pool: Pool,
+    hooks: RunHooks,
 ) -> Result<TypedRun<M>, Error> {
     if config.run.strategy == SearchStrategy::MapElites {
         return Err(InputError::new(
@@ -74,17 +76,24 @@ pub(crate) fn start<M: Evolve + Default>(
         "breed a smaller population, or smaller genomes",
     )
     .map_err(|e| InputError::new(source, e).over_limit())?;
-    let setup = setup(
-        &config.model,
-        &config.settings,
-        typed,
-        seed,
-        population,
-        source,
-    )?;
-    let problem = with_term(config, setup.problem, base)?;
+    let made = |start: Vec<M::Genome>| {
+        setup(
+            &config.model,
+            &config.settings,
+            start,
+            seed,
+            population,
+            source,
+        )
+    };
+    // With an own term, the model is set up twice more: to make generation 0 once without its
+    // fitness, and to foresee each generation's genomes (`hooks.rs`).
+    let again = hooks.term.as_ref().map(|_| typed.clone());
+    let setup = made(typed)?;
+    let scout = || Ok(made(again.clone().unwrap_or_default())?.strategy);
+    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
     // The settings are valid; generation 0 grows as the run is made.
-    if let Some(t) = config.generation_time(&start, pool.threads()) {
+    if let Some(t) = config.generation_time(&start, hooked.pool.threads()) {
         sylva_core::budget::check_time(t.seconds, t.what, t.advice)
             .map_err(|e| InputError::new(source, e).over_limit())?;
     }
@@ -93,12 +102,76 @@ pub(crate) fn start<M: Evolve + Default>(
         population,
         keep_history: 0,
     };
-    let run = Run::with_genomes(problem, setup.strategy, pool, settings, setup.first)
-        .map_err(|e| InputError::new("[run]", e))?;
-    Ok(TypedRun {
+    let refused = |e| InputError::new("[run]", e);
+    if let Some(scored) = &hooked.scored {
+        // Generation 0 made once more without the model's fitness, to score it in batches.
+        let again = made(again.unwrap_or_default())?;
+        let first = first_generation(
+            &problem.problem,
+            again.strategy,
+            &hooked.pool,
+            settings.clone(),
+            again.first,
+        )
+        .map_err(refused)?;
+        scored.prepare(&problem.problem, &first, &hooked.pool)?;
+    }
+    let run = Run::with_genomes(
+        problem,
+        setup.strategy,
+        hooked.pool.clone(),
+        settings,
+        setup.first,
+    )
+    .map_err(refused)?;
+    let typed = TypedRun {
         config: config.clone(),
         run,
-    })
+        hooked,
+    };
+    typed.failure()?;
+    Ok(typed)
+}
+
+/// The problem of `config` with its added term (the `[match]` outline or `hooks`' own term,
+/// not both), and the hooks at work; with an own term, a second breeding of the model made
+/// by `scout`, to foresee what generations evaluate.
+fn with_hooks<M: Evolve + Default>(
+    config: &EvolveConfig<M>,
+    problem: M::Problem,
+    base: &Path,
+    pool: Pool,
+    hooks: RunHooks,
+    scout: impl FnOnce() -> Result<M::Strategy, InputError>,
+) -> Result<(WithTerm<M::Problem>, Hooked<M>), InputError> {
+    let mut hooked = Hooked::none(pool);
+    hooked.stop = hooks.stop;
+    let Some(own) = hooks.term else {
+        return Ok((with_term(config, problem, base)?, hooked));
+    };
+    if config.outline.is_some() {
+        return Err(InputError::new(
+            "fitness",
+            "the config's `[match]` section adds its outline term already, and a run takes one \
+             term of its own: leave `[match]` out, or score the outline in the function",
+        ));
+    }
+    check_term(&own, &sylva_evolve::Problem::term_names(&problem))?;
+    let scored = Arc::new(Scored::new(&config.model, &own));
+    hooked.scored = Some(scored.clone());
+    hooked.scout = Some(scout()?);
+    let added = sylva_evolve::Added {
+        term: scored as Arc<dyn sylva_evolve::Term<M::Problem>>,
+        weight: own.weight,
+        beside: own.beside,
+    };
+    Ok((
+        WithTerm {
+            problem,
+            added: Some(added),
+        },
+        hooked,
+    ))
 }
 
 /// The start genomes as model `M`'s; another model's is refused.
@@ -122,6 +195,7 @@ pub(super) fn typed_start<M: Evolve>(start: &[Genome]) -> Result<Vec<M::Genome>,
 }
 
 /// Resumes the run of `config` saved in a checkpoint's `text` (read from `path`).
+#[allow(clippy::too_many_arguments)] // The erased model's call, one argument each.
 pub(crate) fn resume<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
@@ -129,6 +203,7 @@ pub(crate) fn resume<M: Evolve + Default>(
     path: &Path,
     text: &str,
     pool: Pool,
+    hooks: RunHooks,
 ) -> Result<TypedRun<M>, Error> {
     let saved = SavedRun::<M>::parse(path, text)?;
     if saved.config.resumable() != config.resumable() {
@@ -139,14 +214,31 @@ pub(crate) fn resume<M: Evolve + Default>(
         )
         .into());
     }
-    let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
-    let problem = with_term(config, setup.problem, base)?;
-    let run = Run::resume(problem, setup.strategy, pool, saved.checkpoint)
+    check_resumed(saved.own_term.as_ref(), hooks.term.as_ref())
         .map_err(|e| InputError::file(path, e))?;
-    Ok(TypedRun {
+    let made = || setup(&config.model, &config.settings, Vec::new(), 0, 0, source);
+    let setup = made()?;
+    let scout = || Ok(made()?.strategy);
+    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
+    if let Some(scored) = &hooked.scored {
+        // The engine scores a resumed population again.
+        let genomes = saved.checkpoint.population.iter().map(|i| &i.genome);
+        scored.prepare(&problem.problem, genomes, &hooked.pool)?;
+    }
+    let run = Run::resume(
+        problem,
+        setup.strategy,
+        hooked.pool.clone(),
+        saved.checkpoint,
+    )
+    .map_err(|e| InputError::file(path, e))?;
+    let typed = TypedRun {
         config: config.clone(),
         run,
-    })
+        hooked,
+    };
+    typed.failure()?;
+    Ok(typed)
 }
 
 impl<M: Evolve + Default> EvolveConfig<M> {

@@ -39,6 +39,8 @@
 //!
 //! Each holds its model's handle (`erased.rs`) beside the typed value.
 //! - `checkpoint.rs`: the checkpoint file a run resumes from.
+//! - `hooks.rs`: what a front end adds to a run ([`RunHooks`]): a [`Stop`] that cuts a long
+//!   generation short, and a fitness term of its own scored a batch of plants at a time.
 //! - `outline.rs`: the `[match]` term, a plant's silhouette against target pictures.
 //! - `varieties.rs`: [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
 //!   "map-elites"` and `[map]`): a map of the fittest plant of every kind.
@@ -47,6 +49,7 @@
 
 mod checkpoint;
 mod config;
+mod hooks;
 pub mod outline;
 mod run;
 mod schema;
@@ -56,6 +59,7 @@ mod varieties;
 pub use checkpoint::checkpoint_model;
 pub use config::{Config, GenerationTime, evaluations_done};
 pub(crate) use config::{resume, start};
+pub use hooks::{OwnTerm, PlantScorer, RunHooks, ScorerError, Stop, Stopped};
 pub(crate) use run::TypedRun;
 pub use run::{Evolution, Member};
 pub use schema::{
