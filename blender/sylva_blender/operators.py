@@ -1,0 +1,346 @@
+"""The Sylva tab's operators: grow, regrow, save a genome, breed nine variants, and mutate or
+cross the favourites. Every one that changes the scene is REGISTER and UNDO, so Ctrl-Z takes
+it back as one step; errors are reported naming what was wrong."""
+
+import os
+import time
+
+import bpy
+from bpy.props import StringProperty
+from bpy_extras.io_utils import ExportHelper
+from mathutils import Vector
+
+from . import plants
+
+
+def _fail(op, message):
+    op.report({"ERROR"}, message)
+    return {"CANCELLED"}
+
+
+def _ms(start):
+    return f"{(time.perf_counter() - start) * 1000:.0f} ms"
+
+
+def _active_plant(context):
+    obj = context.active_object
+    return obj if plants.is_plant(obj) else None
+
+
+class SYLVA_OT_grow(bpy.types.Operator):
+    """Grow a plant from the chosen example, genome file or random genome at the 3D cursor"""
+
+    bl_idname = "sylva.grow"
+    bl_label = "Grow Plant"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        start = time.perf_counter()
+        settings = context.scene.sylva
+        try:
+            s = plants.sylva()
+        except plants.Unavailable as e:
+            return _fail(self, str(e))
+        model = settings.model
+        try:
+            if settings.source == "EXAMPLE":
+                found = dict(plants.examples(model))
+                if settings.example not in found:
+                    return _fail(self, f"No bundled example named '{settings.example}' for {model} "
+                                 f"(examples found: {', '.join(found) or 'none'})")
+                source = settings.example
+                genome = s.Genome.load(found[source])
+                operator = "example"
+            elif settings.source == "FILE":
+                path = bpy.path.abspath(settings.genome_file)
+                if not settings.genome_file:
+                    return _fail(self, "Choose a genome file (a .json of any Sylva model) first")
+                if not os.path.isfile(path):
+                    return _fail(self, f"Genome file not found: {path}")
+                genome = s.Genome.load(path)
+                source = path
+                operator = "file"
+            else:
+                genome = s.Genome.random(model, settings.random_seed)
+                source = f"random {model} seed {settings.random_seed}"
+                operator = "random"
+        except (s.SylvaError, OSError) as e:  # InputError says where in the file and what
+            return _fail(self, f"Could not read the genome: {e}")
+
+        try:
+            plant = plants.grow(genome, plants.grow_options(plants.DEFAULT_SETTINGS, genome))
+        except s.SylvaError as e:
+            return _fail(self, f"Could not grow {source}: {e}")
+        obj = plants.new_object(context, f"{genome.model} {operator}")
+        obj.location = context.scene.cursor.location
+        plants.set_plant(obj, genome, plant, {"operator": operator, "generation": 0})
+        obj[plants.SOURCE] = source
+        obj.name = plants.object_name(genome, {"operator": source if operator == "example" else operator})
+
+        for other in context.selected_objects:
+            other.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        triangles = len(plant.mesh.indices)
+        if triangles == 0:
+            self.report({"WARNING"}, f"{source} grew no triangles: try another seed or genome")
+        else:
+            self.report({"INFO"}, f"Grew {obj.name}: {triangles} triangles in {_ms(start)}")
+        if operator == "file" and genome.model != model:
+            self.report({"WARNING"},
+                        f"The file holds a {genome.model} genome, not {model}: grown as {genome.model}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_regrow(bpy.types.Operator):
+    """Grow the active plant again from its custom properties (after editing its genome JSON)"""
+
+    bl_idname = "sylva.regrow"
+    bl_label = "Regrow"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return _active_plant(context) is not None
+
+    def execute(self, context):
+        obj = _active_plant(context)
+        try:
+            plants.regrow(obj)
+        except Exception as e:
+            return _fail(self, f"Could not regrow {obj.name}: {e}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_save_genome(bpy.types.Operator, ExportHelper):
+    """Save the active plant's genome as a genome file (`sylva grow FILE` grows it again)"""
+
+    bl_idname = "sylva.save_genome"
+    bl_label = "Save Genome"
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return _active_plant(context) is not None
+
+    def execute(self, context):
+        obj = _active_plant(context)
+        try:
+            plants.genome_of(obj).save(self.filepath)
+        except Exception as e:
+            return _fail(self, f"Could not save the genome of {obj.name} to {self.filepath}: {e}")
+        self.report({"INFO"}, f"Saved {self.filepath}")
+        return {"FINISHED"}
+
+
+def _copy_settings(source, target):
+    with plants.quiet():
+        for name in ("own_seed", "seed", "use_taper", "taper", "roots", "detail"):
+            setattr(target.sylva, name, getattr(source.sylva, name))
+
+
+def _place(results, target, op):
+    """Puts each child into its object as soon as it has grown (while the workers grow the
+    next ones); `target(k)` gives the object and origin of child k, made on first need, so
+    nothing changes when no child grows. Returns the plants placed, or the last error."""
+    placed, failed, error = [], [], None
+    for k, (genome, plant, used_or_error) in enumerate(results):
+        if genome is None:
+            failed.append(k)
+            error = used_or_error
+            continue
+        obj, origin = target(k)
+        parents = origin["parents"]
+        origin = dict(origin, parents=[parents[i] for i in used_or_error])
+        plants.set_plant(obj, genome, plant, origin)
+        obj.name = plants.object_name(genome, origin)
+        placed.append((k, obj, plant))
+    if placed and failed:
+        op.report({"WARNING"}, f"{len(failed)} variant(s) kept their old plant (cells "
+                  f"{', '.join(str(k + 1) for k in failed)}): {error}")
+    return placed, error
+
+
+class SYLVA_OT_breed(bpy.types.Operator):
+    """Breed nine mutants of the active plant in a 3 by 3 grid beside it (the Sylva Brood
+    collection), replacing the grid's plants if there is one"""
+
+    bl_idname = "sylva.breed"
+    bl_label = "Breed Nine Variants"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return _active_plant(context) is not None
+
+    def execute(self, context):
+        start = time.perf_counter()
+        mother = _active_plant(context)
+        if mother is None:
+            return _fail(self, "Select a Sylva plant to breed from (grow one first)")
+        if plants.CELL in mother:
+            # Breeding from a grid plant would replace the grid it stands in.
+            return _fail(self, f"{mother.name} is in the breeding grid: Mutate or Cross there, "
+                         "or Keep it and breed from the copy")
+        settings = context.scene.sylva
+        try:
+            genome = plants.genome_of(mother)
+        except Exception as e:
+            return _fail(self, f"The genome of {mother.name} does not read: {e}")
+        step = settings.breed_step
+        grow = plants.settings_of(mother.sylva)
+        jobs = [("mutate", [genome], settings.depth, step * 9 + k, grow) for k in range(9)]
+        collection = plants.brood_collection(context, create=False)
+        cells = plants.brood(context)
+        origin = {
+            "operator": "mutate",
+            "parents": [mother[plants.ID]],
+            "generation": mother.get(plants.GENERATION, 0) + 1,
+            "lineage": plants.lineage_of(mother),
+        }
+
+        def target(k):
+            nonlocal collection
+            if collection is None:
+                collection = plants.brood_collection(context)
+            obj = cells.get(k) or plants.new_object(context, f"variant {k + 1}", collection)
+            obj[plants.CELL] = k
+            _copy_settings(mother, obj)
+            return obj, origin
+
+        placed, error = _place(plants.breed(jobs), target, self)
+        if not placed:
+            return _fail(self, f"No variant of {mother.name} grew: {error}")
+        # Laid out once all have grown: the widest sets the spacing.
+        footprint = max(mother.dimensions.x, mother.dimensions.y)
+        space = max(plants.spacing([plant for _, _, plant in placed]), 1.2 * footprint)
+        centre = mother.location + Vector((2.5 * space, 0.0, 0.0))
+        for k, obj in plants.brood(context).items():
+            obj.location = centre + Vector((((k % 3) - 1) * space, (1 - k // 3) * space, 0.0))
+        for obj in context.selected_objects:
+            obj.select_set(False)
+        settings.breed_step = step + 1
+        self.report({"INFO"}, f"Bred nine variants of {mother.name} in {_ms(start)}: "
+                    "select favourites, then Mutate or Cross")
+        return {"FINISHED"}
+
+
+class _Favourites:
+    bl_options = {"REGISTER", "UNDO"}
+    least = 1
+
+    @classmethod
+    def poll(cls, context):
+        return bool(plants.brood(context))
+
+    def execute(self, context):
+        start = time.perf_counter()
+        cells = plants.brood(context)
+        if not cells:
+            return _fail(self, "No breeding grid: select a plant and Breed Nine Variants first")
+        favourites = [obj for obj in context.selected_objects if plants.is_plant(obj)]
+        if len(favourites) < self.least:
+            return _fail(self, f"Select at least {self.least} favourite plant(s) to {self.verb}")
+        targets = [obj for _, obj in sorted(cells.items()) if not obj.select_get()]
+        if not targets:
+            return _fail(self, f"All nine are selected: select only the favourites to {self.verb}; "
+                         "the others are replaced")
+        models = sorted({obj[plants.MODEL] for obj in favourites})
+        if self.kind == "cross" and len(models) > 1:
+            return _fail(self, f"Cross needs favourites of one model; selected: {', '.join(models)}")
+        try:
+            genomes = [plants.genome_of(obj) for obj in favourites]
+        except Exception as e:
+            return _fail(self, f"A favourite's genome does not read: {e}")
+        settings = context.scene.sylva
+        step = settings.breed_step
+        lineage = {}
+        for obj in favourites:
+            lineage.update(plants.lineage_of(obj))
+        generation = max(obj.get(plants.GENERATION, 0) for obj in favourites) + 1
+        ids = [obj[plants.ID] for obj in favourites]
+        jobs, origins = [], []
+        for k, obj in enumerate(targets):
+            if self.kind == "mutate":
+                # Favourites take turns as the mother of the replaced plants.
+                parent = k % len(favourites)
+                jobs.append(("mutate", [genomes[parent]], settings.depth, step * 9 + k,
+                             plants.settings_of(favourites[parent].sylva)))
+                parents = [ids[parent]]
+            else:
+                jobs.append(("cross", genomes, settings.depth, step * 9 + k,
+                             plants.settings_of(favourites[0].sylva)))
+                parents = ids
+            origins.append({"operator": self.kind, "parents": parents,
+                            "generation": generation, "lineage": lineage})
+        def target(k):
+            _copy_settings(favourites[k % len(favourites)], targets[k])
+            return targets[k], origins[k]
+
+        placed, error = _place(plants.breed(jobs), target, self)
+        if not placed:
+            return _fail(self, f"No child grew: {error}")
+        settings.breed_step = step + 1
+        self.report({"INFO"}, f"{self.verb.capitalize()}: {len(targets)} new plants from "
+                    f"{len(favourites)} favourite(s) in {_ms(start)}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_mutate(_Favourites, bpy.types.Operator):
+    """Replace the grid plants that are not selected by mutants of the selected favourites"""
+
+    bl_idname = "sylva.mutate"
+    bl_label = "Mutate"
+    kind = "mutate"
+    verb = "mutate"
+
+
+class SYLVA_OT_cross(_Favourites, bpy.types.Operator):
+    """Replace the grid plants that are not selected by children of all the selected favourites"""
+
+    bl_idname = "sylva.cross"
+    bl_label = "Cross"
+    kind = "cross"
+    verb = "cross"
+    least = 2
+
+
+class SYLVA_OT_keep(bpy.types.Operator):
+    """Copy the active grid plant out of the grid, beside it, as a plant of its own"""
+
+    bl_idname = "sylva.keep"
+    bl_label = "Keep"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _active_plant(context)
+        return obj is not None and plants.CELL in obj
+
+    def execute(self, context):
+        obj = _active_plant(context)
+        if obj is None or plants.CELL not in obj:
+            return _fail(self, "Make a plant of the breeding grid active to keep it")
+        copy = obj.copy()
+        copy.data = obj.data.copy()  # its own mesh: the grid's will be replaced
+        del copy[plants.CELL]
+        context.scene.collection.objects.link(copy)
+        copy.location = obj.location + Vector((0.0, -3.0 * max(obj.dimensions.x, obj.dimensions.y, 0.3), 0.0))
+        for other in context.selected_objects:
+            other.select_set(False)
+        copy.select_set(True)
+        context.view_layer.objects.active = copy
+        self.report({"INFO"}, f"Kept {copy.name}")
+        return {"FINISHED"}
+
+
+classes = (
+    SYLVA_OT_grow,
+    SYLVA_OT_regrow,
+    SYLVA_OT_save_genome,
+    SYLVA_OT_breed,
+    SYLVA_OT_mutate,
+    SYLVA_OT_cross,
+    SYLVA_OT_keep,
+)

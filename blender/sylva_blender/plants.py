@@ -1,0 +1,293 @@
+"""Plant objects: a mesh object whose custom properties hold what it grew from (genome JSON,
+seed, model, lineage), so it can be regrown, bred, exported with its origin (glTF extras)
+or grown again by `sylva grow` outside Blender.
+
+The Python package is imported lazily: a missing or broken wheel shows as an error in the
+panel, naming what failed, instead of stopping the add-on from registering.
+"""
+
+import hashlib
+import json
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import bpy
+
+from . import plantmesh
+
+# Custom properties of a plant object. Strings and ints only, so they survive glTF export
+# as extras and show in Object Properties > Custom Properties.
+GENOME = "sylva_genome"  # the genome file's JSON text
+SEED = "sylva_seed"  # the seed it grew with (int; decimal text when over 2^31 - 1)
+MODEL = "sylva_model"
+ID = "sylva_id"  # first 12 hex digits of the SHA-1 of the genome JSON
+PARENTS = "sylva_parents"  # JSON list of the parents' ids
+OPERATOR = "sylva_operator"  # example, file, random, mutate or cross
+GENERATION = "sylva_generation"
+LINEAGE = "sylva_lineage"  # JSON {id: {operator, parents, generation}}, itself and ancestors
+VERSION = "sylva_version"
+CELL = "sylva_cell"  # 0..8: its place in the breeding grid
+SOURCE = "sylva_source"  # the example's name, the genome file's path or the random draw
+
+BROOD = "Sylva Brood"
+DETAIL_MODIFIER = "Sylva Detail"
+INT_MAX = 2**31 - 1  # Blender's integer properties are 32-bit
+LINEAGE_MAX = 256  # ancestors kept per plant; the oldest generations go first
+# Tries per variant when a mutant or cross grows nothing (an L-system mutant whose shoot
+# draws nothing) or fails to grow; each try draws another seed.
+TRIES = 6
+
+class Unavailable(RuntimeError):
+    """The sylva package could not be imported."""
+
+
+def sylva():
+    """The sylva package, or Unavailable saying why not."""
+    try:
+        import sylva as module
+    except Exception as e:  # ImportError, or an OSError of a wheel for another machine
+        raise Unavailable(f"Sylva's Python package could not be imported: {type(e).__name__}: {e}") from e
+    return module
+
+
+def import_error():
+    """Why the package could not be imported, or None."""
+    try:
+        sylva()
+    except Unavailable as e:
+        return str(e)
+    return None
+
+
+def genome_id(genome):
+    return hashlib.sha1(genome.to_json().encode()).hexdigest()[:12]
+
+
+def is_plant(obj):
+    return obj is not None and obj.type == "MESH" and GENOME in obj
+
+
+# Settings set by the add-on itself (a new plant's seed, say) must not each regrow it: their
+# update callbacks look at this depth and return while it is above 0.
+_quiet = 0
+
+
+class quiet:
+    def __enter__(self):
+        global _quiet
+        _quiet += 1
+
+    def __exit__(self, *exc):
+        global _quiet
+        _quiet -= 1
+
+
+def is_quiet():
+    return _quiet > 0
+
+
+def examples_dir():
+    return os.path.join(os.path.dirname(__file__), "examples")
+
+
+def examples(model):
+    """(name, path) of the bundled example genomes of `model`, sorted by name."""
+    folder = os.path.join(examples_dir(), model)
+    if not os.path.isdir(folder):
+        return []
+    return sorted(
+        (name[: -len(".json")], os.path.join(folder, name))
+        for name in os.listdir(folder)
+        if name.endswith(".json")
+    )
+
+
+# A new plant's settings: the defaults of the object's `sylva` group (see __init__.py).
+DEFAULT_SETTINGS = {"own_seed": True, "seed": 0, "roots": True, "taper": None}
+
+
+def settings_of(group):
+    """An object's growth settings (its `sylva` group) as a plain dict, for worker threads."""
+    return {
+        "own_seed": group.own_seed,
+        "seed": group.seed,
+        "roots": group.roots,
+        "taper": group.taper if group.use_taper else None,
+    }
+
+
+def grow_options(settings, genome):
+    """Keyword arguments of Genome.grow for settings_of(...) and a genome."""
+    return {
+        "seed": genome.default_seed if settings["own_seed"] else settings["seed"],
+        "roots": settings["roots"],
+        "taper": settings["taper"],
+    }
+
+
+def grow(genome, options):
+    """Grows and meshes; safe on any thread (no bpy), and releases the GIL."""
+    plant = genome.grow(**options)
+    plant.mesh  # gather the triangle arrays here, off Blender's thread
+    return plant
+
+
+def new_object(context, name, collection=None):
+    me = bpy.data.meshes.new(name)
+    obj = bpy.data.objects.new(name, me)
+    (collection or context.collection).objects.link(obj)
+    return obj
+
+
+def object_name(genome, origin):
+    return f"{genome.model} {origin['operator']} {genome_id(genome)[:6]}"
+
+
+def set_plant(obj, genome, plant, origin):
+    """Makes `obj` the plant `plant` grown from `genome`; `origin` holds its operator,
+    parents (ids), generation and the lineage it inherits."""
+    gid = genome_id(genome)
+    obj[GENOME] = genome.to_json()
+    obj[MODEL] = genome.model
+    obj[ID] = gid
+    obj[OPERATOR] = origin["operator"]
+    obj[PARENTS] = json.dumps(origin.get("parents", []))
+    obj[GENERATION] = origin.get("generation", 0)
+    lineage = dict(origin.get("lineage", {}))
+    lineage[gid] = {
+        "operator": origin["operator"],
+        "parents": origin.get("parents", []),
+        "generation": origin.get("generation", 0),
+    }
+    if len(lineage) > LINEAGE_MAX:
+        newest = sorted(lineage.items(), key=lambda kv: kv[1]["generation"], reverse=True)
+        lineage = dict(newest[:LINEAGE_MAX])
+    obj[LINEAGE] = json.dumps(lineage, sort_keys=True)
+    obj[VERSION] = sylva().__version__
+    _show(obj, plant)
+
+
+def _show(obj, plant):
+    obj[SEED] = plant.seed if plant.seed <= INT_MAX else str(plant.seed)
+    if obj.sylva.own_seed:
+        # So that unticking "Genome's Seed" starts from the seed it grew with (PlantMaker's
+        # random genomes carry 64-bit seeds, which Blender's 32-bit field cannot hold).
+        with quiet():
+            obj.sylva.seed = plant.seed % (INT_MAX + 1)
+    plantmesh.fill_mesh(obj.data, plant)
+    obj.sylva.error = ""
+    apply_detail(obj)
+
+
+def lineage_of(obj):
+    try:
+        return json.loads(obj.get(LINEAGE, "{}"))
+    except ValueError:
+        return {}
+
+
+def genome_of(obj):
+    """The genome a plant object holds (its custom property, perhaps edited by hand)."""
+    return sylva().Genome.from_json(obj[GENOME], source=GENOME)
+
+
+def regrow(obj):
+    """Grows `obj` again from its custom properties and settings. Errors are kept in
+    obj.sylva.error, which the panel shows, and raised."""
+    try:
+        genome = genome_of(obj)
+        plant = grow(genome, grow_options(settings_of(obj.sylva), genome))
+    except Exception as e:
+        obj.sylva.error = f"{type(e).__name__}: {e}"
+        raise
+    if genome.to_json() != obj[GENOME]:
+        obj[GENOME] = genome.to_json()  # normalised, so the id stays the file's hash
+    obj[ID] = genome_id(genome)
+    obj[MODEL] = genome.model
+    _show(obj, plant)
+    return plant
+
+
+def apply_detail(obj):
+    """Detail below 1 keeps that share of the triangles through a Decimate modifier (the
+    package does not take Sylva's mesh options yet); 1 removes the modifier."""
+    detail = obj.sylva.detail
+    mod = obj.modifiers.get(DETAIL_MODIFIER)
+    if detail >= 0.999:
+        if mod is not None:
+            obj.modifiers.remove(mod)
+        return
+    if mod is None:
+        mod = obj.modifiers.new(DETAIL_MODIFIER, "DECIMATE")
+    mod.ratio = detail
+
+
+# Breeding ---------------------------------------------------------------------------------
+
+# PlantMaker's crossover level (the paper's Depth button for crossover); the other models
+# cross as their configs' defaults say.
+CROSS_LEVEL = {"plantmaker": ("crossover", ["low", "medium", "high"])}
+
+
+def _variant(job):
+    """One child, grown: (genome, plant, parent positions) or the error of the last try.
+    Runs on a worker thread: sylva only, no bpy."""
+    kind, parents, depth, seed, settings = job
+    s = sylva()
+    error = None
+    for attempt in range(TRIES):
+        base = seed * 1000 + attempt * 10
+        try:
+            if kind == "mutate":
+                child = parents[0]
+                # Depth k: the model's own mutation applied k times (the paper's Depth: a
+                # higher value, a stronger mutation), for every model alike.
+                for d in range(depth):
+                    child = child.mutate(base + d)
+                used = [0]
+            else:
+                level = None
+                if parents[0].model in CROSS_LEVEL:
+                    name, levels = CROSS_LEVEL[parents[0].model]
+                    level = {name: levels[min(depth, len(levels)) - 1]}
+                child, used = s.cross(parents, base, settings=level)
+            plant = grow(child, grow_options(settings, child))
+        except Exception as e:
+            error = f"{type(e).__name__}: {e}"
+            continue
+        if len(plant.mesh.indices):
+            return child, plant, used
+        error = "grew nothing (no triangles)"
+    return None, None, error
+
+
+def breed(jobs):
+    """Grows the children of `jobs` on all cores (growth releases the GIL), yielding each
+    in order as soon as it and those before it have grown."""
+    with ThreadPoolExecutor(max_workers=min(len(jobs), os.cpu_count() or 1)) as pool:
+        yield from pool.map(_variant, jobs)
+
+
+def brood_collection(context, create=True):
+    collection = bpy.data.collections.get(BROOD)
+    if collection is None and create:
+        collection = bpy.data.collections.new(BROOD)
+        context.scene.collection.children.link(collection)
+    return collection
+
+
+def brood(context):
+    """The plants of the breeding grid by cell, or {} when there is none."""
+    collection = brood_collection(context, create=False)
+    if collection is None:
+        return {}
+    return {obj[CELL]: obj for obj in collection.objects if is_plant(obj) and CELL in obj}
+
+
+def spacing(plants, at_least=0.3):
+    """Metres between grid cells: the widest plant's footprint and a fifth more."""
+    widest = at_least
+    for plant in plants:
+        (x0, _y0, z0), (x1, _y1, z1) = plant.bounds
+        widest = max(widest, x1 - x0, z1 - z0)
+    return 1.2 * widest
