@@ -566,17 +566,21 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         })
     }
 
-    /// Breeds one generation, offers it to the map, and returns its statistics.
+    /// Breeds one generation, offers it to the map, and returns its statistics. The run
+    /// changes only once the generation's offspring are made and scored, so a step cut short
+    /// while they are (a front end's stop unwinding out of the pool) leaves it as it was.
     pub fn step(&mut self) -> &MapStats {
         let start = Instant::now();
-        self.generation = (self.generation + 1).min(crate::run::MAX_GENERATION);
+        let generation = (self.generation + 1).min(crate::run::MAX_GENERATION);
         let improved = match self.settings.emitter {
             Emitter::Operators => {
-                let offered = self.breed();
+                let offered = self.breed(generation);
+                self.generation = generation;
                 self.offer(offered).0
             }
             Emitter::CmaMe { .. } => {
-                let mut offered = self.sample();
+                let mut offered = self.sample(generation);
+                self.generation = generation;
                 let draws: Vec<Vec<f64>> = (offered.iter_mut())
                     .map(|o| o.draws.take().unwrap_or_default())
                     .collect();
@@ -596,9 +600,9 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         }
     }
 
-    /// A generation bred with the model's operators from elites chosen uniformly.
-    fn breed(&self) -> Vec<Offered<P::Genome>> {
-        let (seed, generation) = (self.settings.seed, self.generation);
+    /// Generation `generation` bred with the model's operators from elites chosen uniformly.
+    fn breed(&self, generation: u32) -> Vec<Offered<P::Genome>> {
+        let seed = self.settings.seed;
         let (problem, describer, cells, filled) =
             (&self.problem, &*self.describer, &self.cells, &self.filled);
         let (crossover, mutation) = (self.operators.crossover(), self.operators.mutation());
@@ -629,9 +633,10 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
         })
     }
 
-    /// A generation sampled by the CMA-ME emitters, each from its share of the slots.
-    fn sample(&self) -> Vec<Offered<P::Genome>> {
-        let (seed, generation) = (self.settings.seed, self.generation);
+    /// Generation `generation` sampled by the CMA-ME emitters, each from its share of the
+    /// slots.
+    fn sample(&self, generation: u32) -> Vec<Offered<P::Genome>> {
+        let seed = self.settings.seed;
         let coding = self.coding.as_deref().expect("CMA-ME runs have a coding");
         let bounds = coding.bounds();
         let owner: Vec<usize> = emitter_slots(self.settings.batch, self.emitters.len())

@@ -2,10 +2,13 @@
 //! (pyribs, CMA-ES, a loop of one's own): bounds, decoding, encoding, and scoring batches
 //! as the config's MAP-Elites run scores them.
 
+use crate::varieties::interruptible;
+use crate::work::Serving;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArray};
 use numpy::{PyArrayDescrMethods, PyUntypedArrayMethods, dtype};
 use pyo3::prelude::*;
 use sylva::core::par::Pool;
+use sylva::evolution::Stop;
 use sylva::evolution::{Coding, SpaceOptions};
 
 use crate::errors::{IntoPy, bad_value};
@@ -236,7 +239,9 @@ impl GenomeSpace {
         X: &Bound<'_, PyAny>,
     ) -> PyResult<(Py<PyArray1<f64>>, Py<PyArray2<f64>>)> {
         let xs = self.rows(py, X)?;
-        let scores = py.detach(|| self.space.evaluate(&xs, &self.pool)).py()?;
+        // Ctrl-C stops the batch within one row's evaluation (`KeyboardInterrupt`).
+        let (stop, serving) = (Stop::new(), Serving::default());
+        let scores = interruptible(py, &stop, &serving, || self.space.evaluate(&xs, &self.pool))?;
         let (n, k) = (scores.fitness.len(), self.space.descriptors().len());
         let objective = PyArray1::from_vec(py, scores.fitness).unbind();
         let descriptors = PyArray1::from_vec(py, scores.descriptors)

@@ -9,10 +9,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sylva::MapStats;
 use sylva::Varieties as Map;
+use sylva::evolution::Stop;
 
 use crate::errors::IntoPy;
 use crate::evolution::{Config, Evolution, checkpoint_text};
 use crate::genome::Genome;
+use crate::work::{Serving, work};
 
 /// One filled cell of a map: where it is, and its elite.
 #[pyclass(module = "sylva", name = "Variety", frozen, get_all)]
@@ -160,6 +162,23 @@ fn row<'py>(py: Python<'py>, s: &MapStats) -> PyResult<Bound<'py, PyDict>> {
 #[pyclass(module = "sylva", name = "Varieties")]
 pub struct Varieties {
     map: Mutex<Map>,
+    /// Set on Ctrl-C while native work runs ([`work`]).
+    stop: Stop,
+    serving: Serving,
+}
+
+/// Runs `job` off this thread with Ctrl-C heard ([`work`]): `KeyboardInterrupt` within one
+/// genome's evaluation, `job`'s own error otherwise.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    serving: &Serving,
+    job: impl FnOnce() -> Result<T, sylva::Error> + Send,
+) -> PyResult<T> {
+    work(py, stop, None, serving, || stop.watch(job))?
+        .map_err(sylva::Error::from)
+        .and_then(|r| r)
+        .py()
 }
 
 impl Varieties {
@@ -182,9 +201,12 @@ impl Varieties {
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
-        let map = py.detach(|| Map::start(inner, start, pool)).py()?;
+        let (stop, serving) = (Stop::new(), Serving::default());
+        let map = interruptible(py, &stop, &serving, || Map::start(inner, start, pool))?;
         Ok(Varieties {
             map: Mutex::new(map),
+            stop,
+            serving,
         })
     }
 }
@@ -222,9 +244,14 @@ impl Varieties {
         let (path, text) = checkpoint_text(path, text)?;
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
-        let map = py.detach(|| Map::resume(inner, &path, &text, pool)).py()?;
+        let (stop, serving) = (Stop::new(), Serving::default());
+        let map = interruptible(py, &stop, &serving, || {
+            Map::resume(inner, &path, &text, pool)
+        })?;
         Ok(Varieties {
             map: Mutex::new(map),
+            stop,
+            serving,
         })
     }
 
@@ -280,16 +307,20 @@ impl Varieties {
     }
 
     /// Breeds one generation and offers it to the map; returns its statistics row (see
-    /// `stats`). Releases the GIL.
+    /// `stats`). Releases the GIL. Ctrl-C raises `KeyboardInterrupt` within one offspring's
+    /// evaluation and leaves the map as it was before the generation.
     fn step<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let stats = py.detach(|| self.with(|m| m.step().clone()));
+        let stats = interruptible(py, &self.stop, &self.serving, || {
+            self.with(|m| m.step_until(&self.stop).cloned())
+                .map_err(sylva::Error::from)
+        })?;
         row(py, &stats)
     }
 
     /// Breeds `generations` generations (up to the config's `[run] generations` when left
     /// out), calling `on_generation(row)` after each when given. Releases the GIL while it
-    /// breeds. Ctrl-C raises `KeyboardInterrupt` when the generation under way ends,
-    /// leaving the map whole at that generation.
+    /// breeds. Ctrl-C raises `KeyboardInterrupt` within one offspring's evaluation, leaving
+    /// the map whole at the last generation it finished.
     #[pyo3(signature = (generations = None, on_generation = None))]
     fn run(
         &self,
@@ -302,7 +333,6 @@ impl Varieties {
         });
         for _ in 0..todo {
             let row = self.step(py)?;
-            py.check_signals()?;
             if let Some(callback) = &on_generation {
                 callback.call1((row,))?;
             }

@@ -348,3 +348,49 @@ def test_bad_vectors_and_options_are_refused_naming_the_argument():
     assert sylva.GenomeSpace(CONFIGS["bintree"], coding="codons").coding == "codons"
     with pytest.raises(TypeError, match="Config, a dict or the path"):
         sylva.GenomeSpace(42)
+
+
+def sigint_after(seconds: float) -> threading.Timer:
+    """A real SIGINT to this process (what Ctrl-C sends) after `seconds`."""
+    import os
+    import signal
+
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_a_map_generation_and_a_batch_leaving_them_whole(tmp_path):
+    # L-system plants grow in a voxel world, about 0.2 s each on one core: a generation of
+    # 40 takes seconds, so the signal comes while it is under way.
+    text = (EXAMPLES / "lsystem" / "varieties.toml").read_text()
+    herb = (EXAMPLES / "lsystem" / "herb.json").as_posix()
+    text = text.replace('start = "herb.json"', f'start = "{herb}"')
+    text = text.replace("initial = 24", "initial = 2").replace("batch = 24", "batch = 40")
+    (tmp_path / "map.toml").write_text(text)
+    config = sylva.Config.load(tmp_path / "map.toml")
+    varieties = sylva.varieties(config, threads=2)
+    before = varieties.checkpoint()
+    for call in (varieties.step, lambda: varieties.run(5)):
+        timer = sigint_after(0.3)
+        started = time.perf_counter()
+        try:
+            with pytest.raises(KeyboardInterrupt):
+                call()
+        finally:
+            timer.cancel()
+        assert time.perf_counter() - started < 10
+        # The map is as it was before the generation it was breeding.
+        assert varieties.generation == 0 and len(varieties.stats) == 1
+        assert varieties.checkpoint() == before
+    # A batch of genomes to score is stopped alike.
+    space = sylva.GenomeSpace(config, threads=2)
+    rows = np.random.default_rng(1).uniform(size=(60, space.dim))
+    timer = sigint_after(0.3)
+    started = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            space.evaluate(rows)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - started < 10

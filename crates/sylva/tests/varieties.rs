@@ -264,3 +264,22 @@ fn cma_me_is_refused_for_genomes_of_varying_structure() {
         );
     }
 }
+
+#[test]
+fn a_stopped_step_leaves_the_map_as_it_was() {
+    let map = "descriptors = [{ name = \"porosity\", cells = 5 }]\n";
+    let config = config("bintree", map);
+    let mut stopped =
+        Varieties::start(&config, Vec::new(), Pool::with_threads(2).unwrap()).unwrap();
+    let before = bytes(&stopped);
+    let stop = sylva::evolution::Stop::new();
+    stop.stop();
+    assert!(stopped.step_until(&stop).is_err());
+    assert_eq!(bytes(&stopped), before);
+    // It goes on exactly as a map that was never stopped.
+    stop.reset();
+    stopped.step_until(&stop).unwrap();
+    let mut straight = Varieties::start(&config, Vec::new(), Pool::Serial).unwrap();
+    straight.step();
+    assert_eq!(bytes(&stopped), bytes(&straight));
+}

@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 use sylva_core::Plant;
-use sylva_core::par::Pool;
+use sylva_core::par::{Pool, Stop, Stopped};
 use sylva_evolve::map::{Axis, Describe, Emitter, MapCheckpoint, MapRun, MapSettings, MapStats};
 use sylva_evolve::{Problem, WithTerm};
 use sylva_fitness::descriptors::{self, Descriptor, Scratch};
@@ -428,6 +428,18 @@ impl Varieties {
     /// Breeds one generation, offers it to the map, and returns its statistics.
     pub fn step(&mut self) -> &MapStats {
         self.run.step()
+    }
+
+    /// [`Varieties::step`], cut short once `stop` is set (within one offspring's
+    /// evaluation): then `Err(Stopped)`, and the map is as it was before the step.
+    pub fn step_until(&mut self, stop: &Stop) -> Result<&MapStats, Stopped> {
+        stop.watch(|| {
+            self.run.step();
+        })?;
+        Ok(self
+            .stats()
+            .last()
+            .expect("a map has generation 0's statistics"))
     }
 
     /// The last completed generation.
