@@ -154,6 +154,13 @@ fn watched() -> Option<Stop> {
     WATCHED.with(|w| w.borrow().clone())
 }
 
+/// Ends the work under way here if the [`Stop`] it is watched by is set, as a [`Pool`] map's
+/// jobs do: for a long loop that runs outside a map on the watching thread (a model making a
+/// large first generation). Does nothing for unwatched work.
+pub fn stop_point() {
+    check(watched().as_ref());
+}
+
 /// Ends the job under way if its stop is set: the job unwinds, without the panic hook (no
 /// message is printed), to [`Stop::watch`], which returns [`Stopped`].
 fn check(stop: Option<&Stop>) {
@@ -206,6 +213,24 @@ impl Stop {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stop_point_ends_watched_loops_only() {
+        let stop = Stop::new();
+        let mut done = 0;
+        let result = stop.watch(|| {
+            for i in 0..100 {
+                if i == 10 {
+                    stop.stop();
+                }
+                stop_point();
+                done += 1;
+            }
+        });
+        assert_eq!((result, done), (Err(Stopped), 10));
+        // Outside watched work it does nothing, set or not.
+        stop_point();
+    }
 
     #[test]
     fn a_stop_ends_watched_maps_between_jobs() {

@@ -174,6 +174,10 @@ pub fn first_generation(
     let mut rng = sylva_core::rng::stream(seed, 0, u32::MAX);
     let mut start = chosen.clone();
     while start.len() < population {
+        // A population of millions takes seconds to make: a front end's stop is heard.
+        if start.len().is_multiple_of(4096) {
+            sylva_core::par::stop_point();
+        }
         let mut g = chosen[start.len() % chosen.len()].clone();
         mutation.mutate(&mut g, &mut rng);
         start.push(g);
