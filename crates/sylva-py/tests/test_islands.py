@@ -105,7 +105,7 @@ config = sylva.Config.load(sys.argv[1]).with_run(population=200, generations=400
 def on_round(info):
     print("round", info["round"], *info["pids"], flush=True)
 try:
-    sylva.islands(config, islands=2, migrate_every=2, seed=3, backend="local",
+    sylva.islands(config, islands=2, migrate_every=2, seed=3, backend=sys.argv[3],
                   checkpoint=sys.argv[2], on_round=on_round)
 except KeyboardInterrupt:
     print("stopped", flush=True)
@@ -121,7 +121,7 @@ def test_ctrl_c_stops_local_islands_without_tracebacks_from_workers(tmp_path):
     # goes to the whole group.
     driver = subprocess.Popen(
         [sys.executable, "-c", CTRL_C_SCRIPT, str(EXAMPLES / "automata" / "sphere.toml"),
-         str(tmp_path / "islands.json")],
+         str(tmp_path / "islands.json"), "local"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
     )
     try:
@@ -204,3 +204,30 @@ def test_ray_islands_match_the_local_pool_and_survive_a_killed_actor(cluster, lo
     disturbed = sylva.islands(small_sphere(), backend="ray", on_round=kill_one, **RUN)
     assert killed and disturbed.restarts >= 1
     assert fingerprint(disturbed) == fingerprint(local)
+
+
+def test_ctrl_c_stops_ray_islands_without_tracebacks(tmp_path):
+    import subprocess
+    import sys
+
+    pytest.importorskip("ray")
+    # A local Ray started by the driver, in a home of its own (Ray writes its token there);
+    # the terminal's Ctrl-C goes to the driver's whole process group, Ray's processes too.
+    env = dict(os.environ, HOME=str(tmp_path), RAY_USAGE_STATS_ENABLED="0")
+    env.pop("RAY_ADDRESS", None)
+    driver = subprocess.Popen(
+        [sys.executable, "-c", CTRL_C_SCRIPT, str(EXAMPLES / "automata" / "sphere.toml"),
+         str(tmp_path / "islands.json"), "ray"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env=env,
+    )
+    try:
+        first = driver.stdout.readline().split()
+        assert first[:2] == ["round", "1"], (first, driver.stderr.read() if not first else "")
+        os.killpg(driver.pid, signal.SIGINT)
+        out, err = driver.communicate(timeout=120)
+    finally:
+        if driver.poll() is None:
+            os.killpg(driver.pid, signal.SIGKILL)
+    assert driver.returncode == 130 and out.strip().endswith("stopped"), (out, err)
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
