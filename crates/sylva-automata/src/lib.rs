@@ -12,6 +12,7 @@
 //! - [`sexpr`]: trees printed and parsed as lilgp-style S-expressions.
 //! - [`compile`]: cellular encoding into flat automata, and the semantics chosen.
 //! - [`sim`]: the bounded simulator.
+//! - [`sprout`]: random programs built to grow into trees, for a random plant to look at.
 //! - [`gp`]: ramped half-and-half initialisation, typed subtree crossover and mutation.
 //! - [`genome`]: [`AutomataGenome`], the genome file (a program and how it grows).
 //! - [`problem`]: Poncin's GP run as an evolution problem (the `[automata]` settings).
@@ -104,6 +105,7 @@ pub mod gp;
 pub mod problem;
 pub mod sexpr;
 pub mod sim;
+pub mod sprout;
 pub mod tree;
 
 pub use compile::{AtEnd, ElseEnd, Program, Semantics};
@@ -139,9 +141,10 @@ impl Model for AutomataModel {
         genome.develop(seed)
     }
 
-    /// A ramped half-and-half program grown with the settings' growth.
+    /// A random program built to grow into a tree ([`sprout::random_tree`]), grown with the
+    /// settings' growth. A run's random programs are the paper's ramped half-and-half trees.
     fn random<R: Rng + ?Sized>(&self, s: &AutomataSettings, rng: &mut R) -> AutomataGenome {
-        AutomataGenome::with_growth(s.gp().random_tree(rng), s.growth.clone())
+        AutomataGenome::with_growth(sprout::random_tree(rng), s.growth.clone())
     }
 
     /// Subtree mutation of the program; the growth settings stay the genome's.

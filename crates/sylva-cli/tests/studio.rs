@@ -852,10 +852,20 @@ fn genome_distance(a: &Value, b: &Value) -> f64 {
             (x - y).abs() / (x.abs() + y.abs()).max(1e-9)
         }
         (Value::String(x), Value::String(y)) => {
+            // Edit distance, so a number that gains a sign does not shift the rest of a
+            // program out of place.
             let (x, y): (Vec<char>, Vec<char>) = (x.chars().collect(), y.chars().collect());
-            let n = x.len().max(y.len()).max(1);
-            let same = x.iter().zip(&y).filter(|(p, q)| p == q).count();
-            (n - same) as f64 / n as f64
+            let mut row: Vec<usize> = (0..=y.len()).collect();
+            for (i, p) in x.iter().enumerate() {
+                let mut diagonal = row[0];
+                row[0] = i + 1;
+                for (j, q) in y.iter().enumerate() {
+                    let substitute = diagonal + usize::from(p != q);
+                    diagonal = row[j + 1];
+                    row[j + 1] = substitute.min(row[j] + 1).min(diagonal + 1);
+                }
+            }
+            row[y.len()] as f64 / x.len().max(y.len()).max(1) as f64
         }
         (Value::Array(x), Value::Array(y)) => (0..x.len().max(y.len()))
             .map(|i| match (x.get(i), y.get(i)) {

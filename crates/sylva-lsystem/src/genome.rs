@@ -38,7 +38,7 @@ use sylva_evolve::Mutate;
 
 use crate::garden::{Garden, GrowSettings, Sowing};
 use crate::grammar::{
-    Compartment, MAX_RULES, Module, RuleSet, Symbol, Word, parse_rule, parse_word,
+    Axis, Compartment, MAX_RULES, Module, Rule, RuleSet, Symbol, Word, parse_rule, parse_word,
 };
 use crate::interpret::{Angles, ModuleShape};
 use crate::mutate::{MutationRates, mutate_rules};
@@ -355,6 +355,21 @@ impl LSystemGenome {
         }
     }
 
+    /// A random genome built to grow, for a person who asks for a random plant (the
+    /// paper's evolution starts from [`LSystemGenome::empty`], which does not germinate):
+    /// each compartment has one to three rules, and each rule lays a wood module, then one to
+    /// three bracketed laterals (rolled apart; each a pitch or turn or two, then an organ or
+    /// an apex), and most often continues its own axis. The first rule's first lateral is an
+    /// organ (a leaf, a fine root), so the plant feeds from its first year, and its second
+    /// an apex, so it branches. Angles and module shapes are the bush's, nudged by half.
+    pub fn random_growing<R: Rng + ?Sized>(rng: &mut R) -> LSystemGenome {
+        let mut genome = LSystemGenome::empty();
+        genome.shoot.rules = growing_rules(Compartment::Shoot, rng);
+        genome.root.rules = growing_rules(Compartment::Root, rng);
+        mutate_parameter(&mut genome, 0.5, rng);
+        genome
+    }
+
     /// The bush of the paper's Figure 5 (with its misprinted `B -> >>|` read as `B -> >>l`).
     pub fn bush() -> LSystemGenome {
         let shoot = LSystem::parse(
@@ -439,6 +454,53 @@ impl LSystemGenome {
     }
 }
 
+/// The rules of [`LSystemGenome::random_growing`] for one compartment.
+fn growing_rules<R: Rng + ?Sized>(compartment: Compartment, rng: &mut R) -> RuleSet {
+    let (wood, organ) = match compartment {
+        Compartment::Shoot => (Module::Branch, Module::Leaf),
+        Compartment::Root => (Module::RootBranch, Module::FineRoot),
+    };
+    let count = rng.random_range(1..=3u8);
+    let rules = (0..count)
+        .map(|rule| {
+            let mut word = vec![Symbol::Module(wood)];
+            let laterals = if rule == 0 { 2..=3 } else { 1..=3 };
+            for lateral in 0..rng.random_range(laterals) {
+                if lateral > 0 {
+                    let rolls = rng.random_range(1..=3);
+                    word.extend((0..rolls).map(|_| Symbol::Rotate(Axis::Roll, true)));
+                }
+                word.push(Symbol::Push);
+                for _ in 0..rng.random_range(1..=2) {
+                    let axis = if rng.random_bool(0.5) {
+                        Axis::Pitch
+                    } else {
+                        Axis::Turn
+                    };
+                    word.push(Symbol::Rotate(axis, rng.random_bool(0.5)));
+                }
+                // The first rule feeds the plant first and branches second.
+                let organ_here = match (rule, lateral) {
+                    (0, 0) => true,
+                    (0, 1) => false,
+                    _ => rng.random_bool(0.4),
+                };
+                word.push(if organ_here {
+                    Symbol::Module(organ)
+                } else {
+                    Symbol::Apex(rng.random_range(0..count))
+                });
+                word.push(Symbol::Pop);
+            }
+            if rule == 0 || rng.random_bool(0.7) {
+                word.push(Symbol::Apex(rule));
+            }
+            Rule { successor: word }
+        })
+        .collect();
+    RuleSet { rules }
+}
+
 /// The paper's "mutate parameter": nudges every module shape by up to ±`scale` of itself
 /// and every angle by up to ±`scale`·50 degrees, each clamped to its range.
 pub fn mutate_parameter<R: Rng + ?Sized>(genome: &mut LSystemGenome, scale: f64, rng: &mut R) {
@@ -484,6 +546,29 @@ impl Mutate<LSystemGenome> for LSystemMutation {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn random_growing_genomes_are_well_formed_and_feed_and_branch() {
+        for seed in 0..200 {
+            let g = LSystemGenome::random_growing(&mut sylva_core::rng::seeded(seed));
+            assert_eq!(
+                LSystemGenome::from_json(&g.to_json()).unwrap(),
+                g,
+                "seed {seed}"
+            );
+            for (system, organ) in [(&g.shoot, Module::Leaf), (&g.root, Module::FineRoot)] {
+                let first = &system.rules.rules[0].successor;
+                assert!(crate::mutate::balanced(first), "seed {seed}");
+                assert!(first.contains(&Symbol::Module(organ)), "seed {seed} feeds");
+                assert!(first.contains(&Symbol::Apex(0)), "seed {seed} goes on");
+                let laterals = first
+                    .iter()
+                    .filter(|s| matches!(s, Symbol::Apex(_)))
+                    .count();
+                assert!(laterals >= 2, "seed {seed} branches");
+            }
+        }
+    }
 
     #[test]
     fn the_bush_round_trips() {

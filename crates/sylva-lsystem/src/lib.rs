@@ -71,14 +71,10 @@ impl Model for LSystemModel {
         genome.develop(seed)
     }
 
-    /// `random_rounds` mutations of the empty genome (the paper's start).
-    fn random<R: Rng + ?Sized>(&self, s: &LSystemSettings, rng: &mut R) -> LSystemGenome {
-        let mutation = s.mutation();
-        let mut g = LSystemGenome::empty();
-        for _ in 0..s.random_rounds {
-            mutation.mutate(&mut g, rng);
-        }
-        g
+    /// A random genome built to grow ([`LSystemGenome::random_growing`]). A run's random
+    /// genomes are the paper's instead: `random_rounds` mutations of its `start`.
+    fn random<R: Rng + ?Sized>(&self, _: &LSystemSettings, rng: &mut R) -> LSystemGenome {
+        LSystemGenome::random_growing(rng)
     }
 
     /// The paper's character and rule mutations at the settings' rates.

@@ -114,7 +114,8 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     /// any, and is recorded in the plant ([`plant_meta`]).
     fn develop(&self, genome: &Self::Genome, seed: u64) -> Result<Plant, DevelopError>;
 
-    /// A random genome.
+    /// A random genome, for a person who asks for one: it should grow into a plant worth
+    /// looking at (a run's first generation is [`Problem::random_genome`], the paper's).
     fn random<R: Rng + ?Sized>(&self, settings: &Self::Settings, rng: &mut R) -> Self::Genome;
 
     /// A mutated copy of `genome`.

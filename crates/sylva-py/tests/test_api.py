@@ -130,7 +130,17 @@ def test_operators_make_valid_genomes_of_the_model(model):
     assert child == sylva.cross([genome, other], seed=4)[0]
     for g in [mutant, other, child]:
         assert sylva.Genome.from_json(g.to_json()) == g
-        assert g.grow(seed=1).segments >= 0
+        g.grow(seed=1)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_random_genomes_grow_into_branching_plants(model):
+    genomes = [sylva.Genome.random(model, seed) for seed in range(3)]
+    for seed, genome in enumerate(genomes):
+        assert genome == sylva.Genome.random(model, seed)
+        plant = genome.grow()
+        assert plant.tips >= 2, f"seed {seed}: {plant.tips} tips"
+    assert len(set(genomes)) == 3
 
 
 def test_mesh_arrays_outlive_their_plant():

@@ -26,6 +26,9 @@ use crate::evolution::{MapValue, TypedRun, resume, resume_map, start, start_map}
 use crate::evolution::{RunHooks, SpaceOptions, SpaceValue, Stop, new_space};
 use crate::genome::{Genome, Settings, settings_of};
 
+/// How many genomes [`DynModel::random`] draws, at most, to find one that grows.
+pub(crate) const RANDOM_DRAWS: u32 = 100;
+
 /// A model's genome or config, erased.
 pub(crate) type Value = dyn Any + Send + Sync;
 
@@ -203,7 +206,24 @@ impl<M: Evolve + Default> DynModel for M {
     fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Box<Value>, InputError> {
         let settings = settings_of(self, settings)?;
         let mut rng = sylva_core::rng::seeded(seed);
-        Ok(Box::new(Model::random(self, &settings, &mut rng)))
+        // Some models' random genomes often grow nothing (the L-system's paper starts from
+        // a genome that does not germinate): draw on from the same stream until one grows.
+        for _ in 0..RANDOM_DRAWS {
+            let genome = Model::random(self, &settings, &mut rng);
+            let seed = Model::default_seed(self, &genome);
+            let grows = Model::develop(self, &genome, seed).is_ok_and(|p| !p.segments().is_empty());
+            if grows {
+                return Ok(Box::new(genome));
+            }
+        }
+        Err(InputError::new(
+            "settings",
+            format!(
+                "none of the {RANDOM_DRAWS} random {} genomes drawn from seed {seed} grows a \
+                 segment with these settings; expected settings under which some grow",
+                M::NAME
+            ),
+        ))
     }
 
     fn write(&self, g: &Value) -> String {

@@ -46,8 +46,10 @@ impl ModelEntry {
         self.model.title()
     }
 
-    /// A random genome, made by the model with `settings` (its settings as JSON, or its
-    /// defaults) from the stream of `seed`.
+    /// A random genome that grows: made by the model with `settings` (its settings as JSON,
+    /// or its defaults) from the stream of `seed`, which draws on until a genome grows at
+    /// least one segment with its default seed. After 100 draws that grow nothing (settings
+    /// under which nothing can grow) it is an error.
     pub fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
         let genome = self.model.random(settings, seed)?;
         Ok(Genome::erased(self.model.clone(), genome))

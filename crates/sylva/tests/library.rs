@@ -230,6 +230,23 @@ fn start_genomes_must_be_of_the_run_s_model() {
 }
 
 #[test]
+fn random_genomes_of_every_model_grow_into_branching_plants() {
+    for entry in Registry::standard().models() {
+        let genomes: Vec<Genome> = (0..4)
+            .map(|seed| entry.random(Settings::Default, seed).unwrap())
+            .collect();
+        for (seed, genome) in genomes.iter().enumerate() {
+            let plant = genome.develop(genome.default_seed()).unwrap();
+            let tips = plant.tips().count();
+            assert!(tips >= 2, "{} seed {seed}: {tips} tips", entry.name());
+            let again = entry.random(Settings::Default, seed as u64).unwrap();
+            assert_eq!(&again, genome, "{} seed {seed}", entry.name());
+        }
+        assert_ne!(genomes[0], genomes[1], "{}", entry.name());
+    }
+}
+
+#[test]
 fn every_model_breeds_by_hand_with_its_own_operators() {
     for name in [
         "bintree/oak.json",
