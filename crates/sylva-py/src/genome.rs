@@ -164,28 +164,34 @@ impl Genome {
 
     /// Grows the plant with `seed` (the genome's own seed when none is given) and meshes it;
     /// `roots=False` leaves the roots out; `taper=E` thickens the branches by the pipe model,
-    /// radius ∝ (tips above)^(1/E), E from 2 to 3. Releases the GIL.
-    #[pyo3(signature = (seed = None, roots = true, taper = None))]
+    /// radius ∝ (tips above)^(1/E), E from 2 to 3; `wind=S` adds a wind skin and a looping
+    /// clip named `wind` (strength S from 0 to 10, 1 a breeze; `wind_period` seconds a sway,
+    /// 0.5 to 60, default 4), which the plant's GLB carries. Releases the GIL.
+    #[pyo3(signature = (seed = None, roots = true, taper = None, wind = None, wind_period = None))]
     fn grow(
         &self,
         py: Python<'_>,
         seed: Option<u64>,
         roots: bool,
         taper: Option<f64>,
+        wind: Option<f32>,
+        wind_period: Option<f32>,
     ) -> PyResult<Plant> {
         let genome = self.inner.clone();
         let taper = taper
             .map(sylva::core::taper::PipeTaper::new)
             .transpose()
             .map_err(|e| bad_value("taper", e))?;
+        let wind = wind_options(wind, wind_period)?;
         let options = sylva::GrowOptions {
             seed,
             roots,
             taper,
+            wind,
             ..sylva::GrowOptions::default()
         };
         let grown = py.detach(|| sylva::Grown::grow(genome, &options)).py()?;
-        Ok(Plant::new(grown))
+        Ok(Plant::with_wind(grown, wind))
     }
 
     /// A mutated copy, made by the model's own mutation with `settings` (a dict of the
@@ -298,4 +304,29 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         dict.set_item(m.name(), m.title())?;
     }
     Ok(dict)
+}
+
+/// The wind `grow` asks for: none without a strength, a period only with one.
+fn wind_options(
+    strength: Option<f32>,
+    period: Option<f32>,
+) -> PyResult<Option<sylva::mesh::wind::WindOptions>> {
+    use sylva::mesh::wind::{WindError, WindOptions};
+    let Some(strength) = strength else {
+        return match period {
+            Some(_) => Err(bad_value(
+                "wind_period",
+                "a period needs wind: give `wind`, a strength from 0 to 10, too",
+            )),
+            None => Ok(None),
+        };
+    };
+    let period = period.unwrap_or(WindOptions::default().period);
+    WindOptions::new(strength, period).map(Some).map_err(|e| {
+        let argument = match e {
+            WindError::Strength(_) => "wind",
+            WindError::Period(_) => "wind_period",
+        };
+        bad_value(argument, e)
+    })
 }

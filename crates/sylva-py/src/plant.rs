@@ -12,6 +12,7 @@ use pyo3::types::{PyBytes, PyDict, PyList};
 use sylva::assets::{Origin, Placed, SceneAssets};
 use sylva::core::measures::TreeMeasures;
 use sylva::files::Outputs;
+use sylva::mesh::wind::WindOptions;
 use sylva::render::View;
 
 use crate::errors::{IntoPy, bad_value};
@@ -25,13 +26,21 @@ pub struct Plant {
     grown: sylva::Grown,
     /// The mesh's triangles gathered from its primitives, the first time they are asked for.
     triangles: OnceLock<Triangles>,
+    /// The wind it grew with, for its levels of detail.
+    wind: Option<WindOptions>,
 }
 
 impl Plant {
     pub fn new(grown: sylva::Grown) -> Plant {
+        Plant::with_wind(grown, None)
+    }
+
+    /// A plant grown with `wind` (its rig is in `grown`).
+    pub fn with_wind(grown: sylva::Grown, wind: Option<WindOptions>) -> Plant {
         Plant {
             grown,
             triangles: OnceLock::new(),
+            wind,
         }
     }
 }
@@ -171,6 +180,66 @@ impl Plant {
     /// The plant as GLB bytes.
     fn glb<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = py.detach(|| glb_bytes(&self.grown.scene())).py()?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The wind it grew with (`grow(wind=...)`), or None: a dict of its `strength` and
+    /// `period` (seconds), the skin's `joints`, the finer joints `left_out` past the skin's
+    /// limit, and the clip's name (`clip`, "wind").
+    #[getter]
+    fn wind<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let (Some(wind), Some(rig)) = (self.wind, &self.grown.rig) else {
+            return Ok(None);
+        };
+        let dict = PyDict::new(py);
+        dict.set_item("strength", wind.strength)?;
+        dict.set_item("period", wind.period)?;
+        dict.set_item("joints", rig.joints.len())?;
+        dict.set_item("left_out", rig.dropped)?;
+        dict.set_item("clip", "wind")?;
+        Ok(Some(dict))
+    }
+
+    /// Its levels of detail as GLB bytes: `levels` (2 to 8) meshes of falling detail as
+    /// sibling nodes named `NAME_LOD0` (the plant in full) to `NAME_LODn`, each with its
+    /// triangles and screen coverage in its extras, and the wind skin and clip on every
+    /// level when the plant has wind (as `sylva grow --lod` writes them). Grows the plant
+    /// again. Releases the GIL.
+    #[pyo3(signature = (levels, name = "plant"))]
+    fn lod_glb<'py>(
+        &self,
+        py: Python<'py>,
+        levels: usize,
+        name: &str,
+    ) -> PyResult<Bound<'py, PyBytes>> {
+        let most = sylva::gltf::lod::MAX_LEVELS;
+        if !(2..=most).contains(&levels) {
+            return Err(bad_value(
+                "levels",
+                format!("expected an int from 2 to {most}, got {levels}"),
+            ));
+        }
+        if name.is_empty() {
+            return Err(bad_value("name", "expected a name for the nodes, got \"\""));
+        }
+        let g = &self.grown;
+        let options = sylva::GrowOptions {
+            seed: Some(g.seed),
+            roots: g.roots,
+            taper: g.taper,
+            wind: self.wind,
+            lod: Some(levels),
+            height: g.height,
+            ..sylva::GrowOptions::default()
+        };
+        let genome = g.genome.clone();
+        let bytes = py
+            .detach(|| {
+                let grown = sylva::Grown::grow(genome, &options)?;
+                let chain = sylva::LodAssets::new(grown, &options)?;
+                glb_bytes(&chain.group_scene(name))
+            })
+            .py()?;
         Ok(PyBytes::new(py, &bytes))
     }
 

@@ -143,6 +143,33 @@ def test_random_genomes_grow_into_branching_plants(model):
     assert len(set(genomes)) == 3
 
 
+def test_wind_and_levels_of_detail_come_as_gltf():
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    still = tulip.grow()
+    assert still.wind is None
+    windy = tulip.grow(wind=2.5, wind_period=3)
+    assert windy.wind == {"strength": 2.5, "period": 3.0, "joints": windy.wind["joints"],
+                          "left_out": 0, "clip": "wind"}
+    assert windy.wind["joints"] > 1
+    gltf = glb_json(windy.glb())
+    assert len(gltf["skins"][0]["joints"]) == windy.wind["joints"]
+    assert [a["name"] for a in gltf["animations"]] == ["wind"]
+    assert "skins" not in glb_json(still.glb())
+    lod = glb_json(still.lod_glb(3, name="tulip"))
+    assert [n["name"] for n in lod["nodes"] if "mesh" in n] == ["tulip_LOD0", "tulip_LOD1", "tulip_LOD2"]
+    assert still.lod_glb(3, name="tulip") == still.lod_glb(3, name="tulip")
+    assert "skins" in glb_json(windy.lod_glb(2))
+    for bad, names in [(dict(wind=11), "wind"), (dict(wind=-1), "wind"),
+                       (dict(wind_period=3), "wind_period"), (dict(wind=1, wind_period=100), "wind_period")]:
+        with pytest.raises(sylva.InputError, match=names):
+            tulip.grow(**bad)
+    for levels in (1, 9):
+        with pytest.raises(sylva.InputError, match="levels: expected an int from 2 to 8"):
+            still.lod_glb(levels)
+    with pytest.raises(TypeError, match="wind"):
+        pickle.dumps(windy)
+
+
 def test_mesh_arrays_outlive_their_plant():
     plant = sylva.Genome.load(GENOMES["plantmaker"]).grow()
     expected = plant.mesh.positions.copy()
