@@ -61,11 +61,12 @@ check(os.path.join("extensions", ".local") in sylva.__file__,
       f"sylva {sylva.__version__} imported from the bundled wheel: {sylva.__file__}")
 ext = sys.modules[module]
 plants = sys.modules[module + ".plants"]
-for panel in ("SYLVA_PT_grow", "SYLVA_PT_plant", "SYLVA_PT_breed"):
+for panel in ("SYLVA_PT_grow", "SYLVA_PT_plant", "SYLVA_PT_breed", "SYLVA_PT_evolve", "SYLVA_PT_assets"):
     cls = getattr(bpy.types, panel, None)
     check(cls is not None and cls.bl_category == "Sylva" and cls.bl_region_type == "UI"
           and cls.bl_space_type == "VIEW_3D", f"{panel} in the 3D view's sidebar, tab Sylva")
-ops = ("grow", "regrow", "save_genome", "breed", "mutate", "cross", "keep")
+ops = ("grow", "regrow", "save_genome", "breed", "mutate", "cross", "keep", "wind", "lod", "forest",
+       "mark_zone", "evolve")
 for name in ops:
     cls = getattr(bpy.types, f"SYLVA_OT_{name}")
     undo = name == "save_genome" or {"REGISTER", "UNDO"} <= set(cls.bl_options)
@@ -186,9 +187,17 @@ check_plant(obj, sylva.Genome.random("plantmaker", 3), "random plantmaker 3")
 check(isinstance(obj["sylva_seed"], str) or obj["sylva_seed"] >= 0,
       f"random plantmaker: its 64-bit seed kept in full ({obj['sylva_seed']!r})")
 
-empty = grown("RANDOM", "lsystem", random_seed=1)
-check(triangles(empty) == 0 == len(sylva.Genome.random("lsystem", 1).grow().mesh.indices)
-      and empty["sylva_model"] == "lsystem", "random lsystem 1 grows nothing: an empty mesh, with a warning")
+obj = grown("RANDOM", "lsystem", random_seed=1)
+check_plant(obj, sylva.Genome.random("lsystem", 1), "random lsystem 1")
+check(triangles(obj) > 0, f"random lsystem 1 grows: {triangles(obj)} triangles")
+# The paper's empty L-system (no rules) does not germinate: an empty mesh, with a warning.
+bare = json.loads(sylva.Genome.load(dict(examples["lsystem"])["herb"]).to_json())
+bare["shoot"]["rules"] = bare["root"]["rules"] = []
+with open(os.path.join(tmp, "bare.json"), "w") as f:
+    json.dump(bare, f)
+empty = grown("FILE", "lsystem", genome_file=os.path.join(tmp, "bare.json"))
+check(triangles(empty) == 0 and empty["sylva_model"] == "lsystem",
+      "an L-system without rules grows nothing: an empty mesh, with a warning")
 
 # -- Settings regrow the plant (the update callbacks of obj.sylva) ---------------------------
 tree = objects["tree"]
@@ -306,10 +315,213 @@ copy = bpy.context.active_object
 check(copy is not cells[2] and "sylva_cell" not in copy and copy["sylva_id"] == cells[2]["sylva_id"]
       and copy.data is not cells[2].data, "Keep: a copy out of the grid, with its own mesh")
 
+# -- Wind: Sylva's rig as an armature and its action ----------------------------------------
+fern = objects["fern"]
+select([fern])
+settings.wind_strength, settings.wind_period = 1.5, 2.0
+bpy.ops.sylva.wind()
+rig = bpy.context.active_object
+expected = plants.genome_of(fern).grow(wind=1.5, wind_period=2.0)
+skinned = [c for c in rig.children if c.type == "MESH"]
+check(rig.type == "ARMATURE" and len(rig.data.bones) == expected.wind["joints"] and len(skinned) == 1,
+      f"Add Wind: an armature of {len(rig.data.bones)} bones (the rig's {expected.wind['joints']} joints), "
+      "the skinned plant its child")
+mesh = skinned[0]
+modifier = next((m for m in mesh.modifiers if m.type == "ARMATURE"), None)
+check(modifier is not None and modifier.object == rig and len(mesh.vertex_groups) > 1
+      and triangles(mesh) == len(expected.mesh.indices),
+      f"Add Wind: the mesh ({triangles(mesh)} triangles, as the package's) is skinned to it "
+      f"({len(mesh.vertex_groups)} vertex groups, an Armature modifier)")
+track = rig.animation_data.nla_tracks.get("wind") if rig.animation_data else None
+strip = track.strips[0] if track and len(track.strips) else None
+action = strip.action if strip else None
+frames = scene.frame_end - scene.frame_start + 1
+check(action is not None and action.name == f"{fern.name} wind"
+      and strip.frame_end >= scene.frame_end,
+      f"Add Wind: action '{action.name if action else None}' of {action.frame_range[1] - action.frame_range[0] if action else 0:.0f} "
+      f"frames (2 s at {scene.render.fps} fps), an NLA strip repeated {strip.repeat if strip else 0:g} times over "
+      f"the scene's {frames} frames")
+
+
+def pose(frame):
+    scene.frame_set(frame)
+    tip = rig.pose.bones[-1]
+    return np.array(tip.matrix)
+
+
+half = scene.frame_start + scene.render.fps // 2
+swing = np.abs(pose(scene.frame_start) - pose(half)).max()
+late = np.abs(pose(half) - pose(half + 4 * scene.render.fps)).max()
+check(len(rig.animation_data.nla_tracks) == 1 and swing > 1e-4 and late < 1e-4,
+      f"Add Wind: a tip bone sways ({swing:.3f} over half a second) and the clip loops (as it was "
+      f"two periods later, within {late:.0e})")
+check(fern.hide_get() and fern.hide_render and mesh["sylva_id"] == fern["sylva_id"]
+      and json.loads(mesh["sylva_wind_rig"])["joints"] == expected.wind["joints"],
+      "Add Wind: the plant is hidden, the skinned mesh carries its id and the wind")
+select([fern])
+bpy.ops.sylva.wind()
+rigs = [o for o in bpy.data.objects if o.type == "ARMATURE" and o.get("sylva_wind_rig_of") == fern.name]
+check(len(rigs) == 1, "Add Wind again: the plant's old rig is replaced")
+fern.hide_set(False)
+fern.hide_render = False
+
+# -- Levels of detail: a collection of NAME_LODn objects ------------------------------------
+tulip = objects["tulip"]
+select([tulip])
+settings.lod_levels = 3
+bpy.ops.sylva.lod()
+lod_collection = bpy.data.collections.get(f"{tulip.name}_LODs")
+levels = sorted(lod_collection.objects, key=lambda o: o.name) if lod_collection else []
+counts = [triangles(o) for o in levels]
+full = len(plants.genome_of(tulip).grow().mesh.indices)
+check([o.name for o in levels] == [f"{tulip.name}_LOD{k}" for k in range(3)]
+      and counts[0] == full and counts == sorted(counts, reverse=True) and counts[1] < counts[0],
+      f"Levels of Detail: {', '.join(o.name for o in levels)} in {lod_collection.name if lod_collection else None} "
+      f"({', '.join(map(str, counts))} triangles; the plant's {full})")
+check(all(o.location == tulip.location for o in levels) and not levels[0].hide_get()
+      and all(o.hide_get() for o in levels[1:]) and all(o["sylva_id"] == tulip["sylva_id"] for o in levels),
+      "Levels of Detail: where the plant stands, LOD0 shown and the rest hidden, each with the plant's id")
+select([tulip])
+settings.lod_levels = 2
+bpy.ops.sylva.lod()
+check(len(bpy.data.collections[f"{tulip.name}_LODs"].objects) == 2, "Levels of Detail again: the old chain replaced")
+
+# -- Forest: collection instances of variants over a ground mesh -----------------------------
+
+
+def rss_mb():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+ground_mesh = bpy.data.meshes.new("hill")
+ground_mesh.from_pydata([(-20, -20, 0), (20, -20, 0), (20, 20, 4), (-20, 20, 4)], [], [(0, 1, 2, 3)])
+hill = bpy.data.objects.new("hill", ground_mesh)
+hill.location = (200, 0, 0)
+scene.collection.objects.link(hill)
+conifer = objects["conifer"]
+select([conifer])
+fails(lambda: bpy.ops.sylva.forest(), "Select one ground mesh")
+settings.forest_count, settings.forest_variants, settings.forest_seed = 1000, 8, 3
+meshes_before = len(bpy.data.meshes)
+select([hill, conifer], active=conifer)
+rss_before = rss_mb()
+t = time.perf_counter()
+bpy.ops.sylva.forest()
+forest_s = time.perf_counter() - t
+rss_after = rss_mb()
+woods = bpy.data.collections.get(f"{conifer.name} Forest")
+trees = list(woods.objects) if woods else []
+kinds = {tree.instance_collection for tree in trees}
+library = bpy.data.collections.get(f"{conifer.name} Forest Variants")
+check(len(trees) == 1000 and all(t.type == "EMPTY" and t.instance_type == "COLLECTION" for t in trees)
+      and len(kinds) == 8 and kinds <= set(library.children),
+      f"Plant Forest: {len(trees)} collection instances of {len(kinds)} variants in {woods.name if woods else None}")
+check(len(bpy.data.meshes) - meshes_before == 7,
+      f"Plant Forest: {len(bpy.data.meshes) - meshes_before} new meshes (the conifer grown with 7 other seeds; "
+      "the plant is the 8th), not one per tree")
+seeds = sorted(v.objects[0]["sylva_seed"] for v in library.children if "sylva_seed" in v.objects[0])
+check(len(set(seeds)) == 7 and all(v.objects[0].get("sylva_id", conifer["sylva_id"]) == conifer["sylva_id"]
+                                   for v in library.children),
+      f"Plant Forest, varied by seed: one genome, the conifer's, grown with seeds {seeds}")
+places = np.array([t.location for t in trees])
+on_hill = (np.abs(places[:, 0] - 200) <= 20).all() and (np.abs(places[:, 1]) <= 20).all() \
+    and np.allclose(places[:, 2], (places[:, 1] + 20) / 10, atol=1e-3)
+check(on_hill, "Plant Forest: every tree stands on the hill's surface")
+layer = next(c for c in bpy.context.view_layer.layer_collection.children if c.collection == library)
+check(layer.exclude and all(len(c.objects) == 1 and plants.is_plant(c.objects[0]) or c.objects[0].data == conifer.data
+                            for c in library.children),
+      "Plant Forest: the variants, a plant each, are kept out of the view layer")
+select([hill, conifer], active=conifer)
+bpy.ops.sylva.forest()
+again = np.array([t.location for t in bpy.data.collections[f"{conifer.name} Forest"].objects])
+check(len(again) == 1000 and np.allclose(np.sort(again, axis=0), np.sort(places, axis=0)),
+      "Plant Forest again with the same seed: the same places, the old forest replaced")
+settings.forest_variety, settings.forest_count = "MUTANTS", 50
+select([hill, conifer], active=conifer)
+bpy.ops.sylva.forest()
+library = bpy.data.collections[f"{conifer.name} Forest Variants"]
+ids = {v.objects[0].get("sylva_id") for v in library.children} - {None}
+check(len(bpy.data.collections[f"{conifer.name} Forest"].objects) == 50 and len(ids) == 7
+      and conifer["sylva_id"] not in ids, f"Plant Forest of mutants: 7 genomes of their own beside the conifer")
+assets = sys.modules[module + ".assets"]
+oak_forest = assets.forest(bpy.context, objects["oak"], hill, 20, 3, 1)
+check(oak_forest[2], "Plant Forest of oaks varied by seed: reported alike (the binary tree ignores the seed)")
+settings.forest_variety = "SEEDS"
+
+# -- Evolve toward a target and zones in the scene ----------------------------------------------
+evolve = sys.modules[module + ".evolve"]
+scene.cursor.location = (-60, 0, 0)
+bpy.ops.mesh.primitive_uv_sphere_add(radius=1.5, location=(-60, 0, 3.0))
+ball = bpy.context.active_object
+bpy.ops.mesh.primitive_cube_add(size=1.0, location=(-60, 0, 5.0))
+lid = bpy.context.active_object
+select([lid])
+bpy.ops.sylva.mark_zone(kind="forbidden")
+check(lid["sylva_zone"] == "forbidden" and lid.display_type == "WIRE" and lid.hide_render
+      and evolve.zones_in(scene) == [lid], "Mark Zone: the box forbidden, drawn as a wire, left out of renders")
+select([conifer])
+fails(lambda: bpy.ops.sylva.mark_zone(kind="favoured"), "plants cannot be zones")
+settings.target = None
+fails(lambda: bpy.ops.sylva.evolve(), "Choose a target")
+settings.target = hill
+fails(lambda: bpy.ops.sylva.evolve(), "Cannot tell the shape of hill", "choose Sphere")
+settings.target = ball
+made = evolve.config(ball, "AUTO", [lid], scene.cursor.location, 10, 200, 1)
+fitness = made["automata"]["fitness"]
+target = fitness["target"]
+unit = fitness["unit"]
+check(target["shape"] == "sphere" and abs(target["radius"] - 150) < 0.5 and abs(unit - 0.01) < 1e-4
+      and np.allclose(target["center"], [0, 300, 0], atol=0.5),
+      f"Evolve: the UV sphere (radius 1.5 m, 3 m up) is the target sphere of radius {target['radius']:.1f} units "
+      f"centred {target['center'][1]:.1f} up, a unit {unit * 100:.2f} cm (the paper's scale)")
+cells = fitness["grid"]
+check(cells["weight"] == 0 and len(cells["boxes"]) == 1 and cells["boxes"][0]["weight"] == -1
+      and cells["boxes"][0]["to"][1] == 4 and cells["boxes"][0]["from"][1] >= 3,
+      f"Evolve: the forbidden box is the grid's top cells {cells['boxes'][0]['from']} to {cells['boxes'][0]['to']}")
+settings.evolve_population, settings.evolve_generations, settings.evolve_seed = 300, 12, 2
+t = time.perf_counter()
+bpy.ops.sylva.evolve()
+evolved = bpy.context.active_object
+ticks = 0
+while evolve.tick() is not None and time.perf_counter() - t < 120:
+    ticks += 1
+    time.sleep(0.05)
+evolve_s = time.perf_counter() - t
+stats = evolve._current["last"].run.stats
+check(plants.is_plant(evolved) and evolved["sylva_model"] == "automata" and evolved["sylva_operator"] == "evolve"
+      and evolved.location == scene.cursor.location and triangles(evolved) > 0,
+      f"Evolve: the best plant so far stands at the cursor ({triangles(evolved)} triangles), updated "
+      f"while the run went on ({ticks} looks)")
+check(len(stats) == 13 and stats[-1]["best"] > stats[0]["best"]
+      and abs(evolved["sylva_fitness"] - stats[-1]["best"]) < 1e-12,
+      f"Evolve: the first generation and 12 more on a worker thread, best fitness {stats[0]['best']:.3g} -> {stats[-1]['best']:.3g} "
+      "(the plant shown is the last best)")
+check("generation 12 of 12" in evolve.last_status(), f"Evolve: status '{evolve.last_status()}'")
+settings.evolve_generations = 10000
+bpy.ops.sylva.evolve()
+evolve.tick()
+bpy.ops.sylva.evolve_stop()
+while evolve.tick() is not None:
+    time.sleep(0.05)
+done = len(evolve._current["last"].run.stats) - 1
+check(done < 10000 and not evolve.running(), f"Evolve, Stop: the run ends after generation {done} of 10000")
+
 # -- Panels: drawn into a stand-in layout (headless bpy has no window to draw in) ----------
 # It checks that every property a panel shows exists, every button names a registered
 # operator, every icon is Blender's, for the states a user meets.
 ICONS = set(bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items.keys())
+
+
+class Properties:
+    """An operator's properties as a button sets them: only the ones it has."""
+
+    def __init__(self, rna):
+        object.__setattr__(self, "rna", rna)
+
+    def __setattr__(self, name, value):
+        if name not in self.rna.properties:
+            raise AssertionError(f"operator {self.rna.identifier} has no property {name}")
 
 
 class Layout:
@@ -339,6 +551,7 @@ class Layout:
         if not hasattr(getattr(bpy.ops, module), name) or getattr(getattr(bpy.ops, module), name).get_rna_type() is None:
             raise AssertionError(f"no operator {idname}")
         self.seen.append(idname)
+        return Properties(getattr(getattr(bpy.ops, module), name).get_rna_type())
 
     def label(self, text="", **kw):
         self._icon(kw)
@@ -376,6 +589,11 @@ try:
     drawn = draw(bpy.types.SYLVA_PT_breed, grid_plant, [grid_plant, grid()[2]])
     check({"sylva.breed", "sylva.mutate", "sylva.cross", "sylva.keep"} <= set(drawn)
           and "2 favourite(s) selected" in drawn, f"Breed panel with a grid: {', '.join(drawn)}")
+    drawn = draw(bpy.types.SYLVA_PT_evolve, None, [])
+    check({"sylva.evolve", "sylva.mark_zone", "prop target", "prop evolve_branches"} <= set(drawn),
+          f"Evolve panel: {', '.join(drawn)}")
+    drawn = draw(bpy.types.SYLVA_PT_assets, oak_obj, [oak_obj])
+    check({"sylva.wind", "sylva.lod", "sylva.forest"} <= set(drawn), f"Assets panel: {', '.join(drawn)}")
 except AssertionError as e:
     check(False, f"panels draw: {e}")
 
@@ -429,6 +647,12 @@ for model, name in (("plantmaker", "tulip"), ("plantmaker", "conifer"), ("lsyste
         what = "nine variants of the" if kind == "breed" else "two favourites crossed into seven,"
         figure(max(steps), 1.0, f"{kind}: {what} {name} ({'k, '.join(map(str, sizes))}k triangles in the grid): "
                f"{', '.join(f'{x * 1000:.0f}' for x in steps)} ms (target under 1000)")
+
+print(f"     evolve: 12 generations of 300 automata toward a sphere under a forbidden box, the best "
+      f"shown as it improved: {evolve_s:.2f} s")
+figure(forest_s, 5.0, f"forest: 1000 conifers of 8 variants as instances on a hill: {forest_s:.2f} s (target under 5)")
+figure(rss_after / 1024, 1.0, f"forest: Blender's memory {rss_before:.0f} MB before, {rss_after:.0f} MB after "
+       "(target under 1 GB)")
 
 if render_dir:
     sys.path.insert(0, os.path.dirname(__file__))

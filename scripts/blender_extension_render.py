@@ -3,6 +3,7 @@ Cycles on the CPU (Eevee and Workbench need a GPU context that bpy has not got w
 display). Called by scripts/blender_extension_check.py --render DIR once the extension is
 installed; everything in the scene is grown by the extension's own operators."""
 
+import importlib
 import math
 import os
 import time
@@ -82,28 +83,29 @@ def _render(scene, path, samples):
     print(f"rendered {path} ({samples} samples, Cycles CPU) in {time.perf_counter() - start:.1f} s")
 
 
+def _fresh(scene, example):
+    """An empty stage with the PlantMaker example grown at the cursor; returns it."""
+    _clear()
+    _stage(scene)
+    scene.sylva.example = example
+    bpy.ops.sylva.grow()
+    return bpy.context.active_object
+
+
 def render(out, plants):
     os.makedirs(out, exist_ok=True)
     scene = bpy.context.scene
     settings = scene.sylva
     settings.breed_step = 0  # the same pictures whatever the scene went through before
 
-    _clear()
-    _stage(scene)
     scene.cursor.location = (0, 0, 0)
     settings.source = "EXAMPLE"
     settings.model = "plantmaker"
-    settings.example = "flowering-bush"
-    bpy.ops.sylva.grow()
-    bush = bpy.context.active_object
+    bush = _fresh(scene, "flowering-bush")
     _frame(scene, [bush], elevation=15, azimuth=-30, margin=0.7)
     _render(scene, os.path.join(out, "blender-grow.png"), 48)
 
-    _clear()
-    _stage(scene)
-    settings.example = "conifer"
-    bpy.ops.sylva.grow()
-    conifer = bpy.context.active_object
+    conifer = _fresh(scene, "conifer")
     settings.depth = 1
     bpy.ops.sylva.breed()
     grid = plants.brood(bpy.context)
@@ -118,3 +120,78 @@ def render(out, plants):
     bpy.context.view_layer.objects.active = grid[0]
     bpy.ops.sylva.cross()
     _render(scene, os.path.join(out, "blender-cross.png"), 32)
+
+    # Wind: the conifer as grown, and beside it its wind rig in a gale, a quarter way into
+    # the clip (the sway's far point).
+    still = _fresh(scene, "conifer")
+    bpy.ops.sylva.grow()
+    windy = bpy.context.active_object
+    windy.location.x = 1.3 * max(still.dimensions.x, still.dimensions.y)
+    bpy.context.view_layer.update()
+    settings.wind_strength, settings.wind_period = 8.0, 4.0
+    bpy.ops.sylva.wind()
+    rig = bpy.context.active_object
+    scene.frame_set(scene.frame_start + scene.render.fps)
+    bpy.context.view_layer.update()
+    _frame(scene, [still, *rig.children], elevation=10, azimuth=0, margin=0.75)
+    _render(scene, os.path.join(out, "blender-wind.png"), 32)
+
+    # Levels of detail, laid side by side for the picture (they stand together in a scene).
+    bush = _fresh(scene, "flowering-bush")
+    settings.lod_levels = 4
+    bpy.ops.sylva.lod()
+    levels = sorted(bpy.data.collections[f"{bush.name}_LODs"].objects, key=lambda o: o.name)
+    bush.hide_render = True
+    step = 1.15 * max(bush.dimensions.x, bush.dimensions.y)
+    for k, level in enumerate(levels):
+        level.hide_set(False)
+        level.location.x = k * step
+    bpy.context.view_layer.update()
+    _frame(scene, levels, elevation=12, azimuth=0, margin=0.62)
+    _render(scene, os.path.join(out, "blender-lod.png"), 32)
+
+    # A forest: 600 conifers of 8 variants as instances on a sloping meadow.
+    scene.cursor.location = (0, -45, 0)
+    conifer = _fresh(scene, "conifer")
+    conifer.hide_render = True
+    hill_mesh = bpy.data.meshes.new("meadow")
+    hill_mesh.from_pydata([(-30, -30, 0), (30, -30, 0), (30, 30, 6), (-30, 30, 6)], [], [(0, 1, 2, 3)])
+    hill = bpy.data.objects.new("meadow", hill_mesh)
+    scene.collection.objects.link(hill)
+    hill_mesh.materials.append(bpy.data.materials["ground"])
+    settings.forest_count, settings.forest_variants, settings.forest_seed = 600, 8, 1
+    hill.select_set(True)
+    bpy.ops.sylva.forest()
+    _frame(scene, [hill], elevation=22, azimuth=-20, margin=0.55)
+    _render(scene, os.path.join(out, "blender-forest.png"), 24)
+
+    # Evolving toward a sphere under a forbidden box: the target drawn as glass for the
+    # picture (in the scene it is any mesh the artist placed).
+    _clear()
+    _stage(scene)
+    scene.cursor.location = (0, 0, 0)
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=2.0, location=(0, 0, 4.0), segments=48, ring_count=24)
+    ball = bpy.context.active_object
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0, 0, 6.6), scale=(4.0, 4.0, 0.8))
+    lid = bpy.context.active_object
+    bpy.ops.sylva.mark_zone(kind="forbidden")
+    lid.hide_render = False
+    lid.display_type = "TEXTURED"
+    for obj, colour in ((ball, (0.6, 0.8, 1.0, 1.0)), (lid, (1.0, 0.25, 0.2, 1.0))):
+        glass = bpy.data.materials.new(f"{obj.name} glass")
+        if glass.node_tree is None:
+            glass.use_nodes = True
+        bsdf = next(n for n in glass.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+        bsdf.inputs["Base Color"].default_value = colour
+        bsdf.inputs["Alpha"].default_value = 0.18
+        obj.data.materials.append(glass)
+    settings.target, settings.target_shape = ball, "AUTO"
+    settings.evolve_population, settings.evolve_generations, settings.evolve_seed = 1000, 60, 1
+    bpy.ops.sylva.evolve()
+    evolved = bpy.context.active_object
+    evolve = importlib.import_module(plants.__name__.rsplit(".", 1)[0] + ".evolve")
+    while evolve.tick() is not None:
+        time.sleep(0.1)
+    print(evolve.last_status())
+    _frame(scene, [ball, lid, evolved], elevation=16, azimuth=-20, margin=1.0)
+    _render(scene, os.path.join(out, "blender-evolve.png"), 32)

@@ -1,5 +1,7 @@
 """Sylva inside Blender: grow plants from Sylva's genomes as mesh objects, regrow them when a
-setting changes, and breed them in a 3 by 3 grid (docs/blender.md).
+setting changes, breed them in a 3 by 3 grid, evolve them toward a target and zones placed in
+the scene, and make game and film assets of them: a wind rig, levels of detail and forests of
+instances (docs/blender.md).
 
 Stands on the `sylva` Python package, bundled as a wheel (blender_manifest.toml); built into
 an extension zip by scripts/blender-extension.
@@ -17,7 +19,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from . import operators, plants
+from . import evolve, operators, plants
 
 # Blender keeps only pointers to the strings of dynamic enum items: the lists must outlive
 # the callback, or the UI shows garbage.
@@ -76,6 +78,47 @@ class SylvaSceneSettings(bpy.types.PropertyGroup):
     )
     breed_step: IntProperty(name="Breeding Step", min=0, default=0, options={"HIDDEN"},
                             description="Counts breeding steps, so each draws new seeds")
+    wind_strength: FloatProperty(name="Strength", min=0.0, max=10.0, default=1.0,
+                                 description="Sway of Sylva's wind: 1 is a breeze, 10 a gale")
+    wind_period: FloatProperty(name="Period", min=0.5, max=60.0, default=4.0, unit="TIME_ABSOLUTE",
+                               description="Seconds of one sway: the clip's length")
+    lod_levels: IntProperty(name="Levels", min=2, max=8, default=4,
+                            description="Levels of detail, the plant in full first")
+    forest_count: IntProperty(name="Plants", min=1, max=100000, default=1000,
+                              description="Plants scattered over the ground")
+    forest_variants: IntProperty(name="Variants", min=1, max=32, default=8,
+                                 description="Different plants: the active one and as many more")
+    target: PointerProperty(
+        type=bpy.types.Object, name="Target", poll=lambda self, obj: obj.type == "MESH",
+        description="A sphere, box, cylinder or cone mesh: the surface the branch ends should reach",
+    )
+    target_shape: EnumProperty(
+        name="Shape",
+        items=[
+            ("AUTO", "Auto", "The primitive the mesh was added as (Add > Mesh > UV Sphere, Cube, ...)"),
+            ("SPHERE", "Sphere", "A sphere, or an ellipsoid when scaled unevenly"),
+            ("BOX", "Box", "A box"),
+            ("CYLINDER", "Cylinder", "An upright cylinder"),
+            ("CONE", "Cone", "An upright cone, its apex at the top"),
+        ],
+        default="AUTO",
+    )
+    evolve_branches: IntProperty(name="Branch Ends", min=1, max=200, default=30,
+                                 description="Branch ends the plant should have (Poncin's N_target)")
+    evolve_population: IntProperty(name="Population", min=10, max=100000, default=1000)
+    evolve_generations: IntProperty(name="Generations", min=1, max=10000, default=50)
+    evolve_seed: IntProperty(name="Seed", min=0, default=1, description="Seed of the run")
+    forest_variety: EnumProperty(
+        name="Vary By",
+        items=[
+            ("SEEDS", "Seeds", "The plant's genome grown with other seeds: one species, each plant "
+             "its own (PlantMaker plants differ with their seed; the other models grow alike)"),
+            ("MUTANTS", "Mutants", "Mutants of the plant: plants that differ in their genes"),
+        ],
+        default="SEEDS",
+    )
+    forest_seed: IntProperty(name="Seed", min=0, default=1,
+                             description="Seed of the variants, the places, turns and sizes")
 
 
 def _regrow(self, context):
@@ -216,6 +259,62 @@ class SYLVA_PT_breed(_Panel, bpy.types.Panel):
             box.label(text=f"{len(plants.lineage_of(obj))} in its lineage")
 
 
+class SYLVA_PT_assets(_Panel, bpy.types.Panel):
+    bl_label = "Assets"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.sylva
+        col = layout.column(align=True)
+        row = col.row(align=True)
+        row.prop(settings, "wind_strength")
+        row.prop(settings, "wind_period")
+        col.operator("sylva.wind", icon="FORCE_WIND")
+        col = layout.column(align=True)
+        col.prop(settings, "lod_levels")
+        col.operator("sylva.lod", icon="MOD_DECIM")
+        col = layout.column(align=True)
+        row = col.row(align=True)
+        row.prop(settings, "forest_count")
+        row.prop(settings, "forest_variants")
+        row = col.row(align=True)
+        row.prop(settings, "forest_variety", expand=True)
+        col.prop(settings, "forest_seed")
+        col.operator("sylva.forest", icon="OUTLINER_OB_GROUP_INSTANCE")
+        if not plants.is_plant(context.active_object):
+            layout.label(text="Make a plant active first")
+
+
+class SYLVA_PT_evolve(_Panel, bpy.types.Panel):
+    bl_label = "Evolve"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.sylva
+        col = layout.column(align=True)
+        col.prop(settings, "target")
+        col.prop(settings, "target_shape")
+        col.prop(settings, "evolve_branches")
+        row = layout.row(align=True)
+        row.label(text="Zones")
+        for kind, icon in (("favoured", "ADD"), ("forbidden", "CANCEL"), ("none", "X")):
+            row.operator("sylva.mark_zone", text=kind.capitalize() if kind != "none" else "Clear",
+                         icon=icon).kind = kind
+        zones = evolve.zones_in(context.scene)
+        favoured = sum(1 for z in zones if z[evolve.ZONE] == "favoured")
+        layout.label(text=f"{favoured} favoured, {len(zones) - favoured} forbidden box(es)")
+        col = layout.column(align=True)
+        col.prop(settings, "evolve_population")
+        col.prop(settings, "evolve_generations")
+        col.prop(settings, "evolve_seed")
+        if evolve.running():
+            layout.operator("sylva.evolve_stop", icon="CANCEL")
+        else:
+            layout.operator("sylva.evolve", icon="PLAY")
+        if evolve.last_status():
+            _wrapped(layout, evolve.last_status(), context, icon="INFO")
+
+
 classes = (
     SylvaSceneSettings,
     SylvaPlantSettings,
@@ -223,6 +322,8 @@ classes = (
     SYLVA_PT_grow,
     SYLVA_PT_plant,
     SYLVA_PT_breed,
+    SYLVA_PT_evolve,
+    SYLVA_PT_assets,
 )
 
 

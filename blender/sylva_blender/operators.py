@@ -10,7 +10,7 @@ from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper
 from mathutils import Vector
 
-from . import plants
+from . import assets, evolve, plants
 
 
 def _fail(op, message):
@@ -25,6 +25,25 @@ def _ms(start):
 def _active_plant(context):
     obj = context.active_object
     return obj if plants.is_plant(obj) else None
+
+
+class _OnActivePlant:
+    """An operator on the active plant: greyed out without one, one undo step. Subclasses
+    say what they do in `run` and what to select in `missing`."""
+
+    bl_options = {"REGISTER", "UNDO"}
+    missing = "Select a Sylva plant first"
+
+    @classmethod
+    def poll(cls, context):
+        return _active_plant(context) is not None
+
+    def execute(self, context):
+        start = time.perf_counter()
+        obj = _active_plant(context)
+        if obj is None:
+            return _fail(self, self.missing)
+        return self.run(context, obj, start)
 
 
 class SYLVA_OT_grow(bpy.types.Operator):
@@ -92,19 +111,13 @@ class SYLVA_OT_grow(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class SYLVA_OT_regrow(bpy.types.Operator):
+class SYLVA_OT_regrow(_OnActivePlant, bpy.types.Operator):
     """Grow the active plant again from its custom properties (after editing its genome JSON)"""
 
     bl_idname = "sylva.regrow"
     bl_label = "Regrow"
-    bl_options = {"REGISTER", "UNDO"}
 
-    @classmethod
-    def poll(cls, context):
-        return _active_plant(context) is not None
-
-    def execute(self, context):
-        obj = _active_plant(context)
+    def run(self, context, obj, start):
         try:
             plants.regrow(obj)
         except Exception as e:
@@ -162,23 +175,15 @@ def _place(results, target, op):
     return placed, error
 
 
-class SYLVA_OT_breed(bpy.types.Operator):
+class SYLVA_OT_breed(_OnActivePlant, bpy.types.Operator):
     """Breed nine mutants of the active plant in a 3 by 3 grid beside it (the Sylva Brood
     collection), replacing the grid's plants if there is one"""
 
     bl_idname = "sylva.breed"
     bl_label = "Breed Nine Variants"
-    bl_options = {"REGISTER", "UNDO"}
+    missing = "Select a Sylva plant to breed from (grow one first)"
 
-    @classmethod
-    def poll(cls, context):
-        return _active_plant(context) is not None
-
-    def execute(self, context):
-        start = time.perf_counter()
-        mother = _active_plant(context)
-        if mother is None:
-            return _fail(self, "Select a Sylva plant to breed from (grow one first)")
+    def run(self, context, mother, start):
         if plants.CELL in mother:
             # Breeding from a grid plant would replace the grid it stands in.
             return _fail(self, f"{mother.name} is in the breeding grid: Mutate or Cross there, "
@@ -335,6 +340,156 @@ class SYLVA_OT_keep(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class SYLVA_OT_wind(_OnActivePlant, bpy.types.Operator):
+    """Rig the active plant for wind: Sylva's armature (one bone per joint) with its looping
+    clip as the action, played over the scene's frames, and the skinned plant as its child;
+    the plant itself is hidden"""
+
+    bl_idname = "sylva.wind"
+    bl_label = "Add Wind"
+    missing = "Select a Sylva plant to rig for wind"
+
+    def run(self, context, obj, start):
+        settings = context.scene.sylva
+        try:
+            armature, mesh, info = assets.wind(context, obj, settings.wind_strength, settings.wind_period)
+        except Exception as e:
+            return _fail(self, f"Could not rig {obj.name} for wind: {e}")
+        for other in context.selected_objects:
+            other.select_set(False)
+        armature.select_set(True)
+        context.view_layer.objects.active = armature
+        left_out = f" ({info['left_out']} finer joints left out)" if info["left_out"] else ""
+        self.report({"INFO"}, f"Wind on {obj.name}: {info['joints']} bones{left_out}, a "
+                    f"{info['period']:g} s clip looping over the scene, in {_ms(start)}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_lod(_OnActivePlant, bpy.types.Operator):
+    """Make the active plant's levels of detail: a collection of NAME_LOD0 (the plant in full)
+    to NAME_LODn objects of falling triangle counts, as game engines import them"""
+
+    bl_idname = "sylva.lod"
+    bl_label = "Levels of Detail"
+    missing = "Select a Sylva plant to make levels of detail of"
+
+    def run(self, context, obj, start):
+        try:
+            levels = assets.lods(context, obj, context.scene.sylva.lod_levels)
+        except Exception as e:
+            return _fail(self, f"Could not make levels of detail of {obj.name}: {e}")
+        counts = ", ".join(str(len(lod.data.polygons)) for lod in levels)
+        self.report({"INFO"}, f"{len(levels)} levels of {obj.name} ({counts} triangles) in {_ms(start)}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_forest(_OnActivePlant, bpy.types.Operator):
+    """Scatter a forest of the active plant and its variants over the other selected mesh (the
+    ground), as collection instances that share the variants' meshes"""
+
+    bl_idname = "sylva.forest"
+    bl_label = "Plant Forest"
+    missing = "Make a Sylva plant active, with the ground mesh also selected"
+
+    def run(self, context, obj, start):
+        grounds = [o for o in context.selected_objects
+                   if o is not obj and o.type == "MESH" and not plants.is_plant(o)]
+        if len(grounds) != 1:
+            return _fail(self, "Select one ground mesh besides the active plant "
+                         f"(selected: {len(grounds)} meshes that are not plants)")
+        settings = context.scene.sylva
+        try:
+            woods, kinds, alike = assets.forest(context, obj, grounds[0], settings.forest_count,
+                                                settings.forest_variants, settings.forest_seed,
+                                                settings.forest_variety)
+        except Exception as e:
+            return _fail(self, f"Could not plant a forest of {obj.name} on {grounds[0].name}: {e}")
+        note = "" if len(kinds) == settings.forest_variants else \
+            f" ({settings.forest_variants - len(kinds)} variant(s) did not grow)"
+        self.report({"INFO"}, f"{len(woods.objects)} plants of {len(kinds)} variants{note} on "
+                    f"{grounds[0].name} in {_ms(start)}")
+        if alike:
+            self.report({"WARNING"}, f"{obj[plants.MODEL]} plants grow alike whatever the seed: "
+                        "choose Mutants for variants that differ")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_mark_zone(bpy.types.Operator):
+    """Mark the selected meshes as boxes of space the plant should fill with leaves
+    (favoured) or keep out of (forbidden), or clear the mark"""
+
+    bl_idname = "sylva.mark_zone"
+    bl_label = "Mark Zone"
+    bl_options = {"REGISTER", "UNDO"}
+    kind: bpy.props.EnumProperty(items=[("favoured", "Favoured", ""), ("forbidden", "Forbidden", ""),
+                                        ("none", "Clear", "")])
+
+    def execute(self, context):
+        boxes = [o for o in context.selected_objects if o.type == "MESH" and not plants.is_plant(o)]
+        if not boxes:
+            return _fail(self, "Select the meshes (boxes) to mark; plants cannot be zones")
+        for box in boxes:
+            if self.kind == "none":
+                box.pop(evolve.ZONE, None)
+                box.display_type, box.hide_render = "TEXTURED", False
+            else:
+                # Seen through in the viewport, left out of renders: a guide, not scenery.
+                box[evolve.ZONE] = self.kind
+                box.display_type, box.hide_render = "WIRE", True
+        what = "cleared" if self.kind == "none" else f"marked {self.kind}"
+        self.report({"INFO"}, f"{len(boxes)} box(es) {what}: {', '.join(b.name for b in boxes)}")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_evolve(bpy.types.Operator):
+    """Evolve Poncin's automata toward the target mesh (branch ends on its surface) and the
+    marked zones (leaves in favoured boxes, none in forbidden ones), in the background: the
+    best plant so far stands at the 3D cursor, progress shows in the status bar"""
+
+    bl_idname = "sylva.evolve"
+    bl_label = "Evolve Toward Target"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        settings = context.scene.sylva
+        target = settings.target
+        if target is None or target.type != "MESH":
+            return _fail(self, "Choose a target: a sphere, box, cylinder or cone mesh placed and "
+                         "scaled where the plant's branch ends should be")
+        zones = evolve.zones_in(context.scene)
+        try:
+            obj = evolve.begin(context, target, settings.target_shape, zones, settings.evolve_generations,
+                               settings.evolve_population, settings.evolve_seed, settings.evolve_branches)
+        except (evolve.SceneError, plants.Unavailable) as e:
+            return _fail(self, str(e))
+        except Exception as e:  # the package refusing the config it was given
+            return _fail(self, f"Could not start the run: {e}")
+        bpy.app.timers.register(evolve.tick, first_interval=0.1)
+        for other in context.selected_objects:
+            other.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        self.report({"INFO"}, f"Evolving toward {target.name} and {len(zones)} zone(s): "
+                    f"{settings.evolve_generations} generations of {settings.evolve_population} "
+                    "plants in the background; progress in the status bar")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_evolve_stop(bpy.types.Operator):
+    """Stop the run after the generation under way; the best plant so far stays"""
+
+    bl_idname = "sylva.evolve_stop"
+    bl_label = "Stop"
+
+    @classmethod
+    def poll(cls, context):
+        return evolve.running()
+
+    def execute(self, context):
+        evolve.stop()
+        return {"FINISHED"}
+
+
 classes = (
     SYLVA_OT_grow,
     SYLVA_OT_regrow,
@@ -343,4 +498,10 @@ classes = (
     SYLVA_OT_mutate,
     SYLVA_OT_cross,
     SYLVA_OT_keep,
+    SYLVA_OT_wind,
+    SYLVA_OT_lod,
+    SYLVA_OT_forest,
+    SYLVA_OT_mark_zone,
+    SYLVA_OT_evolve,
+    SYLVA_OT_evolve_stop,
 )
