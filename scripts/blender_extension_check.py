@@ -3,20 +3,26 @@ each makes: objects, mesh sizes against the package's own arrays, materials, cus
 properties, lineage, and the errors it reports. Prints the timings asked of it. Run by
 scripts/check-blender-extension with a fresh BLENDER_USER_RESOURCES.
 
-    python scripts/blender_extension_check.py EXTENSION.zip [--render DIR]
+    python scripts/blender_extension_check.py EXTENSION.zip [--sylva target/release/sylva] [--render DIR]
+
+With --sylva, the studio archive is checked against a real studio: it makes the archive,
+and reads back what Blender wrote to it while it runs.
 """
 
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import time
+import urllib.request
 
 import bpy
 import numpy as np
 
 zip_path = os.path.abspath(sys.argv[1])
 render_dir = sys.argv[sys.argv.index("--render") + 1] if "--render" in sys.argv else None
+sylva_cli = sys.argv[sys.argv.index("--sylva") + 1] if "--sylva" in sys.argv else None
 failures = []
 
 
@@ -314,6 +320,80 @@ bpy.ops.sylva.keep()
 copy = bpy.context.active_object
 check(copy is not cells[2] and "sylva_cell" not in copy and copy["sylva_id"] == cells[2]["sylva_id"]
       and copy.data is not cells[2].data, "Keep: a copy out of the grid, with its own mesh")
+
+# -- A studio archive: plants grown from it, bred plants written back -----------------------------
+archive = sys.modules[module + ".archive"]
+if sylva_cli:
+    db = os.path.join(tmp, "studio.db")
+    studio = subprocess.Popen([sylva_cli, "studio", "--port", "0", "--db", db], stdout=subprocess.PIPE, text=True)
+    try:
+        address = studio.stdout.readline().strip().removeprefix("Sylva studio: http://").rstrip("/")
+
+        def api(method, path, body=None):
+            data = None if body is None else json.dumps(body).encode()
+            request = urllib.request.Request(f"http://{address}{path}", data=data, method=method,
+                                             headers={"Content-Type": "application/json"})
+            with urllib.request.urlopen(request, timeout=60) as answer:
+                return json.loads(answer.read())
+
+        session = api("POST", "/api/sessions", {"mode": "breed", "model": "plantmaker",
+                                                "start": {"examples": ["plantmaker/tulip", "plantmaker/fern"]}})
+        studio_ids = [cell["plant"] for cell in session["state"]["grid"]]
+        settings.model, settings.source, settings.archive = "plantmaker", "ARCHIVE", db
+        items = [i[0] for i in ext._archive_items(settings, bpy.context)]
+        check(set(map(str, studio_ids)) <= set(items),
+              f"Archive: the studio's {len(studio_ids)} plants offered ({len(items)} in the list)")
+        tulip_row = api("GET", f"/api/plants/{studio_ids[0]}")
+        from_archive = grown("ARCHIVE", "plantmaker", archive_plant=str(studio_ids[0]))
+        check_plant(from_archive, sylva.Genome.from_json(tulip_row["genome_text"]), f"archive plant {studio_ids[0]}")
+        check(from_archive["sylva_archive_id"] == studio_ids[0] and from_archive["sylva_archive"] == db,
+              f"Archive: the plant knows its row ({from_archive['sylva_archive_id']})")
+        select([from_archive])
+        bpy.ops.sylva.breed()
+        cells = grid()
+        rows = [cells[k]["sylva_archive_id"] for k in sorted(cells)]
+        seen = [api("GET", f"/api/plants/{r}") for r in rows]
+        check(len(set(rows)) == 9 and all(p["parents"][0]["plant"] == studio_ids[0] and p["operator"] == "mutate"
+                                          for p in seen),
+              f"Archive: nine bred plants written back, rows {rows[0]} to {rows[-1]}, which the running studio "
+              f"shows as mutants of plant {studio_ids[0]}")
+        check(all(sylva.Genome.from_json(p["genome_text"]) == plants.genome_of(cells[k])
+                  for k, p in zip(sorted(cells), seen)),
+              "Archive: each row's genome is its plant's")
+        select([cells[0], cells[4]])
+        bpy.ops.sylva.cross()
+        crossed = [o for k, o in sorted(grid().items()) if k not in (0, 4)]
+        seen = [api("GET", f"/api/plants/{o['sylva_archive_id']}") for o in crossed]
+        check(all(p["operator"] == "cross" and {q["plant"] for q in p["parents"]} <= {rows[0], rows[4]}
+                  and p["parents"] for p in seen),
+              "Archive: crosses written back with the favourites as parents")
+        settings.archive_record = False
+        select([cells[0]])
+        bpy.ops.sylva.mutate()
+        check(all("sylva_archive_id" not in o for k, o in grid().items() if k != 0),
+              "Archive: with Record in Archive off, mutants are not written")
+        settings.archive_record = True
+    finally:
+        studio.terminate()
+        studio.wait()
+else:
+    print("note the studio archive is checked with --sylva target/release/sylva (scripts/check-blender-extension passes it)")
+settings.archive = os.path.join(tmp, "missing.db")
+fails(lambda: grown("ARCHIVE", "plantmaker", archive_plant="none"), "Choose a plant")
+check(ext._archive_items(settings, bpy.context)[0][0] == "none", "Archive: a missing file offers no plant")
+try:
+    archive.plant(settings.archive, 1)
+    check(False, "a missing archive refused")
+except archive.ArchiveError as e:
+    check("not found" in str(e), f"Archive: {e}")
+with open(os.path.join(tmp, "notes.db"), "w") as f:
+    f.write("not sqlite")
+try:
+    archive.plants(os.path.join(tmp, "notes.db"))
+    check(False, "a file that is not an archive refused")
+except archive.ArchiveError as e:
+    check("not a studio archive" in str(e), f"Archive: {e}")
+settings.archive, settings.source = "", "EXAMPLE"
 
 # -- Wind: Sylva's rig as an armature and its action ----------------------------------------
 fern = objects["fern"]

@@ -19,7 +19,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from . import evolve, operators, plants
+from . import archive, evolve, operators, plants
 
 # Blender keeps only pointers to the strings of dynamic enum items: the lists must outlive
 # the callback, or the UI shows garbage.
@@ -44,6 +44,21 @@ def _example_items(self, context):
     return items
 
 
+def _archive_items(self, context):
+    items = []
+    if self.archive:
+        try:
+            rows = archive.plants(bpy.path.abspath(self.archive), self.model)
+        except archive.ArchiveError as e:
+            rows, items = [], [("none", "(not an archive)", str(e))]
+        for row, model, operator, session, created in rows:
+            where = f"session {session}" if session is not None else "no session"
+            items.append((str(row), f"#{row} {operator}", f"{model}, {where}, {created}"))
+    items = items or [("none", "(no plants of this model)", "")]
+    _items[("archive", self.archive, self.model)] = items
+    return items
+
+
 def _model_changed(self, context):
     found = plants.examples(self.model)
     if found:
@@ -61,6 +76,7 @@ class SylvaSceneSettings(bpy.types.PropertyGroup):
             ("EXAMPLE", "Example", "One of the example genomes bundled with the extension"),
             ("FILE", "File", "A genome file (.json) of any model"),
             ("RANDOM", "Random", "A random genome of the model, drawn from a seed"),
+            ("ARCHIVE", "Archive", "A plant of a studio archive (the file of sylva studio --db)"),
         ],
         default="EXAMPLE",
     )
@@ -70,6 +86,15 @@ class SylvaSceneSettings(bpy.types.PropertyGroup):
         description="A genome file written by Sylva (sylva evolve, the studio, Save Genome)",
     )
     random_seed: IntProperty(name="Seed", min=0, default=1, description="Seed of the random genome")
+    archive: StringProperty(
+        name="Archive", subtype="FILE_PATH",
+        description=("A studio archive (sylva studio --db FILE): plants grow from it, and plants "
+                     "bred here are written back with their parents"),
+    )
+    archive_plant: EnumProperty(name="Plant", items=_archive_items,
+                                description="A plant of the archive, newest first")
+    archive_record: BoolProperty(name="Record in Archive", default=True,
+                                 description="Write plants bred here, and their parents, to the archive")
     depth: IntProperty(
         name="Depth", min=1, max=5, default=1,
         description=("Intensity of breeding (PlantMaker's Depth): Mutate applies the model's "
@@ -191,6 +216,9 @@ class SYLVA_PT_grow(_Panel, bpy.types.Panel):
             layout.prop(settings, "example")
         elif settings.source == "FILE":
             layout.prop(settings, "genome_file")
+        elif settings.source == "ARCHIVE":
+            layout.prop(settings, "archive")
+            layout.prop(settings, "archive_plant")
         else:
             layout.prop(settings, "random_seed")
         layout.operator("sylva.grow", icon="OUTLINER_OB_MESH")
@@ -238,6 +266,8 @@ class SYLVA_PT_breed(_Panel, bpy.types.Panel):
         layout = self.layout
         settings = context.scene.sylva
         layout.prop(settings, "depth")
+        if settings.archive:
+            layout.prop(settings, "archive_record")
         layout.operator("sylva.breed", icon="MOD_ARRAY")
         favourites = [o for o in context.selected_objects if plants.is_plant(o)]
         grid = plants.brood(context)

@@ -3,6 +3,7 @@ cross the favourites. Every one that changes the scene is REGISTER and UNDO, so 
 it back as one step; errors are reported naming what was wrong."""
 
 import os
+import sqlite3
 import time
 
 import bpy
@@ -10,7 +11,7 @@ from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper
 from mathutils import Vector
 
-from . import assets, evolve, plants
+from . import archive, assets, evolve, plants
 
 
 def _fail(op, message):
@@ -79,22 +80,44 @@ class SYLVA_OT_grow(bpy.types.Operator):
                 genome = s.Genome.load(path)
                 source = path
                 operator = "file"
+            elif settings.source == "ARCHIVE":
+                if not settings.archive:
+                    return _fail(self, "Choose a studio archive (the file of sylva studio --db) first")
+                path = bpy.path.abspath(settings.archive)
+                if settings.archive_plant in ("", "none"):
+                    return _fail(self, f"Choose a plant of {os.path.basename(path)} (it has none of {model})")
+                row = int(settings.archive_plant)
+                text, seed, _, operator = archive.plant(path, row)
+                genome = s.Genome.from_json(text, source=f"{path} plant {row}")
+                source = f"{os.path.basename(path)} plant {row}"
             else:
                 genome = s.Genome.random(model, settings.random_seed)
                 source = f"random {model} seed {settings.random_seed}"
                 operator = "random"
-        except (s.SylvaError, OSError) as e:  # InputError says where in the file and what
+        except (s.SylvaError, OSError, archive.ArchiveError) as e:  # where in the file and what
             return _fail(self, f"Could not read the genome: {e}")
 
+        grow = plants.grow_options(plants.DEFAULT_SETTINGS, genome)
+        if settings.source == "ARCHIVE":
+            grow["seed"] = seed  # the seed the studio grew it with
         try:
-            plant = plants.grow(genome, plants.grow_options(plants.DEFAULT_SETTINGS, genome))
+            plant = plants.grow(genome, grow)
         except s.SylvaError as e:
             return _fail(self, f"Could not grow {source}: {e}")
         obj = plants.new_object(context, f"{genome.model} {operator}")
         obj.location = context.scene.cursor.location
+        if grow["seed"] != genome.default_seed:
+            with plants.quiet():
+                obj.sylva.own_seed = False
         plants.set_plant(obj, genome, plant, {"operator": operator, "generation": 0})
         obj[plants.SOURCE] = source
-        obj.name = plants.object_name(genome, {"operator": source if operator == "example" else operator})
+        if settings.source == "ARCHIVE":
+            obj[archive.ARCHIVE_ID], obj[archive.ARCHIVE_PATH] = row, os.path.abspath(path)
+        if settings.source == "ARCHIVE":
+            named = f"#{row}"
+        else:
+            named = source if operator == "example" else operator
+        obj.name = plants.object_name(genome, {"operator": named})
 
         for other in context.selected_objects:
             other.select_set(False)
@@ -168,11 +191,26 @@ def _place(results, target, op):
         origin = dict(origin, parents=[parents[i] for i in used_or_error])
         plants.set_plant(obj, genome, plant, origin)
         obj.name = plants.object_name(genome, origin)
-        placed.append((k, obj, plant))
+        placed.append((k, obj, plant, used_or_error))
     if placed and failed:
         op.report({"WARNING"}, f"{len(failed)} variant(s) kept their old plant (cells "
                   f"{', '.join(str(k + 1) for k in failed)}): {error}")
     return placed, error
+
+
+def _record(context, op, children):
+    """Writes bred plants and their parents to the open studio archive, if one is open and
+    recording is on: `children` is [(object, [parent objects])]. A failure is a warning: the
+    plants stay in the scene."""
+    settings = context.scene.sylva
+    if not (settings.archive and settings.archive_record):
+        return 0
+    path = bpy.path.abspath(settings.archive)
+    try:
+        return len(archive.record(path, children))
+    except (archive.ArchiveError, sqlite3.Error) as e:
+        op.report({"WARNING"}, f"The bred plants were not written to {path}: {e}")
+        return 0
 
 
 class SYLVA_OT_breed(_OnActivePlant, bpy.types.Operator):
@@ -217,16 +255,18 @@ class SYLVA_OT_breed(_OnActivePlant, bpy.types.Operator):
         placed, error = _place(plants.breed(jobs), target, self)
         if not placed:
             return _fail(self, f"No variant of {mother.name} grew: {error}")
+        recorded = _record(context, self, [(obj, [mother]) for _, obj, _, _ in placed])
         # Laid out once all have grown: the widest sets the spacing.
         footprint = max(mother.dimensions.x, mother.dimensions.y)
-        space = max(plants.spacing([plant for _, _, plant in placed]), 1.2 * footprint)
+        space = max(plants.spacing([plant for _, _, plant, _ in placed]), 1.2 * footprint)
         centre = mother.location + Vector((2.5 * space, 0.0, 0.0))
         for k, obj in plants.brood(context).items():
             obj.location = centre + Vector((((k % 3) - 1) * space, (1 - k // 3) * space, 0.0))
         for obj in context.selected_objects:
             obj.select_set(False)
         settings.breed_step = step + 1
-        self.report({"INFO"}, f"Bred nine variants of {mother.name} in {_ms(start)}: "
+        kept = f"; {recorded} written to the archive" if recorded else ""
+        self.report({"INFO"}, f"Bred nine variants of {mother.name} in {_ms(start)}{kept}: "
                     "select favourites, then Mutate or Cross")
         return {"FINISHED"}
 
@@ -286,6 +326,11 @@ class _Favourites:
         placed, error = _place(plants.breed(jobs), target, self)
         if not placed:
             return _fail(self, f"No child grew: {error}")
+        if self.kind == "mutate":
+            parents = [(obj, [favourites[k % len(favourites)]]) for k, obj, _, _ in placed]
+        else:
+            parents = [(obj, [favourites[i] for i in used]) for _, obj, _, used in placed]
+        _record(context, self, parents)
         settings.breed_step = step + 1
         self.report({"INFO"}, f"{self.verb.capitalize()}: {len(targets)} new plants from "
                     f"{len(favourites)} favourite(s) in {_ms(start)}")

@@ -27,7 +27,7 @@ GENERATION = "sylva_generation"
 LINEAGE = "sylva_lineage"  # JSON {id: {operator, parents, generation}}, itself and ancestors
 VERSION = "sylva_version"
 CELL = "sylva_cell"  # 0..8: its place in the breeding grid
-SOURCE = "sylva_source"  # the example's name, the genome file's path or the random draw
+SOURCE = "sylva_source"  # the example's name, the genome file's path, the random draw or the archive row
 
 BROOD = "Sylva Brood"
 DETAIL_MODIFIER = "Sylva Detail"
@@ -147,6 +147,8 @@ def set_plant(obj, genome, plant, origin):
     """Makes `obj` the plant `plant` grown from `genome`; `origin` holds its operator,
     parents (ids), generation and the lineage it inherits."""
     gid = genome_id(genome)
+    for key in ("sylva_archive_id", "sylva_archive"):  # a new plant: not that archive row
+        obj.pop(key, None)
     obj[GENOME] = genome.to_json()
     obj[MODEL] = genome.model
     obj[ID] = gid
