@@ -19,6 +19,7 @@ import urllib.request
 
 import bpy
 import numpy as np
+from mathutils import Vector
 
 zip_path = os.path.abspath(sys.argv[1])
 render_dir = sys.argv[sys.argv.index("--render") + 1] if "--render" in sys.argv else None
@@ -72,7 +73,7 @@ for panel in ("SYLVA_PT_grow", "SYLVA_PT_plant", "SYLVA_PT_breed", "SYLVA_PT_evo
     check(cls is not None and cls.bl_category == "Sylva" and cls.bl_region_type == "UI"
           and cls.bl_space_type == "VIEW_3D", f"{panel} in the 3D view's sidebar, tab Sylva")
 ops = ("grow", "regrow", "save_genome", "breed", "mutate", "cross", "keep", "wind", "lod", "forest",
-       "mark_zone", "evolve")
+       "mark_zone", "evolve", "evolve_picture")
 for name in ops:
     cls = getattr(bpy.types, f"SYLVA_OT_{name}")
     undo = name == "save_genome" or {"REGISTER", "UNDO"} <= set(cls.bl_options)
@@ -587,6 +588,30 @@ while evolve.tick() is not None:
 done = len(evolve._current["last"].run.stats) - 1
 check(done < 10000 and not evolve.running(), f"Evolve, Stop: the run ends after generation {done} of 10000")
 
+# Toward a picture, seen from the active camera.
+settings.picture = ""
+fails(lambda: bpy.ops.sylva.evolve_picture(), "Choose a reference picture")
+settings.picture = os.path.join(tmp, "missing.png")
+fails(lambda: bpy.ops.sylva.evolve_picture(), "Picture not found", "missing.png")
+settings.picture = os.path.abspath("examples/match/round.png")
+settings.picture_model = "bintree"
+settings.evolve_population, settings.evolve_generations = 60, 6
+camera = scene.camera
+check(camera is not None, f"the scene has an active camera ({camera.name if camera else None})")
+bpy.ops.sylva.evolve_picture()
+matched = bpy.context.active_object
+while evolve.tick() is not None:
+    time.sleep(0.05)
+stats = evolve._current["last"].run.stats
+front = matched.matrix_world.to_3x3() @ Vector((0.0, -1.0, 0.0))
+to_camera = camera.matrix_world.translation - matched.location
+facing = (front.x * to_camera.x + front.y * to_camera.y) / (front.to_2d().length * to_camera.to_2d().length)
+check(plants.is_plant(matched) and matched["sylva_model"] == "bintree" and len(stats) == 7
+      and abs(matched["sylva_fitness"] - stats[-1]["best"]) < 1e-12 and 0 < matched["sylva_fitness"] <= 1,
+      f"Evolve Toward Picture: 6 generations of binary trees toward round.png's outline, the best "
+      f"(IoU term {matched['sylva_fitness']:.3f}; {stats[0]['best']:.3f} in the first generation) at the cursor")
+check(facing > 0.999, f"Evolve Toward Picture: the plant's front faces the active camera (cosine {facing:.4f})")
+
 # -- Panels: drawn into a stand-in layout (headless bpy has no window to draw in) ----------
 # It checks that every property a panel shows exists, every button names a registered
 # operator, every icon is Blender's, for the states a user meets.
@@ -670,7 +695,7 @@ try:
     check({"sylva.breed", "sylva.mutate", "sylva.cross", "sylva.keep"} <= set(drawn)
           and "2 favourite(s) selected" in drawn, f"Breed panel with a grid: {', '.join(drawn)}")
     drawn = draw(bpy.types.SYLVA_PT_evolve, None, [])
-    check({"sylva.evolve", "sylva.mark_zone", "prop target", "prop evolve_branches"} <= set(drawn),
+    check({"sylva.evolve", "sylva.evolve_picture", "sylva.mark_zone", "prop target", "prop picture"} <= set(drawn),
           f"Evolve panel: {', '.join(drawn)}")
     drawn = draw(bpy.types.SYLVA_PT_assets, oak_obj, [oak_obj])
     check({"sylva.wind", "sylva.lod", "sylva.forest"} <= set(drawn), f"Assets panel: {', '.join(drawn)}")

@@ -195,3 +195,24 @@ def render(out, plants):
     print(evolve.last_status())
     _frame(scene, [ball, lid, evolved], elevation=16, azimuth=-20, margin=1.0)
     _render(scene, os.path.join(out, "blender-evolve.png"), 32)
+
+    # Toward a picture: the example outline round.png, matched by binary trees, seen
+    # from the camera the run faced them to.
+    _clear()
+    _stage(scene)
+    scene.cursor.location = (0, 0, 0)
+    cam = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    cam.location = (0, -30, 4)
+    settings.picture = os.path.abspath("examples/match/round.png")
+    settings.picture_model = "bintree"
+    settings.evolve_population, settings.evolve_generations, settings.evolve_seed = 100, 30, 1
+    bpy.ops.sylva.evolve_picture()
+    matched = bpy.context.active_object
+    while evolve.tick() is not None:
+        time.sleep(0.1)
+    print(evolve.last_status())
+    bpy.data.objects.remove(cam)
+    _frame(scene, [matched], elevation=5, azimuth=0, margin=0.7)
+    _render(scene, os.path.join(out, "blender-picture.png"), 32)

@@ -130,6 +130,12 @@ class SylvaSceneSettings(bpy.types.PropertyGroup):
     )
     evolve_branches: IntProperty(name="Branch Ends", min=1, max=200, default=30,
                                  description="Branch ends the plant should have (Poncin's N_target)")
+    picture: StringProperty(
+        name="Picture", subtype="FILE_PATH",
+        description="A picture of the tree (PNG or JPEG), as the active camera sees it: its outline is matched",
+    )
+    picture_model: EnumProperty(name="Model", items=_model_items,
+                                description="The model whose plants are matched to the picture")
     evolve_population: IntProperty(name="Population", min=10, max=100000, default=1000)
     evolve_generations: IntProperty(name="Generations", min=1, max=10000, default=50)
     evolve_seed: IntProperty(name="Seed", min=0, default=1, description="Seed of the run")
@@ -341,6 +347,11 @@ class SYLVA_PT_evolve(_Panel, bpy.types.Panel):
             layout.operator("sylva.evolve_stop", icon="CANCEL")
         else:
             layout.operator("sylva.evolve", icon="PLAY")
+        col = layout.column(align=True)
+        col.prop(settings, "picture")
+        col.prop(settings, "picture_model")
+        if not evolve.running():
+            col.operator("sylva.evolve_picture", icon="IMAGE_DATA")
         if evolve.last_status():
             _wrapped(layout, evolve.last_status(), context, icon="INFO")
 

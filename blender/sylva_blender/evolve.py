@@ -1,7 +1,9 @@
 """Evolving toward what is in the scene (Poncin's automata): a mesh the artist places and
 scales is the target surface the branch ends should lie on, boxes marked favoured or
-forbidden are cells of his density grid, which count leaves; the run goes on a worker
-thread, with progress in the status bar and the best plant so far in the viewport.
+forbidden are cells of his density grid, which count leaves. Or toward a picture of the
+tree, seen from the active camera: its outline, as `sylva match` matches one. The run goes
+on a worker thread, with progress in the status bar and the best plant so far in the
+viewport.
 
 The scene is turned into a config of the automata model, as `examples/automata/sphere.toml`
 and `box-above.toml` write one by hand: the paper's typical run (two automata, 100
@@ -10,6 +12,8 @@ extent is 150 units; a unit is then that many metres, so a plant evolved for a 2
 one for a 20 m tree grow alike.
 """
 
+import math
+import os
 import threading
 
 import bpy
@@ -199,14 +203,42 @@ def running():
 def begin(context, target, shape, zones, generations, population, seed, branches):
     """Starts a run toward `target` and the zones, the plant standing at the 3D cursor, and
     makes the object that will show its best plant. Returns the object."""
+    origin = context.scene.cursor.location.copy()
+    made = config(target, shape, zones, origin, generations, population, seed, branches)
+    return _begin(context, made, generations, target.name)
+
+
+def picture_config(path, model, generations, population, seed):
+    """The config of a run toward a picture's outline (the outline alone decides, as
+    `sylva match` runs it)."""
+    return {
+        "model": model,
+        "run": {"generations": generations, "population": population, "seed": seed},
+        "match": {"front": path, "beside": False},
+    }
+
+
+def begin_picture(context, path, model, generations, population, seed):
+    """Starts a run toward the outline of the picture at `path`, seen from the active camera:
+    the plant stands at the 3D cursor, turned so that the side Sylva matched (its front)
+    faces the camera. Returns the object."""
+    made = picture_config(path, model, generations, population, seed)
+    obj = _begin(context, made, generations, os.path.basename(path))
+    camera = context.scene.camera
+    if camera is not None:
+        to_camera = camera.matrix_world.translation - obj.location
+        # Sylva's front view looks along its -Z, Blender's +Y: the front faces -Y.
+        obj.rotation_euler = (0.0, 0.0, math.atan2(to_camera.y, to_camera.x) + math.pi / 2)
+    return obj
+
+
+def _begin(context, made, generations, target_name):
     if running():
         raise SceneError("A run is going on: stop it first")
-    origin = context.scene.cursor.location.copy()
-    run = Run(config(target, shape, zones, origin, generations, population, seed, branches),
-              generations)
-    obj = plants.new_object(context, f"Sylva evolved toward {target.name}")
-    obj.location = origin
-    _current.update(run=run.start(), object=obj, shown=None, target=target.name)
+    run = Run(made, generations)
+    obj = plants.new_object(context, f"Sylva evolved toward {target_name}")
+    obj.location = context.scene.cursor.location
+    _current.update(run=run.start(), object=obj, shown=None, target=target_name)
     return obj
 
 

@@ -486,6 +486,24 @@ class SYLVA_OT_mark_zone(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _start(op, context, begin):
+    """Starts a run with `begin()` (which returns the object that shows its best plant),
+    makes that object active and has Blender's timer show the run's progress. Returns the
+    operator's CANCELLED result on failure, None on success."""
+    try:
+        obj = begin()
+    except (evolve.SceneError, plants.Unavailable) as e:
+        return _fail(op, str(e))
+    except Exception as e:  # the package refusing the config or picture: it names what and why
+        return _fail(op, f"Could not start the run: {e}")
+    bpy.app.timers.register(evolve.tick, first_interval=0.1)
+    for other in context.selected_objects:
+        other.select_set(False)
+    obj.select_set(True)
+    context.view_layer.objects.active = obj
+    return None
+
+
 class SYLVA_OT_evolve(bpy.types.Operator):
     """Evolve Poncin's automata toward the target mesh (branch ends on its surface) and the
     marked zones (leaves in favoured boxes, none in forbidden ones), in the background: the
@@ -502,21 +520,41 @@ class SYLVA_OT_evolve(bpy.types.Operator):
             return _fail(self, "Choose a target: a sphere, box, cylinder or cone mesh placed and "
                          "scaled where the plant's branch ends should be")
         zones = evolve.zones_in(context.scene)
-        try:
-            obj = evolve.begin(context, target, settings.target_shape, zones, settings.evolve_generations,
-                               settings.evolve_population, settings.evolve_seed, settings.evolve_branches)
-        except (evolve.SceneError, plants.Unavailable) as e:
-            return _fail(self, str(e))
-        except Exception as e:  # the package refusing the config it was given
-            return _fail(self, f"Could not start the run: {e}")
-        bpy.app.timers.register(evolve.tick, first_interval=0.1)
-        for other in context.selected_objects:
-            other.select_set(False)
-        obj.select_set(True)
-        context.view_layer.objects.active = obj
+        failed = _start(self, context, lambda: evolve.begin(
+            context, target, settings.target_shape, zones, settings.evolve_generations,
+            settings.evolve_population, settings.evolve_seed, settings.evolve_branches))
+        if failed:
+            return failed
         self.report({"INFO"}, f"Evolving toward {target.name} and {len(zones)} zone(s): "
                     f"{settings.evolve_generations} generations of {settings.evolve_population} "
                     "plants in the background; progress in the status bar")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_evolve_picture(bpy.types.Operator):
+    """Evolve plants of the chosen model whose outline matches the reference picture, seen
+    from the active camera, in the background: the best plant so far stands at the 3D cursor
+    facing the camera, progress in the status bar"""
+
+    bl_idname = "sylva.evolve_picture"
+    bl_label = "Evolve Toward Picture"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        settings = context.scene.sylva
+        path = bpy.path.abspath(settings.picture) if settings.picture else ""
+        if not path:
+            return _fail(self, "Choose a reference picture (PNG or JPEG) of the tree, as the active camera sees it")
+        if not os.path.isfile(path):
+            return _fail(self, f"Picture not found: {path}")
+        failed = _start(self, context, lambda: evolve.begin_picture(
+            context, path, settings.picture_model, settings.evolve_generations,
+            settings.evolve_population, settings.evolve_seed))
+        if failed:
+            return failed
+        facing = "facing the active camera" if context.scene.camera else "facing -Y (no active camera)"
+        self.report({"INFO"}, f"Evolving {settings.picture_model} plants toward the outline of "
+                    f"{os.path.basename(path)}, {facing}: progress in the status bar")
         return {"FINISHED"}
 
 
@@ -548,5 +586,6 @@ classes = (
     SYLVA_OT_forest,
     SYLVA_OT_mark_zone,
     SYLVA_OT_evolve,
+    SYLVA_OT_evolve_picture,
     SYLVA_OT_evolve_stop,
 )
