@@ -190,7 +190,7 @@ class Run:
         self._thread.join()
 
 
-# The run going on ("run"), the object showing its best plant ("object"), the id of the
+# The run going on ("run"), the name of the object showing its best plant ("object"), the id of the
 # member shown ("shown"), the target's name, the status text, and the run before ("last").
 _current = {}
 
@@ -238,7 +238,8 @@ def _begin(context, made, generations, target_name):
     run = Run(made, generations)
     obj = plants.new_object(context, f"Sylva evolved toward {target_name}")
     obj.location = context.scene.cursor.location
-    _current.update(run=run.start(), object=obj, shown=None, target=target_name)
+    # By name: an undo or a reload makes new Python objects of the same data.
+    _current.update(run=run.start(), object=obj.name, shown=None, target=target_name)
     return obj
 
 
@@ -246,11 +247,11 @@ def tick():
     """Shows the run's progress: the status bar's text and, when a better plant turns up,
     that plant in the viewport. Registered with bpy.app.timers while a run goes on: returns
     the seconds until the next look, or None once the run has ended."""
-    run, obj = _current.get("run"), _current.get("object")
+    run, obj = _current.get("run"), bpy.data.objects.get(_current.get("object", ""))
     if run is None:
         return None
     done, best, error, alive = run.progress()
-    if obj is not None and obj.name in bpy.data.objects and best is not None and best.id != _current["shown"]:
+    if obj is not None and best is not None and best.id != _current["shown"]:
         plant = plants.grow(best.genome, {"seed": best.genome.default_seed, "roots": True, "taper": None})
         plants.set_plant(obj, best.genome, plant, {"operator": "evolve", "generation": best.generation})
         obj[plants.SOURCE] = f"evolved toward {_current['target']}"
