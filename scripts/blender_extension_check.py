@@ -387,6 +387,15 @@ try:
     check(False, "a missing archive refused")
 except archive.ArchiveError as e:
     check("not found" in str(e), f"Archive: {e}")
+import sqlite3  # noqa: E402
+with sqlite3.connect(os.path.join(tmp, "other.db")) as other:  # SQLite, but not the studio's
+    other.execute("CREATE TABLE schema_version (version INTEGER)")
+    other.execute("INSERT INTO schema_version VALUES (1)")
+try:
+    archive.plants(os.path.join(tmp, "other.db"))
+    check(False, "a SQLite file without the studio's tables refused")
+except archive.ArchiveError as e:
+    check("other.db" in str(e) and "plants" in str(e), f"Archive: {e}")
 with open(os.path.join(tmp, "notes.db"), "w") as f:
     f.write("not sqlite")
 try:
@@ -445,6 +454,10 @@ rigs = [o for o in bpy.data.objects if o.type == "ARMATURE" and o.get("sylva_win
 check(len(rigs) == 1, "Add Wind again: the plant's old rig is replaced")
 fern.hide_set(False)
 fern.hide_render = False
+
+select([empty])
+fails(lambda: bpy.ops.sylva.wind(), "grew no branches to rig")
+fails(lambda: bpy.ops.sylva.lod(), "grew nothing to make levels of detail of")
 
 # -- Levels of detail: a collection of NAME_LODn objects ------------------------------------
 tulip = objects["tulip"]

@@ -41,9 +41,24 @@ def connect(path):
     return c
 
 
+class _sqlite_errors:
+    """Turns SQLite's errors (a file locked past the timeout, a table missing) into
+    ArchiveError naming the file."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, error, trace):
+        if isinstance(error, sqlite3.Error):
+            raise ArchiveError(f"{self.path}: {error}") from error
+
+
 def plants(path, model=None, limit=LISTED):
     """The newest plants, (id, model, operator, session, created), of one model or all."""
-    with _closing(connect(path)) as c:
+    with _sqlite_errors(path), _closing(connect(path)) as c:
         if model:
             rows = c.execute("SELECT id, model, operator, session, created FROM plants WHERE model = ?"
                              " ORDER BY id DESC LIMIT ?", (model, limit))
@@ -55,7 +70,7 @@ def plants(path, model=None, limit=LISTED):
 
 def plant(path, plant_id):
     """(genome JSON, seed, model, operator) of plant `plant_id`."""
-    with _closing(connect(path)) as c:
+    with _sqlite_errors(path), _closing(connect(path)) as c:
         row = c.execute("SELECT genome, seed, model, operator FROM plants WHERE id = ?",
                         (plant_id,)).fetchone()
     if row is None:
@@ -71,7 +86,7 @@ def record(path, plants_and_parents):
     id in `sylva_archive_id`. Returns the ids written."""
     path = os.path.abspath(path)
     written = []
-    with _closing(connect(path)) as c, c:
+    with _sqlite_errors(path), _closing(connect(path)) as c, c:
         def row_of(obj, parents):
             if obj.get(ARCHIVE_PATH) == path and ARCHIVE_ID in obj:
                 return obj[ARCHIVE_ID]

@@ -78,6 +78,8 @@ def wind(context, obj, strength, period):
     regrowing); a rig made before for it is replaced. Returns (armature, mesh, info)."""
     genome, options = _grow_options(obj)
     plant = genome.grow(wind=strength, wind_period=period, **options)
+    if plant.segments == 0:
+        raise ValueError(f"{obj.name} grew no branches to rig for wind")
     info = plant.wind
     for old in [o for o in bpy.data.objects if o.get(WIND_RIG + "_of") == obj.name]:
         _remove_rig(old)
@@ -135,6 +137,8 @@ def lods(context, obj, levels):
     are hidden in the viewport. A chain made before is replaced. Returns the objects."""
     genome, options = _grow_options(obj)
     plant = genome.grow(**options)
+    if plant.segments == 0:
+        raise ValueError(f"{obj.name} grew nothing to make levels of detail of")
     name = obj.name
     glb = plant.lod_glb(levels, name=name)
     collection_name = f"{name}_LODs"
