@@ -463,7 +463,10 @@ fails(lambda: bpy.ops.sylva.lod(), "grew nothing to make levels of detail of")
 tulip = objects["tulip"]
 select([tulip])
 settings.lod_levels = 3
+active_collection = bpy.context.view_layer.active_layer_collection.name
 bpy.ops.sylva.lod()
+check(bpy.context.view_layer.active_layer_collection.name == active_collection,
+      f"Levels of Detail leaves the active collection as it was ({active_collection})")
 lod_collection = bpy.data.collections.get(f"{tulip.name}_LODs")
 levels = sorted(lod_collection.objects, key=lambda o: o.name) if lod_collection else []
 counts = [triangles(o) for o in levels]

@@ -30,10 +30,16 @@ def import_glb(context, glb, collection):
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(glb)
+        # The importer puts what it makes in the active collection: ours for the import,
+        # then the user's again.
+        active = context.view_layer.active_layer_collection
         layer = _layer_of(context.view_layer.layer_collection, collection)
         if layer is not None:
             context.view_layer.active_layer_collection = layer
-        bpy.ops.import_scene.gltf(filepath=path)
+        try:
+            bpy.ops.import_scene.gltf(filepath=path)
+        finally:
+            context.view_layer.active_layer_collection = active
     finally:
         os.remove(path)
     made = [obj for obj in bpy.data.objects if obj not in before]

@@ -281,6 +281,9 @@ def _status(text):
     try:
         for window in bpy.context.window_manager.windows:
             window.workspace.status_text_set(text)
+            for area in window.screen.areas:  # the Evolve panel shows the text too
+                if area.type == "VIEW_3D":
+                    area.tag_redraw()
     except (AttributeError, RuntimeError):
         pass
 
