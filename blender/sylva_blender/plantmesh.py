@@ -5,9 +5,6 @@ Sylva is Y-up and Blender Z-up: (x, y, z) becomes (x, -z, y), as Blender's glTF 
 turns it, so a plant grown here stands as the same plant's GLB does when imported.
 """
 
-import json
-import struct
-
 import bpy
 import numpy as np
 
@@ -15,8 +12,6 @@ import numpy as np
 MATERIAL_PREFIX = "Sylva "
 MATERIAL_KEY = "sylva_material"
 IMAGE_KEY = "sylva_texture"
-# Sylva's GLB writer names each embedded texture image so (sylva-gltf's IMAGE_NAME_PREFIX).
-GLB_IMAGE_PREFIX = "sylva-texture-"
 
 ROUGHNESS = {"bark": 0.85, "root": 0.9, "leaf": 0.5, "flower": 0.45}
 
@@ -148,39 +143,14 @@ def _texture_images(plant, materials):
         tid = image.get(IMAGE_KEY)
         if tid in wanted:
             images[tid] = image
-    missing = wanted - images.keys()
-    if missing:
-        # The package gives texture ids, not pictures; its GLB embeds each texture's PNG.
-        # Read only the first time an id is met in this file.
-        for tid, png in _glb_textures(plant.glb()).items():
-            if tid in missing:
-                image = bpy.data.images.new(f"{MATERIAL_PREFIX}texture {tid}", 8, 8)
-                image.pack(data=png, data_len=len(png))
-                image.source = "FILE"
-                image[IMAGE_KEY] = tid
-                images[tid] = image
+    # Made only the first time an id is met in this file.
+    for tid in sorted(wanted - images.keys()):
+        import sylva  # the bundled package, imported already to grow the plant
+
+        png = sylva.texture_png(tid)
+        image = bpy.data.images.new(f"{MATERIAL_PREFIX}texture {tid}", 8, 8)
+        image.pack(data=png, data_len=len(png))
+        image.source = "FILE"
+        image[IMAGE_KEY] = tid
+        images[tid] = image
     return images
-
-
-def _glb_textures(glb):
-    """{texture id: PNG bytes} of the images in a Sylva GLB."""
-    magic, _version, _length = struct.unpack_from("<4sII", glb, 0)
-    if magic != b"glTF":
-        raise ValueError("not a GLB")
-    offset, doc, binary = 12, None, b""
-    while offset < len(glb):
-        size, kind = struct.unpack_from("<II", glb, offset)
-        chunk = glb[offset + 8 : offset + 8 + size]
-        if kind == 0x4E4F534A:  # JSON
-            doc = json.loads(chunk)
-        elif kind == 0x004E4942:  # BIN
-            binary = chunk
-        offset += 8 + size
-    out = {}
-    for image in (doc or {}).get("images", []):
-        name = image.get("name", "")
-        if name.startswith(GLB_IMAGE_PREFIX) and "bufferView" in image:
-            view = doc["bufferViews"][image["bufferView"]]
-            start = view.get("byteOffset", 0)
-            out[int(name[len(GLB_IMAGE_PREFIX) :])] = bytes(binary[start : start + view["byteLength"]])
-    return out

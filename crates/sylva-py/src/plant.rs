@@ -591,6 +591,17 @@ fn render<'py>(
     Ok(PyBytes::new(py, &png))
 }
 
+/// The PNG of Sylva's texture `id` (what a material of `plant.mesh.materials` names in
+/// `texture`): 8-bit grey, 256 × 256, to multiply the material's colour by, the picture the
+/// GLB and OBJ exports embed. Made once per process.
+#[pyfunction]
+pub fn texture_png(py: Python<'_>, id: u16) -> PyResult<Bound<'_, PyBytes>> {
+    let png = sylva::mesh::texture::texture_png(id).map_err(|e| {
+        pyo3::exceptions::PyRuntimeError::new_err(format!("encoding texture {id} as PNG: {e}"))
+    })?;
+    Ok(PyBytes::new(py, &png))
+}
+
 /// Grows a PlantMaker garden: `count` plants of each genome, on a plot `area` = (width,
 /// depth) metres centred on the origin, their seeds, places and turns drawn from `seed`.
 /// Or give `path`, a garden file (`*.garden.json`), to grow the garden it describes.

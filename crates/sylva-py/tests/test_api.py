@@ -170,6 +170,27 @@ def test_wind_and_levels_of_detail_come_as_gltf():
         pickle.dumps(windy)
 
 
+def test_texture_png_is_the_picture_the_glb_embeds():
+    plant = sylva.Genome.load(GENOMES["plantmaker"]).grow()
+    ids = {m["texture"] for m in plant.mesh.materials if m["texture"] is not None}
+    assert ids
+    glb = plant.glb()
+    gltf = glb_json(glb)
+    chunk = struct.unpack_from("<I", glb, 12)[0]
+    binary = glb[20 + chunk + 8 :]
+    embedded = {}
+    for image in gltf["images"]:
+        view = gltf["bufferViews"][image["bufferView"]]
+        start = view.get("byteOffset", 0)
+        embedded[int(image["name"].rsplit("-", 1)[1])] = binary[start : start + view["byteLength"]]
+    for tid in ids:
+        png = sylva.texture_png(tid)
+        assert png == embedded[tid]
+        assert png.startswith(b"\x89PNG") and struct.unpack(">II", png[16:24]) == (256, 256)
+    with pytest.raises(OverflowError):
+        sylva.texture_png(-1)
+
+
 def test_mesh_arrays_outlive_their_plant():
     plant = sylva.Genome.load(GENOMES["plantmaker"]).grow()
     expected = plant.mesh.positions.copy()

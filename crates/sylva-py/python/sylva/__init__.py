@@ -44,6 +44,7 @@ from ._sylva import (
     scene,
     set_max_memory,
     set_max_time,
+    texture_png,
     varieties,
 )
 from .errors import InputError, LimitError, SylvaError
@@ -75,5 +76,6 @@ __all__ = [
     "scene",
     "set_max_memory",
     "set_max_time",
+    "texture_png",
     "varieties",
 ]

@@ -51,10 +51,16 @@ class Genome:
     def with_field(self, field: str, value: Any) -> Genome:
         """A copy with ``field`` set to ``value``, checked as the genome file would be."""
     def grow(
-        self, seed: int | None = None, roots: bool = True, taper: float | None = None
+        self,
+        seed: int | None = None,
+        roots: bool = True,
+        taper: float | None = None,
+        wind: float | None = None,
+        wind_period: float | None = None,
     ) -> Plant:
         """Grows and meshes the plant with ``seed`` (the genome's own when None); ``taper=E``
-        thickens the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3."""
+        thickens the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3;
+        ``wind=S`` (0 to 10) adds a wind skin and a looping clip of ``wind_period`` seconds."""
     def mutate(self, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A mutated copy, made by the model's own mutation."""
     def __eq__(self, other: object) -> bool: ...
@@ -115,6 +121,11 @@ class Plant:
         """Writes GLB, OBJ or VRML97 by the extension; all or nothing."""
     def glb(self) -> bytes:
         """The plant as GLB bytes."""
+    @property
+    def wind(self) -> dict[str, Any] | None:
+        """The wind it grew with (strength, period, joints, left_out, clip), or None."""
+    def lod_glb(self, levels: int, name: str = "plant") -> bytes:
+        """Its levels of detail (2 to 8) as one GLB of nodes NAME_LOD0 to NAME_LODn."""
     def render(
         self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (800, 800)
     ) -> bytes:
@@ -425,6 +436,9 @@ def garden(
     path: _Path | None = None,
 ) -> Scene:
     """Grows a PlantMaker garden, from genomes or a garden file."""
+
+def texture_png(id: int) -> bytes:
+    """The PNG of Sylva's texture ``id`` (a material's ``texture``): grey, 256 × 256."""
 
 def scene(
     plants: Sequence[Plant],
