@@ -126,9 +126,13 @@ def grow_options(settings, genome):
 
 
 def grow(genome, options):
-    """Grows and meshes; safe on any thread (no bpy), and releases the GIL."""
+    """Grows and meshes; safe on any thread (no bpy), and releases the GIL. Also makes the
+    textures the plant's materials name (cached by the package), so that on a worker thread
+    Blender's thread finds them made."""
     plant = genome.grow(**options)
-    plant.mesh  # gather the triangle arrays here, off Blender's thread
+    materials = plant.mesh.materials  # gathers the triangle arrays too, off Blender's thread
+    for texture in {m["texture"] for m in materials if m["texture"] is not None}:
+        sylva().texture_png(texture)
     return plant
 
 

@@ -593,12 +593,14 @@ fn render<'py>(
 
 /// The PNG of Sylva's texture `id` (what a material of `plant.mesh.materials` names in
 /// `texture`): 8-bit grey, 256 × 256, to multiply the material's colour by, the picture the
-/// GLB and OBJ exports embed. Made once per process.
+/// GLB and OBJ exports embed. Made once per process; releases the GIL while it is made.
 #[pyfunction]
 pub fn texture_png(py: Python<'_>, id: u16) -> PyResult<Bound<'_, PyBytes>> {
-    let png = sylva::mesh::texture::texture_png(id).map_err(|e| {
-        pyo3::exceptions::PyRuntimeError::new_err(format!("encoding texture {id} as PNG: {e}"))
-    })?;
+    let png = py
+        .detach(|| sylva::mesh::texture::texture_png(id))
+        .map_err(|e| {
+            pyo3::exceptions::PyRuntimeError::new_err(format!("encoding texture {id} as PNG: {e}"))
+        })?;
     Ok(PyBytes::new(py, &png))
 }
 
