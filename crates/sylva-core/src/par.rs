@@ -21,7 +21,8 @@
 
 use std::cell::RefCell;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
 
 use rayon::prelude::*;
 
@@ -134,9 +135,30 @@ impl Pool {
 }
 
 /// A flag that cuts work short between jobs ([`Stop::watch`]); clones share it, so a front
-/// end keeps one and sets it from another thread (on Ctrl-C).
+/// end keeps one and sets it from another thread (on Ctrl-C). It may also carry a deadline
+/// ([`Stop::stop_at`]), after which it counts as set: a run given so many seconds ends on
+/// time however long its steps are.
 #[derive(Clone, Debug, Default)]
-pub struct Stop(Arc<AtomicBool>);
+pub struct Stop(Arc<StopState>);
+
+#[derive(Debug)]
+struct StopState {
+    set: AtomicBool,
+    /// When the stop was made: deadlines are kept as nanoseconds after it.
+    made: Instant,
+    /// Nanoseconds after `made` at which the stop counts as set; `u64::MAX`: never.
+    deadline: AtomicU64,
+}
+
+impl Default for StopState {
+    fn default() -> Self {
+        StopState {
+            set: AtomicBool::new(false),
+            made: Instant::now(),
+            deadline: AtomicU64::new(u64::MAX),
+        }
+    }
+}
 
 /// Work ended by its [`Stop`] before it finished.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
@@ -177,17 +199,39 @@ impl Stop {
 
     /// Sets the flag: watched work ends at its next job.
     pub fn stop(&self) {
-        self.0.store(true, Ordering::Relaxed);
+        self.0.set.store(true, Ordering::Relaxed);
     }
 
-    /// Whether the flag is set.
+    /// Whether the flag is set or the deadline has passed.
     pub fn is_stopped(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        self.is_set() || self.timed_out()
     }
 
-    /// Clears the flag, for the next piece of work.
+    /// Whether the flag is set ([`Stop::stop`]), deadline aside.
+    pub fn is_set(&self) -> bool {
+        self.0.set.load(Ordering::Relaxed)
+    }
+
+    /// Whether the deadline ([`Stop::stop_at`]) has passed.
+    pub fn timed_out(&self) -> bool {
+        let deadline = self.0.deadline.load(Ordering::Relaxed);
+        deadline != u64::MAX && self.0.made.elapsed().as_nanos() >= u128::from(deadline)
+    }
+
+    /// Makes the stop count as set from `deadline` on (`None`: no deadline, the default).
+    pub fn stop_at(&self, deadline: Option<Instant>) {
+        let nanos = deadline.map_or(u64::MAX, |d| {
+            let after = d.saturating_duration_since(self.0.made).as_nanos();
+            u64::try_from(after)
+                .unwrap_or(u64::MAX - 1)
+                .min(u64::MAX - 1)
+        });
+        self.0.deadline.store(nanos, Ordering::Relaxed);
+    }
+
+    /// Clears the flag, for the next piece of work (the deadline stays).
     pub fn reset(&self) {
-        self.0.store(false, Ordering::Relaxed);
+        self.0.set.store(false, Ordering::Relaxed);
     }
 
     /// Runs `work` on this thread so that every job of every [`Pool`] map it makes from this
@@ -269,6 +313,28 @@ mod tests {
             // Outside a map, the flag does nothing.
             assert_eq!(stop.watch(|| 7), Ok(7));
         }
+    }
+
+    #[test]
+    fn a_deadline_passed_stops_and_none_clears_it() {
+        let stop = Stop::new();
+        stop.stop_at(Some(Instant::now() + std::time::Duration::from_secs(3600)));
+        assert!(!stop.is_stopped() && !stop.timed_out());
+        assert_eq!(stop.watch(|| Pool::Serial.map(3, |i| i)), Ok(vec![0, 1, 2]));
+        stop.stop_at(Some(Instant::now()));
+        assert!(stop.is_stopped() && stop.timed_out());
+        assert_eq!(stop.watch(|| Pool::Serial.map(3, |i| i)), Err(Stopped));
+        // A deadline before the stop was made has passed too; reset leaves it.
+        stop.reset();
+        let before = Instant::now().checked_sub(std::time::Duration::from_secs(1));
+        stop.stop_at(Some(before.unwrap_or_else(Instant::now)));
+        assert!(stop.timed_out());
+        stop.stop_at(None);
+        assert!(!stop.is_stopped());
+        // A clone shares the deadline; the flag alone is not a timeout.
+        let clone = stop.clone();
+        clone.stop();
+        assert!(stop.is_stopped() && !stop.timed_out());
     }
 
     #[test]

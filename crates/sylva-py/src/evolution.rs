@@ -812,7 +812,7 @@ pub fn match_outline(
     threshold: Option<&Bound<'_, PyAny>>,
     threads: u32,
 ) -> PyResult<Evolution> {
-    use sylva::evolution::outline::{Limit, match_config, outlines, start_auto};
+    use sylva::evolution::outline::{Limit, breed_until, match_config, outlines, start_auto};
     let threshold = match threshold {
         None => sylva::picture::Threshold::Otsu,
         Some(t) => serde_json::from_value(from_py(t, "threshold")?)
@@ -890,15 +890,13 @@ pub fn match_outline(
     })?
     .py()?;
     let remaining = limit.remaining(&evolution, elsewhere);
-    let evolution = Evolution::made(evolution, stop, None);
+    let evolution = Evolution::made(evolution, stop.clone(), None);
     let started = std::time::Instant::now();
-    loop {
-        let reached = evolution.with(py, |r| remaining.reached(r, started))?;
-        if reached {
-            break;
-        }
-        evolution.work(py, |r| r.step().map(|_| ()))?.py()?;
-    }
+    evolution
+        .work(py, |r| {
+            breed_until(r, remaining, started, &stop, |_| Ok::<_, sylva::Error>(()))
+        })?
+        .py()?;
     Ok(evolution)
 }
 

@@ -94,3 +94,77 @@ fn bad_match_sections_name_the_field_or_file() {
     let e = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap_err();
     assert!(e.to_string().contains("nowhere.png"), "{e}");
 }
+
+/// `match_config` breeds each model for fitting: mostly mutants for the generational
+/// models, more bits flipped for binary trees; L-systems keep their defaults.
+#[test]
+fn a_match_breeds_for_fitting() {
+    use sylva::evolution::outline::match_config;
+    use sylva::evolution::{MatchConfig, RunConfig};
+    let target = MatchConfig {
+        front: examples().join("match/round.png"),
+        side: None,
+        threshold: sylva::picture::Threshold::default(),
+        weight: 1.0,
+        beside: false,
+        rows: 64,
+        closeness: 0.0,
+    };
+    let registry = Registry::standard();
+    let toml = |model: &str| {
+        match_config(registry, model, &RunConfig::default(), &target)
+            .unwrap()
+            .to_toml()
+    };
+    for model in ["plantmaker", "automata"] {
+        let text = toml(model);
+        assert!(
+            text.contains("mutation = 0.7\nelitism = 5\nreevaluate = false"),
+            "{model}: {text}"
+        );
+    }
+    assert!(toml("plantmaker").contains("mutation_spread = 0.05"));
+    assert!(toml("bintree").contains("mutation_rate = 0.05"));
+    let defaults = registry.get("lsystem").unwrap().default_config().to_toml();
+    let lsystem = toml("lsystem");
+    let section = |t: &str| t[t.find("[lsystem]").unwrap()..t.find("[output]").unwrap()].to_owned();
+    assert_eq!(section(&lsystem), section(&defaults));
+}
+
+/// A match stopped by hand (a front end's Ctrl-C) ends with `Stopped`, not as if its time
+/// were up, and leaves the run at its last whole generation; counted in generations, it
+/// breeds exactly that many.
+#[test]
+fn breeding_until_a_limit_tells_a_stop_from_the_time() {
+    use std::time::Instant;
+    use sylva::core::par::Stop;
+    use sylva::evolution::outline::{Limit, breed_until};
+    let text = "model = \"bintree\"\n[run]\npopulation = 8\n[match]\nfront = \"round.png\"\nbeside = false\n";
+    let config = config(text).unwrap();
+    let mut run = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap();
+    let stop = Stop::new();
+    let mut steps = 0;
+    breed_until(
+        &mut run,
+        Limit::Generations(3),
+        Instant::now(),
+        &stop,
+        |_| {
+            steps += 1;
+            Ok::<_, sylva::Error>(())
+        },
+    )
+    .unwrap();
+    assert_eq!((run.generation(), steps), (3, 3));
+    stop.stop();
+    let e = breed_until(
+        &mut run,
+        Limit::Seconds(3600.0),
+        Instant::now(),
+        &stop,
+        |_| Ok::<_, sylva::Error>(()),
+    );
+    assert!(matches!(e, Err(sylva::Error::Stopped(_))), "{e:?}");
+    assert_eq!(run.generation(), 3);
+    assert!(!stop.timed_out(), "the deadline is cleared after breeding");
+}

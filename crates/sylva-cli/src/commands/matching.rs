@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
+use sylva::core::par::Stop;
 use sylva::evolution::outline::{
-    Limit, Trial, best_iou, match_config, outlines, overlay, start_auto,
+    Limit, Trial, best_iou, breed_until, match_config, outlines, overlay, start_auto,
 };
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
@@ -235,11 +236,11 @@ fn breed(
     };
     show(evolution);
     let mut checkpoints = super::Checkpoints::new(checkpoint, config.run().checkpoint_seconds);
-    while !remaining.reached(evolution, started) {
-        evolution.step()?;
+    breed_until(evolution, remaining, started, &Stop::new(), |evolution| {
         show(evolution);
         checkpoints.due(|| evolution.checkpoint())?;
-    }
+        Ok::<_, anyhow::Error>(())
+    })?;
     checkpoints.save(|| evolution.checkpoint())?;
     bar.finish_and_clear();
     Ok(())
