@@ -213,7 +213,7 @@ impl Scratch {
     /// Where the buffers are and their capacities (see [`silhouette::Scratch::footprint`]).
     #[cfg(test)]
     fn footprint(&self) -> [(usize, usize); 3] {
-        let [canvas, quads, _] = self.silhouette.footprint();
+        let [canvas, quads, _, _] = self.silhouette.footprint();
         [
             canvas,
             quads,
