@@ -97,11 +97,9 @@ fn bad_match_sections_name_the_field_or_file() {
 
 /// `match_config` breeds each model for fitting: mostly mutants for the generational
 /// models, more bits flipped for binary trees; L-systems keep their defaults.
-#[test]
-fn a_match_breeds_for_fitting() {
-    use sylva::evolution::outline::match_config;
-    use sylva::evolution::{MatchConfig, RunConfig};
-    let target = MatchConfig {
+/// What `sylva match examples/match/round.png` asks for, from the front alone.
+fn round_target() -> sylva::evolution::MatchConfig {
+    sylva::evolution::MatchConfig {
         front: examples().join("match/round.png"),
         side: None,
         threshold: sylva::picture::Threshold::default(),
@@ -109,7 +107,14 @@ fn a_match_breeds_for_fitting() {
         beside: false,
         rows: 64,
         closeness: 0.0,
-    };
+    }
+}
+
+#[test]
+fn a_match_breeds_for_fitting() {
+    use sylva::evolution::RunConfig;
+    use sylva::evolution::outline::match_config;
+    let target = round_target();
     let registry = Registry::standard();
     let toml = |model: &str| {
         match_config(registry, model, &RunConfig::default(), &target)
@@ -167,4 +172,115 @@ fn breeding_until_a_limit_tells_a_stop_from_the_time() {
     assert!(matches!(e, Err(sylva::Error::Stopped(_))), "{e:?}");
     assert_eq!(run.generation(), 3);
     assert!(!stop.timed_out(), "the deadline is cleared after breeding");
+}
+
+/// `auto` tries each model for a share of the match, runs off the best two for a further
+/// share, and goes on with the better, the same each time.
+#[test]
+fn auto_tries_every_model_then_runs_off_the_best_two() {
+    use sylva::evolution::RunConfig;
+    use sylva::evolution::outline::{Limit, RUNOFF_SHARE, TRIAL_SHARE, Trial};
+    use sylva::evolution::outline::{best_iou, start_auto};
+    let target = round_target();
+    let run = RunConfig {
+        population: 6,
+        seed: 4,
+        ..RunConfig::default()
+    };
+    let generations = 25;
+    let (first, more) = (
+        (f64::from(generations) * TRIAL_SHARE) as u32,
+        (f64::from(generations) * RUNOFF_SHARE) as u32,
+    );
+    let auto = || {
+        let mut trials = Vec::new();
+        let limit = Limit::Generations(generations);
+        let (evolution, _) = start_auto(
+            Registry::standard(),
+            &target,
+            &run,
+            limit,
+            &Pool::Serial,
+            |t| trials.push(t.clone()),
+        )
+        .unwrap();
+        (evolution, trials)
+    };
+    let (chosen, trials) = auto();
+    let reached = |runoff: bool| -> Vec<(&str, f64, u32)> {
+        (trials.iter())
+            .filter_map(|t| match t {
+                Trial::Reached {
+                    model,
+                    iou,
+                    generations,
+                    runoff: r,
+                } if *r == runoff => Some((*model, *iou, *generations)),
+                _ => None,
+            })
+            .collect()
+    };
+    let (tried, runoff) = (reached(false), reached(true));
+    let models: Vec<&str> = tried.iter().map(|t| t.0).collect();
+    assert_eq!(models, ["bintree", "automata", "plantmaker"], "{trials:?}");
+    assert!(trials.iter().any(|t| matches!(
+        t,
+        Trial::LeftOut {
+            model: "lsystem",
+            ..
+        }
+    )));
+    assert!(tried.iter().all(|t| t.2 == first), "{tried:?}");
+    // The best two of the trials, in their order, each bred further.
+    let mut ranked = tried.clone();
+    ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+    assert_eq!(runoff.len(), 2, "{trials:?}");
+    for (r, t) in runoff.iter().zip(&ranked) {
+        assert_eq!((r.0, r.2), (t.0, first + more));
+    }
+    // The better of the run-off goes on, as it was.
+    let better = if runoff[1].1 > runoff[0].1 {
+        runoff[1]
+    } else {
+        runoff[0]
+    };
+    assert_eq!(chosen.config().model(), better.0);
+    assert_eq!(
+        (best_iou(&chosen), chosen.generation()),
+        (better.1, first + more)
+    );
+    // The same target, seed and generations: the same choice and the same best plant.
+    let (again, _) = auto();
+    assert_eq!(again.best().genome, chosen.best().genome);
+}
+
+/// Trees pass for trees: every tree example of every model passes the stem factors the
+/// outline term weighs its IoU by (the small L-system herb and bush do not).
+#[test]
+fn the_tree_examples_pass_the_stem_factors() {
+    use sylva_fitness::silhouette::{Scratch, plausibility};
+    let mut scratch = Scratch::default();
+    let trees = [
+        "automata/helix.json",
+        "bintree/oak.json",
+        "lsystem/tree.json",
+        "plantmaker/conifer.json",
+        "plantmaker/fern.json",
+        "plantmaker/flowering-bush.json",
+        "plantmaker/palm.json",
+        "plantmaker/tulip.json",
+    ];
+    let plausibility = |example: &str, scratch: &mut Scratch| {
+        let genome = sylva::load_genome(&examples().join(example)).unwrap();
+        let plant = genome.develop(genome.default_seed()).unwrap();
+        plausibility(&plant, scratch)
+    };
+    for example in trees {
+        let p = plausibility(example, &mut scratch);
+        assert!(p > 0.99, "{example}: {p}");
+    }
+    for herb in ["lsystem/herb.json", "lsystem/bush.json"] {
+        let p = plausibility(herb, &mut scratch);
+        assert!(p < 0.5, "{herb}: {p}");
+    }
 }

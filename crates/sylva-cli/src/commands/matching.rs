@@ -156,8 +156,10 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
                     model,
                     iou,
                     generations,
+                    runoff,
                 } => eprintln!(
-                    "auto: {model} reached an outline score of {iou:.3} in {generations} generations"
+                    "auto: {model} reached an outline score of {iou:.3} in {generations} generations{}",
+                    if *runoff { " (run-off)" } else { "" }
                 ),
                 Trial::LeftOut {
                     model,

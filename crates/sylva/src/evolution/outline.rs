@@ -255,8 +255,14 @@ pub fn breed_until<E: From<Error>>(
     bred
 }
 
-/// The share of a match each model's trial gets in [`start_auto`].
-pub const TRIAL_SHARE: f64 = 0.1;
+/// The share of a match each model's first trial gets in [`start_auto`].
+pub const TRIAL_SHARE: f64 = 0.08;
+
+/// The further share of a match the best two models of the first trials get in
+/// [`start_auto`], before the better goes on: a slow model's few first generations
+/// undersell it (a PlantMaker trial of 6 s lost a round outline to binary trees, which
+/// PlantMaker matched better by 20 s).
+pub const RUNOFF_SHARE: f64 = 0.12;
 
 /// The outline IoU of the run's best member (0 for a run without the term).
 pub fn best_iou(evolution: &Evolution) -> f64 {
@@ -267,10 +273,25 @@ pub fn best_iou(evolution: &Evolution) -> f64 {
     }
 }
 
+/// Breeds `evolution` `more` (generations, or seconds from now) and gives its best IoU. The
+/// last generation is bred whole: cut short, the run that goes on would score it again.
+fn trial(evolution: &mut Evolution, more: Limit) -> Result<f64, Error> {
+    let (begun, bred) = (Instant::now(), evolution.generation());
+    let done = |evolution: &Evolution| match more {
+        Limit::Generations(n) => evolution.generation() >= bred.saturating_add(n),
+        Limit::Seconds(_) => more.reached(evolution, begun),
+    };
+    while !done(evolution) {
+        evolution.step()?;
+    }
+    Ok(best_iou(evolution))
+}
+
 /// How one model did in the trials of [`start_auto`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum Trial {
-    /// It bred `generations` generations and reached `iou`.
+    /// It had bred `generations` generations and reached `iou`, at the end of its first
+    /// trial or (`runoff`) of the run-off between the best two.
     Reached {
         /// The model.
         model: &'static str,
@@ -278,6 +299,8 @@ pub enum Trial {
         iou: f64,
         /// Generations bred.
         generations: u32,
+        /// Whether this was the run-off.
+        runoff: bool,
     },
     /// It was left out: a generation may take `seconds`, more than a trial allows.
     LeftOut {
@@ -290,12 +313,13 @@ pub enum Trial {
     },
 }
 
-/// A match by the model that matches the outline best: a short run of each model of the
-/// registry (a tenth of `limit`, [`TRIAL_SHARE`]; a model whose generation may take longer
-/// than that, or counting generations longer than a tenth of a minute, is left out), then
-/// the run of the best (the first on a tie), with the seconds spent on the others.
-/// `on_trial` hears how each model did. The target's pictures are found as their paths say
-/// (relative ones from the current folder; [`start_auto_at`] finds them elsewhere).
+/// A match by the model that matches the outline best: a short trial of each model of the
+/// registry ([`TRIAL_SHARE`] of `limit`; a model whose generation may take longer than
+/// that, or counting generations longer than that share of a minute, is left out), a
+/// run-off of the best two ([`RUNOFF_SHARE`] more each), then the run of the better (the
+/// first on a tie), with the seconds spent on the others. `on_trial` hears how each model
+/// did. The target's pictures are found as their paths say (relative ones from the
+/// current folder; [`start_auto_at`] finds them elsewhere).
 pub fn start_auto(
     registry: &Registry,
     target: &MatchConfig,
@@ -319,14 +343,15 @@ pub fn start_auto_at(
     mut on_trial: impl FnMut(&Trial),
 ) -> Result<(Evolution, f64), Error> {
     let started = Instant::now();
-    let (trial, allowance) = match limit {
-        Limit::Generations(n) => (
-            Limit::Generations(((f64::from(n) * TRIAL_SHARE) as u32).max(1)),
-            60.0 * TRIAL_SHARE,
-        ),
-        Limit::Seconds(s) => (Limit::Seconds(s * TRIAL_SHARE), s * TRIAL_SHARE),
+    let share = |share: f64| match limit {
+        Limit::Generations(n) => Limit::Generations(((f64::from(n) * share) as u32).max(1)),
+        Limit::Seconds(s) => Limit::Seconds(s * share),
     };
-    let mut best: Option<(f64, Evolution)> = None;
+    let allowance = match limit {
+        Limit::Generations(_) => 60.0 * TRIAL_SHARE,
+        Limit::Seconds(s) => s * TRIAL_SHARE,
+    };
+    let mut entrants: Vec<(f64, &'static str, Evolution)> = Vec::new();
     for entry in registry.models() {
         let mut config = match_config(registry, entry.name(), run, target)
             .map_err(|e| InputError::new(e.field, e.message))?;
@@ -342,22 +367,33 @@ pub fn start_auto_at(
             continue;
         }
         let mut evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
-        // A trial's last generation is bred whole (cut short, the winner would score it again).
-        let begun = Instant::now();
-        while !trial.reached(&evolution, begun) {
-            evolution.step()?;
-        }
-        let iou = best_iou(&evolution);
+        let iou = trial(&mut evolution, share(TRIAL_SHARE))?;
         on_trial(&Trial::Reached {
             model: entry.name(),
             iou,
             generations: evolution.generation(),
+            runoff: false,
         });
-        if best.as_ref().is_none_or(|(b, _)| iou > *b) {
-            best = Some((iou, evolution));
+        entrants.push((iou, entry.name(), evolution));
+    }
+    // The best two, the first on a tie, go on to the run-off.
+    entrants.sort_by(|a, b| b.0.total_cmp(&a.0));
+    entrants.truncate(2);
+    if entrants.len() > 1 {
+        for (iou, model, evolution) in &mut entrants {
+            *iou = trial(evolution, share(RUNOFF_SHARE))?;
+            on_trial(&Trial::Reached {
+                model,
+                iou: *iou,
+                generations: evolution.generation(),
+                runoff: true,
+            });
         }
     }
-    let (_, evolution) = best.ok_or_else(|| {
+    let best = entrants
+        .into_iter()
+        .reduce(|a, b| if b.0 > a.0 { b } else { a });
+    let (_, _, evolution) = best.ok_or_else(|| {
         InputError::new(
             "model",
             "no model's generation fits a trial of the time given",
