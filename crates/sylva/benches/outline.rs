@@ -1,0 +1,51 @@
+//! The outline term's cost beside growth on a plant a match evolves: PlantMaker's best plant
+//! for the umbrella outline (`examples/match/umbrella.png`, `sylva match` with its
+//! defaults), grown, and scored (IoU times plausibility) from the front and the side at
+//! 32, 64 (the default) and 128 rows. What a coarse-to-fine schedule could save is what
+//! scoring at 64 rows costs over 32.
+//!
+//! Run with `cargo bench -p sylva --bench outline`.
+#![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use sylva::picture::{Threshold, load_target};
+use sylva_fitness::silhouette::{Outline, Scratch, Side};
+
+fn outline(c: &mut Criterion) {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let genome = sylva::load_genome(&here.join("benches/umbrella-plantmaker.json")).unwrap();
+    let seed = genome.default_seed();
+    let plant = genome.develop(seed).unwrap();
+    let picture = here.join("../../examples/match/umbrella.png");
+    let picture = load_target(&picture, Threshold::default()).unwrap();
+    let mut group = c.benchmark_group("outline");
+    group.bench_function(
+        format!(
+            "grow the umbrella's PlantMaker plant ({} segments, {} organs)",
+            plant.segments().len(),
+            plant.organs().len()
+        ),
+        |b| b.iter(|| black_box(genome.develop(seed).unwrap())),
+    );
+    for rows in [32, 64, 128] {
+        let views =
+            [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, rows).unwrap());
+        let mut scratch = Scratch::default();
+        group.bench_function(format!("score front and side at {rows} rows"), |b| {
+            b.iter(|| {
+                let sum: f64 = views
+                    .iter()
+                    .map(|v| v.score(black_box(&plant), &mut scratch))
+                    .sum();
+                black_box(sum)
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, outline);
+criterion_main!(benches);
