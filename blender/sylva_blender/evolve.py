@@ -157,6 +157,7 @@ class Run:
         self._stop = threading.Event()
         self._done = 0
         self._best = None
+        self._plant = None
         self._error = None
         self._thread = threading.Thread(target=self._work, name="sylva evolve", daemon=True)
 
@@ -171,9 +172,14 @@ class Run:
                     break
                 self.run.step()
                 best = self.run.best()
+                # Grown here, off Blender's thread, as the run's files grow it (pruned to a
+                # picture's outline, as the run scored it).
+                shown = self._best
+                plant = None if shown is not None and shown.id == best.id else plants.grow_member(self.run, best)
                 with self._lock:
                     self._done += 1
-                    self._best = best
+                    if plant is not None:
+                        self._best, self._plant = best, plant
         except Exception as e:  # shown in the status bar and the report
             with self._lock:
                 self._error = f"{type(e).__name__}: {e}"
@@ -182,9 +188,10 @@ class Run:
         self._stop.set()
 
     def progress(self):
-        """(generations done, best member so far or None, error or None, still running)."""
+        """(generations done, best member so far or None, its plant, error or None, still
+        running)."""
         with self._lock:
-            return self._done, self._best, self._error, self._thread.is_alive()
+            return self._done, self._best, self._plant, self._error, self._thread.is_alive()
 
     def join(self):
         self._thread.join()
@@ -197,7 +204,7 @@ _current = {}
 
 def running():
     run = _current.get("run")
-    return run is not None and run.progress()[3]
+    return run is not None and run.progress()[4]
 
 
 def begin(context, target, shape, zones, generations, population, seed, branches):
@@ -250,9 +257,8 @@ def tick():
     run, obj = _current.get("run"), bpy.data.objects.get(_current.get("object", ""))
     if run is None:
         return None
-    done, best, error, alive = run.progress()
+    done, best, plant, error, alive = run.progress()
     if obj is not None and best is not None and best.id != _current["shown"]:
-        plant = plants.grow(best.genome, {"seed": best.genome.default_seed, "roots": True, "taper": None})
         plants.set_plant(obj, best.genome, plant, {"operator": "evolve", "generation": best.generation})
         obj[plants.SOURCE] = f"evolved toward {_current['target']}"
         obj["sylva_fitness"] = best.fitness

@@ -129,7 +129,17 @@ def grow(genome, options):
     """Grows and meshes; safe on any thread (no bpy), and releases the GIL. Also makes the
     textures the plant's materials name (cached by the package), so that on a worker thread
     Blender's thread finds them made."""
-    plant = genome.grow(**options)
+    return _made_ready(genome.grow(**options))
+
+
+def grow_member(run, member):
+    """Grows a run's member as the run's own files grow it (inside a picture's outline, when
+    the run matches one: the plant it scored), as grow() does; call it between the run's
+    steps."""
+    return _made_ready(run.grow(member))
+
+
+def _made_ready(plant):
     materials = plant.mesh.materials  # gathers the triangle arrays too, off Blender's thread
     for texture in {m["texture"] for m in materials if m["texture"] is not None}:
         sylva().texture_png(texture)

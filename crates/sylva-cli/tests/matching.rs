@@ -166,18 +166,24 @@ fn height_scales_the_best_plants_assets_and_is_recorded() {
     assert!(config.contains("height = 7.0"), "{config}");
     let glb = fs::read(out.join("best.glb")).unwrap();
     assert!(String::from_utf8_lossy(&glb).contains("\"height\":7.0"));
-    // The genome is the plant as evolved; only its assets are scaled.
+    // The genome is the plant as evolved; its assets are scaled, and pruned to the outline
+    // as `grow --pruned-to` prunes it.
     let grown = dir.join("grown.glb");
     let best = out.join("best.json");
-    ok(&sylva(&[
-        "grow",
-        s(&best),
-        "-o",
-        s(&grown),
-        "--height",
-        "7",
-    ]));
-    assert_eq!(fs::read(&grown).unwrap(), glb);
+    let config = out.join("config.toml");
+    let grow = |more: &[&str]| {
+        let mut args = vec!["grow", s(&best), "-o", s(&grown), "--height", "7"];
+        args.extend(more);
+        ok(&sylva(&args));
+        fs::read(&grown).unwrap()
+    };
+    assert_eq!(grow(&["--pruned-to", s(&config)]), glb);
+    assert_ne!(grow(&[]), glb, "the match pruned its plant");
+    let evolve = dir.join("evolve.toml");
+    fs::write(&evolve, "model = \"bintree\"\n").unwrap();
+    let refused = sylva(&["grow", s(&best), "-o", s(&grown), "--pruned-to", s(&evolve)]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("evolve.toml"));
     for bad in ["0", "-1", "nan", "1e9"] {
         let flag = format!("--height={bad}");
         let refused = sylva(&["grow", s(&best), "-o", s(&grown), &flag]);

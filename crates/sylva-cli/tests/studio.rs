@@ -1777,6 +1777,59 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         get(&whole, &format!("/api/plants/{plant}"))["operator"],
         "match"
     );
+    // Its plants grow inside the outline, as the library prunes them, and so does one
+    // branched into breeding; the offspring bred from it grow whole.
+    let round_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/match/round.png");
+    let target = sylva::evolution::MatchConfig {
+        front: round_path.clone(),
+        side: Some(round_path),
+        threshold: sylva::picture::Threshold::default(),
+        weight: 1.0,
+        beside: false,
+        rows: 64,
+        closeness: 0.0,
+        prune: Some(true),
+    };
+    let space = sylva::evolution::outline::space(&target, Path::new("")).unwrap();
+    let triangles = |plant: i64| {
+        let path = format!("/api/plants/{plant}/plant.glb");
+        let (status, glb) = request(&whole, "GET", &path, b"", true);
+        assert_eq!(status, 200);
+        let scene = sylva::gltf::import::read_glb(&glb).unwrap();
+        scene
+            .meshes
+            .iter()
+            .map(|(_, m)| m.triangle_count())
+            .sum::<usize>()
+    };
+    let grown = |plant: i64, pruned_to| {
+        let row = get(&whole, &format!("/api/plants/{plant}"));
+        let text = row["genome_text"].as_str().unwrap();
+        let options = sylva::GrowOptions {
+            seed: row["seed"].as_u64(),
+            pruned_to,
+            ..sylva::GrowOptions::default()
+        };
+        let genome = sylva::parse_genome(Path::new("genome.json"), text).unwrap();
+        sylva::Grown::grow(genome, &options)
+            .unwrap()
+            .mesh
+            .triangle_count()
+    };
+    let first = rows[0]["plant"].as_i64().unwrap();
+    let (pruned, whole_plant) = (grown(first, space.clone()), grown(first, None));
+    assert!(pruned < whole_plant, "{pruned} {whole_plant}");
+    assert_eq!(triangles(first), pruned);
+    let branched = post(&whole, &format!("/api/plants/{first}/branch"), json!({}));
+    let cells = grid(&branched);
+    let copy = get(&whole, &format!("/api/plants/{}", cells[0]));
+    assert_eq!(copy["operator"], "branch");
+    let run = get(&whole, &format!("/api/plants/{first}"))["settings"]["run"].clone();
+    assert_eq!(copy["settings"]["pruned_to"], run);
+    assert_eq!(triangles(cells[0]), pruned);
+    let child = get(&whole, &format!("/api/plants/{}", cells[1]));
+    assert_ne!(child["operator"], "branch");
+    assert_eq!(triangles(cells[1]), grown(cells[1], None));
 
     // Killed in the middle, started again: the same run.
     let dir = temp_dir("match-killed");

@@ -591,6 +591,49 @@ impl Plant {
         plant
     }
 
+    /// A copy pruned as a gardener prunes: a segment `keep_segment` refuses goes with
+    /// everything that grows from it (the segments after it and their organs), and so does
+    /// an organ `keep_organ` refuses. Ids are renumbered, parents first as before.
+    pub fn cut(
+        &self,
+        mut keep_segment: impl FnMut(&Segment) -> bool,
+        mut keep_organ: impl FnMut(&Organ) -> bool,
+    ) -> Plant {
+        let mut new_id: Vec<Option<SegmentId>> = Vec::with_capacity(self.segments.len());
+        let mut plant = Plant {
+            segments: Vec::with_capacity(self.segments.len()),
+            organs: Vec::with_capacity(self.organs.len()),
+            materials: self.materials.clone(),
+            meta: self.meta.clone(),
+        };
+        for s in &self.segments {
+            let parent = match s.parent {
+                Some(p) => match new_id[p.index()] {
+                    Some(id) => Some(id),
+                    None => {
+                        new_id.push(None);
+                        continue;
+                    }
+                },
+                None => None,
+            };
+            if !keep_segment(s) {
+                new_id.push(None);
+                continue;
+            }
+            new_id.push(Some(SegmentId(plant.segments.len() as u32)));
+            plant.segments.push(Segment { parent, ..*s });
+        }
+        plant.organs.extend(self.organs.iter().filter_map(|o| {
+            let parent = match o.parent {
+                Some(p) => Some(new_id[p.index()]?),
+                None => None,
+            };
+            keep_organ(o).then_some(Organ { parent, ..*o })
+        }));
+        plant
+    }
+
     /// Scales the plant about its origin by `factor` (positive): every point, radius and
     /// blade, so that it keeps its shape at another size. Refused, and the plant left as it
     /// was, when the factor is not a positive finite number or a point would go beyond
@@ -718,6 +761,54 @@ mod tests {
         assert_eq!(shoot.segments.len(), 2);
         assert_eq!(shoot.segments[1].parent, Some(SegmentId(0)));
         assert_eq!(p.without(MaterialKind::Leaf), p);
+    }
+
+    #[test]
+    fn cutting_a_stem_takes_all_that_grows_from_it() {
+        let mut p = Plant::new(PlantMeta::default());
+        let trunk = p
+            .add_segment(Vec3::ZERO, Vec3::Y, (0.1, 0.1), None, false, Plant::BARK)
+            .unwrap();
+        let cut = p
+            .add_segment(Vec3::Y, Vec3::X, (0.1, 0.1), Some(trunk), true, Plant::BARK)
+            .unwrap();
+        let after_cut = p
+            .add_segment(
+                Vec3::X,
+                Vec3::X * 2.0,
+                (0.1, 0.1),
+                Some(cut),
+                false,
+                Plant::BARK,
+            )
+            .unwrap();
+        let top = p
+            .add_segment(
+                Vec3::Y,
+                Vec3::Y * 2.0,
+                (0.1, 0.1),
+                Some(trunk),
+                false,
+                Plant::BARK,
+            )
+            .unwrap();
+        let leaf = |parent, x: f32| Organ {
+            kind: OrganKind::Leaf,
+            position: Vec3::new(x, 1.0, 0.0),
+            orientation: Quat::IDENTITY,
+            size: Vec2::new(0.3, 0.1),
+            material: Plant::LEAF,
+            parent: Some(parent),
+        };
+        p.add_organ(leaf(after_cut, 2.0)).unwrap();
+        p.add_organ(leaf(top, 0.0)).unwrap();
+        p.add_organ(leaf(top, -1.0)).unwrap();
+        let pruned = p.cut(|s| s.end != Vec3::X, |o| o.position.x > -1.0);
+        assert_eq!(pruned.segments.len(), 2);
+        assert_eq!(pruned.segments[1].end, Vec3::Y * 2.0);
+        assert_eq!(pruned.segments[1].parent, Some(SegmentId(0)));
+        assert_eq!(pruned.organs, vec![leaf(SegmentId(1), 0.0)]);
+        assert_eq!(p.cut(|_| true, |_| true), p);
     }
 
     #[test]

@@ -12,8 +12,12 @@
 //! and root tips) are left out, and so is whatever else lies below the ground (y = 0).
 //!
 //! The term of a run, [`Outline::score`], is the IoU times [`plausibility`]: a plant
-//! whose trunk has grown as wide as the crown it should carry does not pass for a tree. Intersection and union are popcounts over the words. Once
-//! a [`Scratch`] is warm, scoring allocates nothing.
+//! whose trunk has grown as wide as the crown it should carry does not pass for a tree.
+//! Intersection and union are popcounts over the words. Once a [`Scratch`] is warm, scoring
+//! allocates nothing.
+//!
+//! [`prune`] grows a plant inside outlines instead, as a topiary is clipped: what would
+//! show outside their ink is cut (a match does so before scoring, by default).
 
 use sylva_core::Plant;
 use sylva_core::glam::{Vec2, Vec3};
@@ -207,6 +211,9 @@ pub struct Outline {
     /// Each canvas pixel's chamfer distance to the outline's nearest ink
     /// ([`distance_transform`]).
     distance: Vec<u16>,
+    /// The column (in pixels from the canvas's left edge) of the middle of the ink's bottom
+    /// row: where the plant's foot stands when it is pruned to the outline ([`prune`]).
+    foot: f32,
 }
 
 impl Outline {
@@ -258,10 +265,22 @@ impl Outline {
         }
         let mut distance = Vec::new();
         distance_transform(&normalised, &mut distance);
+        // The lowest row with ink (a thin trunk may fall under half of every bottom pixel).
+        let foot = (0..rows)
+            .rev()
+            .find_map(|y| {
+                let ink: Vec<u32> = (0..normalised.width())
+                    .filter(|&x| normalised.get(x, y))
+                    .collect();
+                let sum: f32 = ink.iter().map(|&x| x as f32 + 0.5).sum();
+                (!ink.is_empty()).then(|| sum / ink.len() as f32)
+            })
+            .ok_or(OutlineError::Empty)?;
         Ok(Outline {
             side,
             normalised,
             distance,
+            foot,
         })
     }
 
@@ -345,6 +364,56 @@ impl Outline {
         // Chamfer units are a third of a pixel.
         let mean = sum as f64 / count as f64 / 3.0 / f64::from(canvas.height());
         1.0 / (1.0 + 10.0 * mean)
+    }
+}
+
+/// Rows of the outlines a plant is pruned to: fine enough to keep the gaps between a
+/// crown's leaf clusters, which the scoring rows ([`Outline::rows`]) may blur.
+pub const SPACE_ROWS: u32 = 256;
+
+/// `plant` grown inside `outlines` (one per view), as a topiary is clipped to its form:
+/// a stem whose tip would show outside the ink of any of them is cut with all that grows
+/// from it, and so is a leaf or flower whose blade's middle would. What grows below the
+/// ground stays. A plant with nothing above the ground is returned whole.
+///
+/// Each outline is laid over the plant with its top row at the plant's top
+/// ([`laid_height`]), its bottom row on the ground and its foot ([`Outline::new`]) on the
+/// plant's foot (x = 0 or z = 0): the plant keeps the size its genome gives it, and the
+/// outline cuts it where the target shows sky.
+pub fn prune(outlines: &[Outline], plant: &Plant) -> Plant {
+    let Some(top) = laid_height(plant) else {
+        return plant.clone();
+    };
+    let inside = |p: Vec3| p.y <= 0.0 || outlines.iter().all(|o| o.holds(p, top));
+    plant.cut(
+        |s| !shoot_segment(plant, s.material) || inside(s.end),
+        |o| {
+            let [a, _, c, _] = blade_corners(o);
+            o.kind == OrganKind::RootTip || inside((a + c) * 0.5)
+        },
+    )
+}
+
+/// The height [`prune`] lays outlines at over `plant`: the top of what the outline draws of
+/// it, metres; `None` when nothing of it shows above the ground.
+fn laid_height(plant: &Plant) -> Option<f32> {
+    let top = shapes(plant, Side::Front)
+        .flat_map(|quad| quad.map(|p| p.y))
+        .fold(f32::NEG_INFINITY, f32::max);
+    (top > 0.0 && top.is_finite()).then_some(top)
+}
+
+impl Outline {
+    /// Whether point `p` of a plant `top` metres tall lies on this outline's ink, the outline
+    /// laid over the plant as [`prune`] lays it.
+    fn holds(&self, p: Vec3, top: f32) -> bool {
+        let scale = self.rows() as f32 / top;
+        let q = self.side.project(p);
+        let (x, y) = (q.x * scale + self.foot, (top - q.y) * scale);
+        let (width, height) = (self.normalised.width() as f32, self.rows() as f32);
+        (0.0..width).contains(&x)
+            && (0.0..height).contains(&y)
+            && self.normalised.get(x as u32, y as u32)
     }
 }
 
@@ -860,6 +929,58 @@ mod tests {
         let squat = Outline::new(&rectangle(100, 100, (10, 40, 90, 80)), Side::Side, 64).unwrap();
         let iou = squat.iou(&plant, &mut scratch);
         assert!(iou < 0.3, "{iou}");
+    }
+
+    /// A trunk 4 m tall with a branch out to each side at 3 m, and a root.
+    fn forked() -> Plant {
+        let mut plant = stump(0.1);
+        for x in [-1.5, 1.5] {
+            plant
+                .add_segment(
+                    Vec3::new(0.0, 3.0, 0.0),
+                    Vec3::new(x, 3.8, 0.0),
+                    (0.05, 0.05),
+                    Some(sylva_core::plant::SegmentId(0)),
+                    true,
+                    Plant::BARK,
+                )
+                .unwrap();
+        }
+        plant
+    }
+
+    #[test]
+    fn pruning_cuts_what_shows_outside_the_outline() {
+        // A tree whose crown leans left: a trunk with a crown on its left only. Laid over the
+        // forked plant (its top on the top row, its foot on the trunk), the right branch
+        // ends in the sky and goes; the left branch, the trunk and the root stay.
+        let mut target = rectangle(400, 400, (195, 100, 205, 300));
+        for y in 100..180 {
+            target.fill_span(y, 100, 205);
+        }
+        let outline = Outline::new(&target, Side::Front, SPACE_ROWS).unwrap();
+        let plant = forked();
+        let pruned = prune(std::slice::from_ref(&outline), &plant);
+        let ends: Vec<Vec3> = pruned.segments().iter().map(|s| s.end).collect();
+        assert_eq!(
+            ends,
+            [
+                plant.segments()[0].end,
+                plant.segments()[1].end,
+                plant.segments()[2].end
+            ]
+        );
+        // Seen from the side the target is the same, and the branches lie in the plane
+        // z = 0 over its trunk: nothing goes. An outline all sky where the plant
+        // stands cuts the whole shoot and keeps the root.
+        let side = Outline::new(&target, Side::Side, SPACE_ROWS).unwrap();
+        assert_eq!(prune(std::slice::from_ref(&side), &plant), plant);
+        let mut away = rectangle(400, 400, (100, 100, 110, 300));
+        away.fill_span(299, 300, 310);
+        let away = Outline::new(&away, Side::Front, SPACE_ROWS).unwrap();
+        let bare = prune(&[away], &plant);
+        assert_eq!(bare.segments().len(), 1);
+        assert_eq!(bare.segments()[0], plant.segments()[1]);
     }
 
     #[test]

@@ -13,6 +13,7 @@ use sylva::{GenerationStats, IndividualId};
 use crate::errors::{IntoPy, bad_value, input_error};
 use crate::genome::Genome;
 use crate::json::{from_py, to_py};
+use crate::plant::Plant;
 use crate::work::{PyFitness, Serving, work};
 
 /// An evolution config of any model that evolves: read from a TOML file (`Config.load`),
@@ -672,6 +673,20 @@ impl Evolution {
         Member::of(py, best, &names)
     }
 
+    /// Grows `member` (the best by default) as the run's files grow it: with `[output]`'s
+    /// taper, wind and height, and inside `[match]`'s outlines when the match prunes (as
+    /// `sylva.match` does by default; `member.genome.grow()` grows the genome alone).
+    /// Releases the GIL.
+    #[pyo3(signature = (member = None))]
+    fn grow(&self, py: Python<'_>, member: Option<PyRef<'_, Member>>) -> PyResult<Plant> {
+        let (config, best) = self.with(py, |r| (r.config(), r.best().genome))?;
+        let genome = member.map_or(best, |m| m.genome.inner.clone());
+        let options = config.grow_options().py()?;
+        let wind = options.wind;
+        let grown = py.detach(|| sylva::Grown::grow(genome, &options)).py()?;
+        Ok(Plant::with_wind(grown, wind))
+    }
+
     /// The `count` fittest members, fittest first.
     fn fittest(&self, py: Python<'_>, count: usize) -> PyResult<Vec<Member>> {
         let (members, names) = self.with(py, |r| (r.fittest(count), r.term_names().to_vec()))?;
@@ -794,11 +809,13 @@ impl Evolution {
 /// PNG file would be); `model` a model's name or `"auto"` (each model briefly, then on with
 /// the best); for `generations` (the same bytes each time) or `seconds` of breeding (60 by
 /// default); `threshold` `"otsu"` or a luminance from 0 to 1. The best member's
-/// `terms["iou"]` is its outline term (docs/match.md). Releases the GIL while it breeds;
-/// Ctrl-C raises `KeyboardInterrupt` within one member's evaluation.
+/// `terms["iou"]` is its outline term (docs/match.md); with `prune` (the default) the plants
+/// grow inside the outlines, pruned where they would show outside them (`run.grow()` grows
+/// the best so). Releases the GIL while it breeds; Ctrl-C raises `KeyboardInterrupt` within
+/// one member's evaluation.
 #[pyfunction(name = "match")]
 #[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
-                    population = 100, seed = 1, threshold = None, threads = 0))]
+                    population = 100, seed = 1, threshold = None, threads = 0, prune = true))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
 pub fn match_outline(
     py: Python<'_>,
@@ -811,6 +828,7 @@ pub fn match_outline(
     seed: u64,
     threshold: Option<&Bound<'_, PyAny>>,
     threads: u32,
+    prune: bool,
 ) -> PyResult<Evolution> {
     use sylva::evolution::outline::{Limit, breed_until, match_config, outlines, start_auto};
     let threshold = match threshold {
@@ -832,6 +850,7 @@ pub fn match_outline(
         beside: false,
         rows: 64,
         closeness: 0.0,
+        prune: Some(prune),
     };
     outlines(&outline, Path::new("")).py()?;
     let limit = match (generations, seconds) {

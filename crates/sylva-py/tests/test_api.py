@@ -498,6 +498,19 @@ def test_match_takes_numpy_masks_as_it_takes_pictures(tmp_path):
         sylva.match(np.zeros((64, 48), bool), **kwargs)  # no ink: no outline
 
 
+def test_a_match_grows_its_plants_inside_the_outline():
+    y, x = np.mgrid[0:64, 0:48]
+    cone = ((np.abs(x - 24) < (y - 4) * 0.35) & (y > 4) & (y < 60)) | ((np.abs(x - 24) < 2) & (y >= 56))
+    kwargs = dict(model="plantmaker", generations=1, population=6, seed=2)
+    pruned = sylva.match(cone, **kwargs)
+    best = pruned.best()
+    inside, whole = pruned.grow(), best.genome.grow()
+    assert inside.organs < whole.organs
+    assert pruned.grow(best).glb() == inside.glb()
+    free = sylva.match(cone, prune=False, **kwargs)
+    assert free.grow().glb() == free.best().genome.grow().glb()
+
+
 def test_match_evolves_towards_a_picture(tmp_path):
     target = EXAMPLES / "match" / "cone.png"
     run = sylva.match(target, model="bintree", generations=6, population=12, seed=4)

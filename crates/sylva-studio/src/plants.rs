@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::assets::Origin;
 use sylva::core::Plant;
+use sylva::evolution::outline::{Outline, prune};
 use sylva::mesh::SceneNode;
 use sylva::render::View;
 use sylva::{Genome, GrowOptions, Grown, LodAssets, Preview, Registry};
@@ -24,6 +25,7 @@ use crate::Studio;
 use crate::archive::{self, ParentRow, PlantRow};
 use crate::cache::Bounded;
 use crate::error::ApiError;
+use crate::modes::matching::pruned_to;
 
 /// GLBs kept in memory, by plant and form: at most 256, and 512 MB (a random PlantMaker
 /// plant's GLB in full can be 40 MB).
@@ -106,12 +108,14 @@ pub fn grow_glb(
     genome: &Genome,
     seed: u64,
     roots: bool,
+    pruned_to: Option<Arc<[Outline]>>,
     parents: &[ParentRow],
     operator: &str,
 ) -> Result<Vec<u8>, ApiError> {
     let options = GrowOptions {
         seed: Some(seed),
         roots,
+        pruned_to,
         ..GrowOptions::default()
     };
     let grown =
@@ -141,12 +145,18 @@ pub fn grow_shown(genome: &Genome, seed: u64) -> Result<Plant, ApiError> {
     sylva::assets::grow_plant(genome, seed, false, None).map_err(|e| ApiError::library("genome", e))
 }
 
-/// A plant grown as the views show it: from memory, or grown again (and kept).
+/// A plant grown as the views show it (pruned to its match's outlines, if it grew inside
+/// them): from memory, or grown again (and kept).
 fn shown_plant(studio: &Studio, row: &PlantRow) -> Result<Arc<Plant>, ApiError> {
     if let Some(plant) = studio.plants.get(row.id) {
         return Ok(plant);
     }
-    let plant = Arc::new(grow_shown(&genome_of(&studio.registry, row)?, row.seed)?);
+    let mut plant = grow_shown(&genome_of(&studio.registry, row)?, row.seed)?;
+    if let Some(outlines) = pruned_to(studio, row)? {
+        // Roots are not pruned, so pruning after they are left out cuts the same.
+        plant = prune(&outlines, &plant);
+    }
+    let plant = Arc::new(plant);
     studio
         .plants
         .put(row.id, plant.clone(), plant_bytes(&plant));
@@ -191,6 +201,7 @@ pub fn plant_form(studio: &Studio, id: i64, form: Form) -> Result<Arc<Vec<u8>>, 
             &genome_of(&studio.registry, &row)?,
             row.seed,
             roots,
+            pruned_to(studio, &row)?,
             &parents,
             &row.operator,
         )?,
@@ -260,6 +271,7 @@ fn asset_glb(studio: &Studio, id: i64, q: &GlbQuery) -> Result<Vec<u8>, ApiError
         roots: q.roots,
         wind: q.wind.then(sylva::mesh::wind::WindOptions::default),
         lod: q.lod,
+        pruned_to: pruned_to(studio, &row)?,
         ..GrowOptions::default()
     };
     let failed = |e: sylva::Error| ApiError::library("genome", e);

@@ -2,7 +2,8 @@
 //! for the umbrella outline (`examples/match/umbrella.png`, `sylva match` with its
 //! defaults), grown, and scored (IoU times plausibility) from the front and the side at
 //! 32, 64 (the default) and 128 rows. What a coarse-to-fine schedule could save is what
-//! scoring at 64 rows costs over 32.
+//! scoring at 64 rows costs over 32. And the same plant pruned to the outline (as a match
+//! does by default: `prune`, at 256 rows, then scored at 64).
 //!
 //! Run with `cargo bench -p sylva --bench outline`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -12,7 +13,7 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sylva::picture::{Threshold, load_target};
-use sylva_fitness::silhouette::{Outline, Scratch, Side};
+use sylva_fitness::silhouette::{Outline, SPACE_ROWS, Scratch, Side, prune};
 
 fn outline(c: &mut Criterion) {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -44,6 +45,26 @@ fn outline(c: &mut Criterion) {
             })
         });
     }
+    let space =
+        [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, SPACE_ROWS).unwrap());
+    let views = [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, 64).unwrap());
+    let pruned = prune(&space, &plant);
+    let mut scratch = Scratch::default();
+    group.bench_function(
+        format!(
+            "prune to front and side ({} segments, {} organs kept)",
+            pruned.segments().len(),
+            pruned.organs().len()
+        ),
+        |b| b.iter(|| black_box(prune(&space, black_box(&plant)))),
+    );
+    group.bench_function("prune, then score front and side at 64 rows", |b| {
+        b.iter(|| {
+            let pruned = prune(&space, black_box(&plant));
+            let sum: f64 = views.iter().map(|v| v.score(&pruned, &mut scratch)).sum();
+            black_box(sum)
+        })
+    });
     group.finish();
 }
 

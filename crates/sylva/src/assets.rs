@@ -9,12 +9,14 @@
 //! Mesh options follow from each model's [`MeshHint`], never from its name.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde_json::json;
 use sylva_core::glam::{Quat, Vec3};
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
 use sylva_evolve::IndividualId;
+use sylva_fitness::silhouette::{Outline, prune};
 use sylva_gltf::export::{self, Format, GlbOptions};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::wind::{Rig, WindOptions};
@@ -98,6 +100,9 @@ pub struct GrowOptions {
     /// The plant scaled about its foot so that its highest point stands this many metres
     /// above the ground (`--height`). Default none: the model's own scale.
     pub height: Option<f32>,
+    /// Outlines the plant grows inside, pruned where it would show outside their ink
+    /// (`[match] prune`, [`crate::evolution::outline::space`]). Default none.
+    pub pruned_to: Option<Arc<[Outline]>>,
 }
 
 impl Default for GrowOptions {
@@ -110,6 +115,7 @@ impl Default for GrowOptions {
             lod: None,
             quantize: false,
             height: None,
+            pruned_to: None,
         }
     }
 }
@@ -151,7 +157,11 @@ impl Grown {
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
         let seed = options.seed.unwrap_or_else(|| genome.default_seed());
         let (roots, taper) = (options.roots, options.taper);
-        let mut plant = grow_plant(&genome, seed, roots, taper)?;
+        let mut plant = genome.develop(seed)?;
+        if let Some(outlines) = &options.pruned_to {
+            plant = prune(outlines, &plant);
+        }
+        let mut plant = finish(plant, roots, taper);
         if let Some(height) = options.height {
             scale_to_height(&mut plant, height)?;
         }
@@ -205,14 +215,19 @@ pub fn grow_plant(
     roots: bool,
     taper: Option<PipeTaper>,
 ) -> Result<Plant, Error> {
-    let mut plant = genome.develop(seed)?;
+    Ok(finish(genome.develop(seed)?, roots, taper))
+}
+
+/// A grown plant made ready as [`grow_plant`] makes it: roots left out unless `roots`, the
+/// pipe model's radii with a `taper`.
+fn finish(mut plant: Plant, roots: bool, taper: Option<PipeTaper>) -> Plant {
     if !roots {
         plant = plant.without(MaterialKind::Root);
     }
     if let Some(taper) = taper {
         taper.apply(&mut plant);
     }
-    Ok(plant)
+    plant
 }
 
 /// Lowest and highest height a plant is scaled to (`--height`), metres.

@@ -21,7 +21,9 @@ use sylva_evolve::{GenerationStats, IndividualId};
 use sylva_model::{Bred, DevelopError, Evolve, GenomeError, MeshHint, Model, Parent};
 
 use crate::error::{Error, FieldError, InputError};
-use crate::evolution::{EvolveConfig, GenerationTime, Member, OutputConfig, RunConfig};
+use crate::evolution::{
+    EvolveConfig, GenerationTime, MatchConfig, Member, OutputConfig, RunConfig,
+};
 use crate::evolution::{MapValue, TypedRun, resume, resume_map, start, start_map};
 use crate::evolution::{RunHooks, SpaceOptions, SpaceValue, Stop, new_space};
 use crate::genome::{Genome, Settings, settings_of};
@@ -77,6 +79,7 @@ pub(crate) trait DynModel: Send + Sync {
     fn run_settings_mut<'a>(&self, config: &'a mut Value) -> &'a mut RunConfig;
     fn output<'a>(&self, config: &'a Value) -> &'a OutputConfig;
     fn output_mut<'a>(&self, config: &'a mut Value) -> &'a mut OutputConfig;
+    fn outline<'a>(&self, config: &'a Value) -> Option<&'a MatchConfig>;
     fn to_toml(&self, config: &Value) -> String;
     fn start_files(&self, config: &Value) -> Vec<PathBuf>;
     fn generation_time(
@@ -334,6 +337,10 @@ impl<M: Evolve + Default> DynModel for M {
 
     fn output_mut<'a>(&self, c: &'a mut Value) -> &'a mut OutputConfig {
         &mut config_mut::<M>(c).output
+    }
+
+    fn outline<'a>(&self, c: &'a Value) -> Option<&'a MatchConfig> {
+        config::<M>(c).outline.as_ref()
     }
 
     fn to_toml(&self, c: &Value) -> String {

@@ -107,6 +107,7 @@ fn round_target() -> sylva::evolution::MatchConfig {
         beside: false,
         rows: 64,
         closeness: 0.0,
+        prune: None,
     }
 }
 
@@ -283,4 +284,67 @@ fn the_tree_examples_pass_the_stem_factors() {
         let p = plausibility(herb, &mut scratch);
         assert!(p < 0.5, "{herb}: {p}");
     }
+}
+
+/// A match that prunes (the default) grows its plants inside the outline: the term scores
+/// the pruned plant, the run's files grow it so, and the overlay shows it, each at the IoU
+/// the others see; with `prune = false` the plant grows whole.
+#[test]
+fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
+    use sylva::Grown;
+    use sylva::evolution::outline::{best_iou, match_config, overlay, prune, space};
+    use sylva::evolution::{MatchConfig, RunConfig};
+    let run = RunConfig {
+        generations: 2,
+        population: 12,
+        ..RunConfig::default()
+    };
+    let grown = |target: &MatchConfig| {
+        let config = match_config(Registry::standard(), "plantmaker", &run, target).unwrap();
+        let mut evolution = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap();
+        while evolution.generation() < 2 {
+            evolution.step().unwrap();
+        }
+        let best = evolution.best().clone();
+        let options = config.grow_options().unwrap();
+        let plant = Grown::grow(best.genome.clone(), &options).unwrap().plant;
+        let (_, iou) = overlay(target, Path::new(""), &best.genome).unwrap();
+        (best, options, plant, (iou, best_iou(&evolution)))
+    };
+    let pruning = round_target();
+    let (best, options, plant, (iou, term)) = grown(&pruning);
+    let outlines = options
+        .pruned_to
+        .expect("a pruning match prunes its files' plant");
+    assert_eq!(outlines.len(), 1, "the front view alone");
+    let whole = best.genome.develop(best.genome.default_seed()).unwrap();
+    assert_eq!(plant, prune(&outlines, &whole));
+    assert!(
+        plant.organs().len() < whole.organs().len(),
+        "something was cut"
+    );
+    assert_eq!(
+        space(&pruning, Path::new("")).unwrap().unwrap()[0],
+        outlines[0]
+    );
+    // The overlay is of the pruned plant (at 256 rows; the term at 64, times plausibility).
+    let front = MatchConfig {
+        side: None,
+        rows: 256,
+        ..pruning.clone()
+    };
+    let target = &sylva::evolution::outline::outlines(&front, Path::new("")).unwrap()[0];
+    let mut scratch = sylva_fitness::silhouette::Scratch::default();
+    assert_eq!(iou, target.iou(&plant, &mut scratch));
+    assert!(iou > 0.4 && term > 0.4, "{iou} {term}");
+    let free = MatchConfig {
+        prune: Some(false),
+        ..round_target()
+    };
+    let (best, options, plant, _) = grown(&free);
+    assert!(options.pruned_to.is_none());
+    assert_eq!(
+        plant,
+        best.genome.develop(best.genome.default_seed()).unwrap()
+    );
 }

@@ -12,7 +12,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sylva::assets::{guide_mesh, picture};
 use sylva::core::Plant;
 use sylva::core::budget::Seconds;
-use sylva::core::taper::PipeTaper;
 use sylva::evolution::SearchStrategy;
 use sylva::mesh::SceneNode;
 use sylva::render::{self, SheetCell, SheetOptions};
@@ -250,8 +249,17 @@ pub(super) fn write_results(
         config,
         evolution.guides(),
     )?;
-    let taper = config.output().pipe_taper();
-    let sheet = population_sheet(evolution, config.output().sheet_size as usize, taper, pool)?;
+    let options = GrowOptions {
+        wind: None,
+        height: None,
+        ..config.grow_options()?
+    };
+    let sheet = population_sheet(
+        evolution,
+        config.output().sheet_size as usize,
+        &options,
+        pool,
+    )?;
     files.add(&out.join("population.png"), &sheet)?;
     files.commit()?;
 
@@ -291,13 +299,7 @@ pub(super) fn add_best(
     guides: Option<Plant>,
 ) -> anyhow::Result<Grown> {
     files.add(&out.join("best.json"), best.to_json().as_bytes())?;
-    let options = GrowOptions {
-        taper: config.output().pipe_taper(),
-        wind: config.output().wind_options(),
-        height: config.output().height,
-        ..GrowOptions::default()
-    };
-    let grown = Grown::grow(best.clone(), &options)?;
+    let grown = Grown::grow(best.clone(), &config.grow_options()?)?;
     files.add_scene(&out.join("best.glb"), &grown.scene())?;
     let guides = guides.map(|p| guide_mesh(&p)).transpose()?;
     let mut scene = grown.scene();
@@ -316,19 +318,13 @@ pub(super) fn add_best(
 fn population_sheet(
     evolution: &Evolution,
     count: usize,
-    taper: Option<PipeTaper>,
+    options: &GrowOptions,
     pool: &sylva::core::par::Pool,
 ) -> anyhow::Result<Vec<u8>> {
     let chosen = evolution.fittest(count);
     let grown = chosen
         .iter()
-        .map(|m| {
-            let options = GrowOptions {
-                taper,
-                ..GrowOptions::default()
-            };
-            Grown::grow(m.genome.clone(), &options)
-        })
+        .map(|m| Grown::grow(m.genome.clone(), options))
         .collect::<Result<Vec<_>, _>>()?;
     let cells: Vec<SheetCell> = chosen
         .iter()

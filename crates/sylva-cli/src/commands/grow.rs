@@ -1,8 +1,10 @@
 //! `sylva grow`: one genome into a 3D asset (and a picture).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use sylva::assets::{check_png, picture};
+use sylva::evolution::outline::Outline;
 use sylva::files::Outputs;
 use sylva::render::View;
 use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
@@ -41,6 +43,10 @@ pub struct GrowArgs {
     /// ground, 0.01 to 1000 [default: the model's own scale].
     #[arg(long, value_name = "METRES", value_parser = super::parse_height)]
     height: Option<f32>,
+    /// Grow the plant inside a match's outlines, pruned as that run's files were: the run's
+    /// `config.toml` (`sylva match` writes one; docs/match.md) [default: the whole plant].
+    #[arg(long, value_name = "CONFIG")]
+    pruned_to: Option<PathBuf>,
     #[command(flatten)]
     wind: super::WindArgs,
     #[command(flatten)]
@@ -59,6 +65,10 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         lod: args.lod.map(|n| n as usize),
         wind,
         height: args.height,
+        pruned_to: match &args.pruned_to {
+            Some(path) => Some(outlines_of(path)?),
+            None => None,
+        },
     };
     let glb = options.glb_options();
     if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {
@@ -113,6 +123,19 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The outlines the match run of config `path` prunes its plants to.
+fn outlines_of(path: &std::path::Path) -> anyhow::Result<Arc<[Outline]>> {
+    let options = sylva::Config::load(path)?.grow_options()?;
+    let outlines = options.pruned_to.ok_or_else(|| {
+        InputError::file(
+            path,
+            "expected the config of a match that prunes its plants: it has no `[match]` \
+             section, or `prune = false`",
+        )
+    })?;
+    Ok(outlines)
 }
 
 /// `sylva grow --lod N`: NAME_LOD0.glb … beside the output, and the output as one scene of

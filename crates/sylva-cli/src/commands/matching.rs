@@ -53,6 +53,10 @@ pub struct MatchArgs {
     /// closeness`, docs/match.md).
     #[arg(long, default_value_t = 0.0, value_parser = parse_closeness)]
     closeness: f64,
+    /// Leave the plant as its genome grows it: the outline a goal only, not the form the
+    /// plant is pruned to (`[match] prune = false`, docs/match.md).
+    #[arg(long)]
+    no_prune: bool,
     /// Worker threads; 0 means one per core. Results do not depend on it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
     threads: u32,
@@ -106,6 +110,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         beside: false,
         rows: 64,
         closeness: args.closeness,
+        prune: Some(!args.no_prune),
     };
     // The pictures are read first: a bad one is refused before anything is written.
     outlines(&target, Path::new(""))?;

@@ -14,6 +14,7 @@ use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::core::Plant;
+use sylva::evolution::outline::{Outline, prune};
 use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
@@ -21,6 +22,7 @@ use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
 use crate::modes::Mode;
+use crate::modes::matching::{PRUNED_TO, pruned_run, pruned_to};
 use crate::plants::{
     Form, PreviewSize, genome_of, grow_shown, parse_genome, plant_bytes, preview_glb,
 };
@@ -106,17 +108,22 @@ impl Made {
         parents: Vec<ParentRow>,
     ) -> Result<Made, ApiError> {
         let seed = genome.default_seed();
-        Made::grow_with(genome, seed, operator, settings, parents)
+        Made::grow_with(genome, seed, operator, settings, parents, None)
     }
 
+    /// Grows `genome` with `seed`, pruned to `pruned_to` if given.
     fn grow_with(
         genome: Genome,
         seed: u64,
         operator: Operator,
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
+        pruned_to: Option<&[Outline]>,
     ) -> Result<Made, ApiError> {
-        let plant = grow_shown(&genome, seed)?;
+        let mut plant = grow_shown(&genome, seed)?;
+        if let Some(outlines) = pruned_to {
+            plant = prune(outlines, &plant);
+        }
         let glb = preview_glb(&genome, seed, &plant, PreviewSize::GRID)?;
         Ok(Made {
             genome,
@@ -211,6 +218,8 @@ struct Sprout {
     operator: Operator,
     settings: serde_json::Value,
     parents: Vec<ParentRow>,
+    /// The outlines it grows inside: those of the match it comes from, if it does.
+    pruned_to: Option<Arc<[Outline]>>,
     /// Where the request named it (`start.genomes[2]`), for an error growing it.
     field: String,
 }
@@ -228,6 +237,7 @@ impl Sprout {
             operator,
             settings,
             parents: Vec::new(),
+            pruned_to: None,
             field,
         }
     }
@@ -323,16 +333,22 @@ async fn make_plants(
                     reused.push(row.id);
                 } else {
                     let at = sub(field, &format!("plants[{i}]"));
+                    // A plant of a match keeps the outlines it grew inside.
+                    let mut settings = json!({});
+                    if let Some(run) = pruned_run(&row) {
+                        settings[PRUNED_TO] = json!(run);
+                    }
                     genomes.push(Sprout {
                         seed: Some(row.seed),
                         parents: vec![ParentRow {
                             plant: row.id,
                             dominance: 1.0,
                         }],
+                        pruned_to: pruned_to(studio, &row)?,
                         ..Sprout::new(
                             genome_of(&studio.registry, &row)?,
                             Operator::Branch,
-                            json!({}),
+                            settings,
                             at,
                         )
                     });
@@ -378,13 +394,17 @@ async fn blocking_grow(studio: &Studio, sprouts: Vec<Sprout>) -> Result<Vec<Made
                     operator,
                     settings,
                     parents,
+                    pruned_to,
                     field,
                 } = sprouts[i].clone();
                 let seed = seed.unwrap_or_else(|| genome.default_seed());
-                Made::grow_with(genome, seed, operator, settings, parents).map_err(|mut e| {
-                    e.field = field;
-                    e
-                })
+                let pruned_to = pruned_to.as_deref();
+                Made::grow_with(genome, seed, operator, settings, parents, pruned_to).map_err(
+                    |mut e| {
+                        e.field = field;
+                        e
+                    },
+                )
             })
             .into_iter()
             .collect::<Result<Vec<Made>, ApiError>>()
@@ -926,7 +946,14 @@ pub(crate) async fn edit(
         dominance: 1.0,
     }];
     let made = tokio::task::spawn_blocking(move || {
-        Made::grow_with(genome, seed, operator, json!({ "seed": seed }), parents)
+        Made::grow_with(
+            genome,
+            seed,
+            operator,
+            json!({ "seed": seed }),
+            parents,
+            None,
+        )
     })
     .await?
     .map_err(|mut e| {

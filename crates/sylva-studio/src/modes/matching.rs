@@ -9,6 +9,7 @@
 //! archived as a plant, to open, branch into breeding and export.
 
 use std::path::{Path as FilePath, PathBuf};
+use std::sync::Arc;
 
 use axum::Json;
 use axum::extract::{Path, Query, State};
@@ -17,13 +18,15 @@ use axum::response::{IntoResponse, Response};
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::evolution::outline::{Limit, match_config, outlines, overlay, start_auto_at};
+use sylva::evolution::outline::{
+    Limit, Outline, match_config, outlines, overlay, space, start_auto_at,
+};
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, Operator, RunRow};
+use crate::archive::{self, ModeName, Operator, PlantRow, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
@@ -59,6 +62,9 @@ pub struct MatchDesign {
     population: Option<u32>,
     /// The run's seed. Default 1.
     seed: Option<u64>,
+    /// Whether the plants grow inside the outlines, pruned where they would show outside
+    /// them (`[match] prune`, docs/match.md). Default true.
+    prune: Option<bool>,
 }
 
 /// `POST /api/sessions` in match mode.
@@ -96,7 +102,7 @@ fn picture_bytes(text: &str, field: &str) -> Result<Vec<u8>, ApiError> {
 }
 
 /// The target a match's config carries: its pictures by name, in the match's folder.
-fn target(threshold: Threshold) -> MatchConfig {
+fn target(threshold: Threshold, prune: bool) -> MatchConfig {
     MatchConfig {
         front: PathBuf::from("front"),
         side: Some(PathBuf::from("side")),
@@ -105,6 +111,7 @@ fn target(threshold: Threshold) -> MatchConfig {
         beside: false,
         rows: 64,
         closeness: 0.0,
+        prune: Some(prune),
     }
 }
 
@@ -159,8 +166,9 @@ fn config_for(
     model: &str,
     run: &RunConfig,
     threshold: Threshold,
+    prune: bool,
 ) -> Result<Config, ApiError> {
-    match_config(&studio.registry, model, run, &target(threshold)).map_err(|e| {
+    match_config(&studio.registry, model, run, &target(threshold, prune)).map_err(|e| {
         match e.field.as_str() {
             "model" => ApiError::bad("match.model", e.message),
             field => ApiError::unprocessable(format!("match ({field})"), e.message),
@@ -178,6 +186,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     };
     let run = run_of(&design)?;
     let threshold = design.threshold.unwrap_or_default();
+    let prune = design.prune.unwrap_or(true);
     let model = design.model.clone().unwrap_or_else(|| AUTO.to_owned());
     let auto = model == AUTO;
     // An auto match's config is its first model's until the trials choose.
@@ -187,7 +196,13 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         .first()
         .map(|m| m.name())
         .unwrap_or(AUTO);
-    let config = config_for(studio, if auto { first } else { &model }, &run, threshold)?;
+    let config = config_for(
+        studio,
+        if auto { first } else { &model },
+        &run,
+        threshold,
+        prune,
+    )?;
     // The pictures are read before anything is kept: a bad one is refused naming its field.
     let check = tempfile_dir()?;
     for (view, bytes, field) in [
@@ -199,7 +214,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         let one = MatchConfig {
             side: None,
             front: PathBuf::from(view),
-            ..target(threshold)
+            ..target(threshold, prune)
         };
         outlines(&one, &check).map_err(|e| ApiError::bad(field, e.message))?;
     }
@@ -247,6 +262,47 @@ fn threshold_of(state: &MatchState) -> Threshold {
     serde_json::from_value(state.design["threshold"].clone()).unwrap_or_default()
 }
 
+/// Whether a match prunes its plants to the outlines (true unless asked not to).
+fn prune_of(state: &MatchState) -> bool {
+    state.design["prune"].as_bool().unwrap_or(true)
+}
+
+/// The outlines a plant grows inside: those of the match run it comes from (a generation's
+/// best, or such a plant branched into another session, whose settings name the run as
+/// `pruned_to`), when that match prunes; none for any other plant.
+pub(crate) fn pruned_to(
+    studio: &Studio,
+    row: &PlantRow,
+) -> Result<Option<Arc<[Outline]>>, ApiError> {
+    let Some(run) = pruned_run(row) else {
+        return Ok(None);
+    };
+    let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
+        return Ok(None);
+    };
+    let config = MatchMode::config(studio, &run)?;
+    match config.outline() {
+        Some(outline) => space(outline, &config.base())
+            .map_err(|e| ApiError::internal(format!("match run {}'s pictures: {e}", run.id))),
+        None => Ok(None),
+    }
+}
+
+/// The match run whose outlines `row`'s plant may grow inside: its own run for a
+/// generation's best, the run its settings name as `pruned_to` for one taken elsewhere.
+pub(crate) fn pruned_run(row: &PlantRow) -> Option<i64> {
+    let key = if row.operator == Operator::Match.as_str() {
+        "run"
+    } else {
+        PRUNED_TO
+    };
+    row.settings.get(key).and_then(|r| r.as_i64())
+}
+
+/// The key of a plant's settings naming the match run whose outlines it grows inside, for
+/// a plant of a match taken into another session.
+pub(crate) const PRUNED_TO: &str = "pruned_to";
+
 impl Background for MatchMode {
     const OPERATOR: Operator = Operator::Match;
 
@@ -267,11 +323,11 @@ impl Background for MatchMode {
             return Evolution::start(config, Vec::new(), studio.pool.clone()).map_err(failed);
         }
         let run = config.run().clone();
-        let threshold = threshold_of(&state);
+        let (threshold, prune) = (threshold_of(&state), prune_of(&state));
         let dir = picture_dir(studio, row.session)?;
         let (evolution, _) = start_auto_at(
             &studio.registry,
-            &target(threshold),
+            &target(threshold, prune),
             &dir,
             &run,
             Limit::Generations(run.generations),
@@ -279,7 +335,7 @@ impl Background for MatchMode {
             |_| {},
         )
         .map_err(failed)?;
-        let chosen = config_for(studio, evolution.config().model(), &run, threshold)?;
+        let chosen = config_for(studio, evolution.config().model(), &run, threshold, prune)?;
         studio.archive.transaction(|c| -> Result<_, ApiError> {
             archive::set_run_config(c, row.id, &chosen.to_toml())?;
             archive::set_session_model(c, row.session, chosen.model())?;
@@ -385,8 +441,12 @@ pub(crate) async fn overlay_png(
         let row = plant_row(&studio, q.plant)?;
         let genome = genome_of(&studio.registry, &row)?;
         let dir = picture_dir(&studio, id)?;
-        overlay(&target(threshold_of(&state)), &dir, &genome)
-            .map_err(|e| ApiError::library("plant", e))
+        overlay(
+            &target(threshold_of(&state), prune_of(&state)),
+            &dir,
+            &genome,
+        )
+        .map_err(|e| ApiError::library("plant", e))
     })
     .await??;
     Ok((

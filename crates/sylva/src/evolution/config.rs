@@ -7,6 +7,7 @@ use sylva_core::par::Pool;
 use sylva_evolve::{Run, RunSettings, WithTerm};
 use sylva_model::Evolve;
 
+use crate::assets::GrowOptions;
 use crate::erased::{DynModel, Value};
 use crate::error::{Error, FieldError, InputError};
 use crate::genome::Genome;
@@ -15,7 +16,7 @@ use crate::registry::Registry;
 use super::checkpoint::SavedRun;
 use super::hooks::{RunHooks, Scored, check_resumed, check_term, first_generation};
 use super::run::{Hooked, TypedRun};
-use super::schema::{EvolveConfig, OutputConfig, RunConfig, SearchStrategy};
+use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy};
 
 /// An evolution config of any model.
 pub struct Config {
@@ -421,6 +422,29 @@ impl Config {
     /// What a run writes.
     pub fn output(&self) -> &OutputConfig {
         self.model.output(&*self.config)
+    }
+
+    /// The `[match]` section, if any.
+    pub fn outline(&self) -> Option<&MatchConfig> {
+        self.model.outline(&*self.config)
+    }
+
+    /// How the run's best plant is grown for its files: `[output]`'s taper, wind and
+    /// height, pruned to `[match]`'s outlines when it prunes (their pictures read from
+    /// [`Config::base`]).
+    pub fn grow_options(&self) -> Result<GrowOptions, InputError> {
+        let output = self.output();
+        let pruned_to = match self.outline() {
+            Some(outline) => super::outline::space(outline, &self.base())?,
+            None => None,
+        };
+        Ok(GrowOptions {
+            taper: output.pipe_taper(),
+            wind: output.wind_options(),
+            height: output.height,
+            pruned_to,
+            ..GrowOptions::default()
+        })
     }
 
     /// What a run writes, to change (`sylva match --height` does).

@@ -10,7 +10,9 @@ use std::time::{Duration, Instant};
 use sylva_core::par::{Pool, Stop};
 
 use sylva_evolve::{Added, Problem, Term};
-use sylva_fitness::silhouette::{Outline, Scratch, Side};
+pub use sylva_fitness::silhouette::Outline;
+pub use sylva_fitness::silhouette::prune;
+use sylva_fitness::silhouette::{SPACE_ROWS, Scratch, Side};
 use sylva_model::Evolve;
 
 use crate::error::{Error, FieldError, InputError};
@@ -37,6 +39,8 @@ struct OutlineTerm<M> {
     outlines: Vec<Outline>,
     /// Weight of closeness beside the IoU (`[match] closeness`).
     closeness: f64,
+    /// The outlines the plant is pruned to, if it is (`[match] prune`).
+    space: Option<Arc<[Outline]>>,
 }
 
 impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
@@ -48,9 +52,12 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
     fn score(&self, problem: &M::Problem, evolved: &<M::Problem as Problem>::Genome) -> f64 {
         let genome = self.model.genome_file(problem, evolved);
         let seed = self.model.default_seed(&genome);
-        let Ok(plant) = self.model.develop(&genome, seed) else {
+        let Ok(mut plant) = self.model.develop(&genome, seed) else {
             return 0.0;
         };
+        if let Some(space) = &self.space {
+            plant = prune(space, &plant);
+        }
         SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
             let sum: f64 = (self.outlines.iter())
@@ -78,6 +85,19 @@ pub fn outlines(config: &MatchConfig, base: &Path) -> Result<Vec<Outline>, Input
         .collect()
 }
 
+/// The outlines of `config` that its plants grow inside (at [`SPACE_ROWS`] rows), read
+/// from pictures relative to `base`; none when it does not prune (`[match] prune`).
+pub fn space(config: &MatchConfig, base: &Path) -> Result<Option<Arc<[Outline]>>, InputError> {
+    if !config.prunes() {
+        return Ok(None);
+    }
+    let fine = MatchConfig {
+        rows: SPACE_ROWS,
+        ..config.clone()
+    };
+    Ok(Some(outlines(&fine, base)?.into()))
+}
+
 /// The term `config` adds to model `M`'s problem, its pictures read relative to `base`.
 pub(super) fn added<M: Evolve>(
     model: &M,
@@ -89,6 +109,7 @@ pub(super) fn added<M: Evolve>(
             model: model.clone(),
             outlines: outlines(config, base)?,
             closeness: config.closeness,
+            space: space(config, base)?,
         }),
         weight: config.weight,
         beside: config.beside,
@@ -163,7 +184,10 @@ pub fn overlay(
         ..outline.clone()
     };
     let target = outlines(&front, base)?.remove(0);
-    let plant = genome.develop(genome.default_seed())?;
+    let mut plant = genome.develop(genome.default_seed())?;
+    if let Some(space) = space(outline, base)? {
+        plant = prune(&space, &plant);
+    }
     let mut scratch = Scratch::default();
     let iou = target.iou(&plant, &mut scratch);
     let (canvas, wanted) = (scratch.canvas(), target.normalised());

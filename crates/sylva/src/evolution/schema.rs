@@ -183,6 +183,21 @@ pub struct MatchConfig {
         skip_serializing_if = "is_zero"
     )]
     pub closeness: f64,
+    /// Whether the plant grows inside the outlines, pruned where it would show outside
+    /// their ink as a topiary is clipped to its form ([`sylva_fitness::silhouette::prune`],
+    /// docs/match.md): in the outline's scoring and in every plant the run writes. Default
+    /// ([`MatchConfig::prunes`]): when the outline alone decides (`beside = false`); beside
+    /// the model's own terms, which score the plant as its genome grows it, not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prune: Option<bool>,
+}
+
+impl MatchConfig {
+    /// Whether the plants grow inside the outlines: `prune` as set, else when the outline
+    /// alone decides.
+    pub fn prunes(&self) -> bool {
+        self.prune.unwrap_or(!self.beside)
+    }
 }
 
 fn is_zero(value: &f64) -> bool {
