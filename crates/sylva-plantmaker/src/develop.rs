@@ -121,7 +121,7 @@ fn blend(a: Rgb, b: Rgb, t: f32) -> Rgb {
 }
 
 /// Whether a colour reads as foliage: a green hue, not grey.
-fn is_green(c: Rgb) -> bool {
+pub(crate) fn is_green(c: Rgb) -> bool {
     let [r, g, b] = c.0.map(f32::from);
     let (max, min) = (r.max(g).max(b), r.min(g).min(b));
     if max <= 0.0 || (max - min) / max < 0.15 {

@@ -13,6 +13,7 @@
 //!
 //! - [`genes`]: the three segment kinds, their variables and ranges.
 //! - [`packed`]: the paper's "string of numbers" face of a genome, one line per segment.
+//! - [`palette`]: the colours a run's fans may take (any, or leaf greens and bark browns).
 //! - [`develop`](mod@develop): genotype to phenotype, [`PlantMaker::develop`].
 //! - [`variation`]: the three crossovers with dominance, mutation, the depth control, lineage.
 //! - [`garden`]: many plants of one or more genomes placed on a plot without overlapping.
@@ -38,6 +39,7 @@ pub mod develop;
 pub mod garden;
 pub mod genes;
 pub mod packed;
+pub mod palette;
 pub mod problem;
 pub mod variation;
 pub mod vector;
@@ -52,6 +54,7 @@ pub use genes::{
     Tenths, Thickness,
 };
 pub use packed::PackedError;
+pub use palette::{Painted, Palette};
 pub use problem::{PlantMakerProblem, PlantMakerSettings, PlantMakerStrategy};
 use sylva_model::GenomeError;
 use sylva_model::{FormatV1, model_tag};
@@ -446,6 +449,7 @@ impl sylva_model::Model for PlantMakerModel {
     ) -> PlantMaker {
         let mut child = g.clone();
         sylva_evolve::Mutate::mutate(&s.mutation(), &mut child, rng);
+        s.palette.apply(&mut child);
         child
     }
 
@@ -477,7 +481,8 @@ impl sylva_model::Model for PlantMakerModel {
         s: &PlantMakerSettings,
         rng: &mut R,
     ) -> Result<sylva_model::Bred<PlantMaker>, VariationError> {
-        let bred = variation::crossover(parents, s.crossover, rng)?;
+        let mut bred = variation::crossover(parents, s.crossover, rng)?;
+        s.palette.apply(&mut bred.genome);
         Ok(sylva_model::Bred {
             genome: bred.genome,
             parents: bred.parents,

@@ -17,6 +17,7 @@ use sylva_fitness::poncin::{PoncinContext, TERM_NAMES, TargetShape};
 use sylva_fitness::{PoncinFitness, PoncinScratch};
 
 use crate::PlantMaker;
+use crate::palette::{Painted, Palette};
 use crate::variation::{Level, Mutation, PlantMakerCrossover};
 
 /// PlantMaker's settings: genome sizes, the crossover level and mutation, and for runs
@@ -43,6 +44,10 @@ pub struct PlantMakerSettings {
     /// Mutation noise as a fraction of a variable's range, 0 to 1. Default 0.15.
     #[serde(deserialize_with = "mutation_spread")]
     pub mutation_spread: f64,
+    /// The colours random genomes and offspring give their fans: `any` (the paper's, the
+    /// default) or `foliage` (leaf greens and bark browns; what a match of an outline, which
+    /// cannot see colour, breeds with).
+    pub palette: Palette,
     /// Genome files the first generation starts from, relative to the config file (the
     /// paper's users start from plants they chose); the rest of it is their mutants. Empty
     /// (the default): a random first generation.
@@ -74,6 +79,7 @@ impl Default for PlantMakerSettings {
             crossover: Level::Medium,
             mutation_rate: 0.1,
             mutation_spread: 0.15,
+            palette: Palette::Any,
             start: Vec::new(),
             breeding: GenerationalSettings::default(),
             fitness,
@@ -90,14 +96,16 @@ impl PlantMakerSettings {
         }
     }
 
-    /// A random genome of the settings' sizes.
+    /// A random genome of the settings' sizes, its fans coloured from the palette.
     pub fn random<R: Rng + ?Sized>(&self, rng: &mut R) -> PlantMaker {
-        PlantMaker::random(
+        let mut genome = PlantMaker::random(
             self.branches as usize,
             self.fans as usize,
             self.inflorescences as usize,
             rng,
-        )
+        );
+        self.palette.apply(&mut genome);
+        genome
     }
 }
 
@@ -145,16 +153,24 @@ impl Problem for PlantMakerProblem {
     }
 }
 
-/// PlantMaker breeding with the configured crossover level and mutation.
-pub type PlantMakerStrategy = Generational<PlantMakerCrossover, Mutation>;
+/// PlantMaker breeding with the configured crossover level and mutation, the offspring
+/// coloured from the palette.
+pub type PlantMakerStrategy = Generational<Painted<PlantMakerCrossover>, Painted<Mutation>>;
 
 /// The breeding the settings describe.
 pub fn strategy(settings: &PlantMakerSettings) -> Result<PlantMakerStrategy, GenerationalError> {
+    let palette = settings.palette;
     Generational::new(
-        PlantMakerCrossover {
-            level: settings.crossover,
+        Painted {
+            operator: PlantMakerCrossover {
+                level: settings.crossover,
+            },
+            palette,
         },
-        settings.mutation(),
+        Painted {
+            operator: settings.mutation(),
+            palette,
+        },
         settings.breeding.clone(),
     )
 }
@@ -180,6 +196,7 @@ pub fn first_generation(
         }
         let mut g = chosen[start.len() % chosen.len()].clone();
         mutation.mutate(&mut g, &mut rng);
+        settings.palette.apply(&mut g);
         start.push(g);
     }
     start

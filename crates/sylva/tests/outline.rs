@@ -137,6 +137,62 @@ fn a_match_breeds_for_fitting() {
     assert_eq!(section(&lsystem), section(&defaults));
 }
 
+/// A match's PlantMaker leaves are leaf green (`palette = "foliage"`): the outline cannot
+/// see colour, and the colours do not change the forms bred, which are those of a match
+/// whose fans take any colour.
+#[test]
+fn a_match_grows_green_leaves_and_the_forms_any_colours_would() {
+    use sylva::core::plant::MaterialKind;
+    use sylva::evolution::RunConfig;
+    use sylva::evolution::outline::match_config;
+    let run = RunConfig {
+        population: 12,
+        ..RunConfig::default()
+    };
+    let foliage = match_config(Registry::standard(), "plantmaker", &run, &round_target())
+        .unwrap()
+        .to_toml();
+    assert!(foliage.contains("palette = \"foliage\""), "{foliage}");
+    let any = foliage.replace("palette = \"foliage\"", "palette = \"any\"");
+    let bred = |text: &str| {
+        let config = Registry::standard()
+            .parse_config(Path::new("match.toml"), text)
+            .unwrap();
+        let mut evolution = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap();
+        evolution.step().unwrap();
+        evolution.step().unwrap();
+        let ious: Vec<f64> = evolution
+            .population()
+            .iter()
+            .map(|m| m.fitness.unwrap().total())
+            .collect();
+        let best = evolution.best().genome.clone();
+        (ious, best.develop(best.default_seed()).unwrap())
+    };
+    let ((green_ious, green), (any_ious, plant)) = (bred(&foliage), bred(&any));
+    assert_eq!(green_ious, any_ious);
+    assert_eq!(green.segments().len(), plant.segments().len());
+    assert!(!green.organs().is_empty());
+    for o in green.organs() {
+        let kind = green.materials()[o.material.index()].kind;
+        assert_eq!(
+            kind,
+            MaterialKind::Leaf,
+            "a green blade is a leaf, not a flower"
+        );
+    }
+    let flowers = |p: &sylva::core::Plant| {
+        p.materials()
+            .iter()
+            .filter(|m| m.kind == MaterialKind::Flower)
+            .count()
+    };
+    assert!(
+        flowers(&plant) > 0,
+        "left to drift, colours make flowers of leaves"
+    );
+}
+
 /// A match stopped by hand (a front end's Ctrl-C) ends with `Stopped`, not as if its time
 /// were up, and leaves the run at its last whole generation; counted in generations, it
 /// breeds exactly that many.

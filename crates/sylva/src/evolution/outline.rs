@@ -145,7 +145,9 @@ pub fn match_config(
 /// distant ones. The defaults are the papers' (Koza's 88% crossover and 2% mutation for
 /// the generational models; Susinno's 2% of bits flipped), made to find a shape's kind;
 /// here most offspring are mutants, PlantMaker's mutants move less, the five best
-/// survive, and copies are not grown again (growth is deterministic). Measured on the
+/// survive, and copies are not grown again (growth is deterministic). PlantMaker's fans
+/// keep to leaf greens and bark browns (`palette = "foliage"`): the outline cannot see
+/// colour, and left to drift a match's leaves came out blue, purple and red. Measured on the
 /// tuning outlines (`examples/match`, docs/match.md): the term's mean rose from 0.731 to
 /// 0.828 (PlantMaker, 40 s a target), 0.595 to 0.704 (automata, 20 s) and 0.661 to 0.696
 /// (binary trees, 20 s).
@@ -160,6 +162,7 @@ pub fn fitting_breeding(model: &str) -> Option<serde_json::Value> {
     match model {
         "plantmaker" => Some(serde_json::json!({
             "mutation_spread": 0.05,
+            "palette": "foliage",
             "breeding": mostly_mutants,
         })),
         "automata" => Some(serde_json::json!({ "breeding": mostly_mutants })),
