@@ -140,6 +140,37 @@ fn bad_pictures_are_refused_naming_the_file_and_nothing_is_written() {
     let output = sylva(&["match", s(&target()), "--threshold", "1.5"]);
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("luminance"));
+    // So are rows the outlines cannot be compared at.
+    for rows in ["8", "513", "-1", "many"] {
+        let output = sylva(&["match", s(&target()), &format!("--rows={rows}")]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("--rows"), "{stderr}");
+    }
+    // Rows it can are the run's `[match] rows`.
+    let out = dir.join("rows");
+    let args = [
+        "--model",
+        "bintree",
+        "--generations",
+        "1",
+        "--population",
+        "8",
+    ];
+    let output = sylva(
+        &[
+            &["match", s(&target()), "--rows", "32", "--out", s(&out)],
+            &args[..],
+        ]
+        .concat(),
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let config = fs::read_to_string(out.join("config.toml")).unwrap();
+    assert!(config.contains("rows = 32"), "{config}");
 }
 
 #[test]

@@ -53,6 +53,11 @@ pub struct MatchArgs {
     /// closeness`, docs/match.md).
     #[arg(long, default_value_t = 0.0, value_parser = parse_closeness)]
     closeness: f64,
+    /// Rows the outlines are compared at while breeding, 16 to 512 (`[match] rows`):
+    /// more see finer gaps in a crown and cost more a plant.
+    #[arg(long, default_value_t = 64,
+          value_parser = clap::value_parser!(u32).range(16..=512))]
+    rows: u32,
     /// Leave the plant as its genome grows it: the outline a goal only, not the form the
     /// plant is pruned to (`[match] prune = false`, docs/match.md).
     #[arg(long)]
@@ -108,7 +113,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         threshold: args.threshold,
         weight: 1.0,
         beside: false,
-        rows: 64,
+        rows: args.rows,
         closeness: args.closeness,
         prune: Some(!args.no_prune),
     };
