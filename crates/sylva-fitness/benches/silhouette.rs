@@ -1,6 +1,6 @@
 //! The outline term's cost per plant beside the plant's growth: a binary tree of Susinno's
 //! default genome (1023 segments) grown, and its silhouette drawn and compared with a
-//! target at 64 and 128 rows, front and side.
+//! target at 64, 128 and 256 rows, front and side.
 //!
 //! Run with `cargo bench -p sylva-fitness --bench silhouette`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -35,7 +35,7 @@ fn silhouette(c: &mut Criterion) {
     group.bench_function("grow the binary tree", |b| {
         b.iter(|| black_box(genome.develop(0).unwrap()))
     });
-    for rows in [64, 128] {
+    for rows in [64, 128, 256] {
         for side in [Side::Front, Side::Side] {
             let outline = Outline::new(&picture, side, rows).unwrap();
             let mut scratch = Scratch::default();

@@ -848,7 +848,7 @@ pub fn match_outline(
         threshold,
         weight: 1.0,
         beside: false,
-        rows: 64,
+        rows: sylva::evolution::MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
         prune: Some(prune),
     };

@@ -1,9 +1,8 @@
 //! The outline term's cost beside growth on a plant a match evolves: PlantMaker's best plant
 //! for the umbrella outline (`examples/match/umbrella.png`, `sylva match` with its
 //! defaults), grown, and scored (IoU times plausibility) from the front and the side at
-//! 32, 64 (the default) and 128 rows. What a coarse-to-fine schedule could save is what
-//! scoring at 64 rows costs over 32. And the same plant pruned to the outline (as a match
-//! does by default: `prune`, at 256 rows, then scored at 64).
+//! 32, 64, 128 and 256 (the default) rows. And the same plant pruned to the outline (as a
+//! match does by default: `prune`, at 256 rows), then scored at 256 rows.
 //!
 //! Run with `cargo bench -p sylva --bench outline`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -12,6 +11,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use sylva::evolution::MatchConfig;
 use sylva::picture::{Threshold, load_target};
 use sylva_fitness::silhouette::{Outline, SPACE_ROWS, Scratch, Side, prune};
 
@@ -31,7 +31,7 @@ fn outline(c: &mut Criterion) {
         ),
         |b| b.iter(|| black_box(genome.develop(seed).unwrap())),
     );
-    for rows in [32, 64, 128] {
+    for rows in [32, 64, 128, 256] {
         let views =
             [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, rows).unwrap());
         let mut scratch = Scratch::default();
@@ -47,7 +47,8 @@ fn outline(c: &mut Criterion) {
     }
     let space =
         [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, SPACE_ROWS).unwrap());
-    let views = [Side::Front, Side::Side].map(|side| Outline::new(&picture, side, 64).unwrap());
+    let views = [Side::Front, Side::Side]
+        .map(|side| Outline::new(&picture, side, MatchConfig::DEFAULT_ROWS).unwrap());
     let pruned = prune(&space, &plant);
     let mut scratch = Scratch::default();
     group.bench_function(
@@ -58,7 +59,7 @@ fn outline(c: &mut Criterion) {
         ),
         |b| b.iter(|| black_box(prune(&space, black_box(&plant)))),
     );
-    group.bench_function("prune, then score front and side at 64 rows", |b| {
+    group.bench_function("prune, then score front and side at 256 rows", |b| {
         b.iter(|| {
             let pruned = prune(&space, black_box(&plant));
             let sum: f64 = views.iter().map(|v| v.score(&pruned, &mut scratch)).sum();

@@ -105,7 +105,7 @@ fn round_target() -> sylva::evolution::MatchConfig {
         threshold: sylva::picture::Threshold::default(),
         weight: 1.0,
         beside: false,
-        rows: 64,
+        rows: sylva::evolution::MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
         prune: None,
     }
@@ -383,7 +383,7 @@ fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
         space(&pruning, Path::new("")).unwrap().unwrap()[0],
         outlines[0]
     );
-    // The overlay is of the pruned plant (at 256 rows; the term at 64, times plausibility).
+    // The overlay is of the pruned plant (its IoU alone; the term is times plausibility).
     let front = MatchConfig {
         side: None,
         rows: 256,

@@ -55,7 +55,7 @@ pub struct MatchArgs {
     closeness: f64,
     /// Rows the outlines are compared at while breeding, 16 to 512 (`[match] rows`):
     /// more see finer gaps in a crown and cost more a plant.
-    #[arg(long, default_value_t = 64,
+    #[arg(long, default_value_t = MatchConfig::DEFAULT_ROWS,
           value_parser = clap::value_parser!(u32).range(16..=512))]
     rows: u32,
     /// Leave the plant as its genome grows it: the outline a goal only, not the form the

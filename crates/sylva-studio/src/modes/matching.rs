@@ -109,7 +109,7 @@ fn target(threshold: Threshold, prune: bool) -> MatchConfig {
         threshold,
         weight: 1.0,
         beside: false,
-        rows: 64,
+        rows: MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
         prune: Some(prune),
     }

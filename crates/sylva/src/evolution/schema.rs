@@ -171,8 +171,8 @@ pub struct MatchConfig {
     /// outline alone decides (what `sylva match` writes).
     #[serde(default = "yes")]
     pub beside: bool,
-    /// Rows the outlines are compared at, 16 to 512. Default 64.
-    #[serde(default = "sixty_four", deserialize_with = "match_rows")]
+    /// Rows the outlines are compared at, 16 to 512. Default [`MatchConfig::DEFAULT_ROWS`].
+    #[serde(default = "default_rows", deserialize_with = "match_rows")]
     pub rows: u32,
     /// Weight of closeness beside the IoU, 0 to 10: how near the silhouette lies to the
     /// outline by a distance transform, which keeps rising as a plant that misses the
@@ -193,6 +193,12 @@ pub struct MatchConfig {
 }
 
 impl MatchConfig {
+    /// The rows outlines are compared at unless `rows` says otherwise: 256, the rows the
+    /// plant is pruned at ([`sylva_fitness::silhouette::SPACE_ROWS`]) and its IoU reported
+    /// at, so that what the search sees is what it is judged by. Coarser comparisons blur
+    /// the gaps of a crown and let combs of thin twigs pass for solid ink (docs/match.md).
+    pub const DEFAULT_ROWS: u32 = 256;
+
     /// Whether the plants grow inside the outlines: `prune` as set, else when the outline
     /// alone decides.
     pub fn prunes(&self) -> bool {
@@ -388,8 +394,8 @@ fn yes() -> bool {
     true
 }
 
-fn sixty_four() -> u32 {
-    64
+fn default_rows() -> u32 {
+    MatchConfig::DEFAULT_ROWS
 }
 
 sylva_core::ranged!(match_weight: f64, "weight", 0.0, 1_000_000.0);
