@@ -165,7 +165,7 @@ impl Model for AutomataModel {
     /// The level sets where crossover cuts: low at operators only (the largest subtrees),
     /// medium at operators nine times in ten (Koza's, the default), high at operators half
     /// the time (more single values).
-    fn hand_settings(&self, knobs: Knobs) -> AutomataSettings {
+    fn hand_settings(&self, knobs: Knobs, base: AutomataSettings) -> AutomataSettings {
         let depth = u32::from(knobs.depth.get());
         AutomataSettings {
             nudge: if depth == 1 { 1.0 } else { 0.0 },
@@ -175,7 +175,7 @@ impl Model for AutomataModel {
                 CrossLevel::Medium => 0.9,
                 CrossLevel::High => 0.5,
             },
-            ..AutomataSettings::default()
+            ..base
         }
     }
 

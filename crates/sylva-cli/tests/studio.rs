@@ -1723,16 +1723,23 @@ fn wait_match(server: &Server, session: i64, generation: u64) -> Value {
     }
 }
 
-#[test]
-fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
+/// The round tuning outline: its bytes, and as a data URL for a match request.
+fn round_picture() -> (Vec<u8>, String) {
     use base64::Engine;
     let round =
         std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/match/round.png"))
             .unwrap();
-    let picture = format!(
+    let url = format!(
         "data:image/png;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&round)
     );
+    (round, url)
+}
+
+#[test]
+fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
+    use base64::Engine;
+    let (round, picture) = round_picture();
     let request_of = |model: &str, generations: u32| {
         json!({"mode": "match", "match": {
             "picture": picture, "model": model, "generations": generations,
@@ -1917,4 +1924,77 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         get(&server, "/api/sessions").as_array().unwrap().len(),
         sessions
     );
+}
+
+/// A PlantMaker plant of a match, branched into breeding, keeps the match's leaf greens and
+/// bark browns when bred by hand (`palette = "foliage"`), where the model's defaults let a
+/// fan's colours drift anywhere.
+#[test]
+fn plants_branched_from_a_match_breed_in_its_colours() {
+    use sylva_plantmaker::{Palette, PlantMaker, PlantMakerModel};
+    let (_, picture) = round_picture();
+    let dir = temp_dir("match-colours");
+    let server = start(&dir, "127.0.0.1");
+    let request = json!({"mode": "match", "match": {
+        "picture": picture, "model": "plantmaker", "generations": 1,
+        "population": 4, "seed": 3,
+    }});
+    let s = post(&server, "/api/sessions", request)["id"]
+        .as_i64()
+        .unwrap();
+    let done = wait_match(&server, s, u64::MAX);
+    assert_eq!(done["status"], "done", "{done}");
+    let best = done["rows"].as_array().unwrap().last().unwrap()["plant"]
+        .as_i64()
+        .unwrap();
+    let genome_of = |plant: i64| -> sylva::Genome {
+        let row = get(&server, &format!("/api/plants/{plant}"));
+        sylva::parse_genome(
+            Path::new("genome.json"),
+            row["genome_text"].as_str().unwrap(),
+        )
+        .unwrap()
+    };
+    let in_foliage = |g: &sylva::Genome| {
+        let g: &PlantMaker = g.get::<PlantMakerModel>().unwrap();
+        let mut kept = g.clone();
+        Palette::Foliage.apply(&mut kept);
+        // Colours are bytes: one at the palette's edge may move by a unit when applied again.
+        let near = |a: sylva_plantmaker::Rgb, b: sylva_plantmaker::Rgb| {
+            a.0.iter().zip(b.0).all(|(&x, y)| x.abs_diff(y) <= 2)
+        };
+        (g.fans.iter().zip(&kept.fans))
+            .all(|(f, k)| near(f.min_color, k.min_color) && near(f.max_color, k.max_color))
+    };
+    assert!(in_foliage(&genome_of(best)));
+    let branched = post(&server, &format!("/api/plants/{best}/branch"), json!({}));
+    let id = branched["id"].as_i64().unwrap();
+    let cells = grid(&branched);
+    // The grid's fill (Depth 2 mutants), then mutants of Depth 10 and a crossover.
+    assert!(cells[1..].iter().all(|&c| in_foliage(&genome_of(c))));
+    let mutated = post(
+        &server,
+        &format!("/api/sessions/{id}/mutate"),
+        json!({"plant": cells[0], "depth": 10, "seed": 7}),
+    );
+    let mutants = grid(&mutated);
+    assert_eq!(mutants.len(), 9);
+    assert!(mutants.iter().all(|&c| in_foliage(&genome_of(c))));
+    let crossed = post(
+        &server,
+        &format!("/api/sessions/{id}/cross"),
+        json!({"parents": [{"plant": mutants[1], "dominance": 1.0}, {"plant": mutants[2], "dominance": 1.0}], "level": "high"}),
+    );
+    assert!(grid(&crossed).iter().all(|&c| in_foliage(&genome_of(c))));
+    // Without the match's settings, the same Depth takes colours out of the palette.
+    let parent = genome_of(cells[0]);
+    let knobs = sylva::Knobs {
+        depth: sylva::Depth::new(10).unwrap(),
+        ..sylva::Knobs::default()
+    };
+    let drifted = (0..8)
+        .map(|seed| parent.mutate(sylva::Settings::Knobs(knobs), seed).unwrap())
+        .filter(|child| !in_foliage(child))
+        .count();
+    assert!(drifted > 0, "the default palette kept every colour");
 }

@@ -110,16 +110,15 @@ impl Model for LSystemModel {
     /// L-systems from one parent and the angles and module shapes from the other, medium
     /// each compartment whole from either (the default), high each rule, axiom, angle and
     /// module shape from either.
-    fn hand_settings(&self, knobs: Knobs) -> LSystemSettings {
-        let defaults = LSystemSettings::default();
+    fn hand_settings(&self, knobs: Knobs, base: LSystemSettings) -> LSystemSettings {
         LSystemSettings {
-            rates: defaults.rates.scaled(knobs.depth.scale()),
+            rates: base.rates.scaled(knobs.depth.scale()),
             crossover: match knobs.level {
                 CrossLevel::Low => LSystemCrossover::Halves,
                 CrossLevel::Medium => LSystemCrossover::Compartments,
                 CrossLevel::High => LSystemCrossover::Rules,
             },
-            ..defaults
+            ..base
         }
     }
 

@@ -50,7 +50,7 @@
 //!         StickGenome { height: (g.height * rng.random_range(0.8..1.25)).clamp(0.1, 10.0) }
 //!     }
 //!
-//!     fn hand_settings(&self, _: Knobs) {}
+//!     fn hand_settings(&self, _: Knobs, _: ()) {}
 //!
 //!     fn cross<R: Rng + ?Sized>(
 //!         &self,
@@ -138,8 +138,10 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     /// The settings a person breeding by hand means with `knobs` (PlantMaker's crossover
     /// level and mutation Depth, §2): each model gives them its own operators' meaning, so
     /// the studio's controls act on every model. Depth 2 and the medium level are what a
-    /// person starts with: a model's default mutation and crossover.
-    fn hand_settings(&self, knobs: Knobs) -> Self::Settings;
+    /// person starts with: a model's default mutation and crossover. What the knobs do not
+    /// set is kept from `base`: the model's defaults, or the settings of the run the plants
+    /// come from (a match's PlantMaker plants keep to leaf colours).
+    fn hand_settings(&self, knobs: Knobs, base: Self::Settings) -> Self::Settings;
 
     /// Reads a genome file's text. The default is serde's reader, which refuses unknown
     /// fields and reports the line and column of any error.

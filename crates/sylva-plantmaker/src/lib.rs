@@ -460,7 +460,11 @@ impl sylva_model::Model for PlantMakerModel {
         Some(genome.to_packed())
     }
 
-    fn hand_settings(&self, knobs: sylva_model::Knobs) -> PlantMakerSettings {
+    fn hand_settings(
+        &self,
+        knobs: sylva_model::Knobs,
+        base: PlantMakerSettings,
+    ) -> PlantMakerSettings {
         let d = f64::from(knobs.depth.get());
         PlantMakerSettings {
             crossover: match knobs.level {
@@ -470,7 +474,7 @@ impl sylva_model::Model for PlantMakerModel {
             },
             mutation_rate: 0.05 * d,
             mutation_spread: 0.05 + 0.02 * d,
-            ..PlantMakerSettings::default()
+            ..base
         }
     }
 

@@ -96,8 +96,8 @@ impl Model for Cylinder {
         Ok(plant)
     }
 
-    fn hand_settings(&self, _: Knobs) -> CylinderSettings {
-        CylinderSettings::default()
+    fn hand_settings(&self, _: Knobs, base: CylinderSettings) -> CylinderSettings {
+        base
     }
 
     fn random<R: Rng + ?Sized>(&self, _: &CylinderSettings, rng: &mut R) -> CylinderGenome {

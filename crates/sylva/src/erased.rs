@@ -81,6 +81,7 @@ pub(crate) trait DynModel: Send + Sync {
     fn output_mut<'a>(&self, config: &'a mut Value) -> &'a mut OutputConfig;
     fn outline<'a>(&self, config: &'a Value) -> Option<&'a MatchConfig>;
     fn to_toml(&self, config: &Value) -> String;
+    fn settings_value(&self, config: &Value) -> serde_json::Value;
     fn start_files(&self, config: &Value) -> Vec<PathBuf>;
     fn generation_time(
         &self,
@@ -345,6 +346,11 @@ impl<M: Evolve + Default> DynModel for M {
 
     fn to_toml(&self, c: &Value) -> String {
         config::<M>(c).to_toml()
+    }
+
+    fn settings_value(&self, c: &Value) -> serde_json::Value {
+        // Settings are plain data: they serialise.
+        serde_json::to_value(&config::<M>(c).settings).unwrap_or_default()
     }
 
     fn start_files(&self, c: &Value) -> Vec<PathBuf> {

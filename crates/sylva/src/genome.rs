@@ -31,6 +31,9 @@ pub enum Settings<'a> {
     /// A person's controls, which each model turns into its own settings
     /// ([`sylva_model::Model::hand_settings`]).
     Knobs(Knobs),
+    /// A person's controls over the model's settings as JSON (those of the run the plants
+    /// come from, [`crate::Config::model_settings`]): what the knobs do not set is kept.
+    KnobsOver(Knobs, &'a serde_json::Value),
     /// The model's settings as JSON (its config section; a Python dict), read as a config
     /// section is: unknown fields refused, numbers checked.
     Json(&'a serde_json::Value),
@@ -47,11 +50,15 @@ pub(crate) fn settings_of<M: Model>(
     model: &M,
     settings: Settings<'_>,
 ) -> Result<M::Settings, InputError> {
+    let from_json = |v: &serde_json::Value| {
+        serde_json::from_value(v.clone())
+            .map_err(|e| InputError::new(format!("{} settings", M::NAME), e.to_string()))
+    };
     match settings {
         Settings::Default => Ok(M::Settings::default()),
-        Settings::Knobs(knobs) => Ok(model.hand_settings(knobs)),
-        Settings::Json(v) => serde_json::from_value(v.clone())
-            .map_err(|e| InputError::new(format!("{} settings", M::NAME), e.to_string())),
+        Settings::Knobs(knobs) => Ok(model.hand_settings(knobs, M::Settings::default())),
+        Settings::KnobsOver(knobs, v) => Ok(model.hand_settings(knobs, from_json(v)?)),
+        Settings::Json(v) => from_json(v),
     }
 }
 

@@ -292,6 +292,41 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
     let settings = serde_json::json!({ "mutation_rate": 1.5 });
     let e = oak.mutate(Settings::Json(&settings), 1).unwrap_err();
     assert!(e.to_string().contains("mutation_rate"), "{e}");
+    // Knobs over a run's settings: the knobs set the Depth's rates, the rest is the run's.
+    let knobs = sylva::Knobs::default();
+    let over = |json: &serde_json::Value, seed| fern.mutate(Settings::KnobsOver(knobs, json), seed);
+    let same = serde_json::json!({ "mutation_rate": 0.9, "mutation_spread": 0.9 });
+    for seed in 0..4 {
+        assert_eq!(
+            over(&same, seed).unwrap(),
+            fern.mutate(Settings::Knobs(knobs), seed).unwrap()
+        );
+    }
+    // How far the palette moves a genome's fan colours, in bytes of a channel (colours at
+    // its edge may move by a unit when it is applied again).
+    let off_foliage = |g: &Genome| -> u8 {
+        let g = g.get::<sylva_plantmaker::PlantMakerModel>().unwrap();
+        let mut kept = g.clone();
+        sylva_plantmaker::Palette::Foliage.apply(&mut kept);
+        let far = |a: sylva_plantmaker::Rgb, b: sylva_plantmaker::Rgb| {
+            (a.0.iter().zip(b.0))
+                .map(|(&x, y)| x.abs_diff(y))
+                .max()
+                .unwrap_or(0)
+        };
+        (g.fans.iter().zip(&kept.fans))
+            .map(|(f, k)| far(f.min_color, k.min_color).max(far(f.max_color, k.max_color)))
+            .max()
+            .unwrap_or(0)
+    };
+    let foliage = serde_json::json!({ "palette": "foliage" });
+    assert!(
+        off_foliage(&fern) > 2,
+        "the fern's colours lie outside the palette"
+    );
+    assert!(off_foliage(&over(&foliage, 1).unwrap()) <= 2);
+    let e = over(&serde_json::json!({ "palette": "blue" }), 1).unwrap_err();
+    assert!(e.to_string().contains("plantmaker settings"), "{e}");
     // PlantMaker crosses every parent by dominance, at the settings' level.
     let bush = load_genome(&example("plantmaker/flowering-bush.json")).unwrap();
     let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
@@ -447,7 +482,7 @@ mod void {
         fn random<R: Rng + ?Sized>(&self, _: &(), rng: &mut R) -> u32 {
             rng.random()
         }
-        fn hand_settings(&self, _: sylva_model::Knobs) {}
+        fn hand_settings(&self, _: sylva_model::Knobs, _: ()) {}
         fn mutate<R: Rng + ?Sized>(&self, g: &u32, _: &(), _: &mut R) -> u32 {
             *g
         }

@@ -22,7 +22,7 @@ use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
 use crate::modes::Mode;
-use crate::modes::matching::{PRUNED_TO, pruned_run, pruned_to};
+use crate::modes::matching::{PRUNED_TO, match_settings, pruned_run, pruned_to};
 use crate::plants::{
     Form, PreviewSize, genome_of, grow_shown, parse_genome, plant_bytes, preview_glb,
 };
@@ -79,6 +79,20 @@ pub struct BreedState {
     pub grid: Vec<Cell>,
     /// The session's seed.
     pub seed: u64,
+    /// The model's settings that breeding by hand keeps, beside its Depth and level: those
+    /// of the match run its first plants were taken from (a match's PlantMaker plants keep
+    /// to leaf colours); none for the model's defaults.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hand: Option<serde_json::Value>,
+}
+
+/// What breeding by hand with `knobs` follows in a session that keeps `hand`
+/// ([`BreedState::hand`]).
+fn by_hand(knobs: Knobs, hand: Option<&serde_json::Value>) -> Settings<'_> {
+    match hand {
+        Some(hand) => Settings::KnobsOver(knobs, hand),
+        None => Settings::Knobs(knobs),
+    }
 }
 
 /// A plant about to be archived: grown, meshed and encoded already.
@@ -476,6 +490,14 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let (made, reused) = make_plants(studio, model, plants, seed, 0, "start", None).await?;
     // A new session reuses no plant: archived plants enter it as branches (above).
     debug_assert!(reused.is_empty());
+    // Bred from a match's plants, it keeps the match's settings.
+    let hand = match made
+        .iter()
+        .find_map(|m| m.settings.get(PRUNED_TO)?.as_i64())
+    {
+        Some(run) => match_settings(studio, run)?,
+        None => None,
+    };
     let parents: Vec<Genome> = made.iter().map(|m| m.genome.clone()).collect();
     let fill = GRID.saturating_sub(parents.len());
     let settings = Knobs {
@@ -486,6 +508,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         Vec::new()
     } else {
         let parents = parents.clone();
+        let hand = hand.clone();
         // Drawn as step −1, apart from the start's own streams (step 0).
         breed_children(
             studio,
@@ -494,7 +517,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
             -1,
             move |i, s| {
                 let child = parents[i % parents.len()]
-                    .mutate(Settings::Knobs(settings), s)
+                    .mutate(by_hand(settings, hand.as_ref()), s)
                     .map_err(|e| ApiError::library("start", e))?;
                 Ok((child, Vec::new()))
             },
@@ -518,6 +541,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         let state = BreedState {
             grid: promote(&[], &ids, 0),
             seed,
+            hand,
         };
         archive::set_state(c, id, &json!(state))?;
         Ok((
@@ -588,6 +612,7 @@ fn record(
         let after = BreedState {
             grid,
             seed: state.seed,
+            hand: state.hand.clone(),
         };
         let mut action = action;
         action["children"] = json!(ids);
@@ -719,6 +744,7 @@ pub(crate) async fn cross(
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
     let parent_ids = ids.clone();
+    let hand = state.hand.clone();
     let made = breed_children(
         &studio,
         count,
@@ -726,7 +752,7 @@ pub(crate) async fn cross(
         seq,
         move |_, s| {
             let pairs: Vec<(&Genome, f64)> = genomes.iter().zip(weights.iter().copied()).collect();
-            let (child, used) = Genome::cross(&pairs, Settings::Knobs(knobs), s)
+            let (child, used) = Genome::cross(&pairs, by_hand(knobs, hand.as_ref()), s)
                 .map_err(|e| ApiError::library("parents", e))?;
             let parents = used
                 .iter()
@@ -783,6 +809,7 @@ pub(crate) async fn mutate(
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
     let parent_id = parent.id;
+    let hand = state.hand.clone();
     let made = breed_children(
         &studio,
         count,
@@ -790,7 +817,7 @@ pub(crate) async fn mutate(
         seq,
         move |_, s| {
             let child = genome
-                .mutate(Settings::Knobs(knobs), s)
+                .mutate(by_hand(knobs, hand.as_ref()), s)
                 .map_err(|e| ApiError::library("plant", e))?;
             Ok((
                 child,

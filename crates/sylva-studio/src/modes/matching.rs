@@ -288,6 +288,18 @@ pub(crate) fn pruned_to(
     }
 }
 
+/// The model settings of match run `run` (its config's model section), which breeding by
+/// hand keeps for plants taken from it; none when the run is not archived.
+pub(crate) fn match_settings(
+    studio: &Studio,
+    run: i64,
+) -> Result<Option<serde_json::Value>, ApiError> {
+    let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
+        return Ok(None);
+    };
+    Ok(Some(MatchMode::config(studio, &run)?.model_settings()))
+}
+
 /// The match run whose outlines `row`'s plant may grow inside: its own run for a
 /// generation's best, the run its settings name as `pruned_to` for one taken elsewhere.
 pub(crate) fn pruned_run(row: &PlantRow) -> Option<i64> {

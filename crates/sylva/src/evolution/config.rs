@@ -452,6 +452,12 @@ impl Config {
         self.model.output_mut(&mut *self.config)
     }
 
+    /// The model's settings (its section of the config) as JSON: what breeding by hand
+    /// keeps of a run's settings ([`crate::Settings::KnobsOver`]).
+    pub fn model_settings(&self) -> serde_json::Value {
+        self.model.settings_value(&*self.config)
+    }
+
     /// The config as TOML.
     pub fn to_toml(&self) -> String {
         self.model.to_toml(&*self.config)
