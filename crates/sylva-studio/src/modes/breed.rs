@@ -495,7 +495,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         .iter()
         .find_map(|m| m.settings.get(PRUNED_TO)?.as_i64())
     {
-        Some(run) => match_settings(studio, run)?,
+        Some(run) => match_settings(studio, run, model)?,
         None => None,
     };
     let parents: Vec<Genome> = made.iter().map(|m| m.genome.clone()).collect();

@@ -288,16 +288,19 @@ pub(crate) fn pruned_to(
     }
 }
 
-/// The model settings of match run `run` (its config's model section), which breeding by
-/// hand keeps for plants taken from it; none when the run is not archived.
+/// The settings of `model` in match run `run` (its config's model section), which breeding
+/// by hand keeps for plants taken from it; none when the run is not archived or evolved
+/// another model.
 pub(crate) fn match_settings(
     studio: &Studio,
     run: i64,
+    model: &str,
 ) -> Result<Option<serde_json::Value>, ApiError> {
     let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
         return Ok(None);
     };
-    Ok(Some(MatchMode::config(studio, &run)?.model_settings()))
+    let config = MatchMode::config(studio, &run)?;
+    Ok((config.model() == model).then(|| config.model_settings()))
 }
 
 /// The match run whose outlines `row`'s plant may grow inside: its own run for a
