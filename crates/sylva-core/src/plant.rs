@@ -596,8 +596,23 @@ impl Plant {
     /// an organ `keep_organ` refuses. Ids are renumbered, parents first as before.
     pub fn cut(
         &self,
-        mut keep_segment: impl FnMut(&Segment) -> bool,
+        keep_segment: impl FnMut(&Segment) -> bool,
         mut keep_organ: impl FnMut(&Organ) -> bool,
+    ) -> Plant {
+        self.cut_into(keep_segment, |o, keep| {
+            if keep_organ(o) {
+                keep(*o);
+            }
+        })
+    }
+
+    /// [`Plant::cut`], but each organ on a kept stem is replaced by what `organ` passes to
+    /// its second argument (none, itself, or pieces of it: a leaf clipped by the shears);
+    /// their parents are renumbered as the stem's is.
+    pub fn cut_into(
+        &self,
+        mut keep_segment: impl FnMut(&Segment) -> bool,
+        mut organ: impl FnMut(&Organ, &mut dyn FnMut(Organ)),
     ) -> Plant {
         let mut new_id: Vec<Option<SegmentId>> = Vec::with_capacity(self.segments.len());
         let mut plant = Plant {
@@ -624,13 +639,17 @@ impl Plant {
             new_id.push(Some(SegmentId(plant.segments.len() as u32)));
             plant.segments.push(Segment { parent, ..*s });
         }
-        plant.organs.extend(self.organs.iter().filter_map(|o| {
+        for o in &self.organs {
             let parent = match o.parent {
-                Some(p) => Some(new_id[p.index()]?),
+                Some(p) => match new_id[p.index()] {
+                    Some(id) => Some(id),
+                    None => continue,
+                },
                 None => None,
             };
-            keep_organ(o).then_some(Organ { parent, ..*o })
-        }));
+            let organs = &mut plant.organs;
+            organ(o, &mut |kept| organs.push(Organ { parent, ..kept }));
+        }
         plant
     }
 

@@ -373,25 +373,155 @@ pub const SPACE_ROWS: u32 = 256;
 
 /// `plant` grown inside `outlines` (one per view), as a topiary is clipped to its form:
 /// a stem whose tip would show outside the ink of any of them is cut with all that grows
-/// from it, and so is a leaf or flower whose blade's middle would. What grows below the
-/// ground stays. A plant with nothing above the ground is returned whole.
+/// from it, a leaf that would show over sky is clipped ([`Clip::leaf`]), and a flower whose
+/// blade's middle would is cut. What grows below the ground stays. A plant with nothing
+/// above the ground is returned whole.
 ///
 /// Each outline is laid over the plant with its top row at the plant's top
 /// ([`laid_height`]), its bottom row on the ground and its foot ([`Outline::new`]) on the
 /// plant's foot (x = 0 or z = 0): the plant keeps the size its genome gives it, and the
-/// outline cuts it where the target shows sky.
+/// outline cuts it where the target shows sky. The comparison then frames the pruned plant
+/// on its own ink, which may stand lower or narrower than the outline was laid, so the
+/// outlines are laid again as the comparison lays them and the leaves and flowers clipped
+/// again there (up to [`REFRAMES`] times; stems stay, for a trunk cut there would take the
+/// plant).
+///
+/// Leaves are clipped into pieces as small as [`PIECE_PIXELS`], a side halved at most
+/// [`MAX_CLIP_DEPTH`] times, or fewer when the pieces would give the pruned plant more
+/// parts (segments and organs) than the whole plant grew: pruning never makes a plant
+/// heavier.
 pub fn prune(outlines: &[Outline], plant: &Plant) -> Plant {
     let Some(top) = laid_height(plant) else {
         return plant.clone();
     };
+    let piece = PIECE_PIXELS * top / SPACE_ROWS as f32;
     let inside = |p: Vec3| p.y <= 0.0 || outlines.iter().all(|o| o.holds(p, top));
-    plant.cut(
-        |s| !shoot_segment(plant, s.material) || inside(s.end),
-        |o| {
-            let [a, _, c, _] = blade_corners(o);
-            o.kind == OrganKind::RootTip || inside((a + c) * 0.5)
-        },
-    )
+    let mut quads = Vec::new();
+    let mut depth = MAX_CLIP_DEPTH;
+    loop {
+        let clip = Clip { piece, depth };
+        let mut pruned = plant.cut_into(
+            |s| !shoot_segment(plant, s.material) || inside(s.end),
+            |o, keep| clip.organ(o, &inside, keep),
+        );
+        for _ in 0..REFRAMES {
+            let Some(again) = reframed(outlines, &pruned, clip, &mut quads) else {
+                break;
+            };
+            let settled = again.organs() == pruned.organs();
+            pruned = again;
+            if settled {
+                break;
+            }
+        }
+        let parts = |p: &Plant| p.segments().len() + p.organs().len();
+        if depth == 0 || parts(&pruned) <= parts(plant) {
+            return pruned;
+        }
+        depth -= 1;
+    }
+}
+
+/// Most times [`prune`] lays the outlines again on the pruned plant's own frame.
+pub const REFRAMES: u32 = 3;
+
+/// The side below which [`prune`] stops halving a clipped leaf's pieces, in pixels of the
+/// outlines laid at [`SPACE_ROWS`].
+pub const PIECE_PIXELS: f32 = 2.0;
+
+/// Most times [`prune`] halves a clipped leaf's side: at most 16 pieces along and across.
+pub const MAX_CLIP_DEPTH: u32 = 4;
+
+/// `pruned` with its leaves and flowers clipped again to `outlines` laid as the comparison
+/// frames it ([`Frame::of`]); `None` when a view shows nothing of it.
+fn reframed(
+    outlines: &[Outline],
+    pruned: &Plant,
+    clip: Clip,
+    quads: &mut Vec<[Vec2; 4]>,
+) -> Option<Plant> {
+    let mut frames = Vec::with_capacity(outlines.len());
+    for outline in outlines {
+        quads.clear();
+        quads.extend(shapes(pruned, outline.side));
+        frames.push((Frame::of(quads, outline.rows(), false)?, outline));
+    }
+    let inside = |p: Vec3| {
+        p.y <= 0.0
+            || frames
+                .iter()
+                .all(|(frame, o)| o.ink_at(frame.on_canvas(o.side.project(p))))
+    };
+    Some(pruned.cut_into(|_| true, |o, keep| clip.organ(o, &inside, keep)))
+}
+
+/// How finely [`prune`] clips leaves.
+#[derive(Clone, Copy, Debug)]
+struct Clip {
+    /// The side below which a piece is not halved, plant units.
+    piece: f32,
+    /// Most times a side is halved.
+    depth: u32,
+}
+
+impl Clip {
+    /// Passes to `keep` what of organ `o` stays on a kept stem: a root tip whole, a leaf
+    /// clipped, a flower whole when its blade's middle lies `inside`.
+    fn organ(self, o: &Organ, inside: &impl Fn(Vec3) -> bool, keep: &mut dyn FnMut(Organ)) {
+        match o.kind {
+            OrganKind::RootTip => keep(*o),
+            OrganKind::Leaf => self.leaf(*o, inside, 0, keep),
+            OrganKind::Flower => {
+                let [a, _, c, _] = blade_corners(o);
+                if inside((a + c) * 0.5) {
+                    keep(*o);
+                }
+            }
+        }
+    }
+
+    /// Passes to `keep` what of leaf `o` the shears leave, as a hedge's face cuts the
+    /// leaves it crosses: the whole leaf when its blade's corners, edge middles and middle
+    /// all lie `inside`; else, while a side is longer than a piece, its halves along that
+    /// side (quarters when both are), clipped in turn; a piece no longer halved is kept
+    /// when its middle lies inside. Pieces keep the leaf's stem, kind and material.
+    fn leaf(
+        self,
+        o: Organ,
+        inside: &impl Fn(Vec3) -> bool,
+        depth: u32,
+        keep: &mut dyn FnMut(Organ),
+    ) {
+        let [a, b, c, d] = blade_corners(&o);
+        let middle = (a + c) * 0.5;
+        let (along, across) = (o.size.x > self.piece, o.size.y > self.piece);
+        if depth >= self.depth || !(along || across) {
+            if inside(middle) {
+                keep(o);
+            }
+            return;
+        }
+        let edges = [(a + b) * 0.5, (b + c) * 0.5, (c + d) * 0.5, (d + a) * 0.5];
+        if [a, b, c, d, middle].into_iter().chain(edges).all(inside) {
+            keep(o);
+            return;
+        }
+        let (n_along, n_across) = (1 + u32::from(along), 1 + u32::from(across));
+        let size = Vec2::new(o.size.x / n_along as f32, o.size.y / n_across as f32);
+        let (x, y) = (o.orientation * Vec3::X, o.orientation * Vec3::Y);
+        for i in 0..n_along {
+            for j in 0..n_across {
+                let offset =
+                    y * (size.x * i as f32) + x * ((j as f32 + 0.5) * size.y - 0.5 * o.size.y);
+                let part = Organ {
+                    position: o.position + offset,
+                    size,
+                    ..o
+                };
+                self.leaf(part, inside, depth + 1, keep);
+            }
+        }
+    }
 }
 
 /// The height [`prune`] lays outlines at over `plant`: the top of what the outline draws of
@@ -404,6 +534,14 @@ fn laid_height(plant: &Plant) -> Option<f32> {
 }
 
 impl Outline {
+    /// Whether the pixel under canvas point `q` is ink.
+    fn ink_at(&self, q: Vec2) -> bool {
+        let (width, height) = (self.normalised.width() as f32, self.rows() as f32);
+        (0.0..width).contains(&q.x)
+            && (0.0..height).contains(&q.y)
+            && self.normalised.get(q.x as u32, q.y as u32)
+    }
+
     /// Whether point `p` of a plant `top` metres tall lies on this outline's ink, the outline
     /// laid over the plant as [`prune`] lays it.
     fn holds(&self, p: Vec3, top: f32) -> bool {
@@ -590,12 +728,18 @@ pub fn plausibility(plant: &Plant, scratch: &mut Scratch) -> f64 {
             *t += n;
         }
     };
+    // The pieces of a leaf [`prune`] clipped (one after another on one stem, alike but for
+    // place and size) count as the one leaf they were.
+    let mut previous: Option<&Organ> = None;
     for o in plant
         .organs()
         .iter()
         .filter(|o| o.kind != OrganKind::RootTip)
     {
-        carries(o.parent, tips, 1.0);
+        if !previous.is_some_and(|p| piece_of_same_leaf(p, o)) {
+            carries(o.parent, tips, 1.0);
+        }
+        previous = Some(o);
     }
     for (i, s) in segments.iter().enumerate().rev().filter(|(_, s)| shoot(s)) {
         let n = tips[i].max(1.0);
@@ -644,6 +788,18 @@ pub fn plausibility(plant: &Plant, scratch: &mut Scratch) -> f64 {
         * factor(height * MAX_MEAN_RADIUS_SHARE, mean)
         * factor(within, radius_length)
         * f64::from(stems_above * organs_above)
+}
+
+/// Whether leaf `b`, following `a` in a plant, may be a piece of the same clipped leaf: on
+/// the same stem, of the same material, facing the same way, beside it (pieces tile their
+/// leaf; leaves grown one on another are leaves of their own).
+fn piece_of_same_leaf(a: &Organ, b: &Organ) -> bool {
+    a.kind == OrganKind::Leaf
+        && b.kind == OrganKind::Leaf
+        && a.parent == b.parent
+        && a.material == b.material
+        && a.orientation == b.orientation
+        && a.position != b.position
 }
 
 /// The share of a stem from height `a` to height `b` that lies above the ground (y = 0).
@@ -723,42 +879,70 @@ fn draw(plant: &Plant, side: Side, rows: u32, fit: bool, scratch: &mut Scratch) 
     scratch.canvas.clear();
     scratch.quads.clear();
     scratch.quads.extend(shapes(plant, side));
-    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-    for quad in &scratch.quads {
-        if fit {
-            quad.iter().for_each(|&p| (lo, hi) = (lo.min(p), hi.max(p)));
-        } else {
-            // The ground (y = 0) hides what is below it: the outline is framed on what
-            // shows, stands on the ground, and rows under the bottom one are not drawn.
-            above_ground(quad, |p| (lo, hi) = (lo.min(p), hi.max(p)));
-        }
-    }
-    let size = hi - lo;
-    if !(size.y > 0.0 && size.is_finite()) {
+    let Some(frame) = Frame::of(&scratch.quads, rows, fit) else {
         return false;
-    }
-    // Plant units to pixels: the ink's height fills the rows, its box centred on the canvas
-    // (when fitting, its top drops so its width fits and its foot stays on the bottom row).
-    let mut scale = rows as f32 / size.y;
-    if fit && size.x * scale > width as f32 {
-        scale = width as f32 / size.x;
-    }
-    let top = if fit {
-        lo.y + rows as f32 / scale
-    } else {
-        hi.y
-    };
-    let centre = Vec2::new((lo.x + hi.x) * 0.5, top);
-    let to_pixels = |p: Vec2| {
-        Vec2::new(
-            (p.x - centre.x) * scale + width as f32 * 0.5,
-            (centre.y - p.y) * scale,
-        )
     };
     for quad in &scratch.quads {
-        fill_quad(&mut scratch.canvas, quad.map(to_pixels));
+        fill_quad(&mut scratch.canvas, quad.map(|p| frame.on_canvas(p)));
     }
     true
+}
+
+/// Where a view's shapes land on a canvas of some rows: plant units to pixels.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    /// The plant point at the canvas's top middle.
+    centre: Vec2,
+    /// Pixels per plant unit.
+    scale: f32,
+    /// Half the canvas's width, pixels.
+    half_width: f32,
+}
+
+impl Frame {
+    /// The frame of a plant's `quads` (seen from one side) on a canvas of `rows`: the
+    /// ink's height fills the rows, its box centred (when fitting, its top drops so its
+    /// width fits and its foot stays on the bottom row). `None` when nothing shows.
+    fn of(quads: &[[Vec2; 4]], rows: u32, fit: bool) -> Option<Frame> {
+        let width = (rows * CANVAS_ASPECT) as f32;
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for quad in quads {
+            if fit {
+                quad.iter().for_each(|&p| (lo, hi) = (lo.min(p), hi.max(p)));
+            } else {
+                // The ground (y = 0) hides what is below it: the outline is framed on what
+                // shows, stands on the ground, and rows under the bottom one are not drawn.
+                above_ground(quad, |p| (lo, hi) = (lo.min(p), hi.max(p)));
+            }
+        }
+        let size = hi - lo;
+        if !(size.y > 0.0 && size.is_finite()) {
+            return None;
+        }
+        let mut scale = rows as f32 / size.y;
+        if fit && size.x * scale > width {
+            scale = width / size.x;
+        }
+        let top = if fit {
+            lo.y + rows as f32 / scale
+        } else {
+            hi.y
+        };
+        Some(Frame {
+            centre: Vec2::new((lo.x + hi.x) * 0.5, top),
+            scale,
+            half_width: width * 0.5,
+        })
+    }
+
+    /// Pixel coordinates (rows downwards) of plant point `p` seen in the frame's view.
+    #[inline]
+    fn on_canvas(&self, p: Vec2) -> Vec2 {
+        Vec2::new(
+            (p.x - self.centre.x) * self.scale + self.half_width,
+            (self.centre.y - p.y) * self.scale,
+        )
+    }
 }
 
 /// Calls `visit` with the corners of the part of a convex quadrilateral at or above y = 0:
@@ -1028,6 +1212,100 @@ mod tests {
         let bare = prune(&[away], &plant);
         assert_eq!(bare.segments().len(), 1);
         assert_eq!(bare.segments()[0], plant.segments()[1]);
+    }
+
+    /// A trunk 4 m tall and 0.1 m thick in `pieces` segments, its top one carrying a leaf
+    /// 2 m wide and 1 m long standing across it (x from -1 to 1, y from 2.5 to 3.5).
+    fn trunk_with_a_wide_leaf(pieces: usize) -> Plant {
+        let mut plant = Plant::new(PlantMeta::default());
+        let mut parent = None;
+        for i in 0..pieces {
+            let y = |i: usize| 4.0 * i as f32 / pieces as f32;
+            let id = plant
+                .add_segment(
+                    Vec3::new(0.0, y(i), 0.0),
+                    Vec3::new(0.0, y(i + 1), 0.0),
+                    (0.05, 0.05),
+                    parent,
+                    false,
+                    Plant::BARK,
+                )
+                .unwrap();
+            parent = Some(id);
+        }
+        plant
+            .add_organ(Organ {
+                kind: OrganKind::Leaf,
+                position: Vec3::new(0.0, 2.5, 0.0),
+                orientation: sylva_core::glam::Quat::IDENTITY,
+                size: Vec2::new(1.0, 2.0),
+                material: Plant::LEAF,
+                parent,
+            })
+            .unwrap();
+        plant
+    }
+
+    #[test]
+    fn pruning_clips_a_leaf_to_the_outline() {
+        // The target: a trunk 0.1 m wide (at 50 pixels a metre) with a crown over its left
+        // only, from x = -1 to 0.1 m and y = 2.5 to 3.5 m. The leaf's left half lies on it,
+        // its right in the sky.
+        let mut target = rectangle(400, 400, (198, 100, 203, 300));
+        for y in 125..175 {
+            target.fill_span(y, 150, 205);
+        }
+        let outline = Outline::new(&target, Side::Front, SPACE_ROWS).unwrap();
+        // A bare branch of 64 segments into the sky on the right goes, and leaves room for
+        // the leaf's pieces (pruning never makes a plant heavier: below).
+        let mut plant = trunk_with_a_wide_leaf(256);
+        let mut from = sylva_core::plant::SegmentId(63);
+        for i in 0..64 {
+            let at = |i: usize| Vec3::new(0.5 + i as f32 / 32.0, 1.0, 0.0);
+            from = plant
+                .add_segment(
+                    at(i),
+                    at(i + 1),
+                    (0.01, 0.01),
+                    Some(from),
+                    true,
+                    Plant::BARK,
+                )
+                .unwrap();
+        }
+        let pruned = prune(std::slice::from_ref(&outline), &plant);
+        // Pieces of the leaf stand for what of it lies on ink: its left half, and no more
+        // than a sixteenth of its width beyond (pieces are halved at most four times).
+        let leaves = pruned.organs();
+        assert!(leaves.len() > 1, "{leaves:?}");
+        let area: f32 = leaves.iter().map(|o| o.size.x * o.size.y).sum();
+        assert!((1.0..=1.0 + 2.0 / 16.0 + 1e-4).contains(&area), "{area}");
+        for o in leaves {
+            let [a, _, c, _] = blade_corners(o);
+            let middle = (a + c) * 0.5;
+            assert!((-1.0..0.1).contains(&middle.x), "{o:?}");
+            assert_eq!(
+                (o.parent, o.orientation),
+                (plant.organs()[0].parent, plant.organs()[0].orientation)
+            );
+        }
+        assert_eq!(pruned.segments(), &plant.segments()[..256]);
+        // So the pruned plant's outline matches the target's; cutting the leaf by its
+        // middle alone (which lies on ink) kept all of it, half over the sky.
+        let mut scratch = Scratch::default();
+        let clipped = outline.iou(&pruned, &mut scratch);
+        let whole = outline.iou(&plant, &mut scratch);
+        assert!(clipped > 0.85 && whole < clipped - 0.1, "{clipped} {whole}");
+        // The pieces count as the one leaf they were: the trunk, 0.05 m thick, carries one
+        // tip and may be 1% of 4 m for it (0.04 m), so the pipe-model factor is 0.8 (for
+        // two tips or more it would be 1).
+        let p = plausibility(&pruned, &mut scratch);
+        assert!((p - 0.8).abs() < 1e-5, "{p}");
+        // Pruning never makes a plant heavier: a trunk of one segment and its leaf are two
+        // parts, so the leaf is not cut into pieces but judged by its middle, on ink.
+        let light = trunk_with_a_wide_leaf(1);
+        let pruned = prune(std::slice::from_ref(&outline), &light);
+        assert_eq!(pruned, light);
     }
 
     #[test]
