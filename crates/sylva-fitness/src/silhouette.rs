@@ -21,7 +21,7 @@
 
 use sylva_core::Plant;
 use sylva_core::glam::{Vec2, Vec3};
-use sylva_core::plant::{MaterialKind, Organ, OrganKind};
+use sylva_core::plant::{MaterialKind, Organ, OrganKind, Segment};
 
 /// How much wider than tall the comparison canvas is: outlines up to this aspect are
 /// compared whole (a target wider than this is refused as not plant-like).
@@ -395,31 +395,31 @@ pub fn prune(outlines: &[Outline], plant: &Plant) -> Plant {
         return plant.clone();
     };
     let piece = PIECE_PIXELS * top / SPACE_ROWS as f32;
+    let budget = plant.segments().len() + plant.organs().len();
     let inside = |p: Vec3| p.y <= 0.0 || outlines.iter().all(|o| o.holds(p, top));
     let mut quads = Vec::new();
-    let mut depth = MAX_CLIP_DEPTH;
-    loop {
+    let mut attempt = |depth: u32| {
         let clip = Clip { piece, depth };
-        let mut pruned = plant.cut_into(
-            |s| !shoot_segment(plant, s.material) || inside(s.end),
-            |o, keep| clip.organ(o, &inside, keep),
-        );
+        let keep_stem = |s: &Segment| !shoot_segment(plant, s.material) || inside(s.end);
+        let mut pruned = clip.within(plant, keep_stem, &inside, budget)?;
         for _ in 0..REFRAMES {
-            let Some(again) = reframed(outlines, &pruned, clip, &mut quads) else {
+            let Some(again) = reframed(outlines, &pruned, clip, budget, &mut quads) else {
                 break;
             };
+            let again = again?;
             let settled = again.organs() == pruned.organs();
             pruned = again;
             if settled {
                 break;
             }
         }
-        let parts = |p: &Plant| p.segments().len() + p.organs().len();
-        if depth == 0 || parts(&pruned) <= parts(plant) {
-            return pruned;
-        }
-        depth -= 1;
-    }
+        Some(pruned)
+    };
+    // Judged by their middles (depth 0), leaves are never more than they were.
+    (0..=MAX_CLIP_DEPTH)
+        .rev()
+        .find_map(&mut attempt)
+        .unwrap_or_else(|| plant.clone())
 }
 
 /// Most times [`prune`] lays the outlines again on the pruned plant's own frame.
@@ -433,13 +433,15 @@ pub const PIECE_PIXELS: f32 = 2.0;
 pub const MAX_CLIP_DEPTH: u32 = 4;
 
 /// `pruned` with its leaves and flowers clipped again to `outlines` laid as the comparison
-/// frames it ([`Frame::of`]); `None` when a view shows nothing of it.
+/// frames it ([`Frame::of`]): `None` when a view shows nothing of it, `Some(None)` when the
+/// pieces would take it over `budget` parts.
 fn reframed(
     outlines: &[Outline],
     pruned: &Plant,
     clip: Clip,
+    budget: usize,
     quads: &mut Vec<[Vec2; 4]>,
-) -> Option<Plant> {
+) -> Option<Option<Plant>> {
     let mut frames = Vec::with_capacity(outlines.len());
     for outline in outlines {
         quads.clear();
@@ -452,7 +454,7 @@ fn reframed(
                 .iter()
                 .all(|(frame, o)| o.ink_at(frame.on_canvas(o.side.project(p))))
     };
-    Some(pruned.cut_into(|_| true, |o, keep| clip.organ(o, &inside, keep)))
+    Some(clip.within(pruned, |_| true, &inside, budget))
 }
 
 /// How finely [`prune`] clips leaves.
@@ -465,6 +467,35 @@ struct Clip {
 }
 
 impl Clip {
+    /// `plant` cut to the stems `keep_stem` keeps, its organs clipped ([`Clip::organ`]);
+    /// `None` as soon as the cut plant would have more than `budget` parts (segments and
+    /// organs).
+    fn within(
+        self,
+        plant: &Plant,
+        mut keep_stem: impl FnMut(&Segment) -> bool,
+        inside: &impl Fn(Vec3) -> bool,
+        budget: usize,
+    ) -> Option<Plant> {
+        let parts = std::cell::Cell::new(0usize);
+        let cut = plant.cut_into(
+            |s| {
+                let kept = keep_stem(s);
+                parts.set(parts.get() + usize::from(kept));
+                kept
+            },
+            |o, keep| {
+                if parts.get() <= budget {
+                    self.organ(o, inside, &mut |piece| {
+                        parts.set(parts.get() + 1);
+                        keep(piece);
+                    });
+                }
+            },
+        );
+        (parts.get() <= budget).then_some(cut)
+    }
+
     /// Passes to `keep` what of organ `o` stays on a kept stem: a root tip whole, a leaf
     /// clipped, a flower whole when its blade's middle lies `inside`.
     fn organ(self, o: &Organ, inside: &impl Fn(Vec3) -> bool, keep: &mut dyn FnMut(Organ)) {
