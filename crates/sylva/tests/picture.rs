@@ -227,6 +227,29 @@ fn otsu_splits_a_two_peak_histogram_between_its_peaks() {
 }
 
 #[test]
+fn otsu_splits_halfway_across_the_empty_run_between_two_peaks() {
+    let mut histogram = [0u64; 256];
+    histogram[40] = 300;
+    histogram[200] = 700;
+    let level = otsu(&histogram) * 255.0;
+    assert!((level - 120.0).abs() < 1e-3, "{level}");
+    // Adjacent bins are split between them.
+    let mut histogram = [0u64; 256];
+    histogram[100] = 10;
+    histogram[101] = 10;
+    let level = otsu(&histogram) * 255.0;
+    assert!(level > 100.0 && level < 101.0, "{level}");
+}
+
+#[test]
+fn otsu_without_a_split_is_the_middle() {
+    assert_eq!(otsu(&[0; 256]), 0.5);
+    let mut one = [0u64; 256];
+    one[17] = 5;
+    assert_eq!(otsu(&one), 0.5);
+}
+
+#[test]
 fn an_empty_file_is_refused() {
     let path = dir("empty").join("empty.png");
     std::fs::write(&path, b"").unwrap();
@@ -306,6 +329,22 @@ fn a_picture_too_wide_is_refused_from_its_header() {
 }
 
 #[test]
+fn a_jpeg_too_wide_is_refused_from_its_header() {
+    let picture = GrayImage::from_fn(9000, 8, |x, _| Luma([(x % 256) as u8]));
+    let mut bytes = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, 50)
+        .encode_image(&picture)
+        .unwrap();
+    let path = dir("wide-jpeg").join("wide.jpg");
+    std::fs::write(&path, bytes).unwrap();
+    assert_refused(
+        load_target(&path, Threshold::Otsu),
+        &path,
+        &["the picture is 9000 x 8 pixels; pictures up to 8192 x 8192 are read"],
+    );
+}
+
+#[test]
 fn a_decompression_bomb_is_refused_from_its_header() {
     // 8000 x 8000 RGBA at 16 bits a sample: 512 MB decoded, from a file of 70 bytes.
     let path = dir("bomb").join("bomb.png");
@@ -346,7 +385,7 @@ fn a_missing_file_keeps_its_io_kind() {
 fn a_level_outside_zero_to_one_is_refused() {
     let path = dir("level").join("tree.png");
     tree_drawing().save(&path).unwrap();
-    for level in [f32::NAN, -0.5, 2.0] {
+    for level in [f32::NAN, -0.5, 2.0, f32::INFINITY] {
         assert_refused(
             load_target(&path, Threshold::Level(level)),
             &path,
