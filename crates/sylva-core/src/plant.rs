@@ -596,22 +596,26 @@ impl Plant {
     /// an organ `keep_organ` refuses. Ids are renumbered, parents first as before.
     pub fn cut(
         &self,
-        keep_segment: impl FnMut(&Segment) -> bool,
+        mut keep_segment: impl FnMut(&Segment) -> bool,
         mut keep_organ: impl FnMut(&Organ) -> bool,
     ) -> Plant {
-        self.cut_into(keep_segment, |o, keep| {
-            if keep_organ(o) {
-                keep(*o);
-            }
-        })
+        self.cut_into(
+            |_, s| keep_segment(s),
+            |o, keep| {
+                if keep_organ(o) {
+                    keep(*o);
+                }
+            },
+        )
     }
 
-    /// [`Plant::cut`], but each organ on a kept stem is replaced by what `organ` passes to
-    /// its second argument (none, itself, or pieces of it: a leaf clipped by the shears);
-    /// their parents are renumbered as the stem's is.
+    /// [`Plant::cut`], but `keep_segment` is told each segment's id too, and each organ on a
+    /// kept stem is replaced by what `organ` passes to its second argument (none, itself, or
+    /// pieces of it: a leaf clipped by the shears); their parents are renumbered as the
+    /// stem's is.
     pub fn cut_into(
         &self,
-        mut keep_segment: impl FnMut(&Segment) -> bool,
+        mut keep_segment: impl FnMut(SegmentId, &Segment) -> bool,
         mut organ: impl FnMut(&Organ, &mut dyn FnMut(Organ)),
     ) -> Plant {
         let mut new_id: Vec<Option<SegmentId>> = Vec::with_capacity(self.segments.len());
@@ -621,7 +625,7 @@ impl Plant {
             materials: self.materials.clone(),
             meta: self.meta.clone(),
         };
-        for s in &self.segments {
+        for (i, s) in self.segments.iter().enumerate() {
             let parent = match s.parent {
                 Some(p) => match new_id[p.index()] {
                     Some(id) => Some(id),
@@ -632,7 +636,7 @@ impl Plant {
                 },
                 None => None,
             };
-            if !keep_segment(s) {
+            if !keep_segment(SegmentId(i as u32), s) {
                 new_id.push(None);
                 continue;
             }

@@ -21,7 +21,7 @@
 
 use sylva_core::Plant;
 use sylva_core::glam::{Vec2, Vec3};
-use sylva_core::plant::{MaterialKind, Organ, OrganKind, Segment};
+use sylva_core::plant::{MaterialKind, Organ, OrganKind, Segment, SegmentId};
 
 /// How much wider than tall the comparison canvas is: outlines up to this aspect are
 /// compared whole (a target wider than this is refused as not plant-like).
@@ -383,8 +383,8 @@ pub const SPACE_ROWS: u32 = 256;
 /// outline cuts it where the target shows sky. The comparison then frames the pruned plant
 /// on its own ink, which may stand lower or narrower than the outline was laid, so the
 /// outlines are laid again as the comparison lays them and the leaves and flowers clipped
-/// again there (up to [`REFRAMES`] times; stems stay, for a trunk cut there would take the
-/// plant).
+/// again there, with the bare twigs that show over sky (up to [`REFRAMES`] times; stems
+/// that carry something stay, for a trunk cut there would take the plant).
 ///
 /// Leaves are clipped into pieces as small as [`PIECE_PIXELS`], a side halved at most
 /// [`MAX_CLIP_DEPTH`] times, or fewer when the pieces would give the pruned plant more
@@ -400,14 +400,15 @@ pub fn prune(outlines: &[Outline], plant: &Plant) -> Plant {
     let mut quads = Vec::new();
     let mut attempt = |depth: u32| {
         let clip = Clip { piece, depth };
-        let keep_stem = |s: &Segment| !shoot_segment(plant, s.material) || inside(s.end);
+        let keep_stem = |_, s: &Segment| !shoot_segment(plant, s.material) || inside(s.end);
         let mut pruned = clip.within(plant, keep_stem, &inside, budget)?;
         for _ in 0..REFRAMES {
             let Some(again) = reframed(outlines, &pruned, clip, budget, &mut quads) else {
                 break;
             };
             let again = again?;
-            let settled = again.organs() == pruned.organs();
+            let settled = again.organs() == pruned.organs()
+                && again.segments().len() == pruned.segments().len();
             pruned = again;
             if settled {
                 break;
@@ -433,8 +434,8 @@ pub const PIECE_PIXELS: f32 = 2.0;
 pub const MAX_CLIP_DEPTH: u32 = 4;
 
 /// `pruned` with its leaves and flowers clipped again to `outlines` laid as the comparison
-/// frames it ([`Frame::of`]): `None` when a view shows nothing of it, `Some(None)` when the
-/// pieces would take it over `budget` parts.
+/// frames it ([`Frame::of`]) and its bare twigs over sky cut: `None` when a view shows
+/// nothing of it, `Some(None)` when the pieces would take it over `budget` parts.
 fn reframed(
     outlines: &[Outline],
     pruned: &Plant,
@@ -454,7 +455,26 @@ fn reframed(
                 .iter()
                 .all(|(frame, o)| o.ink_at(frame.on_canvas(o.side.project(p))))
     };
-    Some(clip.within(pruned, |_| true, &inside, budget))
+    // Bare twigs over sky: a shoot's stem whose tip lies outside and that carries no organ
+    // and no stem that stays (children come after their parents, so one pass from the end
+    // settles it). Stems that carry something stay, for a trunk cut here would take the
+    // plant with it.
+    let segments = pruned.segments();
+    let bears = &mut vec![false; segments.len()];
+    for o in pruned.organs() {
+        if let Some(p) = o.parent {
+            bears[p.index()] = true;
+        }
+    }
+    for (i, s) in segments.iter().enumerate().rev() {
+        if bears[i] || !shoot_segment(pruned, s.material) || inside(s.end) {
+            bears[i] = true;
+            if let Some(p) = s.parent {
+                bears[p.index()] = true;
+            }
+        }
+    }
+    Some(clip.within(pruned, |id, _| bears[id.index()], &inside, budget))
 }
 
 /// How finely [`prune`] clips leaves.
@@ -473,14 +493,14 @@ impl Clip {
     fn within(
         self,
         plant: &Plant,
-        mut keep_stem: impl FnMut(&Segment) -> bool,
+        mut keep_stem: impl FnMut(SegmentId, &Segment) -> bool,
         inside: &impl Fn(Vec3) -> bool,
         budget: usize,
     ) -> Option<Plant> {
         let parts = std::cell::Cell::new(0usize);
         let cut = plant.cut_into(
-            |s| {
-                let kept = keep_stem(s);
+            |id, s| {
+                let kept = keep_stem(id, s);
                 parts.set(parts.get() + usize::from(kept));
                 kept
             },
@@ -1337,6 +1357,68 @@ mod tests {
         let light = trunk_with_a_wide_leaf(1);
         let pruned = prune(std::slice::from_ref(&outline), &light);
         assert_eq!(pruned, light);
+    }
+
+    #[test]
+    fn laid_again_bare_twigs_over_sky_go() {
+        // A trunk with a leaf on a twig to each side at 3 m, its outline the target.
+        let mut plant = Plant::new(PlantMeta::default());
+        let stem = |plant: &mut Plant, from: [f32; 2], to: [f32; 2], parent: Option<u32>| {
+            plant
+                .add_segment(
+                    Vec3::new(from[0], from[1], 0.0),
+                    Vec3::new(to[0], to[1], 0.0),
+                    (0.02, 0.02),
+                    parent.map(sylva_core::plant::SegmentId),
+                    parent.is_some(),
+                    Plant::BARK,
+                )
+                .unwrap()
+        };
+        stem(&mut plant, [0.0, 0.0], [0.0, 4.0], None);
+        for x in [-0.75, 0.75] {
+            let twig = stem(&mut plant, [0.0, 3.0], [x, 3.0], Some(0));
+            plant
+                .add_organ(Organ {
+                    kind: OrganKind::Leaf,
+                    position: Vec3::new(x, 3.0, 0.0),
+                    orientation: sylva_core::glam::Quat::IDENTITY,
+                    size: Vec2::new(0.5, 0.5),
+                    material: Plant::LEAF,
+                    parent: Some(twig),
+                })
+                .unwrap();
+        }
+        let mut scratch = Scratch::default();
+        assert!(draw_normalised(
+            &plant,
+            Side::Front,
+            SPACE_ROWS,
+            &mut scratch
+        ));
+        let outline = Outline::new(scratch.canvas(), Side::Front, SPACE_ROWS).unwrap();
+        // A bare twig ending in the sky below the right leaf goes; a bare twig into the
+        // sky on the left stays, for the twig it carries ends on the left leaf.
+        let mut twiggy = plant.clone();
+        stem(&mut twiggy, [0.0, 2.0], [0.7, 2.5], Some(0));
+        let carrier = stem(&mut twiggy, [0.0, 2.0], [-0.6, 2.4], Some(0));
+        stem(&mut twiggy, [-0.6, 2.4], [-0.7, 3.2], Some(carrier.0));
+        let clip = Clip {
+            piece: 0.01,
+            depth: 0,
+        };
+        let mut quads = Vec::new();
+        let again = reframed(&[outline], &twiggy, clip, usize::MAX, &mut quads);
+        let again = again.flatten().expect("the plant shows");
+        let mut kept = twiggy.segments().to_vec();
+        kept.remove(3);
+        for s in &mut kept[3..] {
+            s.parent = s
+                .parent
+                .map(|p| sylva_core::plant::SegmentId(p.0 - u32::from(p.0 > 3)));
+        }
+        assert_eq!(again.segments(), &kept[..]);
+        assert_eq!(again.organs(), plant.organs());
     }
 
     #[test]
