@@ -710,27 +710,23 @@ fn taper_bars(skeleton: &sylva::skeleton::Skeleton) -> Result<f32, String> {
 fn the_pine_example_tapers_and_fits_its_cone() {
     let dir = temp_dir("automata-pine");
     let (leaves, f_pos, f_num) = (4, 6, 7);
-    // The shipped seed (3) and another.
-    for (seed, run) in [(None, "pine"), (Some(18), "pine-seed18")] {
-        let pine = automata_example_run("pine.toml", &dir, seed);
-        let last = &pine[pine.len() - 1];
-        assert_eq!(pine.len(), 101);
-        assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{run}: {last:?}");
-        assert!(last[leaves] > 0.0, "{run}, a pine with leaves: {last:?}");
-        let skeleton = dir.join(format!("{run}.skeleton.json"));
-        ok(&sylva(&[
-            "grow",
-            s(&dir.join(run).join("best.json")),
-            "-o",
-            s(&skeleton),
-        ]));
-        let skeleton = sylva::skeleton::Skeleton::read(&skeleton).unwrap();
-        let tip = taper_bars(&skeleton).unwrap_or_else(|e| panic!("{run}: {e}"));
-        assert!(
-            tip <= 0.25 + 1e-5,
-            "{run}: the thickest tip is {tip} of the foot"
-        );
-    }
+    // The shipped seed (3). Other seeds are measured in docs/automata.md (17 of 24 meet
+    // both bars); a second seed here cost CI 47 s.
+    let pine = automata_example_run("pine.toml", &dir, None);
+    let last = &pine[pine.len() - 1];
+    assert_eq!(pine.len(), 101);
+    assert!(last[f_num] <= 2.0 && last[f_pos] <= 20.0, "{last:?}");
+    assert!(last[leaves] > 0.0, "a pine with leaves: {last:?}");
+    let skeleton = dir.join("pine.skeleton.json");
+    ok(&sylva(&[
+        "grow",
+        s(&dir.join("pine").join("best.json")),
+        "-o",
+        s(&skeleton),
+    ]));
+    let skeleton = sylva::skeleton::Skeleton::read(&skeleton).unwrap();
+    let tip = taper_bars(&skeleton).unwrap_or_else(|e| panic!("{e}"));
+    assert!(tip <= 0.25 + 1e-5, "the thickest tip is {tip} of the foot");
     fs::remove_dir_all(&dir).unwrap();
 }
 
