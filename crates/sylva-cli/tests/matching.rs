@@ -226,3 +226,29 @@ fn height_scales_the_best_plants_assets_and_is_recorded() {
         );
     }
 }
+
+#[test]
+fn a_population_too_large_for_the_seconds_is_refused_on_time() {
+    // Generation 0 of 200,000 plants takes minutes on any machine; the match's one second
+    // bounds it (and each model's trial), so it ends with a clear error, not hours later.
+    let dir = temp_dir("huge-population");
+    for model in ["plantmaker", "auto"] {
+        let out = dir.join(model);
+        let output = sylva(&[
+            "match",
+            s(&target()),
+            "--model",
+            model,
+            "--population",
+            "200000",
+            "--seconds",
+            "1",
+            "--out",
+            s(&out),
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{model}: {stderr}");
+        assert!(stderr.contains("population"), "{model}: {stderr}");
+        assert!(!out.exists(), "{model}: nothing is written");
+    }
+}

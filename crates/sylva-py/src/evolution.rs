@@ -830,7 +830,9 @@ pub fn match_outline(
     threads: u32,
     prune: bool,
 ) -> PyResult<Evolution> {
-    use sylva::evolution::outline::{Limit, breed_until, match_config, outlines, start_auto};
+    use sylva::evolution::outline::{
+        Limit, breed_until, match_config, outlines, start_auto, start_within,
+    };
     let threshold = match threshold {
         None => sylva::picture::Threshold::Otsu,
         Some(t) => serde_json::from_value(from_py(t, "threshold")?)
@@ -891,17 +893,12 @@ pub fn match_outline(
     let stop = Stop::new();
     let (evolution, elsewhere) = work(py, &stop, None, &Serving::default(), || {
         match &config {
-            Some(config) => {
-                let hooks = sylva::RunHooks {
-                    stop: Some(stop.clone()),
-                    term: None,
-                };
-                Ok((Run::start_with(config, Vec::new(), pool, hooks)?, 0.0))
-            }
+            Some(config) => Ok((start_within(config, limit, &pool, &stop)?, 0.0)),
             // The trials are thrown away if stopped.
             None => {
-                let (mut run, elsewhere) =
-                    stop.watch(|| start_auto(registry, &outline, &run, limit, &pool, |_| {}))??;
+                let (mut run, elsewhere) = stop.watch(|| {
+                    start_auto(registry, &outline, &run, limit, &pool, &stop, |_| {})
+                })??;
                 run.set_stop(Some(stop.clone()));
                 Ok::<_, sylva::Error>((run, elsewhere))
             }

@@ -529,6 +529,10 @@ def test_match_evolves_towards_a_picture(tmp_path):
         sylva.match(text, generations=1)
     with pytest.raises(sylva.InputError, match="seconds"):
         sylva.match(target, generations=1, seconds=5)
+    # A first generation that takes minutes is cut when the match's second is up.
+    for model in ["plantmaker", "auto"]:
+        with pytest.raises(sylva.InputError, match="population"):
+            sylva.match(target, model=model, population=200_000, seconds=1)
 
 
 def test_ctrl_c_stops_a_run_and_leaves_it_whole():

@@ -235,6 +235,7 @@ fn breeding_until_a_limit_tells_a_stop_from_the_time() {
 /// share, and goes on with the better, the same each time.
 #[test]
 fn auto_tries_every_model_then_runs_off_the_best_two() {
+    use sylva::core::par::Stop;
     use sylva::evolution::RunConfig;
     use sylva::evolution::outline::{Limit, RUNOFF_SHARE, TRIAL_SHARE, Trial};
     use sylva::evolution::outline::{best_iou, start_auto};
@@ -258,6 +259,7 @@ fn auto_tries_every_model_then_runs_off_the_best_two() {
             &run,
             limit,
             &Pool::Serial,
+            &Stop::new(),
             |t| trials.push(t.clone()),
         )
         .unwrap();

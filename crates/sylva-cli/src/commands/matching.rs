@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
 use sylva::core::par::Stop;
 use sylva::evolution::outline::{
-    Limit, Trial, best_iou, breed_until, match_config, outlines, overlay, start_auto,
+    Limit, Trial, best_iou, breed_until, match_config, outlines, overlay, start_auto, start_within,
 };
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
@@ -144,6 +144,8 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
     let registry = Registry::standard();
     let pool = super::pool(args.threads)?;
     let checkpoint = out.join(CHECKPOINT);
+    // The match's seconds bound its first generations too, however large the population.
+    let stop = Stop::new();
     let config_of = |model: &str| {
         match_config(registry, model, &run, &target)
             .map_err(|e| InputError::new("--model", format!("{}: {}", e.field, e.message)))
@@ -161,6 +163,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
             &run,
             limit,
             &pool,
+            &stop,
             |t| match t {
                 Trial::Reached {
                     model,
@@ -170,6 +173,10 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
                 } => eprintln!(
                     "auto: {model} reached an outline score of {iou:.3} in {generations} generations{}",
                     if *runoff { " (run-off)" } else { "" }
+                ),
+                Trial::OutOfTime { model, seconds } => eprintln!(
+                    "auto: {model} left out: its first generation was not scored within the {}",
+                    Seconds(*seconds)
                 ),
                 Trial::LeftOut {
                     model,
@@ -186,14 +193,21 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         (evolution, config, elsewhere)
     } else {
         let config = config_of(&args.model)?;
-        let evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
+        let evolution = start_within(&config, limit, &pool, &stop)?;
         (evolution, config, 0.0)
     };
     sylva::files::create_dir(&out)?;
     let mut files = FILES.to_vec();
     files.push("overlay.png");
     sylva::files::remove_leftovers(&out, &files);
-    breed(&mut evolution, &config, limit, &checkpoint, elsewhere)?;
+    breed(
+        &mut evolution,
+        &config,
+        limit,
+        &checkpoint,
+        elsewhere,
+        &stop,
+    )?;
     // The config written is the run's: its generations are the ones bred.
     let mut config = evolution.config();
     config.run_mut().generations = evolution.generation();
@@ -219,6 +233,7 @@ fn breed(
     limit: Limit,
     checkpoint: &Path,
     elsewhere: f64,
+    stop: &Stop,
 ) -> anyhow::Result<()> {
     let bar = match limit {
         Limit::Generations(n) => ProgressBar::new(u64::from(n)).with_style(
@@ -248,7 +263,7 @@ fn breed(
     };
     show(evolution);
     let mut checkpoints = super::Checkpoints::new(checkpoint, config.run().checkpoint_seconds);
-    breed_until(evolution, remaining, started, &Stop::new(), |evolution| {
+    breed_until(evolution, remaining, started, stop, |evolution| {
         show(evolution);
         checkpoints.due(|| evolution.checkpoint())?;
         Ok::<_, anyhow::Error>(())

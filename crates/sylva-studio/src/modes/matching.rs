@@ -347,6 +347,7 @@ impl Background for MatchMode {
             &run,
             Limit::Generations(run.generations),
             &studio.pool,
+            &sylva::core::par::Stop::new(),
             |_| {},
         )
         .map_err(failed)?;

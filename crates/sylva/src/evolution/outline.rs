@@ -7,6 +7,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use sylva_core::budget::Seconds;
 use sylva_core::par::{Pool, Stop};
 
 use sylva_evolve::{Added, Problem, Term};
@@ -21,6 +22,7 @@ use crate::picture;
 use crate::registry::Registry;
 
 use super::config::Config;
+use super::hooks::RunHooks;
 use super::run::Evolution;
 use super::schema::{MatchConfig, RunConfig};
 
@@ -302,16 +304,27 @@ pub fn best_iou(evolution: &Evolution) -> f64 {
 
 /// Breeds `evolution` `more` (generations, or seconds from now) and gives its best IoU. The
 /// last generation is bred whole: cut short, the run that goes on would score it again.
-fn trial(evolution: &mut Evolution, more: Limit) -> Result<f64, Error> {
+/// Only the match's own deadline (`stop`'s, [`start_auto_at`]) cuts one short, and the trial
+/// ends at the last whole generation.
+fn trial(evolution: &mut Evolution, more: Limit, stop: &Stop) -> Result<f64, Error> {
     let (begun, bred) = (Instant::now(), evolution.generation());
     let done = |evolution: &Evolution| match more {
         Limit::Generations(n) => evolution.generation() >= bred.saturating_add(n),
         Limit::Seconds(_) => more.reached(evolution, begun),
     };
     while !done(evolution) {
-        evolution.step()?;
+        match evolution.step() {
+            Ok(_) => {}
+            Err(Error::Stopped(_)) if out_of_time(stop) => break,
+            Err(e) => return Err(e),
+        }
     }
     Ok(best_iou(evolution))
+}
+
+/// Whether `stop` ended work because its deadline passed, not by hand.
+fn out_of_time(stop: &Stop) -> bool {
+    stop.timed_out() && !stop.is_set()
 }
 
 /// How one model did in the trials of [`start_auto`].
@@ -328,6 +341,13 @@ pub enum Trial {
         generations: u32,
         /// Whether this was the run-off.
         runoff: bool,
+    },
+    /// It was left out: its first generation was not scored within the match's time.
+    OutOfTime {
+        /// The model.
+        model: &'static str,
+        /// The match's seconds.
+        seconds: f64,
     },
     /// It was left out: a generation may take `seconds`, more than a trial allows.
     LeftOut {
@@ -347,19 +367,36 @@ pub enum Trial {
 /// first on a tie), with the seconds spent on the others. `on_trial` hears how each model
 /// did. The target's pictures are found as their paths say (relative ones from the
 /// current folder; [`start_auto_at`] finds them elsewhere).
+///
+/// The trials watch `stop`: set by hand, they end with [`Error::Stopped`]. A limit in
+/// seconds is also a deadline on them, however large the population: a trial cut short by
+/// it ends at its last whole generation, a model whose first generation it cuts is left
+/// out ([`Trial::OutOfTime`]), and when it leaves no model the match is refused, naming
+/// the population.
 pub fn start_auto(
     registry: &Registry,
     target: &MatchConfig,
     run: &RunConfig,
     limit: Limit,
     pool: &Pool,
+    stop: &Stop,
     on_trial: impl FnMut(&Trial),
 ) -> Result<(Evolution, f64), Error> {
-    start_auto_at(registry, target, Path::new(""), run, limit, pool, on_trial)
+    start_auto_at(
+        registry,
+        target,
+        Path::new(""),
+        run,
+        limit,
+        pool,
+        stop,
+        on_trial,
+    )
 }
 
 /// [`start_auto`], the target's relative paths found in `base` (the studio keeps its
 /// pictures in a folder of its own).
+#[allow(clippy::too_many_arguments)]
 pub fn start_auto_at(
     registry: &Registry,
     target: &MatchConfig,
@@ -367,9 +404,11 @@ pub fn start_auto_at(
     run: &RunConfig,
     limit: Limit,
     pool: &Pool,
+    stop: &Stop,
     mut on_trial: impl FnMut(&Trial),
 ) -> Result<(Evolution, f64), Error> {
     let started = Instant::now();
+    let _deadline = Deadline::set(stop, deadline(limit, started));
     let share = |share: f64| match limit {
         Limit::Generations(n) => Limit::Generations(((f64::from(n) * share) as u32).max(1)),
         Limit::Seconds(s) => Limit::Seconds(s * share),
@@ -393,8 +432,25 @@ pub fn start_auto_at(
             });
             continue;
         }
-        let mut evolution = Evolution::start(&config, Vec::new(), pool.clone())?;
-        let iou = trial(&mut evolution, share(TRIAL_SHARE))?;
+        let hooks = RunHooks {
+            stop: Some(stop.clone()),
+            term: None,
+        };
+        let mut evolution = match Evolution::start_with(&config, Vec::new(), pool.clone(), hooks) {
+            Ok(evolution) => evolution,
+            Err(Error::Stopped(_)) if out_of_time(stop) => {
+                on_trial(&Trial::OutOfTime {
+                    model: entry.name(),
+                    seconds: match limit {
+                        Limit::Seconds(s) => s,
+                        Limit::Generations(_) => 0.0,
+                    },
+                });
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        let iou = trial(&mut evolution, share(TRIAL_SHARE), stop)?;
         on_trial(&Trial::Reached {
             model: entry.name(),
             iou,
@@ -408,7 +464,7 @@ pub fn start_auto_at(
     entrants.truncate(2);
     if entrants.len() > 1 {
         for (iou, model, evolution) in &mut entrants {
-            *iou = trial(evolution, share(RUNOFF_SHARE))?;
+            *iou = trial(evolution, share(RUNOFF_SHARE), stop)?;
             on_trial(&Trial::Reached {
                 model,
                 iou: *iou,
@@ -420,12 +476,80 @@ pub fn start_auto_at(
     let best = entrants
         .into_iter()
         .reduce(|a, b| if b.0 > a.0 { b } else { a });
-    let (_, _, evolution) = best.ok_or_else(|| {
-        InputError::new(
+    let (_, _, mut evolution) = best.ok_or_else(|| match limit {
+        Limit::Seconds(s) if out_of_time(stop) => InputError::new(
+            "population",
+            format!(
+                "no model scored its first generation of {} plants within the {} given; \
+                 breed a smaller population or give more seconds",
+                run.population,
+                Seconds(s)
+            ),
+        ),
+        _ => InputError::new(
             "model",
             "no model's generation fits a trial of the time given",
-        )
+        ),
     })?;
     let own: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
+    evolution.set_stop(None);
     Ok((evolution, (started.elapsed().as_secs_f64() - own).max(0.0)))
+}
+
+/// A deadline on a [`Stop`] while it lives: cleared when dropped, however the work ends.
+struct Deadline<'a>(&'a Stop);
+
+impl<'a> Deadline<'a> {
+    fn set(stop: &'a Stop, at: Option<Instant>) -> Deadline<'a> {
+        stop.stop_at(at);
+        Deadline(stop)
+    }
+}
+
+impl Drop for Deadline<'_> {
+    fn drop(&mut self) {
+        self.0.stop_at(None);
+    }
+}
+
+/// When a match of `limit` begun at `started` is over: `None` for a count of generations.
+pub fn deadline(limit: Limit, started: Instant) -> Option<Instant> {
+    match limit {
+        Limit::Seconds(s) => {
+            started.checked_add(Duration::try_from_secs_f64(s.max(0.0)).unwrap_or(Duration::MAX))
+        }
+        Limit::Generations(_) => None,
+    }
+}
+
+/// Generation 0 of a match of one model (`config`'s), watched by `stop` (a front end's
+/// stop by hand) and, for a limit in seconds, cut short when they are up: then refused,
+/// naming the population, for a match cannot begin without it.
+pub fn start_within(
+    config: &Config,
+    limit: Limit,
+    pool: &Pool,
+    stop: &Stop,
+) -> Result<Evolution, Error> {
+    let deadline = Deadline::set(stop, deadline(limit, Instant::now()));
+    let hooks = RunHooks {
+        stop: Some(stop.clone()),
+        term: None,
+    };
+    let started = Evolution::start_with(config, Vec::new(), pool.clone(), hooks);
+    let late = out_of_time(stop);
+    drop(deadline);
+    match (started, limit) {
+        (Err(Error::Stopped(_)), Limit::Seconds(s)) if late => Err(InputError::new(
+            "population",
+            format!(
+                "generation 0 of {} plants was not scored within the {} given; breed a \
+                 smaller population or give more seconds",
+                config.run().population,
+                Seconds(s)
+            ),
+        )
+        .into()),
+        (started, _) => started,
+    }
 }
