@@ -252,3 +252,28 @@ fn a_population_too_large_for_the_seconds_is_refused_on_time() {
         assert!(!out.exists(), "{model}: nothing is written");
     }
 }
+
+#[test]
+fn an_out_folder_that_is_a_file_is_refused_before_the_run() {
+    // Checked first: a minute of breeding is not lost to it at the end.
+    let dir = temp_dir("out-is-a-file");
+    let file = dir.join("taken");
+    fs::write(&file, "a file\n").unwrap();
+    for out in [file.clone(), file.join("run")] {
+        for args in [
+            vec!["match", s(&target()), "--generations", "1"],
+            vec!["evolve", "--generations", "1"],
+        ] {
+            let output = sylva(&[&args[..], &["--out", s(&out)]].concat());
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+            assert!(stderr.contains("is a file, not a folder"), "{stderr}");
+            assert!(stderr.contains(s(&file)), "{stderr}");
+            assert!(
+                !stderr.contains("generation"),
+                "refused before breeding: {stderr}"
+            );
+        }
+    }
+    assert_eq!(fs::read_to_string(&file).unwrap(), "a file\n");
+}

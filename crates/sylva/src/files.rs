@@ -67,6 +67,21 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     })
 }
 
+/// Refuses an output folder that cannot be made because it, or a folder it would go in, is
+/// a file: a long run checks before it begins, so that none of its work is lost at the end.
+pub fn check_out_dir(path: &Path) -> Result<(), InputError> {
+    let existing = path
+        .ancestors()
+        .find(|d| !d.as_os_str().is_empty() && d.exists());
+    match existing {
+        Some(d) if !d.is_dir() => Err(InputError::file(
+            d,
+            "is a file, not a folder: the outputs go in a folder",
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Makes a folder and its parents.
 pub fn create_dir(path: &Path) -> Result<(), Error> {
     std::fs::create_dir_all(path).map_err(|source| Error::Io {

@@ -73,6 +73,7 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!("runs/{}-seed{}", config.model(), config.run().seed))
     });
+    sylva::files::check_out_dir(&out)?;
     let pool = super::pool(config.run().threads)?;
     let base = args
         .config

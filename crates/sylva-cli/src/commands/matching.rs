@@ -131,6 +131,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
             .to_string_lossy();
         PathBuf::from(format!("runs/match-{stem}-seed{}", args.seed))
     });
+    sylva::files::check_out_dir(&out)?;
     let run = RunConfig {
         generations: match limit {
             Limit::Generations(n) => n,
