@@ -17,7 +17,9 @@
 //! allocates nothing.
 //!
 //! [`prune`] grows a plant inside outlines instead, as a topiary is clipped: what would
-//! show outside their ink is cut (a match does so before scoring, by default).
+//! show outside their ink is cut, its leaves exactly where they meet the sky, into pieces
+//! an asset carries. A match scores its plants so by default with [`score_pruned`], which
+//! draws the leaves clipped pixel by pixel instead of making the pieces.
 
 use sylva_core::Plant;
 use sylva_core::glam::{Vec2, Vec3};
@@ -74,13 +76,58 @@ impl Bitmap {
 
     /// Inks pixels `x0..x1` of row `y` (clipped to the bitmap).
     pub fn fill_span(&mut self, y: u32, x0: u32, x1: u32) {
-        let x1 = x1.min(self.width);
-        if y >= self.height || x0 >= x1 {
-            return;
+        for (at, bits) in self.span_words(y, x0, x1) {
+            self.words[at] |= bits;
         }
-        let row = &mut self.words[y as usize * self.words_per_row..][..self.words_per_row];
-        let (first, last) = (x0 as usize / 64, (x1 as usize - 1) / 64);
-        for (i, word) in row.iter_mut().enumerate().take(last + 1).skip(first) {
+    }
+
+    /// Inks the pixels of `x0..x1` of row `y` that `mask` inks (a bitmap of the same size).
+    pub(crate) fn fill_span_masked(&mut self, y: u32, x0: u32, x1: u32, mask: &Bitmap) {
+        for (at, bits) in self.span_words(y, x0, x1) {
+            self.words[at] |= bits & mask.words.get(at).copied().unwrap_or(0);
+        }
+    }
+
+    /// Inks each pixel `x` of `x0..x1` in row `y` not inked yet (and inked in `mask`, a
+    /// bitmap of the same size, if given) for which `ink(x)` holds.
+    pub(crate) fn for_each_open(
+        &mut self,
+        y: u32,
+        x0: u32,
+        x1: u32,
+        mask: Option<&Bitmap>,
+        mut ink: impl FnMut(u32) -> bool,
+    ) {
+        let first = (y as usize * self.words_per_row) as u32;
+        for (at, bits) in self.span_words(y, x0, x1) {
+            let mut open = bits & !self.words[at];
+            if let Some(mask) = mask {
+                open &= mask.words.get(at).copied().unwrap_or(0);
+            }
+            while open != 0 {
+                let bit = open.trailing_zeros();
+                open &= open - 1;
+                if ink((at as u32 - first) * 64 + bit) {
+                    self.words[at] |= 1 << bit;
+                }
+            }
+        }
+    }
+
+    /// The words pixels `x0..x1` of row `y` (clipped to the bitmap) lie in, each with the
+    /// bits of those pixels: (index into the words, bits).
+    fn span_words(&self, y: u32, x0: u32, x1: u32) -> impl Iterator<Item = (usize, u64)> + use<> {
+        let x1 = x1.min(self.width);
+        let (at, first, last) = if y >= self.height || x0 >= x1 {
+            (0, 1, 0)
+        } else {
+            (
+                y as usize * self.words_per_row,
+                x0 as usize / 64,
+                (x1 as usize - 1) / 64,
+            )
+        };
+        (first..=last).map(move |i| {
             let lo = if i == first { x0 % 64 } else { 0 };
             let hi = if i == last { (x1 - 1) % 64 + 1 } else { 64 };
             let bits = if hi - lo == 64 {
@@ -88,8 +135,8 @@ impl Bitmap {
             } else {
                 ((1u64 << (hi - lo)) - 1) << lo
             };
-            *word |= bits;
-        }
+            (at + i, bits)
+        })
     }
 
     /// The words of row `y`: pixel `x` is bit `x % 64` of word `x / 64`.
@@ -214,6 +261,9 @@ pub struct Outline {
     /// The column (in pixels from the canvas's left edge) of the middle of the ink's bottom
     /// row: where the plant's foot stands when it is pruned to the outline ([`prune`]).
     foot: f32,
+    /// Ink counts of the boxes from the canvas's top left corner: entry (x, y) of a
+    /// row `width + 1` long counts the ink above row y and left of column x.
+    summed: Vec<u32>,
 }
 
 impl Outline {
@@ -265,6 +315,7 @@ impl Outline {
         }
         let mut distance = Vec::new();
         distance_transform(&normalised, &mut distance);
+        let summed = summed_ink(&normalised);
         // The lowest row with ink (a thin trunk may fall under half of every bottom pixel).
         let foot = (0..rows)
             .rev()
@@ -281,6 +332,7 @@ impl Outline {
             normalised,
             distance,
             foot,
+            summed,
         })
     }
 
@@ -371,82 +423,164 @@ impl Outline {
 /// crown's leaf clusters, which the scoring rows ([`Outline::rows`]) may blur.
 pub const SPACE_ROWS: u32 = 256;
 
-/// `plant` grown inside `outlines` (one per view), as a topiary is clipped to its form:
-/// a stem whose tip would show outside the ink of any of them is cut with all that grows
-/// from it, a leaf that would show over sky is clipped ([`Clip::leaf`]), and a flower whose
-/// blade's middle would is cut. What grows below the ground stays. A plant with nothing
-/// above the ground is returned whole.
+/// `plant` grown inside `outlines` (one per view), as a topiary is clipped to its form,
+/// its leaves cut exactly where they would show over sky: what [`Outline::score_pruned`]
+/// scores, made into parts an asset can carry.
 ///
-/// Each outline is laid over the plant with its top row at the plant's top
-/// ([`laid_height`]), its bottom row on the ground and its foot ([`Outline::new`]) on the
-/// plant's foot (x = 0 or z = 0): the plant keeps the size its genome gives it, and the
-/// outline cuts it where the target shows sky. The comparison then frames the pruned plant
-/// on its own ink, which may stand lower or narrower than the outline was laid, so the
-/// outlines are laid again as the comparison lays them and the leaves and flowers clipped
-/// again there, with the bare twigs that show over sky (up to [`REFRAMES`] times; stems
-/// that carry something stay, for a trunk cut there would take the plant).
-///
-/// Leaves are clipped into pieces as small as [`PIECE_PIXELS`], a side halved at most
-/// [`MAX_CLIP_DEPTH`] times, or fewer when the pieces would give the pruned plant more
-/// parts (segments and organs) than the whole plant grew: pruning never makes a plant
-/// heavier.
+/// The stems are cut first ([`cut_stems`]); then the outlines are laid where the
+/// comparison frames what is left with its leaves clipped ([`lay_clips`]), and each leaf
+/// that lies partly over sky there is cut into pieces: a grid of cells no wider than
+/// [`CELL_PIXELS`] over its blade (at most [`MAX_CELLS`] a side, and coarser past
+/// [`MAX_ORGANS`] pieces), each kept when its middle lies on every outline's ink, the kept
+/// cells merged into rectangles. The pieces are leaves of their own, one after another on
+/// the leaf's stem.
 pub fn prune(outlines: &[Outline], plant: &Plant) -> Plant {
-    let Some(top) = laid_height(plant) else {
+    let mut scratch = Scratch::default();
+    let Some(cut) = cut_stems(outlines, plant) else {
         return plant.clone();
     };
-    let piece = PIECE_PIXELS * top / SPACE_ROWS as f32;
-    let budget = plant.segments().len() + plant.organs().len();
-    let inside = |p: Vec3| p.y <= 0.0 || outlines.iter().all(|o| o.holds(p, top));
-    let mut quads = Vec::new();
-    let mut attempt = |depth: u32| {
-        let clip = Clip { piece, depth };
-        let keep_stem = |_, s: &Segment| !shoot_segment(plant, s.material) || inside(s.end);
-        let mut pruned = clip.within(plant, keep_stem, &inside, budget)?;
-        for _ in 0..REFRAMES {
-            let Some(again) = reframed(outlines, &pruned, clip, budget, &mut quads) else {
-                break;
-            };
-            let again = again?;
-            let settled = again.organs() == pruned.organs()
-                && again.segments().len() == pruned.segments().len();
-            pruned = again;
-            if settled {
-                break;
-            }
+    if !lay_clips(outlines, &cut, &mut scratch) {
+        return cut;
+    }
+    // Past MAX_ORGANS pieces, coarser cells; one cell a leaf is never more organs than the
+    // plant grew.
+    let mut pruned = cut.clone();
+    for cells in [CELL_PIXELS, 2.0, 8.0, f32::INFINITY] {
+        let mut organs = 0usize;
+        pruned = cut.cut_into(
+            |_, _| true,
+            |o, keep| match o.kind {
+                OrganKind::Leaf if cells.is_finite() && organs > MAX_ORGANS => {}
+                OrganKind::Leaf => leaf_pieces(o, outlines, &scratch.clips, cells, &mut |piece| {
+                    organs += 1;
+                    keep(piece);
+                }),
+                _ => {
+                    organs += 1;
+                    keep(*o);
+                }
+            },
+        );
+        if organs <= MAX_ORGANS {
+            break;
         }
-        Some(pruned)
-    };
-    // Judged by their middles (depth 0), leaves are never more than they were.
-    (0..=MAX_CLIP_DEPTH)
-        .rev()
-        .find_map(&mut attempt)
-        .unwrap_or_else(|| plant.clone())
+    }
+    pruned
 }
 
-/// Most times [`prune`] lays the outlines again on the pruned plant's own frame.
+/// Most leaves and flowers [`prune`] cuts a plant's leaves into before it cuts them in
+/// coarser cells (2 and 8 pixels, then one a leaf: kept whole when its middle lies on
+/// ink).
+pub const MAX_ORGANS: usize = 500_000;
+
+/// The outline term of `plant` grown inside `space` ([`prune`]): the mean over `outlines`
+/// (the same pictures and views as `space`, compared at their own rows) of the IoU, or of
+/// `(iou + closeness * nearness) / (1 + closeness)` ([`Outline::closeness`]), times
+/// [`plausibility`]. The plant is not cut into pieces: its leaves are clipped as they are
+/// drawn, pixel by pixel, which is what the pieces [`prune`] makes show. Once `scratch`
+/// is warm, it allocates only the pruned plant.
+pub fn score_pruned(
+    space: &[Outline],
+    outlines: &[Outline],
+    plant: &Plant,
+    closeness: f64,
+    scratch: &mut Scratch,
+) -> f64 {
+    let Some(cut) = cut_stems(space, plant) else {
+        return 0.0;
+    };
+    if outlines.is_empty() || !lay_clips(space, &cut, scratch) {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for (view, outline) in outlines.iter().enumerate() {
+        let same = space
+            .get(view)
+            .is_some_and(|s| s.side == outline.side && s.rows() == outline.rows());
+        if same {
+            std::mem::swap(&mut scratch.canvas, &mut scratch.views[view]);
+        } else {
+            let Some(at) = space.iter().position(|s| s.side == outline.side) else {
+                return 0.0;
+            };
+            let (rows, width) = (outline.rows(), outline.normalised.width());
+            if scratch.canvas.width() != width || scratch.canvas.height() != rows {
+                scratch.canvas = Bitmap::new(width, rows);
+            }
+            let draw = scratch.draws[at];
+            let draw = Frame {
+                scale: draw.scale * rows as f32 / space[at].rows() as f32,
+                half_width: width as f32 * 0.5,
+                ..draw
+            };
+            draw_clipped(&cut, at, space, &scratch.clips, draw, &mut scratch.canvas);
+        }
+        let iou = scratch.canvas.iou(&outline.normalised);
+        sum += if closeness == 0.0 {
+            iou
+        } else {
+            (iou + closeness * outline.closeness_of_canvas(scratch)) / (1.0 + closeness)
+        };
+        if same {
+            std::mem::swap(&mut scratch.canvas, &mut scratch.views[view]);
+        }
+    }
+    sum / outlines.len() as f64 * plausibility(&cut, scratch)
+}
+
+/// Most times the outlines are laid again on the pruned plant's own frame.
 pub const REFRAMES: u32 = 3;
 
-/// The side below which [`prune`] stops halving a clipped leaf's pieces, in pixels of the
-/// outlines laid at [`SPACE_ROWS`].
-pub const PIECE_PIXELS: f32 = 2.0;
+/// The widest a cell of a clipped leaf may be ([`prune`]), in pixels of the outlines laid
+/// at [`SPACE_ROWS`]: fine enough that the pieces' outline is the one scored, pixel for
+/// pixel but at the edges.
+pub const CELL_PIXELS: f32 = 0.5;
 
-/// Most times [`prune`] halves a clipped leaf's side: at most 16 pieces along and across.
-pub const MAX_CLIP_DEPTH: u32 = 4;
+/// Most cells along or across a clipped leaf ([`prune`]): a leaf 32 pixels long is cut in
+/// half-pixel cells, a longer one in coarser ones.
+pub const MAX_CELLS: u32 = 64;
 
-/// `pruned` with its leaves and flowers clipped again to `outlines` laid as the comparison
-/// frames it ([`Frame::of`]) and its bare twigs over sky cut: `None` when a view shows
-/// nothing of it, `Some(None)` when the pieces would take it over `budget` parts.
-fn reframed(
-    outlines: &[Outline],
-    pruned: &Plant,
-    clip: Clip,
-    budget: usize,
-    quads: &mut Vec<[Vec2; 4]>,
-) -> Option<Option<Plant>> {
+/// Most tiles of [`MAX_CELLS`] cells along or across a clipped leaf: a leaf 64 pixels long
+/// is cut in half-pixel cells, a longer one in coarser ones.
+pub const MAX_TILES: u32 = 2;
+
+/// `plant` with the stems cut that show outside `outlines`, each laid over it with its top
+/// row at the plant's top ([`laid_height`]), its bottom row on the ground and its foot
+/// ([`Outline::new`]) on the plant's foot (x = 0 or z = 0), and then laid again as the
+/// comparison frames what is left (up to [`REFRAMES`] times): a stem whose tip lies
+/// outside goes with all that grows from it; laid again, stems that carry something stay
+/// (a trunk cut there would take the plant) and bare twigs over sky go. Leaves are kept
+/// whole when any point of their blade (corners, edge middles, middle) lies inside, to be
+/// clipped later; flowers when their middle does. `None` when nothing shows above the
+/// ground.
+fn cut_stems(outlines: &[Outline], plant: &Plant) -> Option<Plant> {
+    let top = laid_height(plant)?;
+    let inside = |p: Vec3| p.y <= 0.0 || outlines.iter().all(|o| o.holds(p, top));
+    let keep_stem = |_, s: &Segment| !shoot_segment(plant, s.material) || inside(s.end);
+    let mut cut = within(plant, keep_stem, &inside);
+    let mut quads = Vec::new();
+    for _ in 0..REFRAMES {
+        let Some(again) = reframed(outlines, &cut, &mut quads) else {
+            break;
+        };
+        let settled =
+            again.organs() == cut.organs() && again.segments().len() == cut.segments().len();
+        cut = again;
+        if settled {
+            break;
+        }
+    }
+    Some(cut)
+}
+
+/// `cut` with the outlines laid as the comparison frames it ([`Frame::of`]): its leaves and
+/// flowers judged again there ([`within`]) and its bare twigs over sky cut; `None` when a
+/// view shows nothing of it.
+fn reframed(outlines: &[Outline], cut: &Plant, quads: &mut Vec<[Vec2; 4]>) -> Option<Plant> {
     let mut frames = Vec::with_capacity(outlines.len());
     for outline in outlines {
         quads.clear();
-        quads.extend(shapes(pruned, outline.side));
+        quads.extend(shapes(cut, outline.side));
         frames.push((Frame::of(quads, outline.rows(), false)?, outline));
     }
     let inside = |p: Vec3| {
@@ -459,120 +593,614 @@ fn reframed(
     // and no stem that stays (children come after their parents, so one pass from the end
     // settles it). Stems that carry something stay, for a trunk cut here would take the
     // plant with it.
-    let segments = pruned.segments();
+    let segments = cut.segments();
     let bears = &mut vec![false; segments.len()];
-    for o in pruned.organs() {
+    for o in cut.organs() {
         if let Some(p) = o.parent {
             bears[p.index()] = true;
         }
     }
     for (i, s) in segments.iter().enumerate().rev() {
-        if bears[i] || !shoot_segment(pruned, s.material) || inside(s.end) {
+        if bears[i] || !shoot_segment(cut, s.material) || inside(s.end) {
             bears[i] = true;
             if let Some(p) = s.parent {
                 bears[p.index()] = true;
             }
         }
     }
-    Some(clip.within(pruned, |id, _| bears[id.index()], &inside, budget))
+    Some(within(cut, |id, _| bears[id.index()], &inside))
 }
 
-/// How finely [`prune`] clips leaves.
-#[derive(Clone, Copy, Debug)]
-struct Clip {
-    /// The side below which a piece is not halved, plant units.
-    piece: f32,
-    /// Most times a side is halved.
-    depth: u32,
-}
-
-impl Clip {
-    /// `plant` cut to the stems `keep_stem` keeps, its organs clipped ([`Clip::organ`]);
-    /// `None` as soon as the cut plant would have more than `budget` parts (segments and
-    /// organs).
-    fn within(
-        self,
-        plant: &Plant,
-        mut keep_stem: impl FnMut(SegmentId, &Segment) -> bool,
-        inside: &impl Fn(Vec3) -> bool,
-        budget: usize,
-    ) -> Option<Plant> {
-        let parts = std::cell::Cell::new(0usize);
-        let cut = plant.cut_into(
-            |id, s| {
-                let kept = keep_stem(id, s);
-                parts.set(parts.get() + usize::from(kept));
-                kept
-            },
-            |o, keep| {
-                if parts.get() <= budget {
-                    self.organ(o, inside, &mut |piece| {
-                        parts.set(parts.get() + 1);
-                        keep(piece);
-                    });
-                }
-            },
-        );
-        (parts.get() <= budget).then_some(cut)
-    }
-
-    /// Passes to `keep` what of organ `o` stays on a kept stem: a root tip whole, a leaf
-    /// clipped, a flower whole when its blade's middle lies `inside`.
-    fn organ(self, o: &Organ, inside: &impl Fn(Vec3) -> bool, keep: &mut dyn FnMut(Organ)) {
-        match o.kind {
-            OrganKind::RootTip => keep(*o),
-            OrganKind::Leaf => self.leaf(*o, inside, 0, keep),
-            OrganKind::Flower => {
-                let [a, _, c, _] = blade_corners(o);
-                if inside((a + c) * 0.5) {
-                    keep(*o);
-                }
-            }
-        }
-    }
-
-    /// Passes to `keep` what of leaf `o` the shears leave, as a hedge's face cuts the
-    /// leaves it crosses: the whole leaf when its blade's corners, edge middles and middle
-    /// all lie `inside`; else, while a side is longer than a piece, its halves along that
-    /// side (quarters when both are), clipped in turn; a piece no longer halved is kept
-    /// when its middle lies inside. Pieces keep the leaf's stem, kind and material.
-    fn leaf(
-        self,
-        o: Organ,
-        inside: &impl Fn(Vec3) -> bool,
-        depth: u32,
-        keep: &mut dyn FnMut(Organ),
-    ) {
-        let [a, b, c, d] = blade_corners(&o);
+/// `plant` cut to the stems `keep_stem` keeps; on them, root tips stay, a leaf stays whole
+/// when any point of its blade (corners, edge middles, middle) lies `inside`, and a flower
+/// when its middle does.
+fn within(
+    plant: &Plant,
+    keep_stem: impl FnMut(SegmentId, &Segment) -> bool,
+    inside: &impl Fn(Vec3) -> bool,
+) -> Plant {
+    plant.cut_into(keep_stem, |o, keep| {
+        let [a, b, c, d] = blade_corners(o);
         let middle = (a + c) * 0.5;
-        let (along, across) = (o.size.x > self.piece, o.size.y > self.piece);
-        if depth >= self.depth || !(along || across) {
-            if inside(middle) {
-                keep(o);
+        let kept = match o.kind {
+            OrganKind::RootTip => true,
+            OrganKind::Flower => inside(middle),
+            OrganKind::Leaf => {
+                let edges = [(a + b) * 0.5, (b + c) * 0.5, (c + d) * 0.5, (d + a) * 0.5];
+                [a, b, c, d, middle].into_iter().chain(edges).any(inside)
             }
-            return;
+        };
+        if kept {
+            keep(*o);
         }
-        let edges = [(a + b) * 0.5, (b + c) * 0.5, (c + d) * 0.5, (d + a) * 0.5];
-        if [a, b, c, d, middle].into_iter().chain(edges).all(inside) {
-            keep(o);
-            return;
+    })
+}
+
+/// Lays `outlines` over `cut` (a plant [`cut_stems`] made) where the comparison frames it
+/// with its leaves clipped to them, into `scratch.clips`, and draws it so into
+/// `scratch.views` (one canvas per outline), framed as the comparison frames it
+/// (`scratch.draws`). They are laid first where the comparison frames the plant whole,
+/// then, while the frame of the clipped plant moves by more than [`SETTLED_PIXELS`],
+/// where it frames what the clip left (up to [`CLIP_ROUNDS`] times). `false` when a view
+/// shows nothing.
+fn lay_clips(outlines: &[Outline], cut: &Plant, scratch: &mut Scratch) -> bool {
+    let Scratch {
+        quads,
+        clips,
+        draws,
+        views,
+        lies,
+        partial,
+        ..
+    } = scratch;
+    clips.clear();
+    draws.clear();
+    views.resize_with(outlines.len(), || Bitmap::new(0, 0));
+    for (outline, canvas) in outlines.iter().zip(views.iter_mut()) {
+        quads.clear();
+        quads.extend(shapes(cut, outline.side));
+        let Some(frame) = Frame::of(quads, outline.rows(), false) else {
+            return false;
+        };
+        clips.push(frame);
+        draws.push(frame);
+        let (width, rows) = (outline.normalised.width(), outline.rows());
+        if canvas.width() != width || canvas.height() != rows {
+            *canvas = Bitmap::new(width, rows);
         }
-        let (n_along, n_across) = (1 + u32::from(along), 1 + u32::from(across));
-        let size = Vec2::new(o.size.x / n_along as f32, o.size.y / n_across as f32);
-        let (x, y) = (o.orientation * Vec3::X, o.orientation * Vec3::Y);
-        for i in 0..n_along {
-            for j in 0..n_across {
-                let offset =
-                    y * (size.x * i as f32) + x * ((j as f32 + 0.5) * size.y - 0.5 * o.size.y);
-                let part = Organ {
-                    position: o.position + offset,
-                    size,
-                    ..o
+    }
+    if outlines.is_empty() {
+        return false;
+    }
+    for round in 0..=CLIP_ROUNDS {
+        if round > 0 {
+            clips.copy_from_slice(draws);
+        }
+        // How each leaf lies over the outlines so laid: the same from every view.
+        lies.clear();
+        lies.extend(cut.organs().iter().map(|o| match o.kind {
+            OrganKind::RootTip => Lie::Gone,
+            OrganKind::Flower => Lie::Whole,
+            OrganKind::Leaf => match looks(&blade_corners(o), outlines, clips, None) {
+                None => Lie::Gone,
+                Some(0) => Lie::Whole,
+                Some(_) => Lie::Partly,
+            },
+        }));
+        let mut settled = true;
+        for (view, draw) in draws.iter_mut().enumerate() {
+            let Some(frame) = clipped_frame(cut, view, outlines, clips, lies, partial) else {
+                return false;
+            };
+            settled &= frame.within(draw, SETTLED_PIXELS);
+            *draw = frame;
+        }
+        if settled {
+            break;
+        }
+    }
+    for (view, (draw, canvas)) in draws.iter().zip(views.iter_mut()).enumerate() {
+        draw_clipped(cut, view, outlines, clips, *draw, canvas);
+    }
+    true
+}
+
+/// How far (in pixels, at the top and the sides of the plant) the clipped plant's frame
+/// may still move when [`lay_clips`] stops laying the outlines again.
+pub const SETTLED_PIXELS: f32 = 0.5;
+
+/// Most times [`lay_clips`] lays the outlines again where the comparison frames the
+/// clipped plant. Leaves at the edge of a ragged crown may come and go as the frame moves
+/// by a fraction of a pixel, so it need not settle.
+pub const CLIP_ROUNDS: u32 = 2;
+
+/// How a leaf lies over the outlines laid to clip it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lie {
+    /// Over sky in some view (or a root tip, which the outline does not see).
+    Gone,
+    /// On ink in every view (or a flower, kept whole).
+    Whole,
+    /// Partly over sky.
+    Partly,
+}
+
+/// Draws `plant` seen as `outlines[view]` sees it, in frame `draw`, into `canvas`: stems
+/// and flowers whole, each leaf pixel where the blade's point under its centre lies on the
+/// ink of every outline laid in its frame of `clips`. Blades that lie wholly on an
+/// outline's ink skip its look pixel by pixel (its summed-area table tells), and where
+/// the view is drawn in the frame its own outline is laid in, its ink masks the spans.
+fn draw_clipped(
+    plant: &Plant,
+    view: usize,
+    outlines: &[Outline],
+    clips: &[Frame],
+    draw: Frame,
+    canvas: &mut Bitmap,
+) {
+    let own = &outlines[view];
+    let side = own.side;
+    let mask = (clips[view] == draw).then_some(&own.normalised);
+    canvas.clear();
+    for s in plant
+        .segments()
+        .iter()
+        .filter(|s| shoot_segment(plant, s.material))
+    {
+        fill_quad(canvas, stem_band(s, side).map(|p| draw.on_canvas(p)));
+    }
+    for o in plant.organs() {
+        match o.kind {
+            OrganKind::RootTip => {}
+            OrganKind::Flower => {
+                fill_blade(
+                    canvas,
+                    blade_corners(o).map(|p| draw.on_canvas(side.project(p))),
+                );
+            }
+            OrganKind::Leaf => {
+                let corners = blade_corners(o);
+                let Some(checks) = looks(&corners, outlines, clips, mask.map(|_| view)) else {
+                    continue;
                 };
-                self.leaf(part, inside, depth + 1, keep);
+                let quad = corners.map(|p| draw.on_canvas(side.project(p)));
+                if checks == 0 {
+                    match mask {
+                        Some(mask) => {
+                            fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
+                                canvas.fill_span_masked(row, x0, x1, mask)
+                            })
+                        }
+                        None => fill_blade(canvas, quad),
+                    }
+                    continue;
+                }
+                let on_blade = BladeMap::new(&corners, quad);
+                fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
+                    // Only the pixels not yet inked (and on the own outline's ink, where
+                    // it is laid here) need a look, a word at a time.
+                    canvas.for_each_open(row, x0, x1, mask, |x| {
+                        let p = on_blade.at(Vec2::new(x as f32 + 0.5, row as f32 + 0.5));
+                        inside_clips(p, outlines, clips, checks)
+                    });
+                });
             }
         }
     }
+}
+
+/// Which of `outlines` (laid in `clips`) must be looked at point by point to clip a blade
+/// with `corners`, as bits: none where the blade lies wholly on an outline's ink (and
+/// never `skip`); `None` when it lies wholly on one's sky, above the ground.
+fn looks(
+    corners: &[Vec3; 4],
+    outlines: &[Outline],
+    clips: &[Frame],
+    skip: Option<usize>,
+) -> Option<u32> {
+    let mut checks = 0;
+    for (w, (outline, clip)) in outlines.iter().zip(clips).enumerate() {
+        if Some(w) == skip {
+            continue;
+        }
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for &p in corners {
+            let q = clip.on_canvas(outline.side.project(p));
+            (lo, hi) = (lo.min(q), hi.max(q));
+        }
+        match outline.cover(lo, hi) {
+            Cover::None if corners.iter().all(|p| p.y > 0.0) => return None,
+            Cover::All => {}
+            _ => checks |= 1 << w,
+        }
+    }
+    Some(checks)
+}
+
+/// Whether point `p` lies below the ground or on the ink of each outline that `checks`
+/// names (a bit each), laid in its frame of `clips`.
+fn inside_clips(p: Vec3, outlines: &[Outline], clips: &[Frame], checks: u32) -> bool {
+    p.y <= 0.0
+        || (outlines.iter().zip(clips).enumerate())
+            .filter(|(w, _)| checks >> w & 1 == 1)
+            .all(|(_, (o, clip))| o.ink_at(clip.on_canvas(o.side.project(p))))
+}
+
+/// From a point of a blade's quadrilateral in a picture back to the blade's point under
+/// it: the blade is flat, so the map is affine.
+struct BladeMap {
+    origin: Vec2,
+    along: Vec2,
+    across: Vec2,
+    det: f32,
+    corner: Vec3,
+    along3: Vec3,
+    across3: Vec3,
+}
+
+impl BladeMap {
+    fn new(corners: &[Vec3; 4], quad: [Vec2; 4]) -> BladeMap {
+        let (along, across) = (quad[1] - quad[0], quad[3] - quad[0]);
+        BladeMap {
+            origin: quad[0],
+            along,
+            across,
+            det: along.perp_dot(across),
+            corner: corners[0],
+            along3: corners[1] - corners[0],
+            across3: corners[3] - corners[0],
+        }
+    }
+
+    /// The blade's point seen at `q`: its middle when the blade is seen edge on.
+    fn at(&self, q: Vec2) -> Vec3 {
+        let (s, t) = if self.det.abs() < 1e-9 {
+            (0.5, 0.5)
+        } else {
+            let d = q - self.origin;
+            (
+                d.perp_dot(self.across) / self.det,
+                self.along.perp_dot(d) / self.det,
+            )
+        };
+        self.corner + self.along3 * s.clamp(0.0, 1.0) + self.across3 * t.clamp(0.0, 1.0)
+    }
+}
+
+/// How a leaf lies over outlines laid in their frames ([`clip_leaf`]).
+// Returned by value, one leaf at a time: boxing its cells would allocate for every leaf.
+#[allow(clippy::large_enum_variant)]
+enum LeafClip {
+    /// Wholly over one outline's sky.
+    Gone,
+    /// Wholly on every outline's ink.
+    Whole,
+    /// Partly over sky: the cells of a grid over its blade that lie on ink.
+    Cells(Cells),
+}
+
+/// A grid of cells over a leaf's blade, those on ink marked: `rows[j]` holds a bit per
+/// cell along the blade, row `j` counted across it from its corner `a` of
+/// [`blade_corners`].
+struct Cells {
+    along: u32,
+    across: u32,
+    rows: [u64; MAX_CELLS as usize],
+}
+
+impl Cells {
+    /// The corners of the box of cells `i0..i1` along and `j0..j1` across leaf `o`.
+    fn corners(o: &Organ, (i0, i1): (u32, u32), (j0, j1): (u32, u32), cells: &Cells) -> [Vec3; 4] {
+        let [a, b, _, d] = blade_corners(o);
+        let (tip, width) = (b - a, d - a);
+        let at = |i: u32, j: u32| {
+            a + tip * (i as f32 / cells.along as f32) + width * (j as f32 / cells.across as f32)
+        };
+        [at(i0, j0), at(i1, j0), at(i1, j1), at(i0, j1)]
+    }
+}
+
+/// How leaf `o` lies over `outlines` laid in `clips` ([`prune`]): a cell is no wider than
+/// [`CELL_PIXELS`] in any of them (at most [`MAX_CELLS`] a side) and on ink when its
+/// middle lies on every outline's ink (or below the ground; a cell across the ground is
+/// judged halfway up what shows of it).
+fn clip_leaf(o: &Organ, outlines: &[Outline], clips: &[Frame], cell_pixels: f32) -> LeafClip {
+    clip_leaf_where(o, outlines, clips, cell_pixels, |_| true)
+}
+
+/// [`clip_leaf`], looking only at the cells whose corners `wanted` holds for (the others
+/// left off).
+fn clip_leaf_where(
+    o: &Organ,
+    outlines: &[Outline],
+    clips: &[Frame],
+    cell_pixels: f32,
+    wanted: impl Fn(&[Vec3; 4]) -> bool,
+) -> LeafClip {
+    let corners = blade_corners(o);
+    let mut whole = true;
+    let mut cells = [1u32; 2];
+    for (outline, clip) in outlines.iter().zip(clips) {
+        let on = corners.map(|p| clip.on_canvas(outline.side.project(p)));
+        let (lo, hi) = on.iter().fold(
+            (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &q| (lo.min(q), hi.max(q)),
+        );
+        match outline.cover(lo, hi) {
+            Cover::None if corners.iter().all(|p| p.y > 0.0) => return LeafClip::Gone,
+            Cover::All => {}
+            _ => whole = false,
+        }
+        for (n, edge) in cells.iter_mut().zip([on[1] - on[0], on[3] - on[0]]) {
+            let wanted = (edge.length() / cell_pixels)
+                .ceil()
+                .clamp(1.0, MAX_CELLS as f32);
+            *n = (*n).max(wanted as u32);
+        }
+    }
+    if whole {
+        return LeafClip::Whole;
+    }
+    let [along, across] = cells;
+    let (a, tip, width) = (corners[0], corners[1] - corners[0], corners[3] - corners[0]);
+    // How far above its middle a cell reaches.
+    let reach = 0.5 * (tip.y.abs() / along as f32 + width.y.abs() / across as f32);
+    let mut rows = [0u64; MAX_CELLS as usize];
+    let (step_along, step_across) = (tip / along as f32, width / across as f32);
+    // Blocks of 8 by 8 cells none of which `wanted` holds for are passed over whole (the
+    // callers' tests hold for a box when they hold for a cell in it).
+    let block = |i: u32, j: u32| {
+        let corner = a + step_along * i as f32 + step_across * j as f32;
+        let (n, m) = (8.min(along - i) as f32, 8.min(across - j) as f32);
+        wanted(&[
+            corner,
+            corner + step_along * n,
+            corner + step_along * n + step_across * m,
+            corner + step_across * m,
+        ])
+    };
+    let mut blocks = 0u8;
+    for (j, row) in rows.iter_mut().enumerate().take(across as usize) {
+        let j = j as u32;
+        if j.is_multiple_of(8) {
+            blocks = 0;
+            for b in 0..along.div_ceil(8) {
+                blocks |= u8::from(block(b * 8, j)) << b;
+            }
+        }
+        let mut i = 0;
+        while i < along {
+            if i.is_multiple_of(8) && blocks >> (i / 8) & 1 == 0 {
+                i += 8;
+                continue;
+            }
+            i += 1;
+            let i = i - 1;
+            let corner = a + step_along * i as f32 + step_across * j as f32;
+            let cell = [
+                corner,
+                corner + step_along,
+                corner + step_along + step_across,
+                corner + step_across,
+            ];
+            if !wanted(&cell) {
+                continue;
+            }
+            let mut p = corner + (step_along + step_across) * 0.5;
+            if p.y <= 0.0 && p.y + reach > 0.0 {
+                p.y = (p.y + reach) * 0.5;
+            }
+            if inside_clips(p, outlines, clips, u32::MAX) {
+                *row |= 1 << i;
+            }
+        }
+    }
+    LeafClip::Cells(Cells {
+        along,
+        across,
+        rows,
+    })
+}
+
+/// Passes to `keep` what of leaf `o` lies on the ink of every outline laid in its frame
+/// ([`clip_leaf`]): the whole leaf, nothing, or its cells on ink merged into rectangles,
+/// each run of a row carried down the rows that hold all of it.
+fn leaf_pieces(
+    o: &Organ,
+    outlines: &[Outline],
+    clips: &[Frame],
+    cell_pixels: f32,
+    keep: &mut dyn FnMut(Organ),
+) {
+    match looks(&blade_corners(o), outlines, clips, None) {
+        None => {}
+        Some(0) => keep(*o),
+        Some(_) => tiles(o, outlines, clips, cell_pixels, |tile| {
+            tile_pieces(tile, outlines, clips, cell_pixels, keep)
+        }),
+    }
+}
+
+/// Calls `f` with each tile of leaf `o`: the leaf cut into as few equal tiles as keep
+/// each within [`MAX_CELLS`] cells a side of at most `cell_pixels` in every view, and at
+/// most [`MAX_TILES`] a side.
+fn tiles(
+    o: &Organ,
+    outlines: &[Outline],
+    clips: &[Frame],
+    cell_pixels: f32,
+    mut f: impl FnMut(&Organ),
+) {
+    let corners = blade_corners(o);
+    let mut cells = [1.0f32; 2];
+    for (outline, clip) in outlines.iter().zip(clips) {
+        let on = corners.map(|p| clip.on_canvas(outline.side.project(p)));
+        for (n, edge) in cells.iter_mut().zip([on[1] - on[0], on[3] - on[0]]) {
+            *n = n.max((edge.length() / cell_pixels).ceil());
+        }
+    }
+    // At most MAX_TILES a side: a leaf longer than that many tiles of MAX_CELLS cells is
+    // cut in coarser cells, so a random plant's giant leaves cost a bounded look.
+    let [along, across] =
+        cells.map(|n| (n / MAX_CELLS as f32).ceil().clamp(1.0, MAX_TILES as f32) as u32);
+    if along == 1 && across == 1 {
+        return f(o);
+    }
+    let size = Vec2::new(o.size.x / along as f32, o.size.y / across as f32);
+    let (x, y) = (o.orientation * Vec3::X, o.orientation * Vec3::Y);
+    for i in 0..along {
+        for j in 0..across {
+            let offset = y * (size.x * i as f32) + x * ((j as f32 + 0.5) * size.y - 0.5 * o.size.y);
+            f(&Organ {
+                position: o.position + offset,
+                size,
+                ..*o
+            });
+        }
+    }
+}
+
+/// Passes to `keep` what of `tile` (a leaf or a tile of one) lies on ink ([`clip_leaf`]).
+fn tile_pieces(
+    o: &Organ,
+    outlines: &[Outline],
+    clips: &[Frame],
+    cell_pixels: f32,
+    keep: &mut dyn FnMut(Organ),
+) {
+    let mut cells = match clip_leaf(o, outlines, clips, cell_pixels) {
+        LeafClip::Gone => return,
+        LeafClip::Whole => return keep(*o),
+        LeafClip::Cells(cells) => cells,
+    };
+    let (x, y) = (o.orientation * Vec3::X, o.orientation * Vec3::Y);
+    let (along, across) = (cells.along, cells.across as usize);
+    for j in 0..across {
+        while cells.rows[j] != 0 {
+            let i0 = cells.rows[j].trailing_zeros();
+            let run = (cells.rows[j] >> i0).trailing_ones();
+            let bits = if run == 64 {
+                u64::MAX
+            } else {
+                ((1u64 << run) - 1) << i0
+            };
+            let mut k = j + 1;
+            while k < across && cells.rows[k] & bits == bits {
+                k += 1;
+            }
+            for row in &mut cells.rows[j..k] {
+                *row &= !bits;
+            }
+            let size = Vec2::new(
+                o.size.x * run as f32 / along as f32,
+                o.size.y * (k - j) as f32 / across as f32,
+            );
+            let middle = (j + k) as f32 * 0.5 / across as f32 - 0.5;
+            keep(Organ {
+                position: o.position
+                    + y * (o.size.x * i0 as f32 / along as f32)
+                    + x * (o.size.y * middle),
+                size,
+                ..*o
+            });
+        }
+    }
+}
+
+/// The frame the comparison gives `cut` seen as `outlines[view]` sees it, once its leaves
+/// are cut to `outlines` laid in `clips` as [`prune`] cuts them: the frame [`Frame::of`]
+/// gives the pieces, worked out without making them. Stems, flowers and the leaves wholly
+/// on ink set a first box; the cells of the leaves partly over sky (listed in `partial`)
+/// are looked at only where their blade reaches past the box so far. `None` when nothing
+/// shows.
+fn clipped_frame(
+    cut: &Plant,
+    view: usize,
+    outlines: &[Outline],
+    clips: &[Frame],
+    lies: &[Lie],
+    partial: &mut Vec<(f32, u32)>,
+) -> Option<Frame> {
+    let outline = &outlines[view];
+    let side = outline.side;
+    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    let add = |quad: &[Vec2; 4], lo: &mut Vec2, hi: &mut Vec2| {
+        above_ground(quad, |p| (*lo, *hi) = (lo.min(p), hi.max(p)));
+    };
+    for s in (cut.segments().iter()).filter(|s| shoot_segment(cut, s.material)) {
+        add(&stem_band(s, side), &mut lo, &mut hi);
+    }
+    partial.clear();
+    for (i, (o, lie)) in cut.organs().iter().zip(lies).enumerate() {
+        match lie {
+            Lie::Gone => {}
+            Lie::Whole => add(&blade_corners(o).map(|p| side.project(p)), &mut lo, &mut hi),
+            Lie::Partly => partial.push((0.0, i as u32)),
+        }
+    }
+    // How far past the box a point lies (0 inside it).
+    let past = |p: Vec2, lo: Vec2, hi: Vec2| (lo - p).max(p - hi).max_element().max(0.0);
+    // The leaves whose part above the ground reaches furthest first: the box grows
+    // fastest, and fewer are left.
+    for (far, i) in partial.iter_mut() {
+        let blade = blade_corners(&cut.organs()[*i as usize]).map(|p| side.project(p));
+        *far = 0.0;
+        above_ground(&blade, |p| *far = far.max(past(p, lo, hi)));
+    }
+    partial.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    for &(far, i) in partial.iter() {
+        if far == 0.0 {
+            break;
+        }
+        let o = &cut.organs()[i as usize];
+        let (box_lo, box_hi) = (lo, hi);
+        // Below the ground counts as past the box (which stands on it): such a cell is
+        // looked at, and adds what of it shows.
+        let reaches = |cell: &[Vec3; 4]| {
+            cell.iter()
+                .any(|&p| past(side.project(p), box_lo, box_hi) > 0.0)
+        };
+        tiles(o, outlines, clips, CELL_PIXELS, |tile| {
+            if !reaches(&blade_corners(tile)) {
+                return;
+            }
+            match clip_leaf_where(tile, outlines, clips, CELL_PIXELS, reaches) {
+                LeafClip::Gone => {}
+                LeafClip::Whole => add(
+                    &blade_corners(tile).map(|p| side.project(p)),
+                    &mut lo,
+                    &mut hi,
+                ),
+                LeafClip::Cells(cells) => {
+                    for j in 0..cells.across {
+                        for i in (0..cells.along).filter(|i| cells.rows[j as usize] >> i & 1 == 1) {
+                            let cell = Cells::corners(tile, (i, i + 1), (j, j + 1), &cells);
+                            add(&cell.map(|p| side.project(p)), &mut lo, &mut hi);
+                        }
+                    }
+                }
+            }
+        });
+    }
+    Frame::of_box(lo, hi, outline.rows())
+}
+
+/// The corners of a stem segment's tapered band seen from `side`.
+fn stem_band(s: &Segment, side: Side) -> [Vec2; 4] {
+    let (r0, r1) = (s.start_radius, s.end_radius);
+    let (a, b) = (side.project(s.start), side.project(s.end));
+    let along = b - a;
+    let normal = if along.length_squared() > 0.0 {
+        along.perp().normalize()
+    } else {
+        Vec2::X
+    };
+    [
+        a + normal * r0,
+        b + normal * r1,
+        b - normal * r1,
+        a - normal * r0,
+    ]
 }
 
 /// The height [`prune`] lays outlines at over `plant`: the top of what the outline draws of
@@ -603,6 +1231,53 @@ impl Outline {
         (0.0..width).contains(&x)
             && (0.0..height).contains(&y)
             && self.normalised.get(x as u32, y as u32)
+    }
+}
+
+/// The summed-area table of `bitmap`'s ink ([`Outline::summed`]).
+fn summed_ink(bitmap: &Bitmap) -> Vec<u32> {
+    let (w, h) = (bitmap.width() as usize, bitmap.height() as usize);
+    let mut summed = vec![0u32; (w + 1) * (h + 1)];
+    for y in 0..h {
+        let mut row = 0;
+        for x in 0..w {
+            row += u32::from(bitmap.get(x as u32, y as u32));
+            summed[(y + 1) * (w + 1) + x + 1] = summed[y * (w + 1) + x + 1] + row;
+        }
+    }
+    summed
+}
+
+/// What of a box of canvas pixels an outline inks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cover {
+    None,
+    Some,
+    All,
+}
+
+impl Outline {
+    /// How much of the pixels from `lo` to `hi` (canvas points, the box's corners) is ink;
+    /// what lies off the canvas is sky.
+    fn cover(&self, lo: Vec2, hi: Vec2) -> Cover {
+        let (w, h) = (self.normalised.width(), self.normalised.height());
+        let clamp = |v: f32, n: u32| (v.max(0.0) as u32).min(n);
+        let (x0, x1) = (clamp(lo.x.floor(), w), clamp(hi.x.floor() + 1.0, w));
+        let (y0, y1) = (clamp(lo.y.floor(), h), clamp(hi.y.floor() + 1.0, h));
+        let pixels = (hi.x.floor() + 1.0 - lo.x.floor()) * (hi.y.floor() + 1.0 - lo.y.floor());
+        if x0 >= x1 || y0 >= y1 {
+            return Cover::None;
+        }
+        let row = w as usize + 1;
+        let at = |x: u32, y: u32| self.summed[y as usize * row + x as usize];
+        let ink = at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0);
+        if ink == 0 {
+            Cover::None
+        } else if ink as f32 >= pixels {
+            Cover::All
+        } else {
+            Cover::Some
+        }
     }
 }
 
@@ -670,6 +1345,17 @@ pub struct Scratch {
     distance: Vec<u16>,
     /// Tips each stem carries ([`plausibility`]).
     tips: Vec<f32>,
+    /// Where each outline is laid to clip a pruned plant's leaves ([`lay_clips`]).
+    clips: Vec<Frame>,
+    /// Where the comparison frames the clipped plant, a frame per outline.
+    draws: Vec<Frame>,
+    /// The clipped plant in each of those frames.
+    views: Vec<Bitmap>,
+    /// How each organ of a pruned plant lies over the outlines laid to clip it.
+    lies: Vec<Lie>,
+    /// The leaves that lie partly over sky, with how far they reach past the box of the
+    /// rest ([`clipped_frame`]).
+    partial: Vec<(f32, u32)>,
 }
 
 impl Default for Scratch {
@@ -679,6 +1365,11 @@ impl Default for Scratch {
             quads: Vec::new(),
             distance: Vec::new(),
             tips: Vec::new(),
+            clips: Vec::new(),
+            draws: Vec::new(),
+            views: Vec::new(),
+            lies: Vec::new(),
+            partial: Vec::new(),
         }
     }
 }
@@ -871,22 +1562,7 @@ fn shapes(plant: &Plant, side: Side) -> impl Iterator<Item = [Vec2; 4]> + '_ {
         .segments()
         .iter()
         .filter(|s| shoot_segment(plant, s.material))
-        .map(move |s| {
-            let (r0, r1) = (s.start_radius, s.end_radius);
-            let (a, b) = (side.project(s.start), side.project(s.end));
-            let along = b - a;
-            let normal = if along.length_squared() > 0.0 {
-                along.perp().normalize()
-            } else {
-                Vec2::X
-            };
-            [
-                a + normal * r0,
-                b + normal * r1,
-                b - normal * r1,
-                a - normal * r0,
-            ]
-        });
+        .map(move |s| stem_band(s, side));
     let organs = plant
         .organs()
         .iter()
@@ -933,14 +1609,23 @@ fn draw(plant: &Plant, side: Side, rows: u32, fit: bool, scratch: &mut Scratch) 
     let Some(frame) = Frame::of(&scratch.quads, rows, fit) else {
         return false;
     };
-    for quad in &scratch.quads {
-        fill_quad(&mut scratch.canvas, quad.map(|p| frame.on_canvas(p)));
+    // Stems come first ([`shapes`]).
+    let stems = (plant.segments().iter())
+        .filter(|s| shoot_segment(plant, s.material))
+        .count();
+    for (i, quad) in scratch.quads.iter().enumerate() {
+        let quad = quad.map(|p| frame.on_canvas(p));
+        if i < stems {
+            fill_quad(&mut scratch.canvas, quad);
+        } else {
+            fill_blade(&mut scratch.canvas, quad);
+        }
     }
     true
 }
 
 /// Where a view's shapes land on a canvas of some rows: plant units to pixels.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Frame {
     /// The plant point at the canvas's top middle.
     centre: Vec2,
@@ -966,23 +1651,48 @@ impl Frame {
                 above_ground(quad, |p| (lo, hi) = (lo.min(p), hi.max(p)));
             }
         }
+        if !fit {
+            return Frame::of_box(lo, hi, rows);
+        }
         let size = hi - lo;
         if !(size.y > 0.0 && size.is_finite()) {
             return None;
         }
-        let mut scale = rows as f32 / size.y;
-        if fit && size.x * scale > width {
-            scale = width / size.x;
-        }
-        let top = if fit {
-            lo.y + rows as f32 / scale
-        } else {
-            hi.y
-        };
+        let scale = (rows as f32 / size.y).min(width / size.x);
         Some(Frame {
-            centre: Vec2::new((lo.x + hi.x) * 0.5, top),
+            centre: Vec2::new((lo.x + hi.x) * 0.5, lo.y + rows as f32 / scale),
             scale,
             half_width: width * 0.5,
+        })
+    }
+
+    /// The frame of a box of shapes from `lo` to `hi` on a canvas of `rows`: its height
+    /// fills the rows, and it is centred. `None` when it is empty.
+    fn of_box(lo: Vec2, hi: Vec2, rows: u32) -> Option<Frame> {
+        let size = hi - lo;
+        if !(size.y > 0.0 && size.is_finite()) {
+            return None;
+        }
+        Some(Frame {
+            centre: Vec2::new((lo.x + hi.x) * 0.5, hi.y),
+            scale: rows as f32 / size.y,
+            half_width: (rows * CANVAS_ASPECT) as f32 * 0.5,
+        })
+    }
+
+    /// Whether this frame puts every point of a box as wide as the canvas is tall, centred
+    /// on it, within `pixels` of where `other` puts it.
+    fn within(&self, other: &Frame, pixels: f32) -> bool {
+        let rows = other.half_width * 2.0 / CANVAS_ASPECT as f32;
+        let back = |c: Vec2| {
+            Vec2::new(
+                other.centre.x + (c.x - other.half_width) / other.scale,
+                other.centre.y - c.y / other.scale,
+            )
+        };
+        [(-0.5, 0.0), (0.5, rows)].into_iter().all(|(x, y)| {
+            let c = Vec2::new(other.half_width + x * rows, y);
+            (self.on_canvas(back(c)) - c).abs().max_element() <= pixels
         })
     }
 
@@ -1017,6 +1727,28 @@ fn above_ground(quad: &[Vec2; 4], mut visit: impl FnMut(Vec2)) {
 /// a thin, nearly level twig as thick as a row at any resolution: at 64 rows a comb of
 /// such twigs filled an outline it covered a fraction of at 256.)
 fn fill_quad(canvas: &mut Bitmap, quad: [Vec2; 4]) {
+    fill_quad_spans(canvas, quad, true, |canvas, row, x0, x1| {
+        canvas.fill_span(row, x0, x1)
+    });
+}
+
+/// Fills a leaf's or flower's blade: [`fill_quad`], but only the pixels whose centres it
+/// covers. A blade thinner than a pixel is not a twig to keep seen, and a leaf cut into
+/// pieces ([`prune`]) would otherwise show each sliver at its edge as a pixel.
+fn fill_blade(canvas: &mut Bitmap, quad: [Vec2; 4]) {
+    fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
+        canvas.fill_span(row, x0, x1)
+    });
+}
+
+/// The spans [`fill_quad`] fills, passed to `span` as (canvas, row, first, end); without
+/// `thin`, none in a row where it covers no pixel's centre ([`fill_blade`]).
+fn fill_quad_spans(
+    canvas: &mut Bitmap,
+    quad: [Vec2; 4],
+    thin: bool,
+    mut span: impl FnMut(&mut Bitmap, u32, u32, u32),
+) {
     let (mut top, mut bottom) = (f32::INFINITY, f32::NEG_INFINITY);
     for p in quad {
         top = top.min(p.y);
@@ -1069,11 +1801,13 @@ fn fill_quad(canvas: &mut Bitmap, quad: [Vec2; 4]) {
         let x1 = (mid_right - 0.5).floor() + 1.0;
         let (x0, x1) = if mid_left <= mid_right && x1 > x0 {
             (x0, x1)
+        } else if !thin {
+            continue;
         } else {
             let mid = ((left + right) * 0.5).floor().max(0.0);
             (mid, mid + 1.0)
         };
-        canvas.fill_span(row, x0 as u32, x1.max(0.0) as u32);
+        span(canvas, row, x0 as u32, x1.max(0.0) as u32);
     }
 }
 
@@ -1268,6 +2002,11 @@ mod tests {
     /// A trunk 4 m tall and 0.1 m thick in `pieces` segments, its top one carrying a leaf
     /// 2 m wide and 1 m long standing across it (x from -1 to 1, y from 2.5 to 3.5).
     fn trunk_with_a_wide_leaf(pieces: usize) -> Plant {
+        trunk_with_a_leaf(pieces, Vec3::new(0.0, 2.5, 0.0), Vec2::new(1.0, 2.0))
+    }
+
+    /// A trunk like [`trunk_with_a_wide_leaf`]'s carrying a leaf of `size` at `position`.
+    fn trunk_with_a_leaf(pieces: usize, position: Vec3, size: Vec2) -> Plant {
         let mut plant = Plant::new(PlantMeta::default());
         let mut parent = None;
         for i in 0..pieces {
@@ -1287,9 +2026,9 @@ mod tests {
         plant
             .add_organ(Organ {
                 kind: OrganKind::Leaf,
-                position: Vec3::new(0.0, 2.5, 0.0),
+                position,
                 orientation: sylva_core::glam::Quat::IDENTITY,
-                size: Vec2::new(1.0, 2.0),
+                size,
                 material: Plant::LEAF,
                 parent,
             })
@@ -1299,16 +2038,15 @@ mod tests {
 
     #[test]
     fn pruning_clips_a_leaf_to_the_outline() {
-        // The target: a trunk 0.1 m wide (at 50 pixels a metre) with a crown over its left
-        // only, from x = -1 to 0.1 m and y = 2.5 to 3.5 m. The leaf's left half lies on it,
-        // its right in the sky.
+        // The target: a trunk 0.1 m wide (at 50 pixels a metre) with a crown over it from
+        // x = -0.5 to 0.5 m and y = 2.5 to 3.5 m. The leaf's middle half lies on it, its
+        // sides in the sky.
         let mut target = rectangle(400, 400, (198, 100, 203, 300));
         for y in 125..175 {
-            target.fill_span(y, 150, 205);
+            target.fill_span(y, 175, 226);
         }
         let outline = Outline::new(&target, Side::Front, SPACE_ROWS).unwrap();
-        // A bare branch of 64 segments into the sky on the right goes, and leaves room for
-        // the leaf's pieces (pruning never makes a plant heavier: below).
+        // A bare branch of 64 segments into the sky on the right goes.
         let mut plant = trunk_with_a_wide_leaf(256);
         let mut from = sylva_core::plant::SegmentId(63);
         for i in 0..64 {
@@ -1325,38 +2063,44 @@ mod tests {
                 .unwrap();
         }
         let pruned = prune(std::slice::from_ref(&outline), &plant);
-        // Pieces of the leaf stand for what of it lies on ink: its left half, and no more
-        // than a sixteenth of its width beyond (pieces are halved at most four times).
+        // Pieces of the leaf stand for what of it lies on ink: its middle, from x = -0.51
+        // to 0.51 m (the crown's edges), give or take a cell (the leaf is 128 pixels wide
+        // at 256 rows, cut in two tiles of 64 cells of a pixel, 1/64 of its width).
         let leaves = pruned.organs();
         assert!(leaves.len() > 1, "{leaves:?}");
         let area: f32 = leaves.iter().map(|o| o.size.x * o.size.y).sum();
-        assert!((1.0..=1.0 + 2.0 / 16.0 + 1e-4).contains(&area), "{area}");
+        assert!((1.02 - 0.05..=1.02 + 0.05).contains(&area), "{area}");
         for o in leaves {
             let [a, _, c, _] = blade_corners(o);
             let middle = (a + c) * 0.5;
-            assert!((-1.0..0.1).contains(&middle.x), "{o:?}");
+            assert!((-0.52..0.52).contains(&middle.x), "{o:?}");
             assert_eq!(
                 (o.parent, o.orientation),
                 (plant.organs()[0].parent, plant.organs()[0].orientation)
             );
         }
         assert_eq!(pruned.segments(), &plant.segments()[..256]);
-        // So the pruned plant's outline matches the target's; cutting the leaf by its
-        // middle alone (which lies on ink) kept all of it, half over the sky.
+        // So the pruned plant's outline matches the target's; the whole leaf, half over the
+        // sky, did not. The term scores the leaf clipped as it is drawn, which is what the
+        // pieces show.
         let mut scratch = Scratch::default();
         let clipped = outline.iou(&pruned, &mut scratch);
         let whole = outline.iou(&plant, &mut scratch);
-        assert!(clipped > 0.85 && whole < clipped - 0.1, "{clipped} {whole}");
+        assert!(clipped > 0.9 && whole < clipped - 0.1, "{clipped} {whole}");
+        let outlines = std::slice::from_ref(&outline);
+        let term = score_pruned(outlines, outlines, &plant, 0.0, &mut scratch);
+        let pieces = outline.score(&pruned, &mut scratch);
+        assert!((term - pieces).abs() < 0.01, "{term} {pieces}");
         // The pieces count as the one leaf they were: the trunk, 0.05 m thick, carries one
         // tip and may be 1% of 4 m for it (0.04 m), so the pipe-model factor is 0.8 (for
         // two tips or more it would be 1).
         let p = plausibility(&pruned, &mut scratch);
         assert!((p - 0.8).abs() < 1e-5, "{p}");
-        // Pruning never makes a plant heavier: a trunk of one segment and its leaf are two
-        // parts, so the leaf is not cut into pieces but judged by its middle, on ink.
-        let light = trunk_with_a_wide_leaf(1);
-        let pruned = prune(std::slice::from_ref(&outline), &light);
-        assert_eq!(pruned, light);
+        // A leaf wholly on ink stays whole, and one wholly over sky goes.
+        let inner = trunk_with_a_leaf(1, Vec3::new(-0.2, 2.8, 0.0), Vec2::new(0.4, 0.4));
+        assert_eq!(prune(outlines, &inner), inner);
+        let sky = trunk_with_a_leaf(1, Vec3::new(1.5, 2.8, 0.0), Vec2::new(0.4, 0.4));
+        assert_eq!(prune(outlines, &sky).organs(), &[]);
     }
 
     #[test]
@@ -1403,13 +2147,8 @@ mod tests {
         stem(&mut twiggy, [0.0, 2.0], [0.7, 2.5], Some(0));
         let carrier = stem(&mut twiggy, [0.0, 2.0], [-0.6, 2.4], Some(0));
         stem(&mut twiggy, [-0.6, 2.4], [-0.7, 3.2], Some(carrier.0));
-        let clip = Clip {
-            piece: 0.01,
-            depth: 0,
-        };
         let mut quads = Vec::new();
-        let again = reframed(&[outline], &twiggy, clip, usize::MAX, &mut quads);
-        let again = again.flatten().expect("the plant shows");
+        let again = reframed(&[outline], &twiggy, &mut quads).expect("the plant shows");
         let mut kept = twiggy.segments().to_vec();
         kept.remove(3);
         for s in &mut kept[3..] {

@@ -1,8 +1,9 @@
 //! The outline term's cost beside growth on a plant a match evolves: PlantMaker's best plant
 //! for the umbrella outline (`examples/match/umbrella.png`, `sylva match` with its
 //! defaults), grown, and scored (IoU times plausibility) from the front and the side at
-//! 32, 64, 128 and 256 (the default) rows. And the same plant pruned to the outline (as a
-//! match does by default: `prune`, at 256 rows), then scored at 256 rows.
+//! 32, 64, 128 and 256 (the default) rows. And the same plant grown inside the outline, as
+//! a match does by default: its term (`score_pruned`: stems cut, leaves clipped as they
+//! are drawn, front and side at 256 rows), and the pieces its outputs carry (`prune`).
 //!
 //! Run with `cargo bench -p sylva --bench outline`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -13,7 +14,7 @@ use std::path::Path;
 use criterion::{Criterion, criterion_group, criterion_main};
 use sylva::evolution::MatchConfig;
 use sylva::picture::{Threshold, load_target};
-use sylva_fitness::silhouette::{Outline, SPACE_ROWS, Scratch, Side, prune};
+use sylva_fitness::silhouette::{Outline, SPACE_ROWS, Scratch, Side, prune, score_pruned};
 
 fn outline(c: &mut Criterion) {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -59,11 +60,15 @@ fn outline(c: &mut Criterion) {
         ),
         |b| b.iter(|| black_box(prune(&space, black_box(&plant)))),
     );
-    group.bench_function("prune, then score front and side at 256 rows", |b| {
+    group.bench_function("the term pruned: front and side at 256 rows", |b| {
         b.iter(|| {
-            let pruned = prune(&space, black_box(&plant));
-            let sum: f64 = views.iter().map(|v| v.score(&pruned, &mut scratch)).sum();
-            black_box(sum)
+            black_box(score_pruned(
+                &space,
+                &views,
+                black_box(&plant),
+                0.0,
+                &mut scratch,
+            ))
         })
     });
     group.finish();

@@ -12,8 +12,8 @@ use sylva_core::par::{Pool, Stop};
 
 use sylva_evolve::{Added, Problem, Term};
 pub use sylva_fitness::silhouette::Outline;
-pub use sylva_fitness::silhouette::prune;
 use sylva_fitness::silhouette::{SPACE_ROWS, Scratch, Side};
+pub use sylva_fitness::silhouette::{prune, score_pruned};
 use sylva_model::Evolve;
 
 use crate::error::{Error, FieldError, InputError};
@@ -54,14 +54,14 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
     fn score(&self, problem: &M::Problem, evolved: &<M::Problem as Problem>::Genome) -> f64 {
         let genome = self.model.genome_file(problem, evolved);
         let seed = self.model.default_seed(&genome);
-        let Ok(mut plant) = self.model.develop(&genome, seed) else {
+        let Ok(plant) = self.model.develop(&genome, seed) else {
             return 0.0;
         };
-        if let Some(space) = &self.space {
-            plant = prune(space, &plant);
-        }
         SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
+            if let Some(space) = &self.space {
+                return score_pruned(space, &self.outlines, &plant, self.closeness, scratch);
+            }
             let sum: f64 = (self.outlines.iter())
                 .map(|o| o.score_with_closeness(&plant, self.closeness, scratch))
                 .sum();
