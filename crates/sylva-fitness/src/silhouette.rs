@@ -88,15 +88,16 @@ impl Bitmap {
         }
     }
 
-    /// Inks each pixel `x` of `x0..x1` in row `y` not inked yet (and inked in `mask`, a
-    /// bitmap of the same size, if given) for which `ink(x)` holds.
-    pub(crate) fn for_each_open(
+    /// Inks, of the pixels of `x0..x1` in row `y` not inked yet (and inked in `mask`, a
+    /// bitmap of the same size, if given), those `ink` picks: it is given them a word at a
+    /// time, as the `x` of the word's first pixel and a bit each, and returns the bits to ink.
+    pub(crate) fn ink_open(
         &mut self,
         y: u32,
         x0: u32,
         x1: u32,
         mask: Option<&Bitmap>,
-        mut ink: impl FnMut(u32) -> bool,
+        mut ink: impl FnMut(u32, u64) -> u64,
     ) {
         let first = (y as usize * self.words_per_row) as u32;
         for (at, bits) in self.span_words(y, x0, x1) {
@@ -104,12 +105,8 @@ impl Bitmap {
             if let Some(mask) = mask {
                 open &= mask.words.get(at).copied().unwrap_or(0);
             }
-            while open != 0 {
-                let bit = open.trailing_zeros();
-                open &= open - 1;
-                if ink((at as u32 - first) * 64 + bit) {
-                    self.words[at] |= 1 << bit;
-                }
+            if open != 0 {
+                self.words[at] |= ink((at as u32 - first) * 64, open) & open;
             }
         }
     }
@@ -261,9 +258,6 @@ pub struct Outline {
     /// The column (in pixels from the canvas's left edge) of the middle of the ink's bottom
     /// row: where the plant's foot stands when it is pruned to the outline ([`prune`]).
     foot: f32,
-    /// Ink counts of the boxes from the canvas's top left corner: entry (x, y) of a
-    /// row `width + 1` long counts the ink above row y and left of column x.
-    summed: Vec<u32>,
 }
 
 impl Outline {
@@ -315,7 +309,6 @@ impl Outline {
         }
         let mut distance = Vec::new();
         distance_transform(&normalised, &mut distance);
-        let summed = summed_ink(&normalised);
         // The lowest row with ink (a thin trunk may fall under half of every bottom pixel).
         let foot = (0..rows)
             .rev()
@@ -332,7 +325,6 @@ impl Outline {
             normalised,
             distance,
             foot,
-            summed,
         })
     }
 
@@ -513,7 +505,13 @@ pub fn score_pruned(
                 half_width: width as f32 * 0.5,
                 ..draw
             };
-            draw_clipped(&cut, at, space, &scratch.clips, draw, &mut scratch.canvas);
+            let Scratch {
+                clips,
+                canvas,
+                clipping,
+                ..
+            } = scratch;
+            draw_clipped(&cut, at, space, clips, draw, canvas, clipping);
         }
         let iou = scratch.canvas.iou(&outline.normalised);
         sum += if closeness == 0.0 {
@@ -651,8 +649,14 @@ fn lay_clips(outlines: &[Outline], cut: &Plant, scratch: &mut Scratch) -> bool {
         views,
         lies,
         partial,
+        clipping,
         ..
     } = scratch;
+    clipping.blades.clear();
+    clipping
+        .blades
+        .extend(cut.organs().iter().map(blade_corners));
+    let blades = &clipping.blades;
     clips.clear();
     draws.clear();
     views.resize_with(outlines.len(), || Bitmap::new(0, 0));
@@ -678,18 +682,24 @@ fn lay_clips(outlines: &[Outline], cut: &Plant, scratch: &mut Scratch) -> bool {
         }
         // How each leaf lies over the outlines so laid: the same from every view.
         lies.clear();
-        lies.extend(cut.organs().iter().map(|o| match o.kind {
-            OrganKind::RootTip => Lie::Gone,
-            OrganKind::Flower => Lie::Whole,
-            OrganKind::Leaf => match looks(&blade_corners(o), outlines, clips, None) {
-                None => Lie::Gone,
-                Some(0) => Lie::Whole,
-                Some(_) => Lie::Partly,
-            },
-        }));
+        lies.extend(
+            cut.organs()
+                .iter()
+                .zip(blades)
+                .map(|(o, blade)| match o.kind {
+                    OrganKind::RootTip => Lie::Gone,
+                    OrganKind::Flower => Lie::Whole,
+                    OrganKind::Leaf => match looks(blade, outlines, clips, None) {
+                        None => Lie::Gone,
+                        Some(0) => Lie::Whole,
+                        Some(_) => Lie::Partly,
+                    },
+                }),
+        );
         let mut settled = true;
         for (view, draw) in draws.iter_mut().enumerate() {
-            let Some(frame) = clipped_frame(cut, view, outlines, clips, lies, partial) else {
+            let Some(frame) = clipped_frame(cut, blades, view, outlines, clips, lies, partial)
+            else {
                 return false;
             };
             settled &= frame.within(draw, SETTLED_PIXELS);
@@ -700,7 +710,7 @@ fn lay_clips(outlines: &[Outline], cut: &Plant, scratch: &mut Scratch) -> bool {
         }
     }
     for (view, (draw, canvas)) in draws.iter().zip(views.iter_mut()).enumerate() {
-        draw_clipped(cut, view, outlines, clips, *draw, canvas);
+        draw_clipped(cut, view, outlines, clips, *draw, canvas, clipping);
     }
     true
 }
@@ -728,8 +738,8 @@ enum Lie {
 /// Draws `plant` seen as `outlines[view]` sees it, in frame `draw`, into `canvas`: stems
 /// and flowers whole, each leaf pixel where the blade's point under its centre lies on the
 /// ink of every outline laid in its frame of `clips`. Blades that lie wholly on an
-/// outline's ink skip its look pixel by pixel (its summed-area table tells), and where
-/// the view is drawn in the frame its own outline is laid in, its ink masks the spans.
+/// outline's ink skip its look pixel by pixel, and where the view is drawn in the frame its
+/// own outline is laid in, its ink masks the spans.
 fn draw_clipped(
     plant: &Plant,
     view: usize,
@@ -737,7 +747,13 @@ fn draw_clipped(
     clips: &[Frame],
     draw: Frame,
     canvas: &mut Bitmap,
+    clipping: &mut Clipping,
 ) {
+    let Clipping {
+        blades,
+        maps,
+        partly,
+    } = clipping;
     let own = &outlines[view];
     let side = own.side;
     let mask = (clips[view] == draw).then_some(&own.normalised);
@@ -749,44 +765,121 @@ fn draw_clipped(
     {
         fill_quad(canvas, stem_band(s, side).map(|p| draw.on_canvas(p)));
     }
-    for o in plant.organs() {
-        match o.kind {
-            OrganKind::RootTip => {}
-            OrganKind::Flower => {
-                fill_blade(
-                    canvas,
-                    blade_corners(o).map(|p| draw.on_canvas(side.project(p))),
-                );
-            }
-            OrganKind::Leaf => {
-                let corners = blade_corners(o);
-                let Some(checks) = looks(&corners, outlines, clips, mask.map(|_| view)) else {
-                    continue;
-                };
-                let quad = corners.map(|p| draw.on_canvas(side.project(p)));
-                if checks == 0 {
-                    match mask {
-                        Some(mask) => {
-                            fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
-                                canvas.fill_span_masked(row, x0, x1, mask)
-                            })
-                        }
-                        None => fill_blade(canvas, quad),
-                    }
-                    continue;
-                }
-                let on_blade = BladeMap::new(&corners, quad);
+    // Whole blades first: a pixel they ink needs no look when a leaf partly over sky
+    // covers it too.
+    partly.clear();
+    for (i, (o, corners)) in plant.organs().iter().zip(blades.iter()).enumerate() {
+        let checks = match o.kind {
+            OrganKind::RootTip => continue,
+            OrganKind::Flower => 0,
+            OrganKind::Leaf => match looks(corners, outlines, clips, mask.map(|_| view)) {
+                Some(checks) => checks,
+                None => continue,
+            },
+        };
+        let quad = corners.map(|p| draw.on_canvas(side.project(p)));
+        match (checks, mask) {
+            (0, Some(mask)) if o.kind == OrganKind::Leaf => {
                 fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
-                    // Only the pixels not yet inked (and on the own outline's ink, where
-                    // it is laid here) need a look, a word at a time.
-                    canvas.for_each_open(row, x0, x1, mask, |x| {
-                        let p = on_blade.at(Vec2::new(x as f32 + 0.5, row as f32 + 0.5));
-                        inside_clips(p, outlines, clips, checks)
-                    });
-                });
+                    canvas.fill_span_masked(row, x0, x1, mask)
+                })
             }
+            (0, _) => fill_blade(canvas, quad),
+            _ => partly.push((i as u32, checks)),
         }
     }
+    for &(i, checks) in partly.iter() {
+        let corners = &blades[i as usize];
+        let quad = corners.map(|p| draw.on_canvas(side.project(p)));
+        draw_partly(canvas, corners, quad, outlines, clips, checks, mask, maps);
+    }
+}
+
+/// Draws into `canvas` the pixels of a blade with `corners`, seen at `quad` on it, whose
+/// blade point lies below the ground or on the ink of each outline `checks` names (a bit
+/// each), laid in its frame of `clips`; only pixels that `mask` inks, if given.
+#[allow(clippy::too_many_arguments)] // The pieces of `draw_clipped`'s loop, kept apart.
+fn draw_partly(
+    canvas: &mut Bitmap,
+    corners: &[Vec3; 4],
+    quad: [Vec2; 4],
+    outlines: &[Outline],
+    clips: &[Frame],
+    checks: u32,
+    mask: Option<&Bitmap>,
+    maps: &mut Vec<(usize, CanvasMap)>,
+) {
+    let Some(on_blade) = BladeMap::new(corners, quad) else {
+        // Seen edge on: its middle stands for the blade.
+        if inside_clips((corners[0] + corners[2]) * 0.5, outlines, clips, checks) {
+            fill_blade(canvas, quad);
+        }
+        return;
+    };
+    maps.clear();
+    maps.extend(
+        (outlines.iter().zip(clips).enumerate())
+            .filter(|(w, _)| checks >> w & 1 == 1)
+            .map(|(w, (o, clip))| (w, on_blade.on(o, clip))),
+    );
+    fill_quad_spans(canvas, quad, false, |canvas, row, x0, x1| {
+        let y = row as f32 + 0.5;
+        canvas.ink_open(row, x0, x1, mask, |base, open| {
+            // The pixels from the first open one to the last are looked at as a whole
+            // first: most often they lie wholly on the ink or the sky of the other
+            // outlines.
+            let (first, last) = (open.trailing_zeros(), 63 - open.leading_zeros());
+            let ends = [first, last].map(|bit| Vec2::new((base + bit) as f32 + 0.5, y));
+            let looks = match run_looks(&ends, &on_blade, maps, outlines) {
+                None => return 0,
+                Some(0) => return open,
+                Some(looks) => looks,
+            };
+            let mut inked = 0;
+            let mut left = open;
+            while left != 0 {
+                let bit = left.trailing_zeros();
+                left &= left - 1;
+                let q = Vec2::new((base + bit) as f32 + 0.5, y);
+                let on = on_blade.at(q).y <= 0.0
+                    || (maps.iter())
+                        .filter(|(w, _)| looks >> w & 1 == 1)
+                        .all(|(w, map)| outlines[*w].ink_at(map.at(q)));
+                inked |= u64::from(on) << bit;
+            }
+            inked
+        });
+    });
+}
+
+/// Which of the outlines in `maps` (a bit each) must be looked at pixel by pixel along the
+/// run of canvas points from `ends[0]` to `ends[1]` of a blade: none when the blade's
+/// points there lie below the ground or on the ink of all of them; `None` when they lie
+/// above the ground and over one's sky.
+fn run_looks(
+    ends: &[Vec2; 2],
+    on_blade: &BladeMap,
+    maps: &[(usize, CanvasMap)],
+    outlines: &[Outline],
+) -> Option<u32> {
+    let [low, high] = ends.map(|q| on_blade.at(q).y);
+    if low.max(high) <= 0.0 {
+        return Some(0);
+    }
+    let mut looks = 0;
+    for &(w, map) in maps {
+        if low.min(high) <= 0.0 {
+            looks |= 1 << w;
+            continue;
+        }
+        let [a, b] = ends.map(|q| map.at(q));
+        match outlines[w].cover(a.min(b), a.max(b)) {
+            Cover::None => return None,
+            Cover::All => {}
+            Cover::Some => looks |= 1 << w,
+        }
+    }
+    Some(looks)
 }
 
 /// Which of `outlines` (laid in `clips`) must be looked at point by point to clip a blade
@@ -829,41 +922,72 @@ fn inside_clips(p: Vec3, outlines: &[Outline], clips: &[Frame], checks: u32) -> 
 /// From a point of a blade's quadrilateral in a picture back to the blade's point under
 /// it: the blade is flat, so the map is affine.
 struct BladeMap {
-    origin: Vec2,
-    along: Vec2,
-    across: Vec2,
-    det: f32,
-    corner: Vec3,
-    along3: Vec3,
-    across3: Vec3,
+    /// The blade's plane's point seen at the canvas's corner.
+    at: Vec3,
+    /// The blade's point's steps per pixel right and down.
+    right: Vec3,
+    down: Vec3,
 }
 
 impl BladeMap {
-    fn new(corners: &[Vec3; 4], quad: [Vec2; 4]) -> BladeMap {
+    /// `None` when the blade is seen edge on.
+    fn new(corners: &[Vec3; 4], quad: [Vec2; 4]) -> Option<BladeMap> {
         let (along, across) = (quad[1] - quad[0], quad[3] - quad[0]);
-        BladeMap {
-            origin: quad[0],
-            along,
-            across,
-            det: along.perp_dot(across),
-            corner: corners[0],
-            along3: corners[1] - corners[0],
-            across3: corners[3] - corners[0],
+        let det = along.perp_dot(across);
+        if det.abs() < 1e-9 {
+            return None;
         }
+        // The blade's coordinates along and across, s and t, change per pixel by these.
+        let (ds, dt) = (
+            Vec2::new(across.y, -across.x) / det,
+            Vec2::new(-along.y, along.x) / det,
+        );
+        let (along3, across3) = (corners[1] - corners[0], corners[3] - corners[0]);
+        let (right, down) = (
+            along3 * ds.x + across3 * dt.x,
+            along3 * ds.y + across3 * dt.y,
+        );
+        Some(BladeMap {
+            at: corners[0] - right * quad[0].x - down * quad[0].y,
+            right,
+            down,
+        })
     }
 
-    /// The blade's point seen at `q`: its middle when the blade is seen edge on.
+    /// The blade's point seen at `q`.
+    #[inline]
     fn at(&self, q: Vec2) -> Vec3 {
-        let (s, t) = if self.det.abs() < 1e-9 {
-            (0.5, 0.5)
-        } else {
-            let d = q - self.origin;
-            (
-                d.perp_dot(self.across) / self.det,
-                self.along.perp_dot(d) / self.det,
-            )
+        self.at + self.right * q.x + self.down * q.y
+    }
+
+    /// Where the blade's point seen at a canvas point lands on `outline`'s canvas laid in
+    /// `clip`.
+    fn on(&self, outline: &Outline, clip: &Frame) -> CanvasMap {
+        let side = outline.side;
+        let step = |v: Vec3| {
+            let v = side.project(v);
+            Vec2::new(v.x, -v.y) * clip.scale
         };
-        self.corner + self.along3 * s.clamp(0.0, 1.0) + self.across3 * t.clamp(0.0, 1.0)
+        CanvasMap {
+            at: clip.on_canvas(side.project(self.at)),
+            right: step(self.right),
+            down: step(self.down),
+        }
+    }
+}
+
+/// An affine map between canvas points.
+#[derive(Clone, Copy, Debug)]
+struct CanvasMap {
+    at: Vec2,
+    right: Vec2,
+    down: Vec2,
+}
+
+impl CanvasMap {
+    #[inline]
+    fn at(&self, q: Vec2) -> Vec2 {
+        self.at + self.right * q.x + self.down * q.y
     }
 }
 
@@ -947,51 +1071,58 @@ fn clip_leaf_where(
     let reach = 0.5 * (tip.y.abs() / along as f32 + width.y.abs() / across as f32);
     let mut rows = [0u64; MAX_CELLS as usize];
     let (step_along, step_across) = (tip / along as f32, width / across as f32);
-    // Blocks of 8 by 8 cells none of which `wanted` holds for are passed over whole (the
-    // callers' tests hold for a box when they hold for a cell in it).
-    let block = |i: u32, j: u32| {
-        let corner = a + step_along * i as f32 + step_across * j as f32;
-        let (n, m) = (8.min(along - i) as f32, 8.min(across - j) as f32);
-        wanted(&[
-            corner,
-            corner + step_along * n,
-            corner + step_along * n + step_across * m,
-            corner + step_across * m,
-        ])
-    };
-    let mut blocks = 0u8;
-    for (j, row) in rows.iter_mut().enumerate().take(across as usize) {
-        let j = j as u32;
-        if j.is_multiple_of(8) {
-            blocks = 0;
-            for b in 0..along.div_ceil(8) {
-                blocks |= u8::from(block(b * 8, j)) << b;
-            }
-        }
-        let mut i = 0;
-        while i < along {
-            if i.is_multiple_of(8) && blocks >> (i / 8) & 1 == 0 {
-                i += 8;
-                continue;
-            }
-            i += 1;
-            let i = i - 1;
-            let corner = a + step_along * i as f32 + step_across * j as f32;
-            let cell = [
+    let middle =
+        |i: u32, j: u32| a + step_along * (i as f32 + 0.5) + step_across * (j as f32 + 0.5);
+    // The cells are looked at in blocks of up to 8 by 8. A block `wanted` does not hold
+    // for is passed over (the callers' tests hold for a box when they hold for a cell in
+    // it); so is one whose middles all lie above the ground over an outline's sky, and one
+    // whose middles all lie on every outline's ink is kept whole.
+    for j0 in (0..across).step_by(8) {
+        for i0 in (0..along).step_by(8) {
+            let (n, m) = (8.min(along - i0), 8.min(across - j0));
+            let corner = a + step_along * i0 as f32 + step_across * j0 as f32;
+            let (far_along, far_across) = (step_along * n as f32, step_across * m as f32);
+            if !wanted(&[
                 corner,
-                corner + step_along,
-                corner + step_along + step_across,
-                corner + step_across,
-            ];
-            if !wanted(&cell) {
+                corner + far_along,
+                corner + far_along + far_across,
+                corner + far_across,
+            ]) {
                 continue;
             }
-            let mut p = corner + (step_along + step_across) * 0.5;
-            if p.y <= 0.0 && p.y + reach > 0.0 {
-                p.y = (p.y + reach) * 0.5;
+            let middles = [(0, 0), (n - 1, 0), (n - 1, m - 1), (0, m - 1)]
+                .map(|(i, j)| middle(i0 + i, j0 + j));
+            let bits = (u64::MAX >> (64 - n)) << i0;
+            let keep_all = |rows: &mut [u64; MAX_CELLS as usize]| {
+                rows[j0 as usize..(j0 + m) as usize]
+                    .iter_mut()
+                    .for_each(|r| *r |= bits);
+            };
+            if middles.iter().all(|p| p.y + reach <= 0.0) {
+                // Below the ground, where the outline does not look.
+                keep_all(&mut rows);
+                continue;
             }
-            if inside_clips(p, outlines, clips, u32::MAX) {
-                *row |= 1 << i;
+            if middles.iter().all(|p| p.y > 0.0) {
+                match block_cover(&middles, outlines, clips) {
+                    Cover::None => continue,
+                    Cover::All => {
+                        keep_all(&mut rows);
+                        continue;
+                    }
+                    Cover::Some => {}
+                }
+            }
+            for j in j0..j0 + m {
+                for i in i0..i0 + n {
+                    let mut p = middle(i, j);
+                    if p.y <= 0.0 && p.y + reach > 0.0 {
+                        p.y = (p.y + reach) * 0.5;
+                    }
+                    if inside_clips(p, outlines, clips, u32::MAX) {
+                        rows[j as usize] |= 1 << i;
+                    }
+                }
             }
         }
     }
@@ -1000,6 +1131,25 @@ fn clip_leaf_where(
         across,
         rows,
     })
+}
+
+/// How the points with corners `points` (a flat quadrilateral's) lie over `outlines` laid
+/// in `clips`: on the sky of one, on the ink of all, or some of each.
+fn block_cover(points: &[Vec3; 4], outlines: &[Outline], clips: &[Frame]) -> Cover {
+    let mut all = true;
+    for (outline, clip) in outlines.iter().zip(clips) {
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for &p in points {
+            let q = clip.on_canvas(outline.side.project(p));
+            (lo, hi) = (lo.min(q), hi.max(q));
+        }
+        match outline.cover(lo, hi) {
+            Cover::None => return Cover::None,
+            Cover::All => {}
+            Cover::Some => all = false,
+        }
+    }
+    if all { Cover::All } else { Cover::Some }
 }
 
 /// Passes to `keep` what of leaf `o` lies on the ink of every outline laid in its frame
@@ -1113,8 +1263,10 @@ fn tile_pieces(
 /// on ink set a first box; the cells of the leaves partly over sky (listed in `partial`)
 /// are looked at only where their blade reaches past the box so far. `None` when nothing
 /// shows.
+#[allow(clippy::too_many_arguments)] // Its scratch, borrowed apart from the rest.
 fn clipped_frame(
     cut: &Plant,
+    blades: &[[Vec3; 4]],
     view: usize,
     outlines: &[Outline],
     clips: &[Frame],
@@ -1131,10 +1283,10 @@ fn clipped_frame(
         add(&stem_band(s, side), &mut lo, &mut hi);
     }
     partial.clear();
-    for (i, (o, lie)) in cut.organs().iter().zip(lies).enumerate() {
+    for (i, (blade, lie)) in blades.iter().zip(lies).enumerate() {
         match lie {
             Lie::Gone => {}
-            Lie::Whole => add(&blade_corners(o).map(|p| side.project(p)), &mut lo, &mut hi),
+            Lie::Whole => add(&blade.map(|p| side.project(p)), &mut lo, &mut hi),
             Lie::Partly => partial.push((0.0, i as u32)),
         }
     }
@@ -1143,7 +1295,7 @@ fn clipped_frame(
     // The leaves whose part above the ground reaches furthest first: the box grows
     // fastest, and fewer are left.
     for (far, i) in partial.iter_mut() {
-        let blade = blade_corners(&cut.organs()[*i as usize]).map(|p| side.project(p));
+        let blade = blades[*i as usize].map(|p| side.project(p));
         *far = 0.0;
         above_ground(&blade, |p| *far = far.max(past(p, lo, hi)));
     }
@@ -1173,8 +1325,44 @@ fn clipped_frame(
                 ),
                 LeafClip::Cells(cells) => {
                     for j in 0..cells.across {
-                        for i in (0..cells.along).filter(|i| cells.rows[j as usize] >> i & 1 == 1) {
-                            let cell = Cells::corners(tile, (i, i + 1), (j, j + 1), &cells);
+                        let row = cells.rows[j as usize];
+                        if row == 0 {
+                            continue;
+                        }
+                        // The cells of a row are steps along a line: where all of them
+                        // between its first and last kept one stand above the ground,
+                        // those two reach furthest every way.
+                        // Heights change evenly along the row too: the cells wholly above
+                        // the ground, those across it and those below it lie in three runs.
+                        let cell = |i: u32| Cells::corners(tile, (i, i + 1), (j, j + 1), &cells);
+                        let (first, last) = (row.trailing_zeros(), 63 - row.leading_zeros());
+                        let ends = [first, last].map(cell);
+                        if ends.iter().flatten().all(|p| p.y >= 0.0) {
+                            for cell in &ends {
+                                add(&cell.map(|p| side.project(p)), &mut lo, &mut hi);
+                            }
+                            continue;
+                        }
+                        if ends.iter().flatten().all(|p| p.y < 0.0) {
+                            continue;
+                        }
+                        let mut above = None;
+                        let mut left = row;
+                        while left != 0 {
+                            let i = left.trailing_zeros();
+                            left &= left - 1;
+                            let corners = cell(i);
+                            if corners.iter().all(|p| p.y < 0.0) {
+                                continue;
+                            }
+                            if corners.iter().all(|p| p.y >= 0.0) {
+                                let (a, _) = above.unwrap_or((corners, corners));
+                                above = Some((a, corners));
+                                continue;
+                            }
+                            add(&corners.map(|p| side.project(p)), &mut lo, &mut hi);
+                        }
+                        for cell in above.iter().flat_map(|(a, b)| [a, b]) {
                             add(&cell.map(|p| side.project(p)), &mut lo, &mut hi);
                         }
                     }
@@ -1234,20 +1422,6 @@ impl Outline {
     }
 }
 
-/// The summed-area table of `bitmap`'s ink ([`Outline::summed`]).
-fn summed_ink(bitmap: &Bitmap) -> Vec<u32> {
-    let (w, h) = (bitmap.width() as usize, bitmap.height() as usize);
-    let mut summed = vec![0u32; (w + 1) * (h + 1)];
-    for y in 0..h {
-        let mut row = 0;
-        for x in 0..w {
-            row += u32::from(bitmap.get(x as u32, y as u32));
-            summed[(y + 1) * (w + 1) + x + 1] = summed[y * (w + 1) + x + 1] + row;
-        }
-    }
-    summed
-}
-
 /// What of a box of canvas pixels an outline inks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Cover {
@@ -1261,22 +1435,38 @@ impl Outline {
     /// what lies off the canvas is sky.
     fn cover(&self, lo: Vec2, hi: Vec2) -> Cover {
         let (w, h) = (self.normalised.width(), self.normalised.height());
-        let clamp = |v: f32, n: u32| (v.max(0.0) as u32).min(n);
-        let (x0, x1) = (clamp(lo.x.floor(), w), clamp(hi.x.floor() + 1.0, w));
-        let (y0, y1) = (clamp(lo.y.floor(), h), clamp(hi.y.floor() + 1.0, h));
-        let pixels = (hi.x.floor() + 1.0 - lo.x.floor()) * (hi.y.floor() + 1.0 - lo.y.floor());
+        // Pixel `v as u32` holds coordinate `v` (truncation is the floor from 0 up).
+        let first = |v: f32, n: u32| (v.max(0.0) as u32).min(n);
+        let end = |v: f32, n: u32| {
+            if v < 0.0 {
+                0
+            } else {
+                (v as u32).saturating_add(1).min(n)
+            }
+        };
+        let (x0, x1) = (first(lo.x, w), end(hi.x, w));
+        let (y0, y1) = (first(lo.y, h), end(hi.y, h));
         if x0 >= x1 || y0 >= y1 {
             return Cover::None;
         }
-        let row = w as usize + 1;
-        let at = |x: u32, y: u32| self.summed[y as usize * row + x as usize];
-        let ink = at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0);
-        if ink == 0 {
-            Cover::None
-        } else if ink as f32 >= pixels {
-            Cover::All
-        } else {
-            Cover::Some
+        // Off the canvas is sky: a box reaching past it is never all ink.
+        let on_canvas = lo.x >= 0.0 && lo.y >= 0.0 && hi.x < w as f32 && hi.y < h as f32;
+        let (mut ink, mut sky) = (false, !on_canvas);
+        let words = &self.normalised.words;
+        for y in y0..y1 {
+            for (at, bits) in self.normalised.span_words(y, x0, x1) {
+                let word = words[at] & bits;
+                ink |= word != 0;
+                sky |= word != bits;
+            }
+            if ink && sky {
+                return Cover::Some;
+            }
+        }
+        match (ink, sky) {
+            (false, _) => Cover::None,
+            (true, false) => Cover::All,
+            (true, true) => Cover::Some,
         }
     }
 }
@@ -1356,6 +1546,19 @@ pub struct Scratch {
     /// The leaves that lie partly over sky, with how far they reach past the box of the
     /// rest ([`clipped_frame`]).
     partial: Vec<(f32, u32)>,
+    /// What [`draw_clipped`] draws from.
+    clipping: Clipping,
+}
+
+/// The corners of a pruned plant's blades, an entry per organ ([`blade_corners`]), and
+/// [`draw_clipped`]'s scratch.
+#[derive(Debug, Default)]
+struct Clipping {
+    blades: Vec<[Vec3; 4]>,
+    /// Where a leaf's blade seen in one view lands on the other outlines.
+    maps: Vec<(usize, CanvasMap)>,
+    /// The leaves partly over sky (index, the outlines to look at as bits).
+    partly: Vec<(u32, u32)>,
 }
 
 impl Default for Scratch {
@@ -1370,6 +1573,7 @@ impl Default for Scratch {
             views: Vec::new(),
             lies: Vec::new(),
             partial: Vec::new(),
+            clipping: Clipping::default(),
         }
     }
 }
@@ -1760,16 +1964,19 @@ fn fill_quad_spans(
     }
     let first = top.max(0.0).floor() as u32;
     let last = (bottom.min(height - 1.0)).floor() as u32;
+    // Each edge from its upper end to its lower.
+    let edges = [0, 1, 2, 3].map(|i| {
+        let (a, b) = (quad[i], quad[(i + 1) % 4]);
+        if a.y <= b.y { (a, b) } else { (b, a) }
+    });
     for row in first..=last {
-        // The quad's extent across this row's band and across its middle line, from its
-        // edges clipped to the band.
+        // The quad's extent across its middle line and (for `thin`) across this row's
+        // band, from its edges clipped to the band.
         let (band_top, band_bottom) = (row as f32, row as f32 + 1.0);
         let middle = row as f32 + 0.5;
         let (mut left, mut right) = (f32::INFINITY, f32::NEG_INFINITY);
         let (mut mid_left, mut mid_right) = (f32::INFINITY, f32::NEG_INFINITY);
-        for i in 0..4 {
-            let (a, b) = (quad[i], quad[(i + 1) % 4]);
-            let (a, b) = if a.y <= b.y { (a, b) } else { (b, a) };
+        for &(a, b) in &edges {
             let (y0, y1) = (a.y.max(band_top), b.y.min(band_bottom));
             if y0 > y1 {
                 continue;
@@ -1783,10 +1990,12 @@ fn fill_quad_spans(
                     b.x
                 }
             };
-            for y in [y0, y1] {
-                let x = at(y);
-                left = left.min(x);
-                right = right.max(x);
+            if thin {
+                for y in [y0, y1] {
+                    let x = at(y);
+                    left = left.min(x);
+                    right = right.max(x);
+                }
             }
             if (y0..=y1).contains(&middle) && b.y > a.y {
                 let x = at(middle);
@@ -1794,14 +2003,11 @@ fn fill_quad_spans(
                 mid_right = mid_right.max(x);
             }
         }
-        if left > right {
-            continue;
-        }
         let x0 = (mid_left - 0.5).ceil().max(0.0);
         let x1 = (mid_right - 0.5).floor() + 1.0;
         let (x0, x1) = if mid_left <= mid_right && x1 > x0 {
             (x0, x1)
-        } else if !thin {
+        } else if !thin || left > right {
             continue;
         } else {
             let mid = ((left + right) * 0.5).floor().max(0.0);
