@@ -155,16 +155,8 @@ impl Grown {
     /// without the roots unless kept, the pipe model's radii with a taper, and a wind skin
     /// and clip with wind (meshed once, recording where each vertex came from).
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
-        let seed = options.seed.unwrap_or_else(|| genome.default_seed());
+        let (seed, plant) = Grown::plant(&genome, options)?;
         let (roots, taper) = (options.roots, options.taper);
-        let mut plant = genome.develop(seed)?;
-        if let Some(outlines) = &options.pruned_to {
-            plant = prune(outlines, &plant);
-        }
-        let mut plant = finish(plant, roots, taper);
-        if let Some(height) = options.height {
-            scale_to_height(&mut plant, height)?;
-        }
         let mut mesher = Mesher::new(mesh_options(genome.mesh_hint()))?;
         let (mesh, rig) = match &options.wind {
             None => (mesher.mesh(&plant)?, None),
@@ -184,6 +176,21 @@ impl Grown {
             rig,
             height: options.height,
         })
+    }
+
+    /// The plant [`Grown::grow`] meshes, with the seed it was grown with: grown, pruned,
+    /// finished and scaled as `options` say.
+    pub fn plant(genome: &Genome, options: &GrowOptions) -> Result<(u64, Plant), Error> {
+        let seed = options.seed.unwrap_or_else(|| genome.default_seed());
+        let mut plant = genome.develop(seed)?;
+        if let Some(outlines) = &options.pruned_to {
+            plant = prune(outlines, &plant);
+        }
+        let mut plant = finish(plant, options.roots, options.taper);
+        if let Some(height) = options.height {
+            scale_to_height(&mut plant, height)?;
+        }
+        Ok((seed, plant))
     }
 
     /// A scene holding this plant at the origin, carrying its origin (and its taper, so
