@@ -10,6 +10,9 @@
 //!   [`TreeMeasures`].
 //! - [`hull`]: the volume of a cloud of points' convex hull (a crown's envelope).
 //! - [`taper`]: the pipe model's radii for any grown plant.
+//! - [`species`]: kinds of foliage and bark with real sizes, and the [`species::Surface`]
+//!   a material may carry.
+//! - [`dress`]: puts leaves or needles of a kind, and a bark, on any grown plant.
 //! - [`budget`]: the memory a job may use (from the limits the process runs under) and the
 //!   time it may take, checked before the work starts.
 //! - [`hash`]: a stable hash for genome fingerprints.
@@ -37,6 +40,7 @@
 //! ```
 
 pub mod budget;
+pub mod dress;
 pub mod environment;
 pub mod hash;
 pub mod hull;
@@ -46,6 +50,7 @@ pub mod par;
 pub mod plant;
 pub mod ranged;
 pub mod rng;
+pub mod species;
 pub mod taper;
 pub mod turtle;
 

@@ -22,6 +22,8 @@ use glam::{Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::species::Surface;
+
 /// Index of a segment in [`Plant::segments`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct SegmentId(pub u32);
@@ -167,6 +169,10 @@ pub struct Material {
     pub color: [f32; 3],
     /// Texture id, if the model uses textures.
     pub texture: Option<u16>,
+    /// A surface Sylva draws itself (alpha-cut leaf cards, petals, tiling bark), put on by
+    /// [`crate::dress`]; `None` (the default, and left out of files) keeps the look above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<Surface>,
 }
 
 impl Material {
@@ -177,6 +183,7 @@ impl Material {
             kind,
             color: kind.default_color(),
             texture: None,
+            surface: None,
         }
     }
 }

@@ -23,8 +23,10 @@ use std::collections::{HashMap, HashSet};
 
 use serde_json::Value;
 use sylva_core::glam::{Mat3, Mat4, Quat, Vec3};
+use sylva_core::species::Surface;
 use sylva_core::{Material, MaterialKind};
 use sylva_mesh::mesh::{Mesh, Primitive};
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::{Scene, SceneNode};
 
 /// Most shades one primitive's `COLOR_0` is split into; triangles of further shades keep
@@ -116,7 +118,12 @@ pub fn texture_ids(bytes: &[u8]) -> Result<Vec<u16>, ImportError> {
     let mut ids: Vec<u16> = reader
         .list("materials")
         .iter()
-        .filter_map(|m| reader.sylva_texture(&m["pbrMetallicRoughness"]["baseColorTexture"]))
+        .filter_map(|m| {
+            match reader.sylva_picture(&m["pbrMetallicRoughness"]["baseColorTexture"]) {
+                Some(Picture::Design(id)) => Some(id),
+                _ => None,
+            }
+        })
         .collect();
     ids.sort_unstable();
     ids.dedup();
@@ -522,27 +529,33 @@ impl Reader<'_> {
             .unwrap_or(MaterialKind::Bark);
         let factor = &m["pbrMetallicRoughness"]["baseColorFactor"];
         let channel = |i: usize| factor[i].as_f64().map_or(0.8, |v| v.clamp(0.0, 1.0) as f32);
+        // A surface Sylva wrote is read back from the extras; a picture from its name.
+        let surface =
+            serde_json::from_value::<Surface>(m["extras"][crate::export::SURFACE_EXTRA].clone())
+                .ok();
+        let picture = self.sylva_picture(&m["pbrMetallicRoughness"]["baseColorTexture"]);
+        let texture = match picture {
+            Some(Picture::Design(id)) | Some(Picture::Petal(Some(id))) => Some(id),
+            _ => None,
+        };
         Ok(Material {
             name,
             kind,
             color: [channel(0), channel(1), channel(2)],
-            texture: self.sylva_texture(&m["pbrMetallicRoughness"]["baseColorTexture"]),
+            texture,
+            surface,
         })
     }
 
-    /// The Sylva texture id behind a texture reference, if its image is one of Sylva's.
-    fn sylva_texture(&self, info: &Value) -> Option<u16> {
+    /// The Sylva picture behind a texture reference, if its image is one of Sylva's.
+    fn sylva_picture(&self, info: &Value) -> Option<Picture> {
         let texture = self
             .list("textures")
             .get(info["index"].as_u64()? as usize)?;
         let image = self
             .list("images")
             .get(texture["source"].as_u64()? as usize)?;
-        image["name"]
-            .as_str()?
-            .strip_prefix(crate::export::IMAGE_NAME_PREFIX)?
-            .parse()
-            .ok()
+        Picture::from_name(image["name"].as_str()?)
     }
 
     /// The bytes of an accessor's elements: (data from the first element, stride, count).
@@ -890,6 +903,57 @@ mod tests {
         bare.materials[0].texture = Some(4);
         let glb = to_glb(&Scene::single(SceneNode::new("b", &bare))).unwrap();
         assert_eq!(read_glb(&glb).unwrap().meshes[0].1.uvs, [[0.0; 2]; 3]);
+    }
+
+    #[test]
+    fn surfaces_are_written_as_cut_outs_and_bark_and_read_back() {
+        use sylva_core::species::{BarkKind, LeafKind, Surface};
+        let mut mesh = crate::export::tests::small_mesh();
+        let surfaces = [
+            Surface::Bark(BarkKind::Plated),
+            Surface::Branchlets(LeafKind::Maple),
+            Surface::Petals,
+        ];
+        for (m, s) in mesh.materials.iter_mut().zip(surfaces) {
+            m.surface = Some(s);
+        }
+        mesh.materials[2].texture = Some(7);
+        let glb = to_glb(&Scene::single(SceneNode::new("p", &mesh))).unwrap();
+        let (json, _) = crate::export::glb::tests::chunks(&glb);
+        let materials = json["materials"].as_array().unwrap();
+        // Bark: its tiling picture and a normal map, opaque and one-sided.
+        assert!(materials[0]["normalTexture"]["index"].is_u64());
+        assert!(materials[0].get("alphaMode").is_none());
+        assert!(materials[0].get("doubleSided").is_none());
+        for cut in &materials[1..] {
+            assert_eq!(cut["alphaMode"], "MASK");
+            assert_eq!(cut["alphaCutoff"], 0.5);
+            assert_eq!(cut["doubleSided"], true);
+        }
+        let images: Vec<&str> = json["images"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|i| i["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            images,
+            [
+                "sylva-bark-plated",
+                "sylva-bark-plated-normal",
+                "sylva-leaves-maple",
+                "sylva-petal-7"
+            ]
+        );
+        let back = read_glb(&glb).unwrap();
+        let read: Vec<_> = back.meshes[0]
+            .1
+            .materials
+            .iter()
+            .map(|m| m.surface)
+            .collect();
+        assert_eq!(read, surfaces.map(Some));
+        assert_eq!(back.meshes[0].1.materials[2].texture, Some(7));
     }
 
     #[test]

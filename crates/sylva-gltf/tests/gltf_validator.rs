@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::json;
+use sylva_core::dress::{Dress, dress};
 use sylva_core::glam::{Quat, Vec2, Vec3};
+use sylva_core::species::LeafKind;
 use sylva_core::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantMeta};
 use sylva_gltf::export::write_scene;
 use sylva_mesh::mesher::{MeshOptions, mesh_plant};
@@ -160,7 +162,25 @@ fn written_glbs_pass_the_khronos_validator() {
         },
     );
 
-    // Past 65 535 vertices: 32-bit indices.    // Past 65 535 vertices: 32-bit indices.
+    // Realism surfaces: leaf cards cut out by alpha (MASK, double-sided) in shades merged
+    // into vertex colours, petals cut to shape, tiling bark with its normal map; a broadleaf
+    // of flat cards and a conifer of crossed ones.
+    let dressed: Vec<(&str, Mesh)> = [("oak", LeafKind::Oak), ("pine", LeafKind::Pine)]
+        .into_iter()
+        .map(|(name, kind)| {
+            let (plant, report) = dress(&tree_with_organs(), &Dress::foliage(kind), 1).unwrap();
+            assert!(report.cards > 0);
+            (name, mesh(&plant))
+        })
+        .collect();
+    for (name, mesh) in &dressed {
+        write(
+            &format!("dressed-{name}.glb"),
+            &Scene::single(SceneNode::new(*name, mesh)),
+        );
+    }
+
+    // Past 65 535 vertices: 32-bit indices.
     let big = mesh(&sylva_testkit::binary_tree(8, 12));
     assert!(big.vertex_count() > 65_535, "{}", big.vertex_count());
     write("big.glb", &Scene::single(SceneNode::new("big", &big)));

@@ -7,6 +7,10 @@
 //!   with texture coordinates).
 //! - [`scene`]: [`Scene`], meshes placed in the world with their origin data.
 //! - [`texture`]: bark, leaf and petal textures generated from a material's texture id.
+//! - [`atlas`]: leaf and needle atlases and petal cut-outs (grey and alpha) for cards.
+//! - [`bark`]: tiling bark colour textures and normal maps, one pair per bark kind.
+//! - [`picture`]: which picture a material shows ([`picture::Picture`]), made and encoded
+//!   once per process, for every writer and the renderer alike.
 //! - [`wind`]: a skin and a looping sway clip for a meshed plant, carried by a
 //!   [`SceneNode`] to the GLB writer.
 //!
@@ -18,8 +22,11 @@
 //!
 //! A mesh never knows which model made the plant.
 
+pub mod atlas;
+pub mod bark;
 pub mod mesh;
 pub mod mesher;
+pub mod picture;
 pub mod scene;
 pub mod texture;
 pub mod wind;

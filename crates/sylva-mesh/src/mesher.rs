@@ -59,6 +59,16 @@
 //!   flower's diameter and `size.y` a petal's greatest width.
 //! - **Root tips** are small smooth-shaded octahedra from the base up local +Y: `size.x`
 //!   long, `size.y` wide.
+//! - **Cards.** A leaf whose material has a [`Surface::Leaves`] is a card instead: one quad
+//!   from its base up local +Y (`size.x` long, `size.y` wide, facing local +Z), or two
+//!   crossed at right angles for kinds that read better so (needle tufts), one-sided (the
+//!   material is drawn from both sides), showing atlas cell [`card_variant`] of the kind
+//!   ([`crate::atlas::card_uvs`]). A flower whose material has [`Surface::Petals`] is a star
+//!   of such one-sided petal cards ([`crate::atlas::PETAL_UVS`]) in place of the diamonds.
+//! - **Bark surfaces.** A tube whose first segment's material has a [`Surface::Bark`] runs
+//!   its texture `u` round the stem as many whole times as the bark's tile fits its
+//!   circumference ([`crate::bark::tile_metres`]), and `v` as many times faster, so the bark
+//!   keeps its real scale on trunks and twigs alike.
 //! - **Texture coordinates** (see [`crate::texture`] for the textures). Tubes: `u = k / R`
 //!   around ring vertex `k` (0 to 1 at the seam, which the rotation-minimising frames keep
 //!   in a straight line along the axis), and `v` the arc length along the axis divided by
@@ -81,12 +91,15 @@
 
 use std::f32::consts::{PI, TAU};
 
+use sylva_core::species::{LeafKind, Surface};
 use sylva_core::{
     OrganKind, Plant,
     glam::{Quat, Vec3},
 };
 use thiserror::Error;
 
+use crate::atlas::{self, card_uvs};
+use crate::bark;
 use crate::mesh::{Mesh, Primitive};
 
 /// How a plant is meshed. Every field documents its default.
@@ -294,9 +307,9 @@ impl RingTables {
         }
     }
 
-    /// Appends a ring's vertices, at texture `v`.
+    /// Appends a ring's vertices, at texture `v`, its `u` running `repeats` times round.
     #[inline]
-    fn ring(&self, ring: &Ring, v: f32, out: &mut Mesh) {
+    fn ring(&self, ring: &Ring, v: f32, repeats: f32, out: &mut Mesh) {
         let Ring {
             center,
             pu,
@@ -315,7 +328,12 @@ impl RingTables {
                 .iter()
                 .map(|&(c, s)| (nu * c + nv * s + nt).to_array()),
         );
-        out.uvs.extend(self.ring_u.iter().map(|&u| [u, v]));
+        if repeats == 1.0 {
+            out.uvs.extend(self.ring_u.iter().map(|&u| [u, v]));
+        } else {
+            out.uvs
+                .extend(self.ring_u.iter().map(|&u| [u * repeats, v]));
+        }
     }
 }
 
@@ -643,10 +661,17 @@ impl Mesher {
         let n = u64::from(self.options.leaf_stations);
         let p = u64::from(self.options.flower_petals);
         for o in plant.organs() {
-            let (v, t) = match o.kind {
-                OrganKind::Leaf => (4 * n + 4, 4 * n),
-                OrganKind::Flower => (8 * p, 4 * p),
-                OrganKind::RootTip => (ROOT_TIP_VERTICES, ROOT_TIP_TRIANGLES),
+            let surface = plant.materials()[o.material.index()].surface;
+            let (v, t) = match (o.kind, surface) {
+                (OrganKind::Leaf, Some(s)) if s.leaves().is_some() => {
+                    let kind = s.leaves().map_or(LeafKind::Oak, |(k, _)| k);
+                    let quads = if kind.spec().crossed { 2 } else { 1 };
+                    (4 * quads, 2 * quads)
+                }
+                (OrganKind::Flower, Some(Surface::Petals)) => (4 * p, 2 * p),
+                (OrganKind::Leaf, _) => (4 * n + 4, 4 * n),
+                (OrganKind::Flower, _) => (8 * p, 4 * p),
+                (OrganKind::RootTip, _) => (ROOT_TIP_VERTICES, ROOT_TIP_TRIANGLES),
             };
             vertices += v;
             triangles += t;
@@ -705,9 +730,18 @@ impl Mesher {
             self.cap(tables, &ring, -n_prev, first.material.index(), true, out);
         }
         let mut base = out.positions.len() as u32;
-        // Texture v: metres along the axis over the circumference there (see the docs).
+        // A bark surface repeats its tile round the stem as often as its width allows.
+        let repeats = match plant.materials()[first.material.index()].surface {
+            Some(Surface::Bark(kind)) => {
+                let around = TAU * first.start_radius / bark::tile_metres(kind);
+                around.round().clamp(1.0, 64.0)
+            }
+            _ => 1.0,
+        };
+        // Texture v: metres along the axis over the circumference there, per repeat (see
+        // the docs).
         let (mut tex_v, mut r_prev) = (0.0f32, first.start_radius);
-        tables.ring(&ring, tex_v, out);
+        tables.ring(&ring, tex_v, repeats, out);
         mark(sources, out, start as u32);
 
         let mut cur = start;
@@ -744,8 +778,8 @@ impl Mesher {
             let u = transport(x_prev, n_prev, u_prev, x, n);
             ring = Ring::new(x, n, u, radius, slope, stretch);
             let circumference = TAU * (0.5 * (r_prev + radius)).max(MIN_UV_RADIUS);
-            tex_v += (x - x_prev).length() / circumference;
-            tables.ring(&ring, tex_v, out);
+            tex_v += (x - x_prev).length() * repeats / circumference;
+            tables.ring(&ring, tex_v, repeats, out);
             mark(sources, out, cur as u32);
             let slot = self.slots[seg.material.index()] as usize;
             out.primitives[slot]
@@ -835,15 +869,66 @@ impl Mesher {
 
     /// Appends every organ.
     fn organs(&self, plant: &Plant, out: &mut Mesh, sources: &mut Option<VertexSources>) {
-        for o in plant.organs() {
+        for (i, o) in plant.organs().iter().enumerate() {
             let source = ORGAN_SOURCE | o.parent.map_or(NO_SEGMENT, |p| p.0.min(NO_SEGMENT));
             // A plant's orientations are unit quaternions; normalising removes rounding.
             let q = o.orientation.normalize();
             let slot = self.slots[o.material.index()] as usize;
             let base = out.positions.len() as u32;
             let (length, width) = (o.size.x, o.size.y);
-            match o.kind {
-                OrganKind::Leaf => {
+            let surface = plant.materials()[o.material.index()].surface;
+            match (o.kind, surface.and_then(Surface::leaves)) {
+                (OrganKind::Leaf, Some((kind, card))) => {
+                    let (x, y, z) = (q * Vec3::X, q * Vec3::Y, q * Vec3::Z);
+                    let uvs = card_uvs(card, card_variant(i));
+                    let quad = |across: Vec3, normal: Vec3, out: &mut Mesh| {
+                        let b = out.positions.len() as u32;
+                        let half = across * (0.5 * width);
+                        let tip = y * length;
+                        for c in [-half, half, tip + half, tip - half] {
+                            out.positions.push((o.position + c).to_array());
+                        }
+                        out.normals
+                            .extend([normal.normalize_or(Vec3::Y).to_array(); 4]);
+                        out.uvs.extend_from_slice(&uvs);
+                        out.primitives[slot].indices.extend_from_slice(&[
+                            b,
+                            b + 1,
+                            b + 2,
+                            b,
+                            b + 2,
+                            b + 3,
+                        ]);
+                    };
+                    quad(x, z, out);
+                    if kind.spec().crossed {
+                        quad(z, -x, out);
+                    }
+                }
+                (OrganKind::Flower, _) if surface == Some(Surface::Petals) => {
+                    let reach = 0.5 * length;
+                    for petal in &self.petals {
+                        let dir = q * petal.dir * reach;
+                        let half = q * petal.side * (0.5 * width);
+                        let normal = (q * petal.normal).normalize_or(Vec3::Y).to_array();
+                        let b = out.positions.len() as u32;
+                        let c = o.position;
+                        for p in [c - half, c + half, c + dir + half, c + dir - half] {
+                            out.positions.push(p.to_array());
+                        }
+                        out.normals.extend([normal; 4]);
+                        out.uvs.extend_from_slice(&atlas::PETAL_UVS);
+                        out.primitives[slot].indices.extend_from_slice(&[
+                            b,
+                            b + 1,
+                            b + 2,
+                            b,
+                            b + 2,
+                            b + 3,
+                        ]);
+                    }
+                }
+                (OrganKind::Leaf, _) => {
                     let (x, y) = (q * Vec3::X, q * Vec3::Y);
                     let at = |half_width: f32, s: f32| {
                         (o.position + x * (half_width * width) + y * (s * length)).to_array()
@@ -867,7 +952,7 @@ impl Mesher {
                         .indices
                         .extend(self.leaf_pattern.iter().map(|&i| i + base));
                 }
-                OrganKind::Flower => {
+                (OrganKind::Flower, _) => {
                     let (reach, width) = (0.5 * length, width);
                     for (p, petal) in self.petals.iter().enumerate() {
                         let dir = q * petal.dir * reach;
@@ -898,7 +983,7 @@ impl Mesher {
                         ]);
                     }
                 }
-                OrganKind::RootTip => {
+                (OrganKind::RootTip, _) => {
                     let (x, y, z) = (q * Vec3::X, q * Vec3::Y, q * Vec3::Z);
                     let (half, mid) = (0.5 * width, o.position + y * (0.5 * length));
                     let corners = [
@@ -922,6 +1007,13 @@ impl Mesher {
             mark(sources, out, source);
         }
     }
+}
+
+/// The atlas cell organ `i` shows: neighbouring cards differ, the same plant always
+/// shows the same cells.
+fn card_variant(i: usize) -> u32 {
+    let h = (i as u32).wrapping_mul(0x9e37_79b1);
+    (h ^ (h >> 15)) >> 7
 }
 
 /// Meshes one plant with a throw-away [`Mesher`].
@@ -1099,7 +1191,8 @@ mod tests {
         assert_eq!(mesh.positions.len(), mesh.uvs.len());
         for uv in &mesh.uvs {
             assert!(uv.iter().all(|c| c.is_finite()), "uv {uv:?}");
-            assert!((0.0..=1.0).contains(&uv[0]) && uv[1] >= 0.0, "uv {uv:?}");
+            // Bark surfaces run u round a stem several times (at most 64).
+            assert!((0.0..=64.0).contains(&uv[0]) && uv[1] >= 0.0, "uv {uv:?}");
         }
         for p in &mesh.positions {
             assert!(p.iter().all(|c| c.is_finite()), "position {p:?}");
@@ -1669,6 +1762,92 @@ mod tests {
             let twin = twin.unwrap_or_else(|| panic!("no twin for {t:?}"));
             assert!((Vec3::from_array(*twin) + n).length() < 1e-6);
         }
+    }
+
+    #[test]
+    fn leaf_surfaces_are_one_sided_cards_showing_their_cells() {
+        use sylva_core::species::{Card, LeafKind, Surface};
+        let mut p = plant();
+        let mut add = |surface: Surface| {
+            let m = p
+                .add_material(sylva_core::Material {
+                    surface: Some(surface),
+                    ..sylva_core::Material::of_kind(sylva_core::MaterialKind::Leaf)
+                })
+                .unwrap();
+            for _ in 0..3 {
+                p.add_organ(organ(
+                    OrganKind::Leaf,
+                    Quat::IDENTITY,
+                    Vec2::new(0.3, 0.2),
+                    m,
+                ))
+                .unwrap();
+            }
+        };
+        add(Surface::Leaves(LeafKind::Oak));
+        add(Surface::Branchlets(LeafKind::Pine));
+        let bare = mesh_of(&plant());
+        let m = mesh_of(&p);
+        check_invariants(&m);
+        // Three flat cards (4 vertices, 2 triangles) and three crossed ones (twice that).
+        assert_eq!(m.vertex_count() - bare.vertex_count(), 3 * 4 + 3 * 8);
+        assert_eq!(m.triangle_count() - bare.triangle_count(), 3 * 2 + 3 * 4);
+        let cards = &m.uvs[bare.vertex_count()..];
+        // An oak card: 0.2 wide, 0.3 tall, facing +Z, its corners the cell's (base at the
+        // cell's bottom), and neighbouring cards showing other cells.
+        let first = &m.positions[bare.vertex_count()..bare.vertex_count() + 4];
+        assert_eq!(first[0], [0.4, 1.0, -0.25]);
+        assert_eq!(first[2], [0.6, 1.3, -0.25]);
+        assert_eq!(m.normals[bare.vertex_count()], [0.0, 0.0, 1.0]);
+        assert_eq!(
+            cards[..4],
+            crate::atlas::card_uvs(Card::Spray, card_variant(0))
+        );
+        assert_ne!(card_variant(0) % 8, card_variant(1) % 8);
+        // The pine cards' second quad stands square to the first.
+        let second = bare.vertex_count() + 12 + 4;
+        assert_eq!(m.normals[second], [-1.0, 0.0, 0.0]);
+        assert_eq!(
+            cards[12..16],
+            crate::atlas::card_uvs(Card::Branchlet, card_variant(3))
+        );
+    }
+
+    #[test]
+    fn bark_surfaces_repeat_round_the_stem_at_their_own_scale() {
+        use sylva_core::species::{BarkKind, Surface};
+        let mut p = Plant::new(PlantMeta::default());
+        // Radius 0.5 m: a 3.1 m circumference holds seven furrowed tiles (0.45 m each).
+        p.add_segment(
+            Vec3::ZERO,
+            Vec3::Y * 3.0,
+            (0.5, 0.5),
+            None,
+            false,
+            Plant::BARK,
+        )
+        .unwrap();
+        let plain = mesh_of(&p);
+        let m = p.materials()[Plant::BARK.index()].clone();
+        p.replace_material(
+            Plant::BARK,
+            sylva_core::Material {
+                surface: Some(Surface::Bark(BarkKind::Furrowed)),
+                ..m
+            },
+        )
+        .unwrap();
+        let dressed = mesh_of(&p);
+        assert_eq!(plain.positions, dressed.positions);
+        // The start cap (a centre and 12 rim vertices) comes first, then the first ring,
+        // whose last vertex is the seam.
+        let seam = 13 + 12;
+        assert_eq!(plain.uvs[seam][0], 1.0);
+        assert_eq!(dressed.uvs[seam][0], 7.0);
+        // Along the stem v runs seven times as fast: texels stay square.
+        let top = seam + 13;
+        assert!((dressed.uvs[top][1] - 7.0 * plain.uvs[top][1]).abs() < 1e-4);
     }
 
     #[test]

@@ -265,17 +265,7 @@ pub fn texture_png(id: u16) -> Result<Arc<Vec<u8>>, image::ImageError> {
 /// Generates texture `id`.
 fn generate(id: u16) -> Texture {
     let seed = u32::from(id);
-    let design: fn(f32, f32, u32) -> f32 = match id % TEXTURE_COUNT {
-        0 => furrowed_bark,
-        1 => lenticel_bark,
-        2 => plated_bark,
-        3 => veined_leaf,
-        4 => glossy_leaf,
-        5 => striped_leaf,
-        6 => gradient_petal,
-        7 => streaked_petal,
-        _ => spotted_petal,
-    };
+    let design = design(id);
     let size = TEXTURE_SIZE;
     let inv = 1.0 / size as f32;
     let image = GrayImage::from_fn(size, size, |x, y| {
@@ -288,12 +278,27 @@ fn generate(id: u16) -> Texture {
     Texture { id, image }
 }
 
+/// The design texture `id` draws: `(u, v, seed)` to a grey level (see the module docs).
+pub(crate) fn design(id: u16) -> fn(f32, f32, u32) -> f32 {
+    match id % TEXTURE_COUNT {
+        0 => furrowed_bark,
+        1 => lenticel_bark,
+        2 => plated_bark,
+        3 => veined_leaf,
+        4 => glossy_leaf,
+        5 => striped_leaf,
+        6 => gradient_petal,
+        7 => streaked_petal,
+        _ => spotted_petal,
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Noise. Everything is periodic over the unit square so textures tile.
 
 /// A 32-bit integer hash of a lattice point and a seed (murmur3's finaliser over a mix).
 #[inline]
-fn hash(x: u32, y: u32, seed: u32) -> u32 {
+pub(crate) fn hash(x: u32, y: u32, seed: u32) -> u32 {
     let mut h = x.wrapping_mul(0x8da6_b343)
         ^ y.wrapping_mul(0xd816_3841)
         ^ seed.wrapping_mul(0xcb1a_b31f).wrapping_add(0x9e37_79b9);
@@ -306,37 +311,37 @@ fn hash(x: u32, y: u32, seed: u32) -> u32 {
 
 /// A hash as a number in `0..1`.
 #[inline]
-fn unit(h: u32) -> f32 {
+pub(crate) fn unit(h: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
 /// Rehashes a hash, for a second independent number from one lattice point.
 #[inline]
-fn rehash(h: u32) -> u32 {
+pub(crate) fn rehash(h: u32) -> u32 {
     hash(h, 0x51ed_270b, 0x2545_f491)
 }
 
 #[inline]
-fn lerp(a: f32, b: f32, t: f32) -> f32 {
+pub(crate) fn lerp(a: f32, b: f32, t: f32) -> f32 {
     a + (b - a) * t
 }
 
 /// Hermite smoothstep of `x` between edges `e0` and `e1` (either order).
 #[inline]
-fn smooth(e0: f32, e1: f32, x: f32) -> f32 {
+pub(crate) fn smooth(e0: f32, e1: f32, x: f32) -> f32 {
     let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
 }
 
 /// `x` modulo `n`, as a lattice index.
 #[inline]
-fn wrap(x: i64, n: u32) -> u32 {
+pub(crate) fn wrap(x: i64, n: u32) -> u32 {
     x.rem_euclid(i64::from(n)) as u32
 }
 
 /// Value noise in `0..1` at `(u, v)` of the unit square, on a lattice of `px` × `py` cells
 /// that wraps at the square's edges.
-fn noise(u: f32, v: f32, px: u32, py: u32, seed: u32) -> f32 {
+pub(crate) fn noise(u: f32, v: f32, px: u32, py: u32, seed: u32) -> f32 {
     let (x, y) = (u * px as f32, v * py as f32);
     let (fx, fy) = (x.floor(), y.floor());
     let (ix, iy) = (fx as i64, fy as i64);
@@ -352,7 +357,7 @@ fn noise(u: f32, v: f32, px: u32, py: u32, seed: u32) -> f32 {
 
 /// Fractal sum of `octaves` noises from `px` × `py` cells up, each twice as fine and half as
 /// strong; in `0..1`, mostly near 0.5.
-fn fbm(u: f32, v: f32, px: u32, py: u32, octaves: u32, seed: u32) -> f32 {
+pub(crate) fn fbm(u: f32, v: f32, px: u32, py: u32, octaves: u32, seed: u32) -> f32 {
     let (mut sum, mut amp, mut norm) = (0.0, 1.0, 0.0);
     for o in 0..octaves {
         sum += amp * noise(u, v, px << o, py << o, seed.wrapping_add(o * 7919));
@@ -365,7 +370,7 @@ fn fbm(u: f32, v: f32, px: u32, py: u32, octaves: u32, seed: u32) -> f32 {
 /// Cell noise over `nx` × `ny` wrapping cells, one jittered point per cell. Distances are in
 /// cell units, so cells taller than wide make shapes elongated along `v`. Returns the
 /// distances to the nearest and second-nearest points and the nearest point's hash.
-fn cells(u: f32, v: f32, nx: u32, ny: u32, seed: u32) -> (f32, f32, u32) {
+pub(crate) fn cells(u: f32, v: f32, nx: u32, ny: u32, seed: u32) -> (f32, f32, u32) {
     let (x, y) = (u * nx as f32, v * ny as f32);
     let (cx, cy) = (x.floor() as i64, y.floor() as i64);
     let (mut f1, mut f2, mut id) = (f32::INFINITY, f32::INFINITY, 0);
@@ -387,7 +392,7 @@ fn cells(u: f32, v: f32, nx: u32, ny: u32, seed: u32) -> (f32, f32, u32) {
 
 /// Distance from `x` to the nearest whole number (0 on a line, 0.5 between lines).
 #[inline]
-fn to_line(x: f32) -> f32 {
+pub(crate) fn to_line(x: f32) -> f32 {
     let t = x - x.floor();
     t.min(1.0 - t)
 }
@@ -398,7 +403,7 @@ fn to_line(x: f32) -> f32 {
 /// Six broad ridges around, wandering with low noise and rough on top, parted by wide dark
 /// furrows that open and close along the trunk; the ridges are broken into blocks by cross
 /// cracks; fibres run along the axis.
-fn furrowed_bark(u: f32, v: f32, s: u32) -> f32 {
+pub(crate) fn furrowed_bark(u: f32, v: f32, s: u32) -> f32 {
     const RIDGES: u32 = 6;
     let warp = fbm(u, v, 3, 2, 3, s) - 0.5;
     let wiggle = fbm(u, v, 8, 6, 2, s ^ 0x11) - 0.5;
@@ -426,7 +431,7 @@ fn furrowed_bark(u: f32, v: f32, s: u32) -> f32 {
 
 /// Smooth and light with soft horizontal bands, and scattered horizontal lenticels: dark
 /// dashes with a slightly raised (lighter) lip.
-fn lenticel_bark(u: f32, v: f32, s: u32) -> f32 {
+pub(crate) fn lenticel_bark(u: f32, v: f32, s: u32) -> f32 {
     const NX: u32 = 4;
     const NY: u32 = 12;
     let bands = fbm(u, v, 1, 20, 3, s) - 0.5;
@@ -460,7 +465,7 @@ fn lenticel_bark(u: f32, v: f32, s: u32) -> f32 {
 /// Large plates (about twice as tall as wide, with wandering outlines), each of its own tone,
 /// rough and fibrous along the axis, parted by wide dark crevices; plate edges catch a little
 /// light where they curl, and some plates have shed a flake showing a darker layer.
-fn plated_bark(u: f32, v: f32, s: u32) -> f32 {
+pub(crate) fn plated_bark(u: f32, v: f32, s: u32) -> f32 {
     let (du, dv) = (
         0.05 * (fbm(u, v, 6, 6, 2, s ^ 0x77) - 0.5),
         0.05 * (fbm(u, v, 6, 6, 2, s ^ 0x88) - 0.5),

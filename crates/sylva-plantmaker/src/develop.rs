@@ -326,6 +326,7 @@ impl Builder {
             kind,
             color: color.0.map(linear),
             texture,
+            surface: None,
         })?;
         self.keys.push(key);
         Ok(id)

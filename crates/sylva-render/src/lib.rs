@@ -73,6 +73,7 @@ use sylva_core::{
     Aabb,
     glam::{Vec2, Vec3},
 };
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::{Scene, SceneNode};
 
 use camera::{Camera, Fit};
@@ -420,35 +421,64 @@ impl Renderer {
     }
 
     /// Draws a node's depth into the shadow map. Only faces turned to the light are drawn:
-    /// meshes are closed or double-sided (see [`sylva_mesh::mesh`]), so they are enough.
+    /// meshes are closed or double-sided (see [`sylva_mesh::mesh`]), so they are enough;
+    /// but cut-out cards, one-sided, are drawn from both sides and cast only their shapes.
     fn draw_shadow(&mut self, node: &SceneNode) {
-        let Renderer { shadow, verts, .. } = self;
+        let Renderer {
+            shadow,
+            verts,
+            textures,
+            ..
+        } = self;
         verts.clear();
-        verts.extend(node.mesh.positions.iter().map(|&p| {
+        verts.extend(node.mesh.positions.iter().enumerate().map(|(k, &p)| {
             let mut v = Vtx::default();
             if let Some(w) = place(node, p) {
                 let l = shadow.to_light(w);
                 if let Some(s) = ScreenVert::from_samples(l.x, l.y) {
                     // The shadow pass keeps light depth where the colour pass keeps 1/z.
                     (v.s, v.iz, v.ok) = (s, l.z, true);
+                    v.uv = node
+                        .mesh
+                        .uvs
+                        .get(k)
+                        .map_or(Vec2::ZERO, |&uv| Vec2::from_array(uv));
                 }
             }
             v
         }));
         let size = shadow.size;
         for prim in &node.mesh.primitives {
+            let cut = cut_out(node.mesh.materials.get(prim.material)).map(|p| textures.get(p));
+            let cull = if cut.is_some() {
+                Cull::None
+            } else {
+                Cull::Back
+            };
             for t in prim.indices.chunks_exact(3) {
                 let Some([a, b, c]) = triangle(verts, t) else {
                     continue;
                 };
-                let Some(tri) = Tri::new([a.s, b.s, c.s], Cull::Back, size, size) else {
+                let Some(tri) = Tri::new([a.s, b.s, c.s], cull, size, size) else {
                     continue;
                 };
                 let (b, c) = if tri.flipped { (c, b) } else { (b, c) };
                 let (d0, d1, d2) = (a.iz, b.iz - a.iz, c.iz - a.iz);
+                let lod = cut.map_or(0.0, |tex| {
+                    let uv_area = 0.5 * (b.uv - a.uv).perp_dot(c.uv - a.uv).abs();
+                    tex.lod(uv_area / tri.sample_area())
+                });
+                let (u0, u1, u2) = (a.uv, b.uv - a.uv, c.uv - a.uv);
                 tri.for_each(|i, l1, l2| {
                     let d = d0 + l1 * d1 + l2 * d2;
                     if d < shadow.depth[i] {
+                        // The light's view is orthographic: uvs interpolate linearly.
+                        if let Some(tex) = cut {
+                            let uv = u0 + u1 * l1 + u2 * l2;
+                            if tex.alpha(lod, uv.x, uv.y) < ALPHA_CUTOFF {
+                                return;
+                            }
+                        }
                         shadow.depth[i] = d;
                     }
                 });
@@ -561,19 +591,23 @@ impl Renderer {
         for prim in &mesh.primitives {
             let material = mesh.materials.get(prim.material);
             let albedo = material.map_or(Vec3::splat(0.5), |m| shade::albedo(m.color));
-            let texture = material.and_then(|m| m.texture).map(|id| textures.get(id));
+            let cut = cut_out(material).is_some();
+            let texture = material.and_then(Picture::base_of).map(|p| textures.get(p));
+            let cull = if cut { Cull::None } else { Cull::Back };
             for t in prim.indices.chunks_exact(3) {
                 let Some([a, b, c]) = triangle(verts, t) else {
                     continue;
                 };
-                let Some(tri) = Tri::new([a.s, b.s, c.s], Cull::Back, w, h) else {
+                let Some(tri) = Tri::new([a.s, b.s, c.s], cull, w, h) else {
                     continue;
                 };
                 // A vertex without a usable normal makes the triangle flat-shaded.
                 let face = (b.p - a.p).cross(c.p - a.p).normalize_or(-camera.forward);
                 let smooth = a.n != Vec3::ZERO && b.n != Vec3::ZERO && c.n != Vec3::ZERO;
+                // A card seen from behind shows its back: normals turned to the viewer.
+                let side = if tri.flipped { 1.0 } else { -1.0 };
                 let (b, c) = if tri.flipped { (c, b) } else { (b, c) };
-                let normal = |v: &Vtx| if smooth { v.n } else { face };
+                let normal = |v: &Vtx| if smooth { v.n * side } else { face * side };
                 // Attributes divided by depth interpolate linearly on screen.
                 let (na, nb, nc) = (normal(&a) * a.iz, normal(&b) * b.iz, normal(&c) * c.iz);
                 let shadows = shadow.size > 0;
@@ -599,22 +633,37 @@ impl Renderer {
                     if iz <= depth[i] {
                         return;
                     }
-                    depth[i] = iz;
-                    let n = (na * l0 + nb * l1 + nc * l2).normalize_or(face);
-                    let lit = if shadows && n.dot(lights.key) > 0.0 {
-                        shadow.lit((la * l0 + lb * l1 + lc * l2) / iz, n)
-                    } else {
-                        1.0
-                    };
                     let albedo = match sampler {
                         // Untextured pictures are exactly what they were before textures.
                         None => albedo,
                         Some((tex, lod, ua, ub, uc)) => {
                             let uv = (ua * l0 + ub * l1 + uc * l2) / iz;
+                            if cut && tex.alpha(lod, uv.x, uv.y) < ALPHA_CUTOFF {
+                                return;
+                            }
                             albedo * tex.sample(lod, uv.x, uv.y)
                         }
                     };
-                    color[i] = shade::pack(srgb, albedo * lights.shade(n, lit));
+                    depth[i] = iz;
+                    let n = (na * l0 + nb * l1 + nc * l2).normalize_or(face);
+                    let shade = if cut {
+                        // Leaves and petals are lit through from behind as well.
+                        let towards = if n.dot(lights.key) >= 0.0 { n } else { -n };
+                        let lit = if shadows {
+                            shadow.lit((la * l0 + lb * l1 + lc * l2) / iz, towards)
+                        } else {
+                            1.0
+                        };
+                        lights.shade_thin(n, lit)
+                    } else {
+                        let lit = if shadows && n.dot(lights.key) > 0.0 {
+                            shadow.lit((la * l0 + lb * l1 + lc * l2) / iz, n)
+                        } else {
+                            1.0
+                        };
+                        lights.shade(n, lit)
+                    };
+                    color[i] = shade::pack(srgb, albedo * shade);
                 });
             }
         }
@@ -651,6 +700,17 @@ impl Renderer {
         }
         img
     }
+}
+
+/// The alpha below which a cut-out shows nothing (as the GLB writer's `alphaCutoff`).
+const ALPHA_CUTOFF: f32 = 0.5;
+
+/// The picture a material cuts its shape out of, if it is a cut-out (leaves, petals).
+fn cut_out(material: Option<&sylva_core::Material>) -> Option<Picture> {
+    let m = material?;
+    m.surface
+        .filter(|s| s.is_cut_out())
+        .and(Picture::base_of(m))
 }
 
 /// The three vertices of a triangle, if its indices are in range and all are drawable.

@@ -50,9 +50,8 @@ pub(crate) enum Cull {
     /// Skip triangles that are clockwise on screen (y down), i.e. facing away from the
     /// camera: mesh triangles are counter-clockwise seen from the front.
     Back,
-    /// Draw both orientations (only the tests need it: every mesh is closed or
-    /// double-sided, so the renderer always culls).
-    #[cfg(test)]
+    /// Draw both orientations (one-sided cards of a cut-out material, seen from both
+    /// sides).
     None,
 }
 

@@ -114,6 +114,16 @@ impl Lights {
         }
     }
 
+    /// Light leaving a thin leaf or petal seen on the side whose unit normal is `n`: what
+    /// [`Lights::shade`] gives, plus a third of the key light passing through when it
+    /// shines on the other side (`lit` is the key light's reach on whichever side it hits).
+    #[inline]
+    pub(crate) fn shade_thin(&self, n: Vec3, lit: f32) -> Vec3 {
+        let front = n.dot(self.key);
+        let through = if front < 0.0 { -front * 0.35 } else { 0.0 };
+        self.shade(n, lit) + self.key_color * (through * lit)
+    }
+
     /// Light arriving at a surface with unit normal `n`; `lit` (0..=1) scales the key light.
     #[inline]
     pub(crate) fn shade(&self, n: Vec3, lit: f32) -> Vec3 {

@@ -696,3 +696,78 @@ fn textures_are_made_once_per_renderer() {
         "a fresh renderer agrees"
     );
 }
+
+/// A one-sided upright card facing +Z (or away, `-Z`) showing the first spray cell of a
+/// leaf kind's atlas, cut out by its alpha.
+fn card(facing_away: bool) -> Mesh {
+    use sylva_core::species::{Card, LeafKind, Surface};
+    let mut mesh = Mesh {
+        materials: vec![sylva_core::Material {
+            surface: Some(Surface::Leaves(LeafKind::Maple)),
+            ..material(MaterialKind::Leaf, [0.1, 0.5, 0.1])
+        }],
+        ..Mesh::default()
+    };
+    let u = if facing_away { -Vec3::X } else { Vec3::X };
+    add_quad(&mut mesh, 0, Vec3::ZERO, u, Vec3::Y);
+    let cell = sylva_mesh::atlas::card_uvs(Card::Spray, 0);
+    mesh.uvs = if facing_away {
+        vec![cell[1], cell[0], cell[3], cell[2]]
+    } else {
+        cell.to_vec()
+    };
+    mesh
+}
+
+#[test]
+fn cut_out_cards_show_their_shape_from_both_sides_and_cast_it() {
+    let opts = plain(View::Front);
+    let mut solid = card(false);
+    solid.materials[0].surface = None;
+    let full = coverage(
+        &render(&scene(&solid), &opts).unwrap(),
+        opts.background,
+        greenish,
+    );
+    let front = coverage(
+        &render(&scene(&card(false)), &opts).unwrap(),
+        opts.background,
+        greenish,
+    );
+    let back = coverage(
+        &render(&scene(&card(true)), &opts).unwrap(),
+        opts.background,
+        greenish,
+    );
+    // The leaf's outline is cut out of the square: far less than the square, but a good
+    // part of it; the back of a one-sided card is drawn too (a plain quad's is culled).
+    assert!(
+        front.count * 10 < full.count * 8,
+        "{} of {}",
+        front.count,
+        full.count
+    );
+    assert!(
+        front.count * 10 > full.count,
+        "{} of {}",
+        front.count,
+        full.count
+    );
+    assert_eq!(front.count, back.count);
+    // Its shadow on the ground is its shape, not a square.
+    let lit = RenderOptions {
+        ground: true,
+        shadows: true,
+        ..plain(View::Iso)
+    };
+    let with = render(&scene(&card(false)), &lit).unwrap();
+    let without = render(
+        &scene(&card(false)),
+        &RenderOptions {
+            shadows: false,
+            ..lit.clone()
+        },
+    )
+    .unwrap();
+    assert_ne!(with, without, "the card casts a shadow");
+}

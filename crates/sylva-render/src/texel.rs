@@ -4,8 +4,10 @@
 //! Each triangle picks a level of detail from how many texels cover one sample (its texture
 //! area over its screen area), and every sample blends bilinear lookups in the two nearest
 //! levels (trilinear filtering), so distant bark shades to its average instead of shimmering.
-//! `u` always wraps; `v` wraps for bark and is clamped for leaf and petal textures, as the
-//! exporters' samplers do.
+//! `u` wraps but for cut-outs; `v` wraps for bark and is clamped for leaf and petal
+//! textures, as the exporters' samplers do. Cut-outs (leaf atlases, petals) also carry their
+//! coverage, filtered down so that each level passes the alpha test over as much of its area
+//! as the full picture does.
 //!
 //! ```ignore
 //! let tex = cache.get(id);
@@ -14,15 +16,17 @@
 //! ```
 
 use std::collections::HashMap;
-use sylva_mesh::texture::texture;
+use sylva_mesh::picture::Picture;
 
 use super::shade::{floor_i64, to_linear_table};
 
-/// One level of a mip chain: `size` × `size` linear grey texels.
+/// One level of a mip chain: `size` × `size` linear grey texels, and their coverage when
+/// the picture cuts a shape out.
 #[derive(Clone, Debug)]
 struct Level {
     size: usize,
     texels: Vec<f32>,
+    alpha: Vec<f32>,
 }
 
 /// A texture ready to sample.
@@ -30,39 +34,97 @@ struct Level {
 pub(crate) struct MipTexture {
     /// From full size down to 1 × 1.
     levels: Vec<Level>,
+    repeat_u: bool,
     repeat_v: bool,
 }
 
+/// Half of each 2 × 2 block's mean: the next level down.
+fn halve(texels: &[f32], size: usize) -> Vec<f32> {
+    let half = size / 2;
+    let at = |x: usize, y: usize| texels[y * size + x];
+    (0..half * half)
+        .map(|k| {
+            let (x, y) = (2 * (k % half), 2 * (k / half));
+            0.25 * (at(x, y) + at(x + 1, y) + at(x, y + 1) + at(x + 1, y + 1))
+        })
+        .collect()
+}
+
+/// The share of `alpha` at or above one half once scaled by `scale`.
+fn coverage(alpha: &[f32], scale: f32) -> f32 {
+    alpha.iter().filter(|&&a| a * scale >= 0.5).count() as f32 / alpha.len().max(1) as f32
+}
+
+/// Scales a level's coverage so that as large a share of it passes the alpha test as of
+/// the full-size picture (Castaño's coverage-preserving mipmaps): without it, thin needles
+/// and leaf tips fade away with distance as averaging pulls their alpha under one half.
+fn keep_coverage(alpha: &mut [f32], target: f32) {
+    let (mut lo, mut hi) = (1.0f32, 8.0f32);
+    if coverage(alpha, lo) >= target {
+        return;
+    }
+    for _ in 0..16 {
+        let mid = 0.5 * (lo + hi);
+        if coverage(alpha, mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    for a in alpha {
+        *a = (*a * hi).min(1.0);
+    }
+}
+
 impl MipTexture {
-    /// Texture `id`, decoded from sRGB to linear light and box-filtered down level by level.
-    pub(crate) fn new(id: u16) -> MipTexture {
-        let t = texture(id);
+    /// `picture`, decoded from sRGB to linear light and box-filtered down level by level
+    /// (its coverage kept, for cut-outs). A normal map reads as flat grey (the renderer
+    /// does not use them).
+    pub(crate) fn new(picture: Picture) -> MipTexture {
+        let image = picture.image();
         let linear = to_linear_table();
-        let size = t.image.width() as usize;
+        let size = image.width() as usize;
+        let (texels, alpha): (Vec<f32>, Vec<f32>) = match &image {
+            image::DynamicImage::ImageLuma8(g) => (
+                g.as_raw().iter().map(|&g| linear[g as usize]).collect(),
+                Vec::new(),
+            ),
+            image::DynamicImage::ImageLumaA8(ga) => ga
+                .pixels()
+                .map(|p| (linear[p.0[0] as usize], f32::from(p.0[1]) / 255.0))
+                .unzip(),
+            _ => (vec![1.0; size * size], Vec::new()),
+        };
+        let target = coverage(&alpha, 1.0);
         let mut levels = vec![Level {
             size,
-            texels: t
-                .image
-                .as_raw()
-                .iter()
-                .map(|&g| linear[g as usize])
-                .collect(),
+            texels,
+            alpha,
         }];
         while let Some(last) = levels.last().filter(|l| l.size > 1) {
-            let (s, half) = (last.size, last.size / 2);
-            let at = |x: usize, y: usize| last.texels[y * s + x];
-            let texels = (0..half * half)
-                .map(|k| {
-                    let (x, y) = (2 * (k % half), 2 * (k / half));
-                    0.25 * (at(x, y) + at(x + 1, y) + at(x, y + 1) + at(x + 1, y + 1))
-                })
-                .collect();
-            levels.push(Level { size: half, texels });
+            let texels = halve(&last.texels, last.size);
+            let mut alpha = if last.alpha.is_empty() {
+                Vec::new()
+            } else {
+                halve(&last.alpha, last.size)
+            };
+            keep_coverage(&mut alpha, target);
+            levels.push(Level {
+                size: last.size / 2,
+                texels,
+                alpha,
+            });
         }
         MipTexture {
             levels,
-            repeat_v: t.info().family.repeats_v(),
+            repeat_u: picture.repeats_u(),
+            repeat_v: picture.repeats_v(),
         }
+    }
+
+    /// Whether it has coverage to test ([`MipTexture::alpha`]).
+    pub(crate) fn cuts_out(&self) -> bool {
+        !self.levels[0].alpha.is_empty()
     }
 
     /// The level of detail for a triangle whose texture area (in `uv` units²) covers
@@ -80,54 +142,72 @@ impl MipTexture {
     /// The linear grey at `(u, v)`, blended between the two levels around `lod`.
     #[inline]
     pub(crate) fn sample(&self, lod: f32, u: f32, v: f32) -> f32 {
+        self.trilinear(lod, u, v, |l| &l.texels)
+    }
+
+    /// The coverage at `(u, v)` (1 for a picture without alpha), as [`MipTexture::sample`].
+    #[inline]
+    pub(crate) fn alpha(&self, lod: f32, u: f32, v: f32) -> f32 {
+        if !self.cuts_out() {
+            return 1.0;
+        }
+        self.trilinear(lod, u, v, |l| &l.alpha)
+    }
+
+    #[inline]
+    fn trilinear(&self, lod: f32, u: f32, v: f32, channel: impl Fn(&Level) -> &[f32]) -> f32 {
         let level = lod as usize;
         let t = lod - level as f32;
-        let fine = self.bilinear(level, u, v);
+        let fine = self.bilinear(level, u, v, &channel);
         if t > 0.0 && level + 1 < self.levels.len() {
-            fine + (self.bilinear(level + 1, u, v) - fine) * t
+            fine + (self.bilinear(level + 1, u, v, &channel) - fine) * t
         } else {
             fine
         }
     }
 
     #[inline]
-    fn bilinear(&self, level: usize, u: f32, v: f32) -> f32 {
+    fn bilinear(&self, level: usize, u: f32, v: f32, channel: impl Fn(&Level) -> &[f32]) -> f32 {
         let l = &self.levels[level];
+        let texels = channel(l);
         let n = l.size as i64;
         // Texel centres sit at half-integers.
         let (x, y) = (u * l.size as f32 - 0.5, v * l.size as f32 - 0.5);
         let (x0, y0) = (floor_i64(x), floor_i64(y));
         let (tx, ty) = (x - x0 as f32, y - y0 as f32);
-        let col = |x: i64| x.rem_euclid(n) as usize;
-        let row = |y: i64| {
-            if self.repeat_v {
-                y.rem_euclid(n) as usize
+        let wrap = |i: i64, repeats: bool| {
+            if repeats {
+                i.rem_euclid(n) as usize
             } else {
-                y.clamp(0, n - 1) as usize
+                i.clamp(0, n - 1) as usize
             }
         };
-        let (c0, c1, r0, r1) = (col(x0), col(x0 + 1), row(y0) * l.size, row(y0 + 1) * l.size);
-        let top = l.texels[r0 + c0] + (l.texels[r0 + c1] - l.texels[r0 + c0]) * tx;
-        let bottom = l.texels[r1 + c0] + (l.texels[r1 + c1] - l.texels[r1 + c0]) * tx;
+        let (c0, c1) = (wrap(x0, self.repeat_u), wrap(x0 + 1, self.repeat_u));
+        let (r0, r1) = (
+            wrap(y0, self.repeat_v) * l.size,
+            wrap(y0 + 1, self.repeat_v) * l.size,
+        );
+        let top = texels[r0 + c0] + (texels[r0 + c1] - texels[r0 + c0]) * tx;
+        let bottom = texels[r1 + c0] + (texels[r1 + c1] - texels[r1 + c0]) * tx;
         top + (bottom - top) * ty
     }
 }
 
-/// Mip chains by texture id, made on first use.
+/// Mip chains by picture, made on first use.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TextureCache {
-    textures: HashMap<u16, MipTexture>,
+    textures: HashMap<Picture, MipTexture>,
 }
 
 impl TextureCache {
-    /// The texture for `id`, generating it the first time.
-    pub(crate) fn get(&mut self, id: u16) -> &MipTexture {
+    /// The texture of `picture`, made the first time.
+    pub(crate) fn get(&mut self, picture: Picture) -> &MipTexture {
         self.textures
-            .entry(id)
-            .or_insert_with(|| MipTexture::new(id))
+            .entry(picture)
+            .or_insert_with(|| MipTexture::new(picture))
     }
 
-    /// Ids held.
+    /// Pictures held.
     #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.textures.len()
@@ -140,7 +220,7 @@ mod tests {
 
     #[test]
     fn levels_halve_down_to_one_texel_and_keep_the_mean() {
-        let t = MipTexture::new(0);
+        let t = MipTexture::new(Picture::Design(0));
         let sizes: Vec<usize> = t.levels.iter().map(|l| l.size).collect();
         assert_eq!(
             sizes.first(),
@@ -156,13 +236,13 @@ mod tests {
 
     #[test]
     fn sampling_wraps_u_and_clamps_leaf_v() {
-        let bark = MipTexture::new(0);
+        let bark = MipTexture::new(Picture::Design(0));
         for &(u, v) in &[(0.3, 0.7), (0.0, 0.0), (0.999, 0.5)] {
             let a = bark.sample(0.0, u, v);
             assert!((a - bark.sample(0.0, u + 1.0, v)).abs() < 1e-4);
             assert!((a - bark.sample(0.0, u - 3.0, v + 2.0)).abs() < 1e-4);
         }
-        let petal = MipTexture::new(6);
+        let petal = MipTexture::new(Picture::Design(6));
         // Clamped: far past the tip reads the last row, not the dark base again.
         assert!((petal.sample(0.0, 0.5, 1.0) - petal.sample(0.0, 0.5, 7.0)).abs() < 1e-6);
         assert!(petal.sample(0.0, 0.5, 1.0) > petal.sample(0.0, 0.5, 0.0) + 0.2);
@@ -178,7 +258,7 @@ mod tests {
 
     #[test]
     fn far_away_means_blurrier() {
-        let t = MipTexture::new(0);
+        let t = MipTexture::new(Picture::Design(0));
         assert_eq!(t.lod(0.0), 0.0);
         assert_eq!(t.lod(f32::NAN), 0.0);
         let size = sylva_mesh::texture::TEXTURE_SIZE as f32;

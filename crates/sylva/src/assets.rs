@@ -12,6 +12,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use serde_json::json;
+use sylva_core::dress::{Dress, Dressed, dress};
 use sylva_core::glam::{Quat, Vec3};
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
@@ -103,6 +104,10 @@ pub struct GrowOptions {
     /// Outlines the plant grows inside, pruned where it would show outside their ink
     /// (`[match] prune`, [`crate::evolution::outline::space`]). Default none.
     pub pruned_to: Option<Arc<[Outline]>>,
+    /// Leaves or needles of a kind at their real size and a tiling bark, put on last, after
+    /// the plant is scaled (`--foliage`, `--bark`; [`sylva_core::dress`]). Default: none,
+    /// the plant as its model grew it.
+    pub dress: Dress,
 }
 
 impl Default for GrowOptions {
@@ -116,6 +121,7 @@ impl Default for GrowOptions {
             quantize: false,
             height: None,
             pruned_to: None,
+            dress: Dress::default(),
         }
     }
 }
@@ -148,6 +154,8 @@ pub struct Grown {
     pub rig: Option<Rig>,
     /// The height it was scaled to, if any ([`GrowOptions::height`]).
     pub height: Option<f32>,
+    /// How it was dressed ([`GrowOptions::dress`]) and what that did.
+    pub dress: (Dress, Dressed),
 }
 
 impl Grown {
@@ -155,7 +163,7 @@ impl Grown {
     /// without the roots unless kept, the pipe model's radii with a taper, and a wind skin
     /// and clip with wind (meshed once, recording where each vertex came from).
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
-        let (seed, plant) = Grown::plant(&genome, options)?;
+        let (seed, plant, dressed) = Grown::dressed_plant(&genome, options)?;
         let (roots, taper) = (options.roots, options.taper);
         let mut mesher = Mesher::new(mesh_options(genome.mesh_hint()))?;
         let (mesh, rig) = match &options.wind {
@@ -175,12 +183,22 @@ impl Grown {
             roots,
             rig,
             height: options.height,
+            dress: (options.dress, dressed),
         })
     }
 
     /// The plant [`Grown::grow`] meshes, with the seed it was grown with: grown, pruned,
-    /// finished and scaled as `options` say.
+    /// finished, scaled and dressed as `options` say.
     pub fn plant(genome: &Genome, options: &GrowOptions) -> Result<(u64, Plant), Error> {
+        let (seed, plant, _) = Grown::dressed_plant(genome, options)?;
+        Ok((seed, plant))
+    }
+
+    /// [`Grown::plant`], and what dressing it did.
+    pub fn dressed_plant(
+        genome: &Genome,
+        options: &GrowOptions,
+    ) -> Result<(u64, Plant, Dressed), Error> {
         let seed = options.seed.unwrap_or_else(|| genome.default_seed());
         let mut plant = genome.develop(seed)?;
         if let Some(outlines) = &options.pruned_to {
@@ -190,7 +208,11 @@ impl Grown {
         if let Some(height) = options.height {
             scale_to_height(&mut plant, height)?;
         }
-        Ok((seed, plant))
+        let mut dressed = Dressed::default();
+        if !options.dress.is_plain() {
+            (plant, dressed) = dress(&plant, &options.dress, seed)?;
+        }
+        Ok((seed, plant, dressed))
     }
 
     /// A scene holding this plant at the origin, carrying its origin (and its taper, so
@@ -204,6 +226,7 @@ impl Grown {
         if let Some(height) = self.height {
             extras["height"] = json!(height);
         }
+        dress_extras(&mut extras, &self.dress.0);
         if let Some(rig) = &self.rig {
             extras["wind"] = wind_extras(rig);
             node.rig = Some(rig);
@@ -235,6 +258,20 @@ fn finish(mut plant: Plant, roots: bool, taper: Option<PipeTaper>) -> Plant {
         taper.apply(&mut plant);
     }
     plant
+}
+
+/// Records a dress in a node's extras (`foliage`, `bark`, and `density` when not 1), so
+/// the asset can be grown again as it is.
+pub fn dress_extras(extras: &mut serde_json::Value, dress: &Dress) {
+    if let Some(kind) = dress.foliage {
+        extras["foliage"] = json!(kind.name());
+    }
+    if let Some(kind) = dress.bark {
+        extras["bark"] = json!(kind.name());
+    }
+    if dress.foliage.is_some() && dress.density != 1.0 {
+        extras["density"] = json!(dress.density);
+    }
 }
 
 /// Lowest and highest height a plant is scaled to (`--height`), metres.

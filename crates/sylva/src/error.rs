@@ -229,6 +229,9 @@ pub enum Error {
         #[source]
         source: DevelopError,
     },
+    /// A plant could not be dressed with leaves and bark (a part out of range).
+    #[error("dressing the plant")]
+    Dress(#[from] sylva_core::PlantError),
     /// A plant could not be meshed (too many triangles, bad options).
     #[error("meshing")]
     Mesh(#[from] sylva_mesh::mesher::MeshError),

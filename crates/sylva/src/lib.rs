@@ -68,6 +68,8 @@ pub use genome::{Genome, Settings, load_genome, parse_genome};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
 pub use skeleton::Skeleton;
+pub use sylva_core::dress::{Dress, Dressed};
+pub use sylva_core::species::{BarkKind, LeafKind};
 pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
 pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};

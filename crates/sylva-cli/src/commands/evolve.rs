@@ -58,6 +58,8 @@ pub struct EvolveArgs {
     /// Continue the run saved in the run directory's checkpoint.
     #[arg(long)]
     resume: bool,
+    #[command(flatten)]
+    dress: super::DressArgs,
 }
 
 /// `sylva evolve`.
@@ -71,6 +73,7 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     run.population = args.population.unwrap_or(run.population);
     run.seed = args.seed.unwrap_or(run.seed);
     run.threads = args.threads.unwrap_or(run.threads);
+    args.dress.apply(config.output_mut());
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!("runs/{}-seed{}", config.model(), config.run().seed))
     });

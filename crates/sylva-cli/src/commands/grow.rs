@@ -48,6 +48,8 @@ pub struct GrowArgs {
     #[arg(long, value_name = "CONFIG")]
     pruned_to: Option<PathBuf>,
     #[command(flatten)]
+    dress: super::DressArgs,
+    #[command(flatten)]
     wind: super::WindArgs,
     #[command(flatten)]
     quantize: super::QuantizeArgs,
@@ -69,6 +71,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
             Some(path) => Some(outlines_of(path)?),
             None => None,
         },
+        dress: args.dress.over(sylva::Dress::default()),
     };
     let glb = options.glb_options();
     if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {
@@ -106,6 +109,29 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         grown.mesh.vertex_count(),
         grown.mesh.triangle_count()
     );
+    let (dress, dressed) = grown.dress;
+    if let Some(kind) = dress.foliage {
+        println!(
+            "foliage: {} {kind} cards{}{}",
+            dressed.cards,
+            if dressed.leaves_replaced > 0 {
+                format!(
+                    " in place of the plant's {} leaves",
+                    dressed.leaves_replaced
+                )
+            } else {
+                " on its last twigs".to_owned()
+            },
+            if dressed.dropped > 0 {
+                format!(
+                    " ({} more left out: at most {} cards)",
+                    dressed.dropped, dress.max_cards
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
     if let Some(rig) = &grown.rig {
         println!(
             "wind: {} joints, clip `wind` of {} s{}",

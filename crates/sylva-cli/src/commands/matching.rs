@@ -76,6 +76,8 @@ pub struct MatchArgs {
     /// Continue the run saved in the run directory's checkpoint.
     #[arg(long)]
     resume: bool,
+    #[command(flatten)]
+    dress: super::DressArgs,
 }
 
 fn parse_seconds(text: &str) -> Result<f64, String> {
@@ -213,6 +215,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
     let mut config = evolution.config();
     config.run_mut().generations = evolution.generation();
     config.output_mut().height = args.height;
+    args.dress.apply(config.output_mut());
     let best = evolution.best();
     let (picture, iou) = overlay(&target, Path::new(""), &best.genome)?;
     write_results(

@@ -143,6 +143,61 @@ impl<T> InFile<T> for Result<T, sylva::Error> {
     }
 }
 
+/// The realism flags of `grow`, `render`, `evolve` and `match`: leaves or needles of a
+/// kind at their real size, and a tiling bark.
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct DressArgs {
+    /// Put leaves or needles of a kind on the plant, at their real size, drawn as
+    /// alpha-cut cards (its own leaves become cards of the kind; a plant without leaves
+    /// gets them on its last twigs): oak, birch, aspen, beech, maple, willow, ash, privet,
+    /// pine, spruce, fir [default: the plant's own leaves].
+    #[arg(long, value_name = "KIND", value_parser = parse_foliage)]
+    pub foliage: Option<sylva::LeafKind>,
+    /// Give the stems a tiling bark with its normal map: smooth, birch, furrowed, plated
+    /// [default: the foliage kind's own bark, or the model's look].
+    #[arg(long, value_name = "KIND", value_parser = parse_bark)]
+    pub bark: Option<sylva::BarkKind>,
+    /// Leaf cards per metre of twig, as a multiple of the kind's own, 0.25 to 4
+    /// [default: 1].
+    #[arg(long, value_name = "X", value_parser = parse_density, requires = "foliage")]
+    pub density: Option<f32>,
+}
+
+impl DressArgs {
+    /// Sets a config's `[output]` dress to what the flags give.
+    pub fn apply(&self, output: &mut sylva::evolution::OutputConfig) {
+        let dress = self.over(output.dress());
+        (output.foliage, output.bark, output.density) = (dress.foliage, dress.bark, dress.density);
+    }
+
+    /// The dress these flags ask for, over `base` (a config's `[output]`, say).
+    pub fn over(&self, base: sylva::Dress) -> sylva::Dress {
+        sylva::Dress {
+            foliage: self.foliage.or(base.foliage),
+            bark: self.bark.or(base.bark),
+            density: self.density.unwrap_or(base.density),
+            ..base
+        }
+    }
+}
+
+fn parse_foliage(text: &str) -> Result<sylva::LeafKind, String> {
+    text.parse()
+        .map_err(|e: sylva::core::species::UnknownKind| e.to_string())
+}
+
+fn parse_bark(text: &str) -> Result<sylva::BarkKind, String> {
+    text.parse()
+        .map_err(|e: sylva::core::species::UnknownKind| e.to_string())
+}
+
+fn parse_density(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(x) if (0.25..=4.0).contains(&x) => Ok(x),
+        _ => Err(format!("expected a multiple from 0.25 to 4; got {text:?}")),
+    }
+}
+
 /// The wind flags of `grow` and `garden`.
 #[derive(clap::Args, Debug, Default)]
 pub struct WindArgs {

@@ -46,16 +46,24 @@ pub struct RenderArgs {
     /// level's picture.
     #[arg(long, value_name = "N", conflicts_with = "wind_frames", value_parser = clap::value_parser!(u32).range(2..=8))]
     lod: Option<u32>,
+    /// Scale the plant so that its highest point stands this many metres above the
+    /// ground, 0.01 to 1000 (genomes only) [default: the model's own scale].
+    #[arg(long, value_name = "METRES", value_parser = super::parse_height)]
+    height: Option<f32>,
+    #[command(flatten)]
+    dress: super::DressArgs,
     #[command(flatten)]
     wind: super::WindArgs,
 }
 
-/// How `sylva render` grows a genome: its seed, roots and taper flags.
+/// How `sylva render` grows a genome: its seed, roots, taper, height and dress flags.
 fn grow_options(args: &RenderArgs) -> GrowOptions {
     GrowOptions {
         seed: args.seed,
         roots: !args.hide_roots,
         taper: args.taper,
+        height: args.height,
+        dress: args.dress.over(sylva::Dress::default()),
         ..GrowOptions::default()
     }
 }
@@ -105,6 +113,19 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         let png = wind_strip(&grown, frames as usize, args.view, args.size)?;
         sylva::files::write(&args.output, &png)?;
     } else if is_glb {
+        for (given, flag) in [
+            (args.dress.foliage.is_some(), "--foliage"),
+            (args.dress.bark.is_some(), "--bark"),
+            (args.height.is_some(), "--height"),
+        ] {
+            if given {
+                return Err(InputError::new(
+                    flag,
+                    "a GLB is drawn as it is; grow the genome with this flag instead",
+                )
+                .into());
+            }
+        }
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
         let imported = sylva::gltf::import::read_glb(&bytes)
             .map_err(|e| InputError::file_error(&args.file, &e))?;

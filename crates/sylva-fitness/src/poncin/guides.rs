@@ -47,6 +47,7 @@ pub fn of(fitness: &PoncinFitness) -> Option<Plant> {
                 kind: MaterialKind::Bark,
                 color: [0.8, 0.08, 0.05],
                 texture: None,
+                surface: None,
             })
             .ok()?;
         for i in 0..grid.len() {
@@ -77,6 +78,7 @@ pub fn guide_plant(color: [f32; 3]) -> Result<(Plant, MaterialId), PlantError> {
         kind: MaterialKind::Bark,
         color,
         texture: None,
+        surface: None,
     })?;
     Ok((plant, material))
 }

@@ -65,10 +65,11 @@ use std::io::{self, BufWriter, Write};
 use serde_json::{Map, Value, json};
 use sylva_core::glam::{Quat, Vec3};
 use sylva_mesh::mesh::Mesh;
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::Scene;
 use sylva_mesh::wind::Rig;
 
-use super::{ExportError, check_mesh, check_node, check_scene};
+use super::{ExportError, MaterialKey, check_mesh, check_node, check_scene, material_key};
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const GLB_VERSION: u32 = 2;
@@ -90,8 +91,10 @@ const CLAMP_TO_EDGE: u32 = 33071;
 pub const EXT_MESH_GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
 /// The quantisation extension's name.
 pub const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
-/// The prefix of the glTF image names that carry a Sylva texture id.
-pub(crate) const IMAGE_NAME_PREFIX: &str = "sylva-texture-";
+/// Where a material's extras carry its [`Surface`], for [`crate::import`] to read back.
+pub(crate) const SURFACE_EXTRA: &str = "sylva_surface";
+/// The alpha below which a cut-out card (leaf or petal) shows nothing.
+pub const ALPHA_CUTOFF: f64 = 0.5;
 /// Most vertices that `u16` indices can address (65 535 is reserved for primitive restart).
 const U16_VERTICES: usize = 65_535;
 /// Roughness of every material: plants are matte.
@@ -819,12 +822,13 @@ struct Writer<S> {
     textures: Vec<Value>,
     images: Vec<Value>,
     samplers: Vec<Value>,
-    /// (name, colour bits, texture) to material index, to write identical materials once.
-    material_of: HashMap<(String, [u32; 3], Option<u16>), usize>,
-    /// Texture id to glTF texture index, to embed each picture once.
-    texture_of: HashMap<u16, usize>,
-    /// The sampler for textures that repeat along v ([0]) and that clamp ([1]), once written.
-    sampler_of: [Option<usize>; 2],
+    /// (name, colour bits, texture, surface) to material index, to write identical
+    /// materials once.
+    material_of: HashMap<MaterialKey, usize>,
+    /// Picture to glTF texture index, to embed each picture once.
+    texture_of: HashMap<Picture, usize>,
+    /// The sampler of each wrapping, once written: index `2·(clamps u) + (clamps v)`.
+    sampler_of: [Option<usize>; 4],
 }
 
 impl<S: Sink> Writer<S> {
@@ -842,7 +846,7 @@ impl<S: Sink> Writer<S> {
             samplers: Vec::new(),
             material_of: HashMap::new(),
             texture_of: HashMap::new(),
-            sampler_of: [None; 2],
+            sampler_of: [None; 4],
         }
     }
 
@@ -876,7 +880,7 @@ impl<S: Sink> Writer<S> {
             }
         };
         let textured = |p: &sylva_mesh::Primitive| {
-            !p.indices.is_empty() && mesh.materials[p.material].texture.is_some()
+            !p.indices.is_empty() && Picture::base_of(&mesh.materials[p.material]).is_some()
         };
         let texcoord = if mesh.primitives.iter().any(textured) {
             let start = self.bin.len();
@@ -896,6 +900,25 @@ impl<S: Sink> Writer<S> {
             let view = self.view(start, ARRAY_BUFFER);
             Some(self.accessor(json!({
                 "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC2",
+            })))
+        } else {
+            None
+        };
+
+        // A normal map needs a tangent space, written rather than left to each viewer.
+        let normal_mapped = |p: &sylva_mesh::Primitive| {
+            !p.indices.is_empty() && Picture::normal_of(&mesh.materials[p.material]).is_some()
+        };
+        let tangent = if mesh.primitives.iter().any(normal_mapped) {
+            let start = self.bin.len();
+            for t in tangents(mesh) {
+                for c in t {
+                    self.bin.put(&c.to_le_bytes());
+                }
+            }
+            let view = self.view(start, ARRAY_BUFFER);
+            Some(self.accessor(json!({
+                "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC4",
             })))
         } else {
             None
@@ -957,11 +980,15 @@ impl<S: Sink> Writer<S> {
                 "count": group.iter().map(|p| p.indices.len()).sum::<usize>(),
                 "type": "SCALAR",
             }));
-            let textured = material.texture.is_some();
+            let textured = Picture::base_of(material).is_some();
+            let normal_map = Picture::normal_of(material).is_some();
             let material = self.material(material)?;
             let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
             if let (Some(t), true) = (texcoord, textured) {
                 attributes["TEXCOORD_0"] = json!(t);
+            }
+            if let (Some(t), true) = (tangent, normal_map) {
+                attributes["TANGENT"] = json!(t);
             }
             if let Some(c) = color {
                 attributes["COLOR_0"] = json!(c);
@@ -1186,13 +1213,15 @@ impl<S: Sink> Writer<S> {
         self.views.len() - 1
     }
 
-    /// The glTF texture showing Sylva texture `id`, embedding its PNG the first time.
-    fn texture(&mut self, id: u16) -> Result<usize, ExportError> {
-        if let Some(&t) = self.texture_of.get(&id) {
+    /// The glTF texture showing `picture`, embedding its PNG the first time.
+    fn texture(&mut self, picture: Picture) -> Result<usize, ExportError> {
+        if let Some(&t) = self.texture_of.get(&picture) {
             return Ok(t);
         }
-        let png = sylva_mesh::texture::texture_png(id)
-            .map_err(|source| ExportError::Png { id, source })?;
+        let png = picture.png().map_err(|source| ExportError::Png {
+            picture: picture.name(),
+            source,
+        })?;
         let start = self.bin.len();
         self.bin.put(&png);
         let view = self.untargeted_view(start);
@@ -1200,29 +1229,34 @@ impl<S: Sink> Writer<S> {
         self.images.push(json!({
             "bufferView": view,
             "mimeType": "image/png",
-            "name": format!("{IMAGE_NAME_PREFIX}{id}"),
+            "name": picture.name(),
         }));
-        let repeats = sylva_mesh::texture::texture_info(id).family.repeats_v();
-        let slot = usize::from(!repeats);
+        let (repeat_u, repeat_v) = (picture.repeats_u(), picture.repeats_v());
+        let slot = 2 * usize::from(!repeat_u) + usize::from(!repeat_v);
+        let wrap = |repeats| if repeats { REPEAT } else { CLAMP_TO_EDGE };
         let sampler = match self.sampler_of[slot] {
             Some(s) => s,
             None => {
                 self.samplers.push(json!({
                     "magFilter": LINEAR,
                     "minFilter": LINEAR_MIPMAP_LINEAR,
-                    "wrapS": REPEAT,
-                    "wrapT": if repeats { REPEAT } else { CLAMP_TO_EDGE },
+                    "wrapS": wrap(repeat_u),
+                    "wrapT": wrap(repeat_v),
                 }));
                 self.sampler_of[slot] = Some(self.samplers.len() - 1);
                 self.samplers.len() - 1
             }
         };
+        let name = match picture {
+            Picture::Design(id) => sylva_mesh::texture::texture_info(id).name.to_owned(),
+            other => other.name(),
+        };
         self.textures.push(json!({
-            "name": sylva_mesh::texture::texture_info(id).name,
+            "name": name,
             "sampler": sampler,
             "source": self.images.len() - 1,
         }));
-        self.texture_of.insert(id, self.textures.len() - 1);
+        self.texture_of.insert(picture, self.textures.len() - 1);
         Ok(self.textures.len() - 1)
     }
 
@@ -1232,7 +1266,7 @@ impl<S: Sink> Writer<S> {
     }
 
     fn material(&mut self, m: &sylva_core::Material) -> Result<usize, ExportError> {
-        let key = (m.name.clone(), m.color.map(f32::to_bits), m.texture);
+        let key = material_key(m);
         if let Some(&i) = self.material_of.get(&key) {
             return Ok(i);
         }
@@ -1242,16 +1276,82 @@ impl<S: Sink> Writer<S> {
             "metallicFactor": 0.0,
             "roughnessFactor": ROUGHNESS,
         });
-        if let Some(id) = m.texture {
-            pbr["baseColorTexture"] = json!({ "index": self.texture(id)? });
+        if let Some(picture) = Picture::base_of(m) {
+            pbr["baseColorTexture"] = json!({ "index": self.texture(picture)? });
         }
-        self.materials.push(json!({
+        let mut material = json!({
             "name": m.name,
             "pbrMetallicRoughness": pbr,
-        }));
+        });
+        if let Some(normal) = Picture::normal_of(m) {
+            material["normalTexture"] = json!({ "index": self.texture(normal)? });
+        }
+        if let Some(surface) = m.surface {
+            if surface.is_cut_out() {
+                material["alphaMode"] = json!("MASK");
+                material["alphaCutoff"] = json!(ALPHA_CUTOFF);
+                material["doubleSided"] = json!(true);
+            }
+            material["extras"] = json!({ SURFACE_EXTRA: surface });
+        }
+        self.materials.push(material);
         self.material_of.insert(key, self.materials.len() - 1);
         Ok(self.materials.len() - 1)
     }
+}
+
+/// Each vertex's tangent (unit, square to its normal, along increasing `u`) and the sign `w`
+/// that turns `normal × tangent` into the direction of decreasing `v` (up the picture, where
+/// normal maps point green, as glTF reads them): accumulated from the triangles' texture
+/// coordinates as MikkTSpace does, without its splitting of vertices.
+fn tangents(mesh: &Mesh) -> Vec<[f32; 4]> {
+    let n = mesh.positions.len();
+    let mut along_u = vec![Vec3::ZERO; n];
+    let mut along_v = vec![Vec3::ZERO; n];
+    let uv = |i: usize| mesh.uvs.get(i).copied().unwrap_or([0.0; 2]);
+    for prim in &mesh.primitives {
+        for t in prim.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            if a.max(b).max(c) >= n {
+                continue;
+            }
+            let p = |i: usize| Vec3::from_array(mesh.positions[i]);
+            let (e1, e2) = (p(b) - p(a), p(c) - p(a));
+            let ([u0, v0], [u1, v1], [u2, v2]) = (uv(a), uv(b), uv(c));
+            let (du1, dv1, du2, dv2) = (u1 - u0, v1 - v0, u2 - u0, v2 - v0);
+            let det = du1 * dv2 - du2 * dv1;
+            if !(det.abs() > 1e-12) {
+                continue;
+            }
+            let su = (e1 * dv2 - e2 * dv1) / det;
+            let sv = (e2 * du1 - e1 * du2) / det;
+            if !(su.is_finite() && sv.is_finite()) {
+                continue;
+            }
+            for i in [a, b, c] {
+                along_u[i] += su;
+                along_v[i] += sv;
+            }
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let normal = mesh
+                .normals
+                .get(i)
+                .map_or(Vec3::Y, |&v| Vec3::from_array(v))
+                .normalize_or(Vec3::Y);
+            let t = (along_u[i] - normal * normal.dot(along_u[i]))
+                .try_normalize()
+                .unwrap_or_else(|| normal.any_orthonormal_vector());
+            let w = if normal.cross(t).dot(-along_v[i]) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            [t.x, t.y, t.z, w]
+        })
+        .collect()
 }
 
 /// The smallest box holding `positions`.
@@ -1287,7 +1387,7 @@ fn short(x: f32) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::export::tests::small_mesh;
     use sylva_mesh::scene::SceneNode;
@@ -1960,7 +2060,7 @@ mod tests {
             assert_eq!(start % 4, 0);
             let png = &bin[start..start + len];
             assert!(png.starts_with(b"\x89PNG"));
-            let id: u16 = image["name"].as_str().unwrap()[IMAGE_NAME_PREFIX.len()..]
+            let id: u16 = image["name"].as_str().unwrap()["sylva-texture-".len()..]
                 .parse()
                 .unwrap();
             assert_eq!(png, sylva_mesh::texture::texture(id).png().unwrap());

@@ -16,8 +16,23 @@
 //! L-system plant) is written as before, without `COLOR_0`; so is a mesh in which a vertex
 //! is shared by triangles of two colours, whose colour a vertex attribute could not hold.
 
+use sylva_core::species::Surface;
 use sylva_core::{Material, MaterialKind};
 use sylva_mesh::mesh::Mesh;
+
+/// A merged material's name for a surface: `leaf-oak`, `bark-furrowed`, `flower-petals-t7`.
+fn surface_name(kind: MaterialKind, surface: Surface, texture: Option<u16>) -> String {
+    let what = match surface {
+        Surface::Leaves(k) => k.name(),
+        Surface::Branchlets(k) => return format!("{}-{}-branchlets", kind.name(), k.name()),
+        Surface::Bark(k) => k.name(),
+        Surface::Petals => "petals",
+    };
+    match texture {
+        Some(t) if surface == Surface::Petals => format!("{}-{what}-t{t}", kind.name()),
+        _ => format!("{}-{what}", kind.name()),
+    }
+}
 
 /// No primitive has claimed this vertex yet.
 const UNCLAIMED: u32 = u32::MAX;
@@ -35,7 +50,7 @@ pub(super) struct LeanPlan {
 impl LeanPlan {
     /// The plan for `mesh`, or `None` when merging would change nothing or is impossible.
     pub fn of(mesh: &Mesh) -> Option<LeanPlan> {
-        let mut keys: Vec<(MaterialKind, Option<u16>)> = Vec::new();
+        let mut keys: Vec<(MaterialKind, Option<u16>, Option<Surface>)> = Vec::new();
         let mut members: Vec<Vec<usize>> = Vec::new();
         let mut merges = false;
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -43,7 +58,7 @@ impl LeanPlan {
                 continue;
             }
             let m = &mesh.materials[prim.material];
-            let key = (m.kind, m.texture);
+            let key = (m.kind, m.texture, m.surface);
             match keys.iter().position(|k| *k == key) {
                 Some(g) => {
                     let first = &mesh.materials[mesh.primitives[members[g][0]].material];
@@ -63,7 +78,7 @@ impl LeanPlan {
         let materials: Vec<Material> = keys
             .iter()
             .zip(&members)
-            .map(|(&(kind, texture), group)| {
+            .map(|(&(kind, texture, surface), group)| {
                 let mut color = [0.0f32; 3];
                 for &p in group {
                     let c = mesh.materials[mesh.primitives[p].material].color;
@@ -72,13 +87,15 @@ impl LeanPlan {
                     }
                 }
                 Material {
-                    name: match texture {
-                        Some(t) => format!("{}-t{t}", kind.name()),
-                        None => kind.name().to_owned(),
+                    name: match (surface, texture) {
+                        (Some(s), _) => surface_name(kind, s, texture),
+                        (None, Some(t)) => format!("{}-t{t}", kind.name()),
+                        (None, None) => kind.name().to_owned(),
                     },
                     kind,
                     color,
                     texture,
+                    surface,
                 }
             })
             .collect();
@@ -102,7 +119,8 @@ impl LeanPlan {
                             let other = &mesh.materials[mesh.primitives[o as usize].material];
                             let this = &mesh.materials[prim.material];
                             if colour_bits(other) != colour_bits(this)
-                                || (other.kind, other.texture) != (this.kind, this.texture)
+                                || (other.kind, other.texture, other.surface)
+                                    != (this.kind, this.texture, this.surface)
                             {
                                 return None;
                             }
@@ -146,6 +164,7 @@ mod tests {
             kind,
             color,
             texture,
+            surface: None,
         }
     }
 

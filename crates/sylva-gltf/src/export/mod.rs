@@ -33,7 +33,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod glb;
+pub(crate) mod glb;
 mod lean;
 mod obj;
 mod stl;
@@ -44,10 +44,12 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 use sylva_mesh::mesh::Mesh;
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::Scene;
 use thiserror::Error;
 
-pub(crate) use glb::IMAGE_NAME_PREFIX;
+pub use glb::ALPHA_CUTOFF;
+pub(crate) use glb::SURFACE_EXTRA;
 pub use glb::{
     EXT_MESH_GPU_INSTANCING, Glb, GlbNode, GlbOptions, GlbStats, KHR_MESH_QUANTIZATION, MeshSource,
     mesh_binary_bytes, mesh_binary_floor, to_glb, to_glb_with,
@@ -55,6 +57,25 @@ pub use glb::{
 pub use obj::to_obj;
 pub use stl::to_stl;
 pub use vrml::{DEFAULT_TEXTURE_STEM, to_vrml, to_vrml_with_textures};
+
+/// What makes two materials the same in a file: name, colour (bit for bit), texture id and
+/// surface. Writers write each distinct one once.
+pub(crate) type MaterialKey = (
+    String,
+    [u32; 3],
+    Option<u16>,
+    Option<sylva_core::species::Surface>,
+);
+
+/// The [`MaterialKey`] of a material.
+pub(crate) fn material_key(m: &sylva_core::Material) -> MaterialKey {
+    (
+        m.name.clone(),
+        m.color.map(f32::to_bits),
+        m.texture,
+        m.surface,
+    )
+}
 
 /// Why a scene could not be exported.
 #[derive(Debug, Error)]
@@ -115,10 +136,10 @@ pub enum ExportError {
         uvs: usize,
     },
     /// A texture could not be encoded as PNG.
-    #[error("cannot encode texture {id} as PNG")]
+    #[error("cannot encode texture {picture} as PNG")]
     Png {
-        /// The texture id.
-        id: u16,
+        /// The picture's name ([`Picture::name`]).
+        picture: String,
         /// What went wrong.
         #[source]
         source: image::ImageError,
@@ -298,27 +319,27 @@ pub fn scene_files(path: &Path, scene: &Scene) -> Result<Vec<(PathBuf, Vec<u8>)>
 }
 
 /// The PNG files OBJ and VRML97 exports of `scene` refer to: one `(file name, PNG bytes)`
-/// per texture id that a material of a primitive with triangles uses, in id order. Files
-/// are named `<stem>_tex<id>.png` with `stem` made a single word as OBJ and VRML names are
-/// (letters, digits, `_` and `-` kept, anything else `_`), which is how [`to_obj`] (from its
-/// MTL file's stem) and [`to_vrml_with_textures`] name them.
+/// per picture ([`Picture`]) that a material of a primitive with triangles shows (its base
+/// picture, normal map and cut-out mask), designs first in id order. Files are named
+/// [`Picture::file_name`] with `stem` made a single word as OBJ and VRML names are (letters,
+/// digits, `_` and `-` kept, anything else `_`): `<stem>_tex<id>.png` for a texture id,
+/// which is how [`to_obj`] (from its MTL file's stem) and [`to_vrml_with_textures`] name them.
 pub fn texture_files(scene: &Scene, stem: &str) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let stem = token(stem);
-    used_textures(scene)
+    used_pictures(scene)
         .into_iter()
-        .map(|id| {
-            let png = sylva_mesh::texture::texture_png(id)
-                .map_err(|source| ExportError::Png { id, source })?;
-            Ok((
-                sylva_mesh::texture::texture_file_name(&stem, id),
-                png.to_vec(),
-            ))
+        .map(|picture| {
+            let png = picture.png().map_err(|source| ExportError::Png {
+                picture: picture.name(),
+                source,
+            })?;
+            Ok((picture.file_name(&stem), png.to_vec()))
         })
         .collect()
 }
 
-/// Texture ids used by materials of primitives that have triangles, ascending.
-fn used_textures(scene: &Scene) -> std::collections::BTreeSet<u16> {
+/// Pictures shown by materials of primitives that have triangles, in order.
+fn used_pictures(scene: &Scene) -> std::collections::BTreeSet<Picture> {
     scene
         .nodes
         .iter()
@@ -327,7 +348,15 @@ fn used_textures(scene: &Scene) -> std::collections::BTreeSet<u16> {
                 .primitives
                 .iter()
                 .filter(|p| !p.indices.is_empty())
-                .filter_map(|p| n.mesh.materials.get(p.material)?.texture)
+                .filter_map(|p| n.mesh.materials.get(p.material))
+                .flat_map(|m| {
+                    [
+                        Picture::base_of(m),
+                        Picture::normal_of(m),
+                        Picture::mask_of(m),
+                    ]
+                })
+                .flatten()
         })
         .collect()
 }

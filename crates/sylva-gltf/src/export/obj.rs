@@ -12,17 +12,21 @@
 //! a number appended if that is taken too). Names are made single words (spaces become `_`).
 //! A textured material gets `map_Kd <stem>_tex<id>.png`, `stem` being the MTL file's (see
 //! [`super::texture_files`]); MTL multiplies the map by `Kd`, like glTF. Leaf and petal
-//! textures, which do not repeat along `v`, are clamped (`-clamp on`).
+//! textures, which do not repeat along `v`, are clamped (`-clamp on`). A material with a
+//! surface ([`sylva_core::species::Surface`]) names its picture the same way
+//! ([`Picture::file_name`]); cut-out leaves and petals add `map_d` with their mask (the
+//! outline as grey and as alpha, so readers of either channel cut it), and bark adds its
+//! normal map as `norm` and `map_Bump`.
 
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
 use sylva_core::glam::Vec3;
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::Scene;
-use sylva_mesh::texture::{texture_file_name, texture_info};
 
-use super::{push_float, push_vec3, token, valid_triangles};
+use super::{MaterialKey, material_key, push_float, push_vec3, token, valid_triangles};
 
 /// Encodes `scene` as OBJ text and the text of its MTL file, which the OBJ names as
 /// `mtl_file_name` in its `mtllib` line. Never fails: indices out of range are dropped and
@@ -45,9 +49,9 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
             .file_stem()
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy()),
     );
-    // Names written, and (name, colour bits, texture) -> name written.
+    // Names written, and (name, colour bits, texture, surface) -> name written.
     let mut taken: HashSet<String> = HashSet::new();
-    let mut written: HashMap<(String, [u32; 3], Option<u16>), String> = HashMap::new();
+    let mut written: HashMap<MaterialKey, String> = HashMap::new();
     let mut offset = 1usize;
     for (index, node) in scene.nodes.iter().enumerate() {
         let mesh = node.mesh;
@@ -79,8 +83,7 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
             let Some(material) = mesh.materials.get(p.material) else {
                 continue;
             };
-            let bits = material.color.map(f32::to_bits);
-            let key = (material.name.clone(), bits, material.texture);
+            let key = material_key(material);
             let mtl_name = match written.get(&key) {
                 Some(n) => n.clone(),
                 None => {
@@ -98,14 +101,22 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
                     taken.insert(n.clone());
                     written.insert(key, n.clone());
                     write_material(&mut mtl, &n, material.color);
-                    if let Some(id) = material.texture {
-                        let clamp = if texture_info(id).family.repeats_v() {
+                    if let Some(picture) = Picture::base_of(material) {
+                        let clamp = if picture.repeats_v() {
                             ""
                         } else {
                             "-clamp on "
                         };
-                        let file = texture_file_name(&texture_stem, id);
+                        let file = picture.file_name(&texture_stem);
                         let _ = writeln!(mtl, "map_Kd {clamp}{file}");
+                    }
+                    if let Some(mask) = Picture::mask_of(material) {
+                        let file = mask.file_name(&texture_stem);
+                        let _ = writeln!(mtl, "map_d -clamp on {file}");
+                    }
+                    if let Some(normal) = Picture::normal_of(material) {
+                        let file = normal.file_name(&texture_stem);
+                        let _ = writeln!(mtl, "norm {file}\nmap_Bump {file}");
                     }
                     n
                 }

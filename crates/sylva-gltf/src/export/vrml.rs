@@ -13,15 +13,18 @@
 //! A textured material's `Appearance` also has `texture ImageTexture { url
 //! "<stem>_tex<id>.png" }` ([`super::texture_files`] gives the files), with `repeatT FALSE`
 //! for leaf and petal textures. The textures are grey, one component, which VRML97
-//! multiplies with `diffuseColor` (an RGB texture would replace it).
+//! multiplies with `diffuseColor` (an RGB texture would replace it). A material with a
+//! surface names its picture ([`Picture::file_name`]): cut-out leaves and petals are grey
+//! and alpha, two components, which VRML97 reads as intensity and transparency, so their
+//! outline is cut; bark's normal map has no place in VRML97 and is left out.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use sylva_core::glam::Vec3;
 use sylva_mesh::mesh::Mesh;
+use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::Scene;
-use sylva_mesh::texture::{texture_file_name, texture_info};
 
 use super::{push_float, push_vec3, token, valid_triangles};
 
@@ -92,16 +95,16 @@ fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool, stem: &str)
         );
         push_vec3(out, color);
         out.push_str(" }\n");
-        if let Some(t) = material.and_then(|m| m.texture) {
-            let repeat = if texture_info(t).family.repeats_v() {
-                ""
-            } else {
-                " repeatT FALSE"
+        if let Some(picture) = material.and_then(Picture::base_of) {
+            let repeat = match (picture.repeats_u(), picture.repeats_v()) {
+                (true, true) => "",
+                (true, false) => " repeatT FALSE",
+                _ => " repeatS FALSE repeatT FALSE",
             };
             let _ = writeln!(
                 out,
                 "        texture ImageTexture {{ url \"{}\"{repeat} }}",
-                texture_file_name(stem, t)
+                picture.file_name(stem)
             );
         }
         out.push_str("      }\n      geometry IndexedFaceSet {\n");

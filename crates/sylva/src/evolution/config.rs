@@ -443,6 +443,7 @@ impl Config {
             wind: output.wind_options(),
             height: output.height,
             pruned_to,
+            dress: output.dress(),
             ..GrowOptions::default()
         })
     }

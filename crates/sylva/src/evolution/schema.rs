@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::ser::SerializeStruct;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use sylva_core::dress::Dress;
+use sylva_core::species::{BarkKind, LeafKind};
 use sylva_core::taper::PipeTaper;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::Evolve;
@@ -106,6 +108,47 @@ pub struct OutputConfig {
     /// own scale (evolution scores the plants as grown).
     #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "height")]
     pub height: Option<f32>,
+    /// Leaves or needles of a kind at their real size on the best plant and the sheet, as
+    /// `sylva grow --foliage` (`"oak"`, `"pine"`, …; [`LeafKind`]). Default none: the
+    /// plant's own leaves (evolution scores the plants as grown).
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "foliage")]
+    pub foliage: Option<LeafKind>,
+    /// A tiling bark, as `sylva grow --bark` (`"smooth"`, `"birch"`, `"furrowed"`,
+    /// `"plated"`). Default none: the foliage's own bark, or the model's look.
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "bark")]
+    pub bark: Option<BarkKind>,
+    /// Leaf cards per metre of twig, as a multiple of the kind's own, 0.25 to 4, as
+    /// `sylva grow --density`. Default 1.
+    #[serde(skip_serializing_if = "is_one", deserialize_with = "density")]
+    pub density: f32,
+}
+
+fn is_one(x: &f32) -> bool {
+    *x == 1.0
+}
+
+/// Reads `foliage` by name, naming the kinds allowed when it is none of them.
+fn foliage<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<LeafKind>, D::Error> {
+    let name = String::deserialize(d)?;
+    name.parse().map(Some).map_err(serde::de::Error::custom)
+}
+
+/// Reads `bark` by name, naming the kinds allowed when it is none of them.
+fn bark<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<BarkKind>, D::Error> {
+    let name = String::deserialize(d)?;
+    name.parse().map(Some).map_err(serde::de::Error::custom)
+}
+
+/// Reads `density`, checked to lie in 0.25..=4.
+fn density<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let x = f32::deserialize(d)?;
+    if (0.25..=4.0).contains(&x) {
+        Ok(x)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "`density` must be a number from 0.25 to 4, got {x}"
+        )))
+    }
 }
 
 /// Reads `height`, checked to lie in 0.01..=1000 metres.
@@ -408,6 +451,16 @@ impl OutputConfig {
         self.taper.and_then(|e| PipeTaper::new(e).ok())
     }
 
+    /// How the outputs are dressed (`foliage`, `bark`, `density`).
+    pub fn dress(&self) -> Dress {
+        Dress {
+            foliage: self.foliage,
+            bark: self.bark,
+            density: self.density,
+            ..Dress::default()
+        }
+    }
+
     /// The wind of `best.glb`, if any.
     pub fn wind_options(&self) -> Option<WindOptions> {
         self.wind
@@ -424,6 +477,9 @@ impl Default for OutputConfig {
             taper: None,
             wind: None,
             height: None,
+            foliage: None,
+            bark: None,
+            density: 1.0,
         }
     }
 }
