@@ -17,10 +17,15 @@
 //!   a petal's outline ([`Surface::Petals`]).
 //! - **Bark.** Every bark material shows the bark kind's tiling texture and normal map
 //!   ([`Surface::Bark`]) in its colour; the foliage kind's own bark when none is given.
-//! - **Trunk.** Each trunk (a woody segment with no parent) flares at its root collar:
-//!   its first stretch, about two and a half radii high, is split into rings that widen
-//!   to 1.5 times the radius at the ground. Along every axis a stem never thickens towards
-//!   its tip, so a stem is one smooth tube from its base, not a stack of discs.
+//! - **Wood.** Stems are thickened by the pipe model ([`PipeTaper`], exponent
+//!   [`Dress::taper`]): each is as thick as the twigs it carries, so twigs are thin and
+//!   limbs thicken towards the trunk; then the whole tree is scaled so that its trunk is
+//!   as thick at breast height (1.3 m, or its foot on a small plant) as an open-grown tree
+//!   of the species (height ÷ [`LeafSpec::slenderness`]). Each trunk (a woody segment with
+//!   no parent) flares at its root collar: its first stretch, about two and a half radii
+//!   high, is split into rings that widen to 1.5 times the radius at the ground. Along
+//!   every axis a stem never thickens towards its tip, so a stem is one smooth tube from
+//!   its base, not a stack of discs.
 //!
 //! Every choice is drawn from the seed's own stream, so the same plant, dress and seed give
 //! the same plant. At most [`Dress::max_cards`] cards are placed; more are thinned evenly
@@ -46,13 +51,15 @@ use rand::{Rng, RngExt};
 use crate::plant::{Material, MaterialId, MaterialKind, Organ, OrganKind, Plant, PlantError};
 use crate::rng;
 use crate::species::{Arrangement, BarkKind, Card, LeafKind, Surface};
+use crate::taper::PipeTaper;
 
 /// Shades of a foliage kind's colour given to its cards.
 pub const SHADES: usize = 5;
 
-/// Most cards a dress places by default: 20,000 cards are 40,000 triangles (one-sided
-/// cards drawn from both sides by their material).
-pub const DEFAULT_MAX_CARDS: u32 = 20_000;
+/// Most cards a dress places by default: 12,000 flat cards are 24,000 triangles (one-sided
+/// cards drawn from both sides by their material), which with the wood keeps a tree in
+/// leaf under a game's budget of 40,000; kinds of crossed cards place half as many.
+pub const DEFAULT_MAX_CARDS: u32 = 12_000;
 
 /// How to dress a plant. Every field says its default ([`Dress::default`] changes nothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,12 +72,18 @@ pub struct Dress {
     /// Cards per metre of twig, as a multiple of the kind's own spacing, 0.25 to 4.
     /// Default 1.
     pub density: f32,
-    /// Most cards placed; beyond, cards are thinned evenly. Default [`DEFAULT_MAX_CARDS`].
+    /// Most flat cards placed (half as many of crossed ones); beyond, cards are thinned
+    /// evenly. Default [`DEFAULT_MAX_CARDS`].
     pub max_cards: u32,
     /// The card size. Default `None`: branchlets on plants at least [`BRANCHLET_HEIGHT`]
     /// tall, sprays on smaller ones.
     pub card: Option<Card>,
+    /// The pipe model the wood is thickened by when bark is dressed. Default exponent 2.5.
+    pub taper: PipeTaper,
 }
+
+/// Height over breast-height diameter of a trunk dressed without a foliage kind.
+pub const DEFAULT_SLENDERNESS: f32 = 40.0;
 
 /// Plants at least this tall (metres) wear branchlets rather than sprays by default: a
 /// crown of sprays would need more cards than an engine's budget allows.
@@ -84,6 +97,7 @@ impl Default for Dress {
             density: 1.0,
             max_cards: DEFAULT_MAX_CARDS,
             card: None,
+            taper: PipeTaper { exponent: 2.5 },
         }
     }
 }
@@ -151,6 +165,16 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
             .is_some_and(|m| m.kind.is_woody())
     };
     let bark = dress.bark_kind();
+    let wood;
+    let plant = if bark.is_some() {
+        let slenderness = dress
+            .foliage
+            .map_or(DEFAULT_SLENDERNESS, |k| k.spec().slenderness);
+        wood = thicken(plant, dress.taper, slenderness);
+        &wood
+    } else {
+        plant
+    };
     if let Some(kind) = bark {
         for (i, m) in plant.materials().iter().enumerate() {
             if m.kind == MaterialKind::Bark {
@@ -296,11 +320,103 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
     {
         twig_cards(&out, *foliage, shades, dress.density, &mut rng, &mut cards);
     }
-    let kept = thin(cards, dress.max_cards as usize, &mut report);
+    let most = match foliage {
+        Some((f, _)) if f.kind.spec().crossed => dress.max_cards / 2,
+        _ => dress.max_cards,
+    };
+    let kept = thin(cards, most as usize, &mut report);
     for card in kept {
         out.add_organ(card)?;
     }
     Ok((out, report))
+}
+
+/// Breast height, metres: where a trunk's diameter is measured.
+const BREAST_HEIGHT: f32 = 1.3;
+
+/// The plant with its wood thickened by the pipe model, then scaled so that its tallest
+/// skeleton's trunk is `height / slenderness` thick at breast height (at a tenth of the
+/// height on plants under 13 m, whose breast height lies too low to tell a trunk by).
+fn thicken(plant: &Plant, taper: PipeTaper, slenderness: f32) -> Plant {
+    let mut plant = plant.clone();
+    taper.apply(&mut plant);
+    let bark: Vec<bool> = plant
+        .segments()
+        .iter()
+        .map(|s| {
+            plant
+                .materials()
+                .get(s.material.index())
+                .is_some_and(|m| m.kind == MaterialKind::Bark)
+        })
+        .collect();
+    let segments = plant.segments();
+    // The trunk: the thickest bark skeleton root (the pipe model makes the one carrying the
+    // most twigs the thickest).
+    let Some(foot) = (0..segments.len())
+        .filter(|&i| segments[i].parent.is_none() && bark[i])
+        .max_by(|&a, &b| {
+            segments[a]
+                .start_radius
+                .total_cmp(&segments[b].start_radius)
+        })
+    else {
+        return plant;
+    };
+    let ground = segments[foot].start.y;
+    let height = plant.height() - ground;
+    if height.is_nan() || height <= 0.0 {
+        return plant;
+    }
+    let at = BREAST_HEIGHT.min(0.1 * height);
+    // Up the trunk's axis (each segment's first continuation) to that height.
+    let mut next = vec![None; segments.len()];
+    for (i, s) in segments.iter().enumerate().rev() {
+        if let Some(p) = s.parent
+            && !s.lateral
+        {
+            next[p.index()] = Some(i);
+        }
+    }
+    let mut i = foot;
+    let radius = loop {
+        let s = &segments[i];
+        let (y0, y1) = (s.start.y - ground, s.end.y - ground);
+        match next[i] {
+            Some(n) if y1 < at => i = n,
+            _ => {
+                let t = if y1 > y0 {
+                    ((at - y0) / (y1 - y0)).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                break s.start_radius + (s.end_radius - s.start_radius) * t;
+            }
+        }
+    };
+    let factor = (0.5 * height / slenderness) / radius;
+    if !(factor.is_finite() && factor > 0.0) {
+        return plant;
+    }
+    // Every radius stays within the plant's range: a factor past it leaves the wood as the
+    // pipe model made it.
+    let widest = segments
+        .iter()
+        .map(|s| s.start_radius.max(s.end_radius))
+        .fold(0.0f32, f32::max);
+    if widest * factor > crate::plant::MAX_COORD {
+        return plant;
+    }
+    for (s, _) in plant
+        .segments_mut()
+        .iter_mut()
+        .zip(&bark)
+        .filter(|(_, b)| **b)
+    {
+        s.start_radius *= factor;
+        s.end_radius *= factor;
+    }
+    plant
 }
 
 /// A kind of leaves on cards of a size.
@@ -580,7 +696,7 @@ fn twig_cards(
     }
     let typical = foliage.typical();
     let density = density.clamp(0.25, 4.0);
-    // Broadleaves: sprays every 0.45 card along the outer stretch of each axis, the last
+    // Broadleaves: sprays every 0.3 card along the outer stretch of each axis, the last
     // 2.5 cards or a fifth of the plant's height if more (a large crown's twigs stand for
     // many more than the model grew). Spruce and fir: a pair of shoots splayed flat every
     // half card, and one along the twig every other station, along the last 6 cards or 40%
@@ -597,7 +713,7 @@ fn twig_cards(
     } else if spec.needles {
         (0.35 * typical / density, (3.0 * typical).max(height / 6.0))
     } else {
-        (0.45 * typical / density, (2.5 * typical).max(height / 5.0))
+        (0.3 * typical / density, (2.5 * typical).max(height / 5.0))
     };
     let divergence = spec.arrangement.divergence_deg().to_radians();
     for (i, s) in segments.iter().enumerate() {
@@ -730,12 +846,24 @@ mod tests {
             // Cards sit on the crown's twigs, not on the trunk.
             assert!(o.position.y > 2.0, "{:?}", o.position);
         }
-        // Bark and a flared foot.
+        // Bark, a trunk as thick as an open-grown oak's (3 m ÷ 32 at a tenth of its height,
+        // its breast height being too low on a 3 m plant), and a flared foot.
         assert_eq!(
             d.materials()[0].surface,
             Some(Surface::Bark(BarkKind::Furrowed))
         );
-        assert!((d.segments()[0].start_radius - 1.5 * 0.12).abs() < 1e-3);
+        let trunk = d.segments()[3];
+        assert!(trunk.start.y < 0.3 && trunk.end.y > 0.3, "{trunk:?}");
+        let t = (0.3 - trunk.start.y) / (trunk.end.y - trunk.start.y);
+        let r = trunk.start_radius + (trunk.end_radius - trunk.start_radius) * t;
+        assert!((2.0 * r - 3.0 / 32.0).abs() < 1e-4, "{r}");
+        let foot = d.segments()[0];
+        assert!(foot.start_radius > 1.4 * trunk.start_radius);
+        // Twigs are as thick as the pipe model says: four tips on the trunk, so a twig is
+        // the trunk's radius over 4^(1/2.5).
+        let twig = d.segments().last().unwrap();
+        let want = trunk.end_radius / 4f32.powf(0.4);
+        assert!((twig.start_radius - want).abs() < 1e-4 * want.max(1.0));
         // The same seed gives the same plant; another seed another.
         assert_eq!(dress(&p, &Dress::foliage(LeafKind::Oak), 7).unwrap().0, d);
         assert_ne!(dress(&p, &Dress::foliage(LeafKind::Oak), 8).unwrap().0, d);

@@ -165,6 +165,9 @@ pub struct LeafSpec {
     pub evergreen: bool,
     /// The bark this species has.
     pub bark: BarkKind,
+    /// Height over trunk diameter at breast height (1.3 m) of an open-grown tree of the
+    /// species: what a dressed trunk is thickened to (see `docs/realism.md`).
+    pub slenderness: f32,
 }
 
 /// The two sizes of card a kind's leaves are drawn on.
@@ -289,6 +292,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.12,
         evergreen: false,
         bark: BarkKind::Furrowed,
+        slenderness: 32.0,
     },
     LeafSpec {
         name: "birch",
@@ -305,6 +309,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.12,
         evergreen: false,
         bark: BarkKind::Birch,
+        slenderness: 50.0,
     },
     LeafSpec {
         name: "aspen",
@@ -321,6 +326,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.14,
         evergreen: false,
         bark: BarkKind::Smooth,
+        slenderness: 55.0,
     },
     LeafSpec {
         name: "beech",
@@ -337,6 +343,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.1,
         evergreen: false,
         bark: BarkKind::Smooth,
+        slenderness: 40.0,
     },
     LeafSpec {
         name: "maple",
@@ -353,6 +360,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.12,
         evergreen: false,
         bark: BarkKind::Furrowed,
+        slenderness: 35.0,
     },
     LeafSpec {
         name: "willow",
@@ -360,15 +368,16 @@ const LEAVES: [LeafSpec; 11] = [
         shape: LeafShape::Lanceolate,
         arrangement: Arrangement::Alternate,
         length: (0.05, 0.10),
-        width_ratio: 0.17,
+        width_ratio: 0.2,
         leaf_of_spray: 0.3,
-        leaf_of_branchlet: 0.1,
+        leaf_of_branchlet: 0.13,
         needles: false,
         crossed: false,
         color: [0.1878, 0.2623, 0.0723], // sRGB 120, 140, 76
         variation: 0.1,
         evergreen: false,
         bark: BarkKind::Furrowed,
+        slenderness: 30.0,
     },
     LeafSpec {
         name: "ash",
@@ -385,6 +394,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.1,
         evergreen: false,
         bark: BarkKind::Furrowed,
+        slenderness: 45.0,
     },
     LeafSpec {
         name: "privet",
@@ -401,6 +411,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.1,
         evergreen: false,
         bark: BarkKind::Smooth,
+        slenderness: 25.0,
     },
     LeafSpec {
         name: "pine",
@@ -417,6 +428,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.08,
         evergreen: true,
         bark: BarkKind::Plated,
+        slenderness: 50.0,
     },
     LeafSpec {
         name: "spruce",
@@ -433,6 +445,7 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.06,
         evergreen: true,
         bark: BarkKind::Plated,
+        slenderness: 55.0,
     },
     LeafSpec {
         name: "fir",
@@ -449,28 +462,29 @@ const LEAVES: [LeafSpec; 11] = [
         variation: 0.06,
         evergreen: true,
         bark: BarkKind::Smooth,
+        slenderness: 55.0,
     },
 ];
 
 const BARKS: [BarkSpec; 4] = [
     BarkSpec {
         name: "smooth",
-        color: [0.2232, 0.2016, 0.1559], // sRGB 130, 124, 110
+        color: [0.3515, 0.3325, 0.2831], // sRGB 160, 156, 145: about sRGB 135, 132, 122 over the texture
         look: "smooth grey with faint horizontal bands and speckles",
     },
     BarkSpec {
         name: "birch",
-        color: [0.7605, 0.7305, 0.6308], // sRGB 226, 222, 208
+        color: [0.8148, 0.7913, 0.6939], // sRGB 233, 230, 217: about sRGB 215, 212, 200 over the texture
         look: "white with dark horizontal lenticels and black fissured patches",
     },
     BarkSpec {
         name: "furrowed",
-        color: [0.1274, 0.0931, 0.0648], // sRGB 100, 86, 72
+        color: [0.3372, 0.2831, 0.2307], // sRGB 157, 145, 132: about sRGB 96, 88, 80 over the texture
         look: "deep vertical furrows between wandering ridges broken by cross cracks",
     },
     BarkSpec {
         name: "plated",
-        color: [0.2016, 0.0723, 0.0319], // sRGB 124, 76, 50
+        color: [0.4020, 0.1559, 0.0742], // sRGB 170, 110, 77: about sRGB 120, 76, 52 over the texture
         look: "flaky red-brown plates parted by dark crevices",
     },
 ];

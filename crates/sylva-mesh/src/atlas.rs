@@ -697,10 +697,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                 cell,
                 at(0.04),
                 at(0.6),
-                22,
+                36,
                 len,
                 (0.35, 0.8),
-                0.011,
+                0.014,
                 2,
                 seed,
             );
@@ -709,10 +709,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                 cell,
                 at(0.5),
                 at(0.64),
-                8,
+                12,
                 len * 1.05,
                 (0.05, 0.4),
-                0.011,
+                0.014,
                 2,
                 seed ^ 7,
             );
@@ -724,10 +724,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                 cell,
                 at(0.02),
                 at(0.92),
-                64,
+                110,
                 len,
                 (0.7, 1.15),
-                0.012,
+                0.015,
                 1,
                 seed,
             );
@@ -741,10 +741,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                     cell,
                     at(y),
                     end,
-                    26,
+                    44,
                     len * 0.85,
                     (0.7, 1.15),
-                    0.011,
+                    0.014,
                     1,
                     h,
                 );
@@ -757,10 +757,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                 cell,
                 at(0.02),
                 at(0.9),
-                40,
+                60,
                 len,
                 (1.25, 1.5),
-                0.016,
+                0.019,
                 2,
                 seed,
             );
@@ -774,10 +774,10 @@ fn needle_cell(canvas: &mut Canvas, cell: Cell, kind: LeafKind, seed: u32) {
                     cell,
                     at(y),
                     end,
-                    16,
+                    26,
                     len * 0.9,
                     (1.25, 1.5),
-                    0.015,
+                    0.018,
                     2,
                     h,
                 );
@@ -805,9 +805,11 @@ fn leafy_twig(
     let dir = (b - a).normalize_or(Vec2::Y);
     if spec.needles {
         let (count, spread, thick, per) = match kind {
-            LeafKind::Pine => ((length / (0.09 * leaf)) as u32, (0.35, 0.8), 0.1, 2),
-            LeafKind::Spruce => ((length / (0.1 * leaf)) as u32, (0.7, 1.15), 0.12, 1),
-            _ => ((length / (0.1 * leaf)) as u32, (1.25, 1.5), 0.13, 2),
+            // Dense mats of needles drawn a little thicker than life: an engine's mipmaps
+            // average alpha, and sparse needles would fade away with distance.
+            LeafKind::Pine => ((length / (0.05 * leaf)) as u32, (0.35, 0.8), 0.13, 2),
+            LeafKind::Spruce => ((length / (0.045 * leaf)) as u32, (0.7, 1.15), 0.16, 2),
+            _ => ((length / (0.05 * leaf)) as u32, (1.25, 1.5), 0.17, 2),
         };
         needles_along(
             canvas,
@@ -835,9 +837,15 @@ fn leafy_twig(
         * match spec.shape {
             LeafShape::Pinnate => 0.5,
             LeafShape::Palmate => 0.7,
-            LeafShape::Lanceolate => 0.35,
+            // Willow's narrow leaves crowd their twigs close and steep, strands that
+            // still read as foliage from afar.
+            LeafShape::Lanceolate => 0.14,
             _ => 0.5,
         };
+    let spread = match spec.shape {
+        LeafShape::Lanceolate => (0.3, 0.6),
+        _ => (0.7, 1.15),
+    };
     let nodes = ((length - 0.3 * leaf) / spacing).max(1.0) as u32;
     let per_node = spec.arrangement.per_node();
     let draw = |canvas: &mut Canvas, base: Vec2, angle: f32, size: f32, h: u32| {
@@ -879,7 +887,7 @@ fn leafy_twig(
         for k in 0..per_node {
             let h = hash(seed, n * 2 + k, 23);
             let sign = side_of(per_node, n, k);
-            let angle = a0 + sign * pick(h, 0.7, 1.15) * (1.0 - 0.3 * t);
+            let angle = a0 + sign * pick(h, spread.0, spread.1) * (1.0 - 0.3 * t);
             draw(
                 canvas,
                 base,
@@ -1091,6 +1099,43 @@ mod tests {
                         "{kind} {card:?} cell {c}: {inked}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The share of a cell's area whose alpha, box-filtered down `halvings` times as an
+    /// engine's mipmaps are, still passes the cut-off.
+    fn coverage_after(atlas: &GrayAlphaImage, card: Card, c: u32, halvings: u32) -> f32 {
+        let (x0, y0, side) = cell_rect(card, c);
+        let k = 1u32 << halvings;
+        let n = side / k;
+        let mut passed = 0;
+        for by in 0..n {
+            for bx in 0..n {
+                let mut sum = 0u32;
+                for y in 0..k {
+                    for x in 0..k {
+                        sum += u32::from(atlas.get_pixel(x0 + bx * k + x, y0 + by * k + y).0[1]);
+                    }
+                }
+                passed += u32::from(sum >= 128 * k * k);
+            }
+        }
+        passed as f32 / (n * n) as f32
+    }
+
+    #[test]
+    fn leaves_and_needles_survive_an_engine_s_mipmaps() {
+        // With each branchlet drawn 16 pixels wide (a tree a few hundred pixels tall),
+        // every kind's branchlets keep at least half the cover they have at full size, so
+        // distant crowns do not thin out in viewers that build plain mipmaps. (Sparse
+        // needles, a pixel or two wide at full size, vanished entirely there.)
+        for kind in LeafKind::ALL {
+            let atlas = leaf_atlas(kind);
+            for c in 0..BRANCHLET_CELLS {
+                let full = coverage_after(&atlas, Card::Branchlet, c, 0);
+                let far = coverage_after(&atlas, Card::Branchlet, c, 5);
+                assert!(far >= 0.5 * full, "{kind} cell {c}: {far} of {full}");
             }
         }
     }

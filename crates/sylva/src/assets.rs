@@ -36,6 +36,20 @@ pub fn mesh_options(hint: MeshHint) -> MeshOptions {
     }
 }
 
+/// How a dressed plant ([`GrowOptions::dress`]) is meshed: as [`mesh_options`], but with
+/// fewer sides on thinner branches (12 on the trunk's axis, then 8, 6, 5, 4 and 3 for the
+/// fifth order of branches on), so that a tree in leaf fits a game's budget; the plants as
+/// their models grow them keep their meshes.
+pub fn mesh_options_for(hint: MeshHint, dress: &Dress) -> MeshOptions {
+    if dress.is_plain() {
+        return mesh_options(hint);
+    }
+    MeshOptions {
+        radial_segments_by_order: vec![12, 8, 6, 5, 4, 3],
+        ..mesh_options(hint)
+    }
+}
+
 /// Where a plant came from: enough to grow or breed it again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Origin {
@@ -165,7 +179,7 @@ impl Grown {
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
         let (seed, plant, dressed) = Grown::dressed_plant(&genome, options)?;
         let (roots, taper) = (options.roots, options.taper);
-        let mut mesher = Mesher::new(mesh_options(genome.mesh_hint()))?;
+        let mut mesher = Mesher::new(mesh_options_for(genome.mesh_hint(), &options.dress))?;
         let (mesh, rig) = match &options.wind {
             None => (mesher.mesh(&plant)?, None),
             Some(wind) => {

@@ -10,7 +10,7 @@ use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::Rig;
 use sylva_mesh::{Mesh, Scene, SceneNode};
 
-use crate::assets::{GrowOptions, Grown, Origin, grow_plant, mesh_options};
+use crate::assets::{GrowOptions, Grown, Origin, grow_plant, mesh_options, mesh_options_for};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
 use sylva_core::Plant;
@@ -39,7 +39,7 @@ impl LodAssets {
     /// has wind. `options` are those `grown` grew with.
     pub fn new(grown: Grown, options: &GrowOptions) -> Result<Self, Error> {
         let (levels, wind) = (options.lod.unwrap_or(1), options.wind.as_ref());
-        let options = mesh_options(grown.genome.mesh_hint());
+        let options = mesh_options_for(grown.genome.mesh_hint(), &grown.dress.0);
         let extras = grown.scene().nodes[0].extras.clone().unwrap_or(json!({}));
         let chain = lod_levels(&grown.plant, &options, levels).map_err(|e| match e {
             LodError::Mesh(e) => Error::Mesh(e),

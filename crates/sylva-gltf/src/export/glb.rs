@@ -1320,7 +1320,7 @@ fn tangents(mesh: &Mesh) -> Vec<[f32; 4]> {
             let ([u0, v0], [u1, v1], [u2, v2]) = (uv(a), uv(b), uv(c));
             let (du1, dv1, du2, dv2) = (u1 - u0, v1 - v0, u2 - u0, v2 - v0);
             let det = du1 * dv2 - du2 * dv1;
-            if !(det.abs() > 1e-12) {
+            if det.is_nan() || det.abs() <= 1e-12 {
                 continue;
             }
             let su = (e1 * dv2 - e2 * dv1) / det;
