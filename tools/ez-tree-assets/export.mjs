@@ -743,6 +743,9 @@ function skeletonOf(tree, records, scale) {
   return { segments, organs };
 }
 
+/** A leaf's length over its quad's: ez-tree's leaf pictures are sprigs of many leaves. */
+const LEAF_OF_CARD = 0.1;
+
 function skeletonJson({ seed, genome, materials, segments, organs }) {
   const lines = [
     "{",
@@ -766,7 +769,12 @@ function skeletonJson({ seed, genome, materials, segments, organs }) {
   };
   list(
     "materials",
-    materials.map((m) => `{"name":${JSON.stringify(m.name)},"kind":"${m.kind}","color":${vec(m.color)},"texture":null}`),
+    materials.map(
+      (m) =>
+        `{"name":${JSON.stringify(m.name)},"kind":"${m.kind}","color":${vec(m.color)},"texture":null` +
+        (m.fill === undefined ? "" : `,"fill":${m.fill},"leaf_of_card":${m.leaf_of_card}`) +
+        "}",
+    ),
   );
   list(
     "segments",
@@ -845,7 +853,15 @@ for (const spec of TREES) {
   const { segments, organs } = skeletonOf(tree, records, scale);
   const materials = [
     { name: "bark", kind: "bark", color: linearFactor(tree.branchesMesh.material.color) },
-    { name: "leaf", kind: "leaf", color: linearFactor(leaves.color) },
+    {
+      name: "leaf",
+      kind: "leaf",
+      color: linearFactor(leaves.color),
+      // The share of a quad the leaf picture covers, measured from its alpha; one leaf of
+      // the sprig is about a tenth of the quad's length (ez-tree's pictures, by eye).
+      fill: genome.leaf_picture.fill_area,
+      leaf_of_card: LEAF_OF_CARD,
+    },
   ];
   writeWhole(path.join(outDir, `${spec.name}.glb`), glb.bytes);
   writeWhole(

@@ -58,6 +58,10 @@ enum Command {
     Breed(commands::breed::BreedArgs),
     /// Render a genome (.json) or a GLB (.glb) to a PNG picture.
     Render(commands::render::RenderArgs),
+    /// How a plant measures against real trees: height, crown, trunk, pipe-model exponent,
+    /// leaf size and area, triangles and textures, each with the range real trees give;
+    /// `--check` exits 1 naming each implausible figure.
+    Inspect(commands::inspect::InspectArgs),
     /// Start the studio: a web page where you breed plants by eye (PlantMaker's grid, the
     /// biomorph garden, the binary-tree family, the GP designer), every step kept in an
     /// SQLite archive. Prints the address to open.
@@ -88,6 +92,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => commands::simulate::run(&args),
         Command::Breed(args) => commands::breed::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Inspect(args) => commands::inspect::run(&args),
         Command::Studio(args) => commands::studio::run(&args),
     });
     match result {

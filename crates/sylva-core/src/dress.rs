@@ -4,28 +4,32 @@
 //! [`dress`] takes any plant, whatever model grew it, and returns a copy dressed as a
 //! [`Dress`] says:
 //!
-//! - **Foliage.** A plant that grew leaves keeps where they are: each becomes one or more
-//!   cards of the kind (sprays of several leaves or a tuft of needles, see
-//!   [`crate::species`]) spread along the blade, as many as cover its area. A plant that grew
-//!   no leaves (binary trees, most automata trees) gets them on its last twigs: cards along
+//! - **Foliage.** The plant's own leaves stay where they grew: each (a blade, or a leaf drawn
+//!   as a segment as the L-system model draws them) becomes one or more cards of the kind
+//!   (sprays of a few leaves, branchlets of a few dozen, or tufts of needles, see
+//!   [`crate::species`]) spread along the blade, as many as cover its area. Twigs bare of
+//!   leaves (every twig of a binary tree or most automata trees) get them too: cards along
 //!   the outer stretch of every axis that ends in a tip, turned about the twig by the kind's
-//!   phyllotaxis (the golden angle for alternate leaves, 90° for opposite pairs), each leaving
-//!   the twig at 40 to 65° and drooping as the species does; needles run along the twig
-//!   instead, as the shoot itself. A card's size follows from a leaf length drawn from the
-//!   kind's real range (in metres, whatever the plant's size), and its colour from a few
-//!   shades around the kind's summer colour. Petals keep their colours and texture, cut to
-//!   a petal's outline ([`Surface::Petals`]).
+//!   phyllotaxis (the golden angle for alternate leaves, 90° for opposite pairs), each
+//!   leaving the twig at 40 to 65° and drooping as the species does; spruce and fir splay
+//!   theirs level in pairs, with shoots along the twig, as their branches lie in flat
+//!   layers. A card's size follows from a leaf length drawn from the kind's real range (in
+//!   metres, whatever the plant's size), and its colour from a few shades around the kind's
+//!   summer colour. Petals keep their colours and texture, cut to a petal's outline
+//!   ([`Surface::Petals`]).
 //! - **Bark.** Every bark material shows the bark kind's tiling texture and normal map
 //!   ([`Surface::Bark`]) in its colour; the foliage kind's own bark when none is given.
-//! - **Wood.** Stems are thickened by the pipe model ([`PipeTaper`], exponent
-//!   [`Dress::taper`]): each is as thick as the twigs it carries, so twigs are thin and
-//!   limbs thicken towards the trunk; then the whole tree is scaled so that its trunk is
-//!   as thick at breast height (1.3 m, or its foot on a small plant) as an open-grown tree
-//!   of the species (height ÷ [`LeafSpec::slenderness`]). Each trunk (a woody segment with
-//!   no parent) flares at its root collar: its first stretch, about two and a half radii
-//!   high, is split into rings that widen to 1.5 times the radius at the ground. Along
-//!   every axis a stem never thickens towards its tip, so a stem is one smooth tube from
-//!   its base, not a stack of discs.
+//! - **Wood.** Straight runs of a stem are joined into one segment, and stems are thickened
+//!   by the pipe model, each leaf a pipe (exponent [`Dress::taper`]): a stem is as thick as
+//!   the leaves and twig tips it carries, so twigs are thin, branches taper as their leaves
+//!   leave them, and limbs thicken towards the trunk. Then the whole tree is scaled so that
+//!   its trunk (or the stems from the ground together, by their basal area) is as thick at
+//!   breast height (1.3 m, or a tenth of the height on a small plant) as an open-grown tree
+//!   of the species (height ÷ [`LeafSpec::slenderness`](crate::species::LeafSpec)). Each
+//!   trunk (a woody segment with no parent) flares at its root collar: its first stretch,
+//!   about two and a half radii high, is split into rings that widen to 1.5 times the radius
+//!   at the ground. Along every axis a stem never thickens towards its tip, so a stem is one
+//!   smooth tube from its base, not a stack of discs.
 //!
 //! Every choice is drawn from the seed's own stream, so the same plant, dress and seed give
 //! the same plant. At most [`Dress::max_cards`] cards are placed; more are thinned evenly
@@ -58,7 +62,8 @@ pub const SHADES: usize = 5;
 
 /// Most cards a dress places by default: 12,000 flat cards are 24,000 triangles (one-sided
 /// cards drawn from both sides by their material), which with the wood keeps a tree in
-/// leaf under a game's budget of 40,000; kinds of crossed cards place half as many.
+/// leaf under a game's budget of 40,000; kinds of crossed cards (conifers) place a third as
+/// many, 16,000 triangles, for a budget of 30,000.
 pub const DEFAULT_MAX_CARDS: u32 = 12_000;
 
 /// How to dress a plant. Every field says its default ([`Dress::default`] changes nothing).
@@ -72,7 +77,7 @@ pub struct Dress {
     /// Cards per metre of twig, as a multiple of the kind's own spacing, 0.25 to 4.
     /// Default 1.
     pub density: f32,
-    /// Most flat cards placed (half as many of crossed ones); beyond, cards are thinned
+    /// Most flat cards placed (a third as many of crossed ones); beyond, cards are thinned
     /// evenly. Default [`DEFAULT_MAX_CARDS`].
     pub max_cards: u32,
     /// The card size. Default `None`: branchlets on plants at least [`BRANCHLET_HEIGHT`]
@@ -131,6 +136,9 @@ pub struct Dressed {
     pub leaves_replaced: u32,
     /// Cards left out to stay within [`Dress::max_cards`].
     pub dropped: u32,
+    /// The most cards this plant could take ([`Dress::max_cards`], a third of it for
+    /// crossed cards).
+    pub most: u32,
     /// Trunks given a flared root collar.
     pub collars: u32,
 }
@@ -170,7 +178,7 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
         let slenderness = dress
             .foliage
             .map_or(DEFAULT_SLENDERNESS, |k| k.spec().slenderness);
-        wood = thicken(plant, dress.taper, slenderness);
+        wood = thicken(&join_straight_runs(plant)?, dress.taper, slenderness);
         &wood
     } else {
         plant
@@ -202,23 +210,40 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
                 .get(m.index())
                 .is_some_and(|m| m.kind == MaterialKind::Leaf)
     };
+    // A leaf segment bearing a blade of its own (PlantMaker's midribs) is that blade's,
+    // not a leaf of its own.
+    let mut bears_blade = vec![false; plant.segments().len()];
+    for o in plant.organs() {
+        if let Some(p) = o.parent
+            && is_leaf(plant, o)
+        {
+            bears_blade[p.index()] = true;
+        }
+    }
     let mut sites = Vec::new();
     let mut new_id: Vec<Option<crate::plant::SegmentId>> =
         Vec::with_capacity(plant.segments().len());
-    for s in plant.segments() {
+    // Each segment's nearest kept ancestor-or-self: where what grew on a gone one goes.
+    let mut host: Vec<Option<crate::plant::SegmentId>> = Vec::with_capacity(plant.segments().len());
+    for (i, s) in plant.segments().iter().enumerate() {
+        let up = s.parent.and_then(|p| host[p.index()]);
         let parent = match s.parent {
             Some(p) => match new_id[p.index()] {
                 Some(id) => Some(id),
                 None => {
                     new_id.push(None);
+                    host.push(up);
                     continue;
                 }
             },
             None => None,
         };
         if leaf_segment(s.material) {
-            sites.push(leaf_site(s, parent));
+            if !bears_blade[i] {
+                sites.push(leaf_site(s, parent));
+            }
             new_id.push(None);
+            host.push(up);
             continue;
         }
         let mut end_radius = s.end_radius;
@@ -252,6 +277,7 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
             )?
         };
         new_id.push(Some(id));
+        host.push(Some(id));
     }
 
     let mut rng = rng::seeded(seed ^ 0x5e1a_d7e5_5d2e_55ed);
@@ -268,7 +294,26 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
         None => None,
     };
     let mut cards = Vec::new();
-    let leafy = !sites.is_empty() || plant.organs().iter().any(|o| is_leaf(plant, o));
+    // Where leaves grow, by segment of the dressed plant, and then whether any grow above
+    // each: twigs bare of leaves get cards of their own.
+    let mut leafy = vec![false; out.segments().len()];
+    let leaf_hosts = sites.iter().map(|site| site.parent).chain(
+        plant
+            .organs()
+            .iter()
+            .filter(|o| is_leaf(plant, o))
+            .map(|o| o.parent.and_then(|p| host[p.index()])),
+    );
+    for h in leaf_hosts.flatten() {
+        leafy[h.index()] = true;
+    }
+    for (i, s) in out.segments().iter().enumerate().rev() {
+        if let Some(p) = s.parent
+            && leafy[i]
+        {
+            leafy[p.index()] = true;
+        }
+    }
     for site in &sites {
         if let Some((foliage, shades)) = &foliage {
             report.leaves_replaced += 1;
@@ -284,14 +329,8 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
         }
     }
     for o in plant.organs() {
-        let parent = match o.parent {
-            Some(p) => match new_id[p.index()] {
-                Some(id) => Some(id),
-                // On a leaf drawn as a segment, which is gone.
-                None => continue,
-            },
-            None => None,
-        };
+        // On a segment that went (a leaf drawn as a segment): on its nearest kept ancestor.
+        let parent = o.parent.and_then(|p| host[p.index()]);
         match (&foliage, o.kind) {
             (Some((foliage, shades)), OrganKind::Leaf) if is_leaf(plant, o) => {
                 report.leaves_replaced += 1;
@@ -315,15 +354,22 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
             _ => out.add_organ(Organ { parent, ..*o })?,
         }
     }
-    if let Some((foliage, shades)) = &foliage
-        && !leafy
-    {
-        twig_cards(&out, *foliage, shades, dress.density, &mut rng, &mut cards);
+    if let Some((foliage, shades)) = &foliage {
+        twig_cards(
+            &out,
+            &leafy,
+            *foliage,
+            shades,
+            dress.density,
+            &mut rng,
+            &mut cards,
+        );
     }
     let most = match foliage {
-        Some((f, _)) if f.kind.spec().crossed => dress.max_cards / 2,
+        Some((f, _)) if f.kind.spec().crossed => dress.max_cards / 3,
         _ => dress.max_cards,
     };
+    report.most = most;
     let kept = thin(cards, most as usize, &mut report);
     for card in kept {
         out.add_organ(card)?;
@@ -334,89 +380,220 @@ pub fn dress(plant: &Plant, dress: &Dress, seed: u64) -> Result<(Plant, Dressed)
 /// Breast height, metres: where a trunk's diameter is measured.
 const BREAST_HEIGHT: f32 = 1.3;
 
-/// The plant with its wood thickened by the pipe model, then scaled so that its tallest
-/// skeleton's trunk is `height / slenderness` thick at breast height (at a tenth of the
+/// The plant with its bark thickened by the pipe model, each leaf a pipe: a stem's
+/// cross-section is the sum of those of the leaves and twig tips it carries, so a branch
+/// tapers along its length as its leaves leave it, and a twig is thin whatever grew it.
+/// Then the whole is scaled so that the trunk (or the stems from the ground together, by
+/// their basal area) is `height / slenderness` thick at breast height (at a tenth of the
 /// height on plants under 13 m, whose breast height lies too low to tell a trunk by).
 fn thicken(plant: &Plant, taper: PipeTaper, slenderness: f32) -> Plant {
     let mut plant = plant.clone();
-    taper.apply(&mut plant);
-    let bark: Vec<bool> = plant
-        .segments()
+    let kind = |m: MaterialId| plant.materials().get(m.index()).map(|m| m.kind);
+    let segments = plant.segments();
+    let n = segments.len();
+    let bark: Vec<bool> = segments
         .iter()
-        .map(|s| {
-            plant
-                .materials()
-                .get(s.material.index())
-                .is_some_and(|m| m.kind == MaterialKind::Bark)
+        .map(|s| kind(s.material) == Some(MaterialKind::Bark))
+        .collect();
+    // Pipes each bark segment carries: its own leaves (organs, and leaves drawn as
+    // segments), its tip if nothing woody grows from it, and all its children's.
+    let mut own = vec![0u32; n];
+    for o in plant.organs() {
+        if o.kind == OrganKind::Leaf
+            && let Some(p) = o.parent
+        {
+            own[p.index()] += 1;
+        }
+    }
+    let mut bears_wood = vec![false; n];
+    for (i, s) in segments.iter().enumerate() {
+        if let Some(p) = s.parent.map(|p| p.index()) {
+            if bark[i] {
+                bears_wood[p] = true;
+            } else if kind(s.material) == Some(MaterialKind::Leaf) {
+                own[p] += 1;
+            }
+        }
+    }
+    // Children come after their parents: one pass from the last segment gathers them.
+    let mut pipes = vec![0u32; n];
+    let mut continuation: Vec<Option<usize>> = vec![None; n];
+    for i in (0..n).rev() {
+        if !bark[i] {
+            continue;
+        }
+        pipes[i] += own[i] + u32::from(!bears_wood[i]);
+        let s = &segments[i];
+        if let Some(p) = s.parent.map(|p| p.index()) {
+            pipes[p] += pipes[i];
+            if !s.lateral && continuation[p].is_none_or(|c| pipes[c] < pipes[i]) {
+                continuation[p] = Some(i);
+            }
+        }
+    }
+    // Radii in units of one pipe's.
+    let inv = 1.0 / taper.exponent;
+    let radius = |k: u32| (f64::from(k.max(1))).powf(inv) as f32;
+    let unit: Vec<(f32, f32)> = (0..n)
+        .map(|i| {
+            let start = radius(pipes[i]);
+            let end = continuation[i].map_or(radius(pipes[i].saturating_sub(own[i])), |c| {
+                radius(pipes[c])
+            });
+            (start, end.min(start))
         })
         .collect();
-    let segments = plant.segments();
-    // The trunk: the thickest bark skeleton root (the pipe model makes the one carrying the
-    // most twigs the thickest).
-    let Some(foot) = (0..segments.len())
+    // The stems from the ground: bark skeleton roots, judged together by basal area.
+    let roots: Vec<usize> = (0..n)
         .filter(|&i| segments[i].parent.is_none() && bark[i])
-        .max_by(|&a, &b| {
-            segments[a]
-                .start_radius
-                .total_cmp(&segments[b].start_radius)
-        })
+        .collect();
+    let Some(ground) = roots
+        .iter()
+        .map(|&i| segments[i].start.y)
+        .min_by(f32::total_cmp)
     else {
         return plant;
     };
-    let ground = segments[foot].start.y;
     let height = plant.height() - ground;
     if height.is_nan() || height <= 0.0 {
         return plant;
     }
     let at = BREAST_HEIGHT.min(0.1 * height);
-    // Up the trunk's axis (each segment's first continuation) to that height.
-    let mut next = vec![None; segments.len()];
-    for (i, s) in segments.iter().enumerate().rev() {
-        if let Some(p) = s.parent
-            && !s.lateral
-        {
-            next[p.index()] = Some(i);
-        }
-    }
-    let mut i = foot;
-    let radius = loop {
-        let s = &segments[i];
-        let (y0, y1) = (s.start.y - ground, s.end.y - ground);
-        match next[i] {
-            Some(n) if y1 < at => i = n,
-            _ => {
-                let t = if y1 > y0 {
-                    ((at - y0) / (y1 - y0)).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                break s.start_radius + (s.end_radius - s.start_radius) * t;
-            }
-        }
-    };
-    let factor = (0.5 * height / slenderness) / radius;
-    if !(factor.is_finite() && factor > 0.0) {
-        return plant;
-    }
-    // Every radius stays within the plant's range: a factor past it leaves the wood as the
-    // pipe model made it.
-    let widest = segments
+    let area: f64 = roots
         .iter()
-        .map(|s| s.start_radius.max(s.end_radius))
-        .fold(0.0f32, f32::max);
-    if widest * factor > crate::plant::MAX_COORD {
+        .filter_map(|&r| radius_up_axis(segments, &continuation, &unit, r, ground + at))
+        .map(|r| f64::from(r) * f64::from(r))
+        .sum();
+    let factor = (0.5 * height / slenderness) / area.sqrt() as f32;
+    if !(factor.is_finite() && factor > 0.0) || factor > crate::plant::MAX_COORD {
         return plant;
     }
-    for (s, _) in plant
+    for ((s, u), _) in plant
         .segments_mut()
         .iter_mut()
+        .zip(&unit)
         .zip(&bark)
         .filter(|(_, b)| **b)
     {
-        s.start_radius *= factor;
-        s.end_radius *= factor;
+        (s.start_radius, s.end_radius) = (u.0 * factor, u.1 * factor);
     }
     plant
+}
+
+/// The radius (from `unit`) of the axis from `foot` at height `y`, following each
+/// segment's `continuation`; the last segment's end radius when the axis ends lower.
+fn radius_up_axis(
+    segments: &[crate::plant::Segment],
+    continuation: &[Option<usize>],
+    unit: &[(f32, f32)],
+    foot: usize,
+    y: f32,
+) -> Option<f32> {
+    let mut i = foot;
+    loop {
+        let s = &segments[i];
+        match continuation[i] {
+            Some(c) if s.end.y < y => i = c,
+            _ => {
+                let t = if s.end.y > s.start.y {
+                    ((y - s.start.y) / (s.end.y - s.start.y)).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                return Some(unit[i].0 + (unit[i].1 - unit[i].0) * t);
+            }
+        }
+    }
+}
+
+/// Straight runs of a stem joined into one segment when they bend less than this (radians)
+/// at each joint: a tube's rings there show nothing.
+const JOIN_BEND: f32 = 0.1;
+
+/// The plant with each straight run of bark joined: a segment whose parent it continues
+/// (its only child, bearing no organ, of the same material) within [`JOIN_BEND`] of its
+/// direction extends that parent, as long as the run stays shorter than a tenth of the
+/// plant's height, so long curves keep their shape.
+fn join_straight_runs(plant: &Plant) -> Result<Plant, PlantError> {
+    let segments = plant.segments();
+    let n = segments.len();
+    let mut children = vec![0u32; n];
+    for s in segments {
+        if let Some(p) = s.parent {
+            children[p.index()] += 1;
+        }
+    }
+    let mut bears = vec![false; n];
+    for o in plant.organs() {
+        if let Some(p) = o.parent {
+            bears[p.index()] = true;
+        }
+    }
+    let bark = |i: usize| {
+        plant
+            .materials()
+            .get(segments[i].material.index())
+            .is_some_and(|m| m.kind == MaterialKind::Bark)
+    };
+    let most = 0.1 * plant.height();
+    // The joined segments, and for each original one the joined one it became.
+    let mut joined: Vec<crate::plant::Segment> = Vec::with_capacity(n);
+    let mut into = Vec::with_capacity(n);
+    let mut run_start: Vec<Vec3> = Vec::with_capacity(n);
+    for (i, s) in segments.iter().enumerate() {
+        if let Some(p) = s.parent.map(|p| p.index())
+            && !s.lateral
+            && children[p] == 1
+            && !bears[p]
+            && bark(i)
+            && bark(p)
+            && s.material == segments[p].material
+        {
+            let j: usize = into[p];
+            let run = &joined[j];
+            let (a, b) = (
+                run.vector().normalize_or(Vec3::Y),
+                s.vector().normalize_or(Vec3::Y),
+            );
+            if a.dot(b) >= JOIN_BEND.cos() && run_start[j].distance(s.end) <= most {
+                joined[j].end = s.end;
+                joined[j].end_radius = s.end_radius;
+                into.push(j);
+                continue;
+            }
+        }
+        let mut seg = *s;
+        seg.parent = s
+            .parent
+            .map(|p| crate::plant::SegmentId(into[p.index()] as u32));
+        run_start.push(s.start);
+        joined.push(seg);
+        into.push(joined.len() - 1);
+    }
+    if joined.len() == n {
+        return Ok(plant.clone());
+    }
+    let mut out = Plant::bare(plant.meta().clone());
+    for m in plant.materials() {
+        out.add_material(m.clone())?;
+    }
+    for s in &joined {
+        out.add_segment(
+            s.start,
+            s.end,
+            (s.start_radius, s.end_radius),
+            s.parent,
+            s.lateral,
+            s.material,
+        )?;
+    }
+    for o in plant.organs() {
+        let parent = o
+            .parent
+            .map(|p| crate::plant::SegmentId(into[p.index()] as u32));
+        out.add_organ(Organ { parent, ..*o })?;
+    }
+    Ok(out)
 }
 
 /// A kind of leaves on cards of a size.
@@ -638,19 +815,27 @@ fn leaf_to_cards(
     let (axis, side) = (q * Vec3::Y, q * Vec3::X);
     let (length, width) = (leaf.size.x, leaf.size.y);
     let typical = foliage.typical();
-    // A blade fills about half its box; a spray about 40% of its card.
+    // A blade fills about half its box, a card about 40% of its own: as many cards as
+    // cover the blade, in rows along it and columns across it (at most 64).
     let n = ((0.5 * length * width * density) / (0.4 * typical * typical)).round();
-    let n = n.clamp(1.0, 8.0) as u32;
-    for i in 0..n {
+    let n = n.clamp(1.0, 64.0) as u32;
+    let rows = ((n as f32 * length / width.max(1e-6)).sqrt().round() as u32).clamp(1, n);
+    let cols = n.div_ceil(rows);
+    for i in 0..rows * cols {
+        let (row, col) = (i / cols, i % cols);
+        let along = (row as f32 + 0.5) / rows as f32;
+        // Across the blade, within its outline there (widest a third of the way up).
+        let half = 0.5 * width * (2.6 * along.sqrt() * (1.0 - along)).min(1.0);
+        let across = half * (2.0 * (col as f32 + 0.5) / cols as f32 - 1.0);
         let material = shades[rng.random_range(0..shades.len())];
-        let at = leaf.position + axis * (length * i as f32 / n as f32);
+        let at = leaf.position + axis * (length * (row as f32 / rows as f32)) + side * across;
         if spec.needles {
             let size = foliage.card_size(rng);
             let turn = rng.random_range(0.0..std::f32::consts::TAU);
             cards.push(shoot(kind, at, axis, turn, size, parent, material));
         } else {
-            // Sprays fan out about the blade's line, alternately to each side.
-            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            // Cards fan out about the blade's line, alternately to each side.
+            let sign = if (row + col) % 2 == 0 { 1.0 } else { -1.0 };
             let dir = (axis + side * (0.4 * sign)).normalize_or(axis);
             let mut card = spray(foliage, at, dir, 0.0, parent, material, rng);
             card.orientation = card_rotation(dir, q * Vec3::Z + Vec3::Y * 0.5);
@@ -659,9 +844,11 @@ fn leaf_to_cards(
     }
 }
 
-/// Cards along the outer stretch of every axis that ends in a tip.
+/// Cards along the outer stretch of every axis that ends in a tip, but on stems where the
+/// plant's own leaves grow (`leafy`: leaves on them or above them), which wear those.
 fn twig_cards(
     plant: &Plant,
+    leafy: &[bool],
     foliage: Foliage,
     shades: &[MaterialId],
     density: f32,
@@ -717,7 +904,7 @@ fn twig_cards(
     };
     let divergence = spec.arrangement.divergence_deg().to_radians();
     for (i, s) in segments.iter().enumerate() {
-        if !woody[i] || to_tip[i] >= zone {
+        if !woody[i] || to_tip[i] >= zone || leafy[i] {
             continue;
         }
         let length = s.length();
@@ -912,12 +1099,78 @@ mod tests {
         p.add_organ(leaf).unwrap();
         let (d, report) = dress(&p, &Dress::foliage(LeafKind::Birch), 1).unwrap();
         assert_eq!(report.leaves_replaced, 1);
-        assert!(report.cards >= 2, "{report:?}");
-        for o in d.organs() {
+        // The trunk's first segment was split into a collar: its last piece carries the
+        // leaf's cards, along the blade; the bare twigs carry cards of their own.
+        let on_trunk: Vec<&Organ> = d
+            .organs()
+            .iter()
+            .filter(|o| o.parent == Some(crate::SegmentId(3)))
+            .collect();
+        assert!(on_trunk.len() >= 2, "{report:?}");
+        for o in on_trunk {
             assert!(o.position.distance(leaf.position) <= 0.6 + 1e-5);
-            // The trunk's first segment was split into a collar: its last piece carries them.
-            assert_eq!(o.parent, Some(crate::SegmentId(3)));
         }
+        assert!(
+            d.organs().iter().any(|o| o.position.y > 2.5),
+            "twigs wear leaves too"
+        );
+    }
+
+    #[test]
+    fn leaves_drawn_as_segments_become_cards_and_blades_on_them_stay() {
+        // A twig with a leaf drawn as a segment (the L-system's), and another whose
+        // leaf segment bears a blade of its own (PlantMaker's midrib): both leaves become
+        // cards, once each, the blade's where it was.
+        let mut p = Plant::new(PlantMeta::default());
+        let t = p
+            .add_segment(
+                Vec3::ZERO,
+                2.0 * Vec3::Y,
+                (0.05, 0.04),
+                None,
+                false,
+                Plant::BARK,
+            )
+            .unwrap();
+        let top = 2.0 * Vec3::Y;
+        p.add_segment(
+            top,
+            top + Vec3::new(0.3, 0.1, 0.0),
+            (0.02, 0.0),
+            Some(t),
+            true,
+            Plant::LEAF,
+        )
+        .unwrap();
+        let midrib = p
+            .add_segment(
+                top,
+                top + Vec3::new(-0.3, 0.1, 0.0),
+                (0.005, 0.0),
+                Some(t),
+                true,
+                Plant::LEAF,
+            )
+            .unwrap();
+        p.add_organ(Organ {
+            kind: OrganKind::Leaf,
+            position: top,
+            orientation: Quat::from_rotation_z(0.7),
+            size: Vec2::new(0.3, 0.15),
+            material: Plant::LEAF,
+            parent: Some(midrib),
+        })
+        .unwrap();
+        let (d, report) = dress(&p, &Dress::foliage(LeafKind::Beech), 1).unwrap();
+        assert_eq!(report.leaves_replaced, 2, "{report:?}");
+        // No leaf segment is left, every card sits on the trunk (the collar's last piece).
+        assert!(d.segments().iter().all(|s| s.material == Plant::BARK));
+        let last = crate::SegmentId(d.segments().len() as u32 - 1);
+        assert!(
+            d.organs().iter().all(|o| o.parent == Some(last)),
+            "{:?}",
+            d.organs()
+        );
     }
 
     #[test]

@@ -421,7 +421,7 @@ const LEAVES: [LeafSpec; 11] = [
         length: (0.03, 0.07),
         width_ratio: 0.03,
         leaf_of_spray: 0.3,
-        leaf_of_branchlet: 0.1,
+        leaf_of_branchlet: 0.08,
         needles: true,
         crossed: true,
         color: [0.0545, 0.1170, 0.0395], // sRGB 66, 96, 56
@@ -438,7 +438,7 @@ const LEAVES: [LeafSpec; 11] = [
         length: (0.01, 0.025),
         width_ratio: 0.06,
         leaf_of_spray: 0.1,
-        leaf_of_branchlet: 0.045,
+        leaf_of_branchlet: 0.035,
         needles: true,
         crossed: true,
         color: [0.0273, 0.0762, 0.0212], // sRGB 46, 78, 40
@@ -455,7 +455,7 @@ const LEAVES: [LeafSpec; 11] = [
         length: (0.015, 0.03),
         width_ratio: 0.08,
         leaf_of_spray: 0.12,
-        leaf_of_branchlet: 0.05,
+        leaf_of_branchlet: 0.04,
         needles: true,
         crossed: false,
         color: [0.0319, 0.0887, 0.0273], // sRGB 50, 84, 46

@@ -11,10 +11,11 @@
 //! `KHR_mesh_quantization` allows. `COLOR_0` splits a primitive into one
 //! material per shade (base colour × vertex colour to a byte, each triangle taking its first
 //! vertex's colour; at most 1024 shades a primitive, further ones in the base colour), as
-//! Sylva's lean materials are written. A base colour texture whose
-//! image is named `sylva-texture-<id>` (as Sylva's GLB writer names them) gives the
-//! material that texture id back; other textures, skins, morph targets, sparse accessors and
-//! non-triangle modes are ignored. Every node's transform is baked into
+//! Sylva's lean materials are written. A base colour texture whose image is one of Sylva's
+//! pictures (named as [`sylva_mesh::picture::Picture::name`] gives, `sylva-texture-<id>`
+//! for a texture id) gives the material its texture id back, and a material's
+//! `extras.sylva_surface` its surface (leaf cards cut out by alpha, petals, bark); other
+//! textures, skins, morph targets, sparse accessors and non-triangle modes are ignored. Every node's transform is baked into
 //! a world-space copy of its mesh. Every offset and count is checked, so a truncated or
 //! hostile file is an error, never a panic; the work is counted before it is done (at most
 //! 100 million triangles and a million instances a file, within the memory budget).
@@ -128,6 +129,52 @@ pub fn texture_ids(bytes: &[u8]) -> Result<Vec<u16>, ImportError> {
     ids.sort_unstable();
     ids.dedup();
     Ok(ids)
+}
+
+/// The extras of a GLB's first node (in its default scene's order) whose extras hold a
+/// `genome` (what Sylva's plants carry), else of its first node, else `null`; read from the
+/// JSON alone.
+pub fn first_extras(bytes: &[u8]) -> Result<Value, ImportError> {
+    let (json, _) = chunks(bytes)?;
+    let root: Value = serde_json::from_slice(json)?;
+    let scene = root["scene"].as_u64().unwrap_or(0) as usize;
+    let nodes = root["scenes"][scene]["nodes"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let extras: Vec<&Value> = nodes
+        .iter()
+        .filter_map(|n| root["nodes"].get(n.as_u64()? as usize))
+        .map(|n| &n["extras"])
+        .collect();
+    Ok(extras
+        .iter()
+        .find(|e| e.get("genome").is_some())
+        .or(extras.first())
+        .map_or(Value::Null, |e| (*e).clone()))
+}
+
+/// The bytes of the textures a GLB carries: each image's buffer view, or the data its
+/// `data:` URI holds (an image in a file beside the GLB counts as nothing), read from its
+/// JSON alone.
+pub fn texture_bytes(bytes: &[u8]) -> Result<u64, ImportError> {
+    let (json, bin) = chunks(bytes)?;
+    let root: Value = serde_json::from_slice(json)?;
+    let reader = Reader { root: &root, bin };
+    let mut total = 0u64;
+    for image in reader.list("images") {
+        if let Some(view) = image.get("bufferView") {
+            let view = reader.item("bufferViews", view)?;
+            total = total.saturating_add(view["byteLength"].as_u64().unwrap_or(0));
+        } else if let Some(data) = image["uri"]
+            .as_str()
+            .and_then(|u| u.strip_prefix("data:"))
+            .and_then(|u| u.split_once(";base64,"))
+        {
+            total = total.saturating_add(data.1.len() as u64 / 4 * 3);
+        }
+    }
+    Ok(total)
 }
 
 /// A GLB's JSON and binary chunks.

@@ -288,6 +288,50 @@ pub fn dress_extras(extras: &mut serde_json::Value, dress: &Dress) {
     }
 }
 
+/// What a GLB node's extras say of how its plant grew ([`Origin::extras`] and what
+/// [`Grown::scene`] adds: seed, taper, height, foliage, bark, density), as the genome and
+/// the options that grow it again. `path` names the file in errors.
+pub fn regrow(
+    extras: &serde_json::Value,
+    path: &Path,
+) -> Result<(Genome, GrowOptions), InputError> {
+    let genome = extras.get("genome").ok_or_else(|| {
+        InputError::file(
+            path,
+            "its node's extras hold no genome: it is not a plant Sylva grew (inspect its              skeleton file instead)",
+        )
+    })?;
+    let text = genome.to_string();
+    let genome = crate::genome::parse_genome(path, &text)?;
+    let field = |name: &str, why: String| InputError::file(path, format!("extras `{name}`: {why}"));
+    let mut options = GrowOptions {
+        seed: extras["seed"].as_u64(),
+        ..GrowOptions::default()
+    };
+    if let Some(e) = extras["taper"]["pipe_exponent"].as_f64() {
+        options.taper = Some(PipeTaper::new(e).map_err(|e| field("taper", e.to_string()))?);
+    }
+    if let Some(h) = extras["height"].as_f64() {
+        options.height = Some(h as f32);
+    }
+    if let Some(k) = extras["foliage"].as_str() {
+        options.dress.foliage = Some(
+            k.parse()
+                .map_err(|e: sylva_core::species::UnknownKind| field("foliage", e.to_string()))?,
+        );
+    }
+    if let Some(k) = extras["bark"].as_str() {
+        options.dress.bark = Some(
+            k.parse()
+                .map_err(|e: sylva_core::species::UnknownKind| field("bark", e.to_string()))?,
+        );
+    }
+    if let Some(d) = extras["density"].as_f64() {
+        options.dress.density = d as f32;
+    }
+    Ok((genome, options))
+}
+
 /// Lowest and highest height a plant is scaled to (`--height`), metres.
 pub const HEIGHTS: (f32, f32) = (0.01, 1000.0);
 

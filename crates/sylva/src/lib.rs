@@ -10,7 +10,9 @@
 //! - [`lod`]: a grown plant's levels of detail as assets ([`LodAssets`]): one mesh per
 //!   level at about half the triangles of the one before, as files or one scene.
 //! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
-//!   origin, written as `PLANT.skeleton.json`.
+//!   origin, written as `PLANT.skeleton.json` and read back.
+//! - [`inspect`]: a plausibility report ([`inspect::Report`]): a plant's figures against
+//!   the ranges real trees give.
 //! - [`biomorph`]: Bornhofen and Lattaud's design loop, a mother and her children grown
 //!   together in one voxel world ([`biomorph::Biomorphs`]).
 //! - [`experiment`]: their experiments, run from a config into a report, records and
@@ -51,6 +53,7 @@ pub mod experiment;
 pub mod files;
 pub mod garden;
 pub mod genome;
+pub mod inspect;
 pub mod lod;
 pub mod picture;
 pub mod registry;

@@ -30,6 +30,7 @@ use std::io;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use sylva_core::species::Surface;
 use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, OrganKind, Plant};
 use sylva_gltf::export::Format;
@@ -104,6 +105,18 @@ pub struct SkeletonMaterial {
     pub color: [f32; 3],
     /// The model's texture id, if it uses textures.
     pub texture: Option<u16>,
+    /// The surface Sylva draws (leaf cards of a kind, petals, bark), when the plant was
+    /// dressed; left out otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<Surface>,
+    /// For cards (leaves drawn as textured quads): the share of a card's area its picture
+    /// covers, so readers can tell the leaf area from the card's; left out otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fill: Option<f32>,
+    /// For cards: a leaf's length over its card's (a card may carry a spray of leaves);
+    /// left out otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leaf_of_card: Option<f32>,
 }
 
 /// A tapered cylinder of the skeleton. Metres; Y is up.
@@ -189,6 +202,15 @@ impl Skeleton {
                     kind: m.kind,
                     color: m.color,
                     texture: m.texture,
+                    surface: m.surface,
+                    fill: m
+                        .surface
+                        .and_then(Surface::leaves)
+                        .map(|(kind, card)| sylva_mesh::atlas::leaf_fill(kind, card)),
+                    leaf_of_card: m
+                        .surface
+                        .and_then(Surface::leaves)
+                        .map(|(kind, card)| kind.spec().leaf_of(card)),
                 })
                 .collect(),
             segments: plant
@@ -252,6 +274,88 @@ impl Skeleton {
             bytes.push(b'\n');
         }
         String::from_utf8(bytes).unwrap_or_default()
+    }
+
+    /// What its materials say of their cards (`fill`, `leaf_of_card`), by material index:
+    /// for [`crate::inspect::Report::of_cards`].
+    pub fn cards(&self) -> Vec<Option<crate::inspect::Cards>> {
+        self.materials
+            .iter()
+            .map(|m| {
+                m.fill.map(|fill| crate::inspect::Cards {
+                    fill: f64::from(fill),
+                    leaf_of_card: f64::from(m.leaf_of_card.unwrap_or(1.0)),
+                })
+            })
+            .collect()
+    }
+
+    /// The plant it holds, every part checked as a grown plant's are: a segment or organ
+    /// that breaks a rule (a parent after its child, a material that is not there, a radius
+    /// that is negative or not a number) is refused, naming it.
+    pub fn to_plant(&self, path: &Path) -> Result<Plant, InputError> {
+        use sylva_core::glam::{Quat, Vec2, Vec3};
+        use sylva_core::{Material, MaterialId, Organ, PlantMeta, SegmentId};
+        let mut plant = Plant::bare(PlantMeta {
+            model: self.origin.model.clone(),
+            genome_hash: u64::from_str_radix(&self.origin.genome_hash, 16).unwrap_or(0),
+            seed: self.origin.seed,
+        });
+        let bad = |what: String, e: sylva_core::PlantError| {
+            InputError::file(path, format!("{what}: {e}"))
+        };
+        for (i, m) in self.materials.iter().enumerate() {
+            plant
+                .add_material(Material {
+                    name: m.name.clone(),
+                    kind: m.kind,
+                    color: m.color,
+                    texture: m.texture,
+                    surface: m.surface,
+                })
+                .map_err(|e| bad(format!("materials[{i}]"), e))?;
+        }
+        for (i, s) in self.segments.iter().enumerate() {
+            if s.parent.is_some_and(|p| p as usize >= i) {
+                return Err(InputError::file(
+                    path,
+                    format!(
+                        "segments[{i}]: its parent must come before it (parents first), got {}",
+                        s.parent.unwrap_or(0)
+                    ),
+                ));
+            }
+            plant
+                .add_segment(
+                    Vec3::from_array(s.start),
+                    Vec3::from_array(s.end),
+                    (s.start_radius, s.end_radius),
+                    s.parent.map(SegmentId),
+                    s.lateral,
+                    MaterialId(s.material),
+                )
+                .map_err(|e| bad(format!("segments[{i}]"), e))?;
+        }
+        for (i, o) in self.organs.iter().enumerate() {
+            let q = Quat::from_array(o.orientation);
+            // Files hold four decimals' worth of rounding: renormalise a near-unit one.
+            let orientation = if (q.length() - 1.0).abs() < 1e-3 {
+                q.normalize()
+            } else {
+                q
+            };
+            plant
+                .add_organ(Organ {
+                    kind: o.kind,
+                    position: Vec3::from_array(o.position),
+                    orientation,
+                    size: Vec2::new(o.length, o.width),
+                    material: MaterialId(o.material),
+                    parent: o.parent.map(SegmentId),
+                })
+                .map_err(|e| bad(format!("organs[{i}]"), e))?;
+        }
+        Ok(plant)
     }
 
     /// Reads a skeleton file, checking its `kind` and `format`.

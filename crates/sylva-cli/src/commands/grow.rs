@@ -125,7 +125,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
             if dressed.dropped > 0 {
                 format!(
                     " ({} more left out: at most {} cards)",
-                    dressed.dropped, dress.max_cards
+                    dressed.dropped, dressed.most
                 )
             } else {
                 String::new()

@@ -5,6 +5,7 @@ pub mod breed;
 pub mod evolve;
 pub mod garden;
 pub mod grow;
+pub mod inspect;
 pub mod matching;
 pub mod render;
 pub mod simulate;
