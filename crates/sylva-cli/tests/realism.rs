@@ -231,3 +231,40 @@ fn check_fails_an_implausible_plant_naming_each_figure() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("leaf_length"), "{stderr}");
 }
+
+#[test]
+fn every_species_preset_is_plausible_and_within_its_budget() {
+    // Conifers at most 30,000 triangles, broadleaves 40,000; textures at most 2 MB.
+    let species = [
+        ("oak", 40_000.0),
+        ("birch", 40_000.0),
+        ("maple", 40_000.0),
+        ("willow", 40_000.0),
+        ("pine", 30_000.0),
+        ("spruce", 30_000.0),
+        ("shrub", 40_000.0),
+        ("aspen", 40_000.0),
+        ("ash", 40_000.0),
+    ];
+    for (name, budget) in species {
+        let preset = example(&format!("species/{name}.toml"));
+        let report = ok(&["inspect", &preset, "--check", "--json"]);
+        let report: serde_json::Value = serde_json::from_str(&report).unwrap();
+        let value = |figure: &str| {
+            report["figures"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|f| f["name"] == figure)
+                .unwrap()["value"]
+                .as_f64()
+                .unwrap()
+        };
+        assert!(
+            value("triangles") <= budget,
+            "{name}: {}",
+            value("triangles")
+        );
+        assert!(value("texture_bytes") <= 2_000_000.0, "{name}");
+    }
+}

@@ -128,9 +128,29 @@ pub fn petal_picture(design: Option<u16>) -> Arc<GrayAlphaImage> {
     picture
 }
 
+static FILLS: LazyLock<Mutex<HashMap<(LeafKind, Card), f32>>> = LazyLock::new(Mutex::default);
+
 /// The share of a card's area its leaves cover (alpha at least one half), averaged over
-/// the cells of its size: a card's leaf area is its area times this.
+/// the cells of its size: a card's leaf area is its area times this. Measured once per
+/// process.
 pub fn leaf_fill(kind: LeafKind, card: Card) -> f32 {
+    if let Some(&f) = FILLS
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get(&(kind, card))
+    {
+        return f;
+    }
+    let fill = measure_fill(kind, card);
+    FILLS
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .insert((kind, card), fill);
+    fill
+}
+
+/// [`leaf_fill`], measured.
+fn measure_fill(kind: LeafKind, card: Card) -> f32 {
     let atlas = leaf_atlas(kind);
     let (mut covered, mut all) = (0usize, 0usize);
     for c in 0..cells(card) {

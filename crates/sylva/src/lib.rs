@@ -11,6 +11,8 @@
 //!   level at about half the triangles of the one before, as files or one scene.
 //! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
 //!   origin, written as `PLANT.skeleton.json` and read back.
+//! - [`preset`]: species presets ([`preset::Preset`]): a genome and how to grow it into a
+//!   tree of a species (height, foliage, bark), in one small file.
 //! - [`inspect`]: a plausibility report ([`inspect::Report`]): a plant's figures against
 //!   the ranges real trees give.
 //! - [`biomorph`]: Bornhofen and Lattaud's design loop, a mother and her children grown
@@ -56,6 +58,7 @@ pub mod genome;
 pub mod inspect;
 pub mod lod;
 pub mod picture;
+pub mod preset;
 pub mod registry;
 pub mod report;
 pub mod skeleton;

@@ -7,15 +7,16 @@ use sylva::assets::{check_png, picture};
 use sylva::evolution::outline::Outline;
 use sylva::files::Outputs;
 use sylva::render::View;
-use sylva::skeleton::{GrowOutput, Skeleton, grow_skeleton};
-use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets, load_genome};
+use sylva::skeleton::{GrowOutput, Skeleton};
+use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets};
 
 use super::InFile;
 
 /// Arguments of `sylva grow`.
 #[derive(clap::Args)]
 pub struct GrowArgs {
-    /// Genome JSON.
+    /// Genome JSON, or a species preset (.toml: a genome and how to grow it; the flags
+    /// below override it).
     genome: PathBuf,
     /// Output: a 3D asset (.glb, .obj, .wrl, .stl), or the skeleton as data (.skeleton.json).
     #[arg(short, long)]
@@ -59,19 +60,23 @@ pub struct GrowArgs {
 pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     let output = GrowOutput::of(&args.output)?;
     let wind = args.wind.options(&args.output)?;
-    let options = GrowOptions {
+    let (genome, base) = super::load_input(&args.genome)?;
+    let flags = super::GrowFlags {
         seed: args.seed,
-        roots: !args.hide_roots,
+        hide_roots: args.hide_roots,
         taper: args.taper,
+        height: args.height,
+        dress: &args.dress,
+    };
+    let options = GrowOptions {
         quantize: args.quantize.check(&args.output, wind.is_some())?,
         lod: args.lod.map(|n| n as usize),
         wind,
-        height: args.height,
         pruned_to: match &args.pruned_to {
             Some(path) => Some(outlines_of(path)?),
             None => None,
         },
-        dress: args.dress.over(sylva::Dress::default()),
+        ..flags.over(base)
     };
     let glb = options.glb_options();
     if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {
@@ -84,7 +89,6 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
     if let Some(png) = &args.png {
         check_png(png)?;
     }
-    let genome = load_genome(&args.genome)?;
     if output == GrowOutput::Skeleton {
         return skeleton(args, &genome, &options);
     }
@@ -213,12 +217,13 @@ fn lod(args: &GrowArgs, grown: Grown, options: &GrowOptions) -> anyhow::Result<(
 /// asked for too.
 fn skeleton(args: &GrowArgs, genome: &Genome, options: &GrowOptions) -> anyhow::Result<()> {
     let roots = options.roots;
-    let seed = options.seed.unwrap_or_else(|| genome.default_seed());
     let growing = super::growing(genome);
     let (skeleton, png) = match &args.png {
         None => {
-            let skeleton = grow_skeleton(genome, seed, roots, args.taper).in_file(&args.genome)?;
-            (skeleton, None)
+            // Grown, pruned, tapered, scaled and dressed as a mesh would be, unmeshed.
+            let (_, plant) = Grown::plant(genome, options).in_file(&args.genome)?;
+            sylva::skeleton::check_budget(&plant).in_file(&args.genome)?;
+            (Skeleton::of(&plant, genome, options.taper, roots), None)
         }
         Some(png) => {
             let plain = GrowOptions {

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use sylva::inspect::{AssetFacts, Report};
 use sylva::skeleton::{SUFFIX, Skeleton};
-use sylva::{GrowOptions, Grown, InputError, load_genome};
+use sylva::{Grown, InputError};
 
 use super::InFile;
 
@@ -14,9 +14,9 @@ const MAX_GLB: u64 = 1 << 30;
 /// Arguments of `sylva inspect`.
 #[derive(clap::Args)]
 pub struct InspectArgs {
-    /// The plant: a genome (.json, grown with the flags below), a GLB Sylva wrote (grown
-    /// again from the genome in its extras), or a skeleton file (.skeleton.json, any
-    /// generator's).
+    /// The plant: a genome (.json) or species preset (.toml), grown with the flags below; a
+    /// GLB Sylva wrote (grown again from the genome in its extras); or a skeleton file
+    /// (.skeleton.json, any generator's).
     file: PathBuf,
     /// The asset to weigh (triangles, texture bytes) when FILE is a skeleton [default: a
     /// genome's own mesh, a GLB itself].
@@ -55,12 +55,13 @@ fn input_of(path: &Path) -> Result<Input, InputError> {
         Ok(Input::Skeleton)
     } else if name.ends_with(".glb") {
         Ok(Input::Glb)
-    } else if name.ends_with(".json") {
+    } else if name.ends_with(".json") || name.ends_with(".toml") {
         Ok(Input::Genome)
     } else {
         Err(InputError::file(
             path,
-            "expected a genome (.json), a GLB (.glb) or a skeleton file (.skeleton.json)",
+            "expected a genome (.json), a species preset (.toml), a GLB (.glb) or a skeleton \
+             file (.skeleton.json)",
         ))
     }
 }
@@ -97,14 +98,15 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<()> {
     };
     let report = match input {
         Input::Genome => {
-            let options = GrowOptions {
+            let (genome, base) = super::load_input(&args.file)?;
+            let options = super::GrowFlags {
                 seed: args.seed,
-                height: args.height,
+                hide_roots: false,
                 taper: args.taper,
-                dress: args.dress.over(sylva::Dress::default()),
-                ..GrowOptions::default()
-            };
-            let genome = load_genome(&args.file)?;
+                height: args.height,
+                dress: &args.dress,
+            }
+            .over(base);
             let grown = Grown::grow(genome, &options).in_file(&args.file)?;
             Report::of(&grown.plant, Some(AssetFacts::of_mesh(&grown.mesh)))
         }

@@ -144,6 +144,45 @@ impl<T> InFile<T> for Result<T, sylva::Error> {
     }
 }
 
+/// The genome a command grows from `path` and the options its file gives: a species
+/// preset's (`.toml`, [`sylva::preset::Preset`]), or a genome file's defaults.
+pub fn load_input(path: &Path) -> Result<(sylva::Genome, sylva::GrowOptions), sylva::InputError> {
+    if sylva::preset::Preset::is_preset(path) {
+        let preset = sylva::preset::Preset::load(path)?;
+        Ok((preset.genome, preset.options))
+    } else {
+        Ok((sylva::load_genome(path)?, sylva::GrowOptions::default()))
+    }
+}
+
+/// The growing flags a command takes, over the options its input file gave (a preset's).
+pub struct GrowFlags<'a> {
+    /// `--seed`.
+    pub seed: Option<u64>,
+    /// `--hide-roots`.
+    pub hide_roots: bool,
+    /// `--taper`.
+    pub taper: Option<sylva::core::taper::PipeTaper>,
+    /// `--height`.
+    pub height: Option<f32>,
+    /// `--foliage`, `--bark`, `--density`.
+    pub dress: &'a DressArgs,
+}
+
+impl GrowFlags<'_> {
+    /// `base` with every flag given in its place.
+    pub fn over(&self, base: sylva::GrowOptions) -> sylva::GrowOptions {
+        sylva::GrowOptions {
+            seed: self.seed.or(base.seed),
+            roots: base.roots && !self.hide_roots,
+            taper: self.taper.or(base.taper),
+            height: self.height.or(base.height),
+            dress: self.dress.over(base.dress),
+            ..base
+        }
+    }
+}
+
 /// The realism flags of `grow`, `render`, `evolve` and `match`: leaves or needles of a
 /// kind at their real size, and a tiling bark.
 #[derive(clap::Args, Debug, Default, Clone)]

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use sylva::assets::{check_png, write_picture};
 use sylva::render::View;
-use sylva::{GrowOptions, Grown, InputError, load_genome};
+use sylva::{GrowOptions, Grown, InputError};
 
 use super::InFile;
 
@@ -14,7 +14,7 @@ const MAX_GLB: u64 = 1 << 30;
 /// Arguments of `sylva render`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Genome JSON or GLB.
+    /// Genome JSON, species preset (.toml) or GLB.
     file: PathBuf,
     /// Output PNG.
     #[arg(short, long)]
@@ -56,16 +56,17 @@ pub struct RenderArgs {
     wind: super::WindArgs,
 }
 
-/// How `sylva render` grows a genome: its seed, roots, taper, height and dress flags.
-fn grow_options(args: &RenderArgs) -> GrowOptions {
-    GrowOptions {
+/// How `sylva render` grows a genome (or a preset's): its seed, roots, taper, height and
+/// dress flags over what the file gave.
+fn grow_options(args: &RenderArgs, base: GrowOptions) -> GrowOptions {
+    super::GrowFlags {
         seed: args.seed,
-        roots: !args.hide_roots,
+        hide_roots: args.hide_roots,
         taper: args.taper,
         height: args.height,
-        dress: args.dress.over(sylva::Dress::default()),
-        ..GrowOptions::default()
+        dress: &args.dress,
     }
+    .over(base)
 }
 
 /// `sylva render`.
@@ -83,10 +84,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let genome = load_genome(&args.file)?;
+        let (genome, base) = super::load_input(&args.file)?;
         let options = GrowOptions {
             lod: Some(levels as usize),
-            ..grow_options(args)
+            ..grow_options(args, base)
         };
         let growing = super::growing(&genome);
         let grown = Grown::grow(genome, &options).in_file(&args.file)?;
@@ -102,11 +103,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             )
             .into());
         }
+        let (genome, base) = super::load_input(&args.file)?;
         let options = GrowOptions {
             wind: args.wind.options(&args.output)?,
-            ..grow_options(args)
+            ..grow_options(args, base)
         };
-        let genome = load_genome(&args.file)?;
         let growing = super::growing(&genome);
         let grown = Grown::grow(genome, &options).in_file(&args.file)?;
         drop(growing);
@@ -131,9 +132,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             .map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
-        let genome = load_genome(&args.file)?;
+        let (genome, base) = super::load_input(&args.file)?;
         let growing = super::growing(&genome);
-        let grown = Grown::grow(genome, &grow_options(args)).in_file(&args.file)?;
+        let grown = Grown::grow(genome, &grow_options(args, base)).in_file(&args.file)?;
         drop(growing);
         write_picture(&grown.scene(), &args.output, args.view, args.size)?;
     }
