@@ -166,8 +166,13 @@ impl Genome {
     /// `roots=False` leaves the roots out; `taper=E` thickens the branches by the pipe model,
     /// radius ∝ (tips above)^(1/E), E from 2 to 3; `wind=S` adds a wind skin and a looping
     /// clip named `wind` (strength S from 0 to 10, 1 a breeze; `wind_period` seconds a sway,
-    /// 0.5 to 60, default 4), which the plant's GLB carries. Releases the GIL.
-    #[pyo3(signature = (seed = None, roots = true, taper = None, wind = None, wind_period = None))]
+    /// 0.5 to 60, default 4), which the plant's GLB carries; `height=M` scales the plant so
+    /// that it stands M metres tall (0.01 to 1000); `foliage="oak"` puts leaves or needles
+    /// of a kind on it at their real size as alpha-cut cards, `bark="furrowed"` a tiling
+    /// bark (the foliage's own by default), `density` cards per metre of twig (0.25 to 4).
+    /// Releases the GIL.
+    #[pyo3(signature = (seed = None, roots = true, taper = None, wind = None, wind_period = None, height = None, foliage = None, bark = None, density = None))]
+    #[allow(clippy::too_many_arguments)]
     fn grow(
         &self,
         py: Python<'_>,
@@ -176,6 +181,10 @@ impl Genome {
         taper: Option<f64>,
         wind: Option<f32>,
         wind_period: Option<f32>,
+        height: Option<f32>,
+        foliage: Option<&str>,
+        bark: Option<&str>,
+        density: Option<f32>,
     ) -> PyResult<Plant> {
         let genome = self.inner.clone();
         let taper = taper
@@ -188,10 +197,39 @@ impl Genome {
             roots,
             taper,
             wind,
+            height: height_value(height)?,
+            dress: dress_value(sylva::Dress::default(), foliage, bark, density)?,
             ..sylva::GrowOptions::default()
         };
         let grown = py.detach(|| sylva::Grown::grow(genome, &options)).py()?;
         Ok(Plant::with_wind(grown, wind))
+    }
+
+    /// Loads a species preset (`.toml`: a genome and how it grows, as
+    /// `examples/species/oak.toml`) and grows it; the arguments given override the file's.
+    #[staticmethod]
+    #[pyo3(signature = (path, seed = None, height = None, foliage = None, bark = None, density = None))]
+    fn grow_preset(
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        seed: Option<u64>,
+        height: Option<f32>,
+        foliage: Option<&str>,
+        bark: Option<&str>,
+        density: Option<f32>,
+    ) -> PyResult<Plant> {
+        let preset =
+            sylva::preset::Preset::load(&path).map_err(|e| crate::errors::input_error(&e))?;
+        let options = sylva::GrowOptions {
+            seed: seed.or(preset.options.seed),
+            height: height_value(height)?.or(preset.options.height),
+            dress: dress_value(preset.options.dress, foliage, bark, density)?,
+            ..preset.options
+        };
+        let grown = py
+            .detach(|| sylva::Grown::grow(preset.genome, &options))
+            .py()?;
+        Ok(Plant::new(grown))
     }
 
     /// A mutated copy, made by the model's own mutation with `settings` (a dict of the
@@ -329,4 +367,48 @@ fn wind_options(
         };
         bad_value(argument, e)
     })
+}
+
+/// A height for `grow`, checked.
+fn height_value(height: Option<f32>) -> PyResult<Option<f32>> {
+    let (lo, hi) = sylva::assets::HEIGHTS;
+    match height {
+        Some(h) if !(lo..=hi).contains(&h) => Err(bad_value(
+            "height",
+            format!("expected metres from {lo} to {hi}, got {h}"),
+        )),
+        h => Ok(h),
+    }
+}
+
+/// `base` with the dress arguments given: kinds by name, density checked.
+fn dress_value(
+    base: sylva::Dress,
+    foliage: Option<&str>,
+    bark: Option<&str>,
+    density: Option<f32>,
+) -> PyResult<sylva::Dress> {
+    let mut dress = base;
+    if let Some(name) = foliage {
+        dress.foliage = Some(
+            name.parse()
+                .map_err(|e: sylva::core::species::UnknownKind| bad_value("foliage", e))?,
+        );
+    }
+    if let Some(name) = bark {
+        dress.bark = Some(
+            name.parse()
+                .map_err(|e: sylva::core::species::UnknownKind| bad_value("bark", e))?,
+        );
+    }
+    if let Some(d) = density {
+        if !(0.25..=4.0).contains(&d) {
+            return Err(bad_value(
+                "density",
+                format!("expected a multiple from 0.25 to 4, got {d}"),
+            ));
+        }
+        dress.density = d;
+    }
+    Ok(dress)
 }

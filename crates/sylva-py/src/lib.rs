@@ -98,6 +98,7 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plant::garden, m)?)?;
     m.add_function(wrap_pyfunction!(plant::scene, m)?)?;
     m.add_function(wrap_pyfunction!(plant::texture_png, m)?)?;
+    m.add_function(wrap_pyfunction!(plant::picture_png, m)?)?;
     m.add_function(wrap_pyfunction!(set_max_memory, m)?)?;
     m.add_function(wrap_pyfunction!(max_memory, m)?)?;
     m.add_function(wrap_pyfunction!(set_max_time, m)?)?;

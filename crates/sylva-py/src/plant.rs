@@ -103,6 +103,37 @@ impl Plant {
         }
     }
 
+    /// How the plant measures against real trees (`sylva inspect`): a dict from each
+    /// figure's name to its `value` (None when not measured), `unit`, `label`, the range
+    /// real trees give (`real`), the band outside which it is implausible (`check`), its
+    /// `verdict` ("real", "unusual", "implausible", "none") and `source`.
+    fn inspect<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        use sylva::inspect::{AssetFacts, Report};
+        let report = Report::of(
+            &self.grown.plant,
+            Some(AssetFacts::of_mesh(&self.grown.mesh)),
+        );
+        let out = PyDict::new(py);
+        for f in &report.figures {
+            let d = PyDict::new(py);
+            d.set_item("value", f.value)?;
+            d.set_item("unit", f.unit)?;
+            d.set_item("label", f.label)?;
+            d.set_item("real", f.real)?;
+            d.set_item("check", f.check)?;
+            let verdict = match f.verdict() {
+                sylva::inspect::Verdict::Real => "real",
+                sylva::inspect::Verdict::Unusual => "unusual",
+                sylva::inspect::Verdict::Implausible => "implausible",
+                sylva::inspect::Verdict::None => "none",
+            };
+            d.set_item("verdict", verdict)?;
+            d.set_item("source", f.source)?;
+            out.set_item(f.name, d)?;
+        }
+        Ok(out)
+    }
+
     /// Lateral area of all segments, square metres.
     #[getter]
     fn surface_area(&self) -> f32 {
@@ -319,7 +350,8 @@ impl Plant {
 
 /// A triangle mesh as numpy arrays: `positions` and `normals` (n, 3) float32, `uvs` (n, 2)
 /// float32, `indices` (t, 3) uint32, `triangle_materials` (t,) uint32 (an index into
-/// `materials`), and `materials`, a list of dicts (name, kind, color, texture). The arrays
+/// `materials`), and `materials`, a list of dicts (name, kind, color, texture; picture and
+/// normal_map, the names of the pictures it shows for `picture_png`, and cut_out). The arrays
 /// are read-only views of the plant's (or scene's) memory, which they keep alive.
 #[pyclass(module = "sylva", name = "Mesh", frozen, get_all)]
 pub struct Mesh {
@@ -405,6 +437,19 @@ impl Mesh {
             d.set_item(intern!(py, "kind"), m.kind.name())?;
             d.set_item(intern!(py, "color"), m.color)?;
             d.set_item(intern!(py, "texture"), m.texture)?;
+            // Realism surfaces: the pictures to show (by name, for `picture_png`), and
+            // whether the picture's alpha cuts the organ's shape out (drawn from both sides).
+            use sylva::mesh::picture::Picture;
+            d.set_item(
+                intern!(py, "picture"),
+                Picture::base_of(m).map(Picture::name),
+            )?;
+            d.set_item(
+                intern!(py, "normal_map"),
+                Picture::normal_of(m).map(Picture::name),
+            )?;
+            let cut = m.surface.is_some_and(|s| s.is_cut_out());
+            d.set_item(intern!(py, "cut_out"), cut)?;
             list.append(d)?;
         }
         Ok(Mesh {
@@ -601,6 +646,19 @@ pub fn texture_png(py: Python<'_>, id: u16) -> PyResult<Bound<'_, PyBytes>> {
         .map_err(|e| {
             pyo3::exceptions::PyRuntimeError::new_err(format!("encoding texture {id} as PNG: {e}"))
         })?;
+    Ok(PyBytes::new(py, &png))
+}
+
+/// The PNG of one of Sylva's pictures by name (what a material of `plant.mesh.materials`
+/// names in `picture` or `normal_map`: `sylva-texture-3`, `sylva-leaves-oak`,
+/// `sylva-bark-furrowed-normal`, …). Made once per process; releases the GIL.
+#[pyfunction]
+pub fn picture_png<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyBytes>> {
+    let picture = sylva::mesh::picture::Picture::from_name(name)
+        .ok_or_else(|| bad_value("name", format!("no picture of Sylva's is named {name:?}")))?;
+    let png = py.detach(|| picture.png()).map_err(|e| {
+        pyo3::exceptions::PyRuntimeError::new_err(format!("encoding {name} as PNG: {e}"))
+    })?;
     Ok(PyBytes::new(py, &png))
 }
 

@@ -680,3 +680,33 @@ def test_a_run_pickles_through_its_checkpoint():
     copy.step()
     assert copy.best().genome == run.best().genome
     assert copy.stats[-1]["best"] == run.stats[-1]["best"]
+
+
+def test_leaves_needles_and_bark_at_real_size_and_the_plausibility_report(tmp_path):
+    oak = sylva.Genome.load(GENOMES["bintree"])
+    dressed = oak.grow(height=14.0, foliage="oak")
+    bare = oak.grow(height=14.0)
+    report = dressed.inspect()
+    assert report["leaf_length"]["verdict"] == "real"
+    assert 0.08 <= report["leaf_length"]["value"] <= 0.12
+    assert all(f["verdict"] != "implausible" for f in report.values())
+    assert bare.inspect()["leaf_length"]["value"] is None
+    assert report["triangles"]["value"] <= 40_000
+    path = tmp_path / "oak.glb"
+    dressed.export(path)
+    text = path.read_bytes()
+    assert b'"alphaMode":"MASK"' in text and b'"foliage":"oak"' in text
+    # A species preset, its arguments overriding the file's.
+    pine = sylva.Genome.grow_preset(EXAMPLES / "species" / "pine.toml", height=12.0)
+    assert 11.0 < pine.inspect()["height"]["value"] < 13.5
+    assert pine.inspect()["leaf_length"]["value"] < 0.08
+    # Bad kinds and values: ValueError naming the argument and what it takes.
+    with pytest.raises(ValueError, match="foliage.*choose one of oak"):
+        oak.grow(foliage="palm")
+    with pytest.raises(ValueError, match="bark.*smooth, birch, furrowed, plated"):
+        oak.grow(bark="cork")
+    for density in (0.0, -1.0, float("nan"), 1e40):
+        with pytest.raises(ValueError, match="density"):
+            oak.grow(foliage="oak", density=density)
+    with pytest.raises(ValueError, match="height"):
+        oak.grow(height=-3.0)

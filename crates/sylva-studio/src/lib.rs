@@ -194,6 +194,8 @@ pub fn router(studio: Studio) -> Router {
         .route("/plants", get(plants::list))
         .route("/plants/{id}", get(plants::get))
         .route("/plants/{id}/plant.glb", get(plants::glb))
+        .route("/plants/{id}/inspect", get(plants::inspect))
+        .route("/kinds", get(plants::kinds))
         .route("/plants/{id}/preview.glb", get(plants::preview))
         .route("/plants/{id}/plant.obj", get(plants::obj))
         .route("/plants/{id}/plant.mtl", get(plants::mtl))

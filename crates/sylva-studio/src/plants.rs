@@ -230,9 +230,66 @@ pub(crate) struct GlbQuery {
     /// Levels of detail, 2 to 8, as `sylva grow --lod N`: one scene of sibling nodes
     /// `NAME_LOD0`, `NAME_LOD1`, … with each level's screen coverage in its extras.
     lod: Option<usize>,
+    /// Leaves or needles of a kind at their real size, as `sylva grow --foliage`.
+    foliage: Option<String>,
+    /// A tiling bark, as `sylva grow --bark`.
+    bark: Option<String>,
+    /// The height to scale to, metres, as `sylva grow --height`.
+    height: Option<f32>,
 }
 
-/// `GET /api/plants/{id}/plant.glb[?roots=true][&wind=true][&lod=N]`: the plant in full,
+impl GlbQuery {
+    /// Its dress parameters.
+    fn dress(&self) -> DressQuery {
+        DressQuery {
+            foliage: self.foliage.clone(),
+            bark: self.bark.clone(),
+            height: self.height,
+        }
+    }
+}
+
+/// The dress a request asks for: `foliage`, `bark` (kinds by name) and `height` (metres).
+#[derive(Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DressQuery {
+    foliage: Option<String>,
+    bark: Option<String>,
+    height: Option<f32>,
+}
+
+impl DressQuery {
+    /// Whether it asks for anything.
+    fn is_empty(&self) -> bool {
+        self.foliage.is_none() && self.bark.is_none() && self.height.is_none()
+    }
+
+    /// The dress and height, each checked (a 400 naming the parameter and what it takes).
+    fn options(&self) -> Result<(sylva::Dress, Option<f32>), ApiError> {
+        let kind =
+            |field: &'static str, e: sylva::core::species::UnknownKind| ApiError::bad(field, e);
+        let mut dress = sylva::Dress::default();
+        if let Some(name) = &self.foliage {
+            dress.foliage = Some(name.parse().map_err(|e| kind("foliage", e))?);
+        }
+        if let Some(name) = &self.bark {
+            dress.bark = Some(name.parse().map_err(|e| kind("bark", e))?);
+        }
+        let (lo, hi) = sylva::assets::HEIGHTS;
+        if let Some(h) = self.height
+            && !(lo..=hi).contains(&h)
+        {
+            return Err(ApiError::bad(
+                "height",
+                format!("expected {lo} to {hi} metres, got {h}"),
+            ));
+        }
+        Ok((dress, self.height))
+    }
+}
+
+/// `GET /api/plants/{id}/plant.glb[?roots=true][&wind=true][&lod=N][&foliage=KIND][&bark=KIND][&height=M]`:
+/// the plant in full,
 /// for exports; with wind or levels of detail, the game asset `sylva grow` writes.
 pub(crate) async fn glb(
     State(studio): State<Studio>,
@@ -250,8 +307,9 @@ pub(crate) async fn glb(
             ),
         ));
     }
+    q.dress().options()?;
     let glb = tokio::task::spawn_blocking(move || {
-        if q.wind || q.lod.is_some() {
+        if q.wind || q.lod.is_some() || !q.dress().is_empty() {
             asset_glb(&studio, id, &q).map(Arc::new)
         } else {
             plant_glb(&studio, id, q.roots)
@@ -266,12 +324,15 @@ pub(crate) async fn glb(
 fn asset_glb(studio: &Studio, id: i64, q: &GlbQuery) -> Result<Vec<u8>, ApiError> {
     let row = plant_row(studio, id)?;
     let genome = genome_of(&studio.registry, &row)?;
+    let (dress, height) = q.dress().options()?;
     let options = GrowOptions {
         seed: Some(row.seed),
         roots: q.roots,
         wind: q.wind.then(sylva::mesh::wind::WindOptions::default),
         lod: q.lod,
         pruned_to: pruned_to(studio, &row)?,
+        dress,
+        height,
         ..GrowOptions::default()
     };
     let failed = |e: sylva::Error| ApiError::library("genome", e);
@@ -283,6 +344,42 @@ fn asset_glb(studio: &Studio, id: i64, q: &GlbQuery) -> Result<Vec<u8>, ApiError
         sylva::gltf::export::to_glb(&grown.scene())
     };
     glb.map_err(|e| ApiError::library("genome", e.into()))
+}
+
+/// `GET /api/plants/{id}/inspect[?foliage=KIND][&bark=KIND][&height=M]`: how the plant
+/// (dressed and scaled as asked) measures against real trees, as `sylva inspect --json`.
+pub(crate) async fn inspect(
+    State(studio): State<Studio>,
+    Path(id): Path<i64>,
+    Query(q): Query<DressQuery>,
+) -> Result<Response, ApiError> {
+    let (dress, height) = q.options()?;
+    let json = tokio::task::spawn_blocking(move || -> Result<String, ApiError> {
+        let row = plant_row(&studio, id)?;
+        let genome = genome_of(&studio.registry, &row)?;
+        let options = GrowOptions {
+            seed: Some(row.seed),
+            pruned_to: pruned_to(&studio, &row)?,
+            dress,
+            height,
+            ..GrowOptions::default()
+        };
+        let grown = Grown::grow(genome, &options).map_err(|e| ApiError::library("genome", e))?;
+        let asset = sylva::inspect::AssetFacts::of_mesh(&grown.mesh);
+        Ok(sylva::inspect::Report::of(&grown.plant, Some(asset)).to_json())
+    })
+    .await??;
+    Ok(([(header::CONTENT_TYPE, "application/json")], json).into_response())
+}
+
+/// `GET /api/kinds`: the foliage and bark kinds a plant can be dressed in, by name.
+pub(crate) async fn kinds() -> Response {
+    let names = |it: &mut dyn Iterator<Item = &'static str>| it.collect::<Vec<_>>();
+    axum::Json(serde_json::json!({
+        "foliage": names(&mut sylva::LeafKind::ALL.iter().map(|k| k.name())),
+        "bark": names(&mut sylva::BarkKind::ALL.iter().map(|k| k.name())),
+    }))
+    .into_response()
 }
 
 #[derive(Deserialize)]

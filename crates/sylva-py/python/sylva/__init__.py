@@ -45,6 +45,7 @@ from ._sylva import (
     set_max_memory,
     set_max_time,
     texture_png,
+    picture_png,
     varieties,
 )
 from .errors import InputError, LimitError, SylvaError
@@ -77,5 +78,6 @@ __all__ = [
     "set_max_memory",
     "set_max_time",
     "texture_png",
+    "picture_png",
     "varieties",
 ]

@@ -57,10 +57,30 @@ class Genome:
         taper: float | None = None,
         wind: float | None = None,
         wind_period: float | None = None,
+        height: float | None = None,
+        foliage: str | None = None,
+        bark: str | None = None,
+        density: float | None = None,
     ) -> Plant:
         """Grows and meshes the plant with ``seed`` (the genome's own when None); ``taper=E``
         thickens the branches by the pipe model, radius ∝ (tips above)^(1/E), E from 2 to 3;
-        ``wind=S`` (0 to 10) adds a wind skin and a looping clip of ``wind_period`` seconds."""
+        ``wind=S`` (0 to 10) adds a wind skin and a looping clip of ``wind_period`` seconds;
+        ``height=M`` scales it to M metres; ``foliage`` (oak, birch, aspen, beech, maple,
+        willow, ash, privet, pine, spruce, fir) puts leaves or needles of that kind on it at
+        their real size, as alpha-cut cards; ``bark`` (smooth, birch, furrowed, plated) a
+        tiling bark, the foliage's own by default; ``density`` cards per metre of twig,
+        0.25 to 4."""
+    @staticmethod
+    def grow_preset(
+        path: str | os.PathLike[str],
+        seed: int | None = None,
+        height: float | None = None,
+        foliage: str | None = None,
+        bark: str | None = None,
+        density: float | None = None,
+    ) -> Plant:
+        """Loads a species preset (``examples/species/oak.toml``: a genome and how it
+        grows) and grows it; the arguments given override the file's."""
     def mutate(self, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A mutated copy, made by the model's own mutation."""
     def __eq__(self, other: object) -> bool: ...
@@ -82,7 +102,9 @@ class Mesh:
     triangle_materials: npt.NDArray[np.uint32]
     """(t,) index into ``materials`` of each triangle."""
     materials: list[dict[str, Any]]
-    """Each material: ``name``, ``kind`` (bark, leaf, flower, root), ``color``, ``texture``."""
+    """Each material: ``name``, ``kind`` (bark, leaf, flower, root), ``color``, ``texture``;
+    ``picture`` and ``normal_map``, the names of the pictures it shows (``picture_png``), and
+    ``cut_out``, whether its picture's alpha cuts the shape out (leaf cards, petals)."""
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as its arrays; unpickled, it owns them, read-only."""
 
@@ -111,6 +133,10 @@ class Plant:
     def volume(self) -> float: ...
     @property
     def total_length(self) -> float: ...
+    def inspect(self) -> dict[str, dict[str, Any]]:
+        """How the plant measures against real trees (``sylva inspect``): each figure's
+        ``value`` (None when not measured), ``unit``, ``label``, ``real`` range, ``check``
+        band, ``verdict`` ("real", "unusual", "implausible", "none") and ``source``."""
     def measures(self) -> dict[str, float]:
         """The measures of Susinno's paper, as a dict."""
     def skeleton(self) -> dict[str, Any]:
@@ -439,6 +465,10 @@ def garden(
 
 def texture_png(id: int) -> bytes:
     """The PNG of Sylva's texture ``id`` (a material's ``texture``): grey, 256 × 256."""
+
+def picture_png(name: str) -> bytes:
+    """The PNG of one of Sylva's pictures by name (a material's ``picture`` or
+    ``normal_map``: ``sylva-leaves-oak``, ``sylva-bark-furrowed-normal``, ...)."""
 
 def scene(
     plants: Sequence[Plant],

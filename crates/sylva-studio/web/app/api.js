@@ -197,6 +197,8 @@ export const api = {
   lineage: (id, depth = 8) => get(`/api/plants/${enc(id)}/lineage?depth=${depth}`),
   branch: (id, mode) => post(`/api/plants/${enc(id)}/branch`, { mode }),
   plantUrl: (id, file) => `/api/plants/${enc(id)}/${file}`,
+  kinds: () => get("/api/kinds"),
+  inspect: (id, query = "") => get(`/api/plants/${enc(id)}/inspect${query ? `?${query}` : ""}`),
   pngUrl: (id, size = "256x256", view = "iso") =>
     `/api/plants/${enc(id)}/plant.png?view=${view}&size=${size}`,
 };

@@ -52,8 +52,47 @@ export function createDetail(ctx, panel) {
     const seed = h("input", { type: "text", inputmode: "numeric", testid: "regrow-seed", value: String(p.seed ?? 1), style: { width: "13em" } });
 
     const inGardens = ((ctx.models || []).find((m) => m.name === p.model)?.modes || []).includes("garden");
-    const exportLink = (file, label, testid, download) =>
-      h("a", { href: api.plantUrl(p.id, file), download, testid, class: "button" }, label);
+    // Leaves and bark: a foliage kind and a height, for the GLB exports and the report.
+    const foliage = h("select", { testid: "look-foliage", title: "Leaves or needles at their real size" },
+      h("option", { value: "" }, "as grown"));
+    const height = h("input", { type: "text", inputmode: "decimal", testid: "look-height", placeholder: "as grown", style: { width: "6em" } });
+    const lookQuery = () => {
+      const q = new URLSearchParams();
+      if (foliage.value) q.set("foliage", foliage.value);
+      if (height.value.trim()) q.set("height", height.value.trim());
+      return q.toString();
+    };
+    const glbLinks = [];
+    const exportLink = (file, label, testid, download) => {
+      const a = h("a", { href: api.plantUrl(p.id, file), download, testid, class: "button" }, label);
+      if (file.startsWith("plant.glb")) glbLinks.push([a, file]);
+      return a;
+    };
+    const relink = () => {
+      const q = lookQuery();
+      for (const [a, file] of glbLinks) {
+        a.href = api.plantUrl(p.id, q ? `${file}${file.includes("?") ? "&" : "?"}${q}` : file);
+      }
+    };
+    foliage.addEventListener("change", relink);
+    height.addEventListener("input", relink);
+    api.kinds().then((k) => {
+      for (const name of k.foliage || []) add(foliage, h("option", { value: name }, name));
+    }).catch(() => {});
+    const report = h("div", { testid: "inspect-report" });
+    async function inspect() {
+      const r = await ctx.act(() => api.inspect(p.id, lookQuery()));
+      if (!r) return;
+      clear(report);
+      const verdict = { real: "", unusual: "unusual", implausible: "IMPLAUSIBLE", none: "not measured" };
+      add(report, h("table", { class: "facts inspect" }, h("tbody", {},
+        (r.figures || []).map((f) => h("tr", { class: f.verdict, title: f.source },
+          h("th", {}, f.label),
+          h("td", {}, f.value === null || f.value === undefined ? "–" : `${fmtNum(f.value)}${f.unit ? ` ${f.unit}` : ""}`),
+          h("td", { class: "hint" }, `${fmtNum(f.real[0])} to ${fmtNum(f.real[1])}`),
+          h("td", {}, verdict[f.verdict] ?? "")))
+      )));
+    }
 
     const title = h("div", { class: "detail-head" },
       h("h2", {}, `Plant #${p.id}`),
@@ -78,6 +117,13 @@ export function createDetail(ctx, panel) {
         inGardens ? h("button", { testid: "branch-garden", title: "A new garden with this plant as the mother", onclick: () => branch("garden") }, "Branch to a garden") : null,
         h("button", { testid: "add-to-grid", title: "Put this plant back in the current breeding grid", onclick: addToGrid }, "Add to grid"),
       ),
+      h("h3", {}, "Leaves and bark"),
+      h("div", { class: "buttons" },
+        h("label", { class: "field" }, h("span", {}, "Foliage"), foliage),
+        h("label", { class: "field" }, h("span", {}, "Height (m)"), height),
+        h("button", { testid: "inspect", title: "How this plant measures against real trees", onclick: inspect }, "Inspect"),
+      ),
+      report,
       h("h3", {}, "Export"),
       h("div", { class: "buttons exports" },
         exportLink("plant.glb", "GLB", "export-glb", `plant-${p.id}.glb`),
