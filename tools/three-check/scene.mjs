@@ -1,7 +1,7 @@
 // Loads GLBs with three.js's own GLTFLoader under Node and prints, per file, one line of JSON
 // saying what three.js made of it: the names of the scene's top nodes, the meshes, instanced
-// meshes and their instance counts, the distinct geometries, the materials and whether they
-// use vertex colours, how many geometries carry a colour attribute, and the world-space box
+// meshes and their instance counts, the distinct geometries, the materials (name, three.js
+// type, alpha test) and whether they use vertex colours, how many geometries carry a colour attribute, and the world-space box
 // of every vertex (instances and quantised positions included). Tests read the lines.
 // Usage: node tools/three-check/scene.mjs FILE.glb...
 // three.js comes from the studio's pinned install: npm ci --prefix crates/sylva-studio/web
@@ -45,7 +45,7 @@ for (const file of process.argv.slice(2)) {
     geometries.add(o.geometry);
     const index = o.geometry.index;
     triangles += count * (index ? index.count : o.geometry.attributes.position.count) / 3;
-    for (const m of [o.material].flat()) materials.set(m.uuid, { name: m.name, vertexColors: m.vertexColors });
+    for (const m of [o.material].flat()) materials.set(m.uuid, { name: m.name, type: m.type, alphaTest: m.alphaTest, vertexColors: m.vertexColors });
   });
   const colored = [...geometries].filter((g) => g.attributes.color).length;
   gltf.scene.updateMatrixWorld(true);

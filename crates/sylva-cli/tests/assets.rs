@@ -41,7 +41,7 @@ fn shades_become_vertex_colours_of_one_material_per_kind() {
 }
 
 #[test]
-fn levels_of_detail_halve_and_load_as_named_siblings() {
+fn levels_of_detail_halve_end_in_an_impostor_and_load_as_named_siblings() {
     let dir = temp_dir("lod");
     let tree = dir.join("tree.glb");
     let run = sylva(&[
@@ -53,33 +53,50 @@ fn levels_of_detail_halve_and_load_as_named_siblings() {
         "4",
     ]);
     assert!(run.status.success(), "{run:?}");
-    let levels: Vec<_> = (0..4)
+    // Four meshed levels, then the impostor.
+    let levels: Vec<_> = (0..5)
         .map(|k| dir.join(format!("tree_LOD{k}.glb")))
         .collect();
     let mut all = levels.clone();
     all.push(tree.clone());
     sylva_testkit::validate(&all);
     let seen = three_scene(&all);
-    let group = &seen[4];
+    let group = &seen[5];
     let names: Vec<&str> = group["nodes"]
         .as_array()
         .unwrap()
         .iter()
         .map(|n| n.as_str().unwrap())
         .collect();
-    assert_eq!(names, ["tree_LOD0", "tree_LOD1", "tree_LOD2", "tree_LOD3"]);
+    assert_eq!(
+        names,
+        [
+            "tree_LOD0",
+            "tree_LOD1",
+            "tree_LOD2",
+            "tree_LOD3",
+            "tree_LOD4"
+        ]
+    );
     let full = seen[0]["triangles"].as_f64().unwrap();
     let mut coverage = f64::INFINITY;
-    for k in 0..4 {
+    for k in 0..5 {
         // Each file holds its level alone, and the group's node says the same of it.
         let triangles = seen[k]["triangles"].as_f64().unwrap();
-        let aim = full / f64::from(1u32 << k);
-        assert!(
-            triangles <= aim && triangles >= 0.7 * aim,
-            "LOD{k}: {triangles} for {aim}"
-        );
         let lod = &group["extras"][k]["lod"];
+        if k < 4 {
+            let aim = full / f64::from(1u32 << k);
+            assert!(
+                triangles <= aim && triangles >= 0.7 * aim,
+                "LOD{k}: {triangles} for {aim}"
+            );
+            assert!(lod["impostor"].is_null());
+        } else {
+            assert_eq!(triangles, 4.0, "two crossed cards");
+            assert_eq!(lod["impostor"], true);
+        }
         assert_eq!(lod["level"], k);
+        assert_eq!(lod["levels"], 5);
         assert_eq!(lod["triangles"].as_f64().unwrap(), triangles);
         assert_eq!(seen[k]["nodes"][0], format!("tree_LOD{k}"));
         let c = lod["screen_coverage"].as_f64().unwrap();
@@ -93,8 +110,21 @@ fn levels_of_detail_halve_and_load_as_named_siblings() {
     }
     assert!(
         (coverage - 0.01).abs() < 1e-6,
-        "the last level is culled at 1%"
+        "the impostor is culled at 1%"
     );
+    let handover = group["extras"][3]["lod"]["screen_coverage"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        handover <= 0.1 + 1e-6,
+        "the impostor takes over at 10% or less"
+    );
+    // three.js reads the impostor's material as unlit and cut out.
+    let material = &seen[4]["materials"][0];
+    assert_eq!(material["type"], "MeshBasicMaterial", "{material}");
+    assert_eq!(material["alphaTest"], 0.5);
+    let bytes = std::fs::metadata(&levels[4]).unwrap().len();
+    assert!(bytes < 400_000, "the impostor's file is {bytes} bytes");
 
     // The same bytes again; with wind, every level rigged and still valid.
     let first = std::fs::read(&tree).unwrap();
@@ -122,7 +152,11 @@ fn levels_of_detail_halve_and_load_as_named_siblings() {
         "--wind",
     ]);
     assert!(run.status.success(), "{run:?}");
-    sylva_testkit::validate(&[windy.clone(), dir.join("windy_LOD2.glb")]);
+    sylva_testkit::validate(&[
+        windy.clone(),
+        dir.join("windy_LOD2.glb"),
+        dir.join("windy_LOD3.glb"),
+    ]);
 
     // Refused before any work: a format without levels, and counts out of range.
     for (output, lod) in [("tree.obj", "3"), ("tree.glb", "1"), ("tree.glb", "9")] {
@@ -159,7 +193,7 @@ fn a_strip_of_the_levels_is_drawn_side_by_side() {
     let png = std::fs::read(&strip).unwrap();
     // PNG header: width and height, big-endian, at bytes 16 and 20.
     let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
-    assert_eq!(width, 3 * 120);
+    assert_eq!(width, 4 * 120, "three levels and the impostor");
     let glb = dir.join("oak.glb");
     assert!(
         sylva(&["grow", &example("bintree/oak.json"), "-o", s(&glb)])
@@ -185,6 +219,7 @@ fn grow_quantizes_single_plants_and_their_levels() {
         small.clone(),
         dir.join("small_LOD0.glb"),
         dir.join("small_LOD1.glb"),
+        dir.join("small_LOD2.glb"),
     ];
     sylva_testkit::validate(&files);
     assert!(std::fs::metadata(&files[2]).unwrap().len() < std::fs::metadata(&plain).unwrap().len());

@@ -1645,6 +1645,10 @@ fn a_map_fills_in_the_background_survives_a_kill_and_its_plants_branch_and_expor
     assert_eq!(status, 200, "{}", String::from_utf8_lossy(&glb));
     let text = String::from_utf8_lossy(&glb);
     assert!(glb.starts_with(b"glTF") && text.contains("_LOD2") && text.contains("\"wind\""));
+    assert!(
+        text.contains("_LOD3") && text.contains("KHR_materials_unlit"),
+        "the impostor"
+    );
     let (status, _) = request(
         &server,
         "GET",

@@ -565,6 +565,9 @@ pub enum Surface {
     Petals,
     /// Stems with a tiling bark of a kind (a base colour and a normal map).
     Bark(BarkKind),
+    /// A card showing a picture of a whole plant, cut out by its alpha: the last level of a
+    /// plant's detail, for trees far away (an impostor). The picture is its mesh's own.
+    Impostor,
 }
 
 impl Surface {

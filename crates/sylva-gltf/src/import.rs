@@ -473,6 +473,9 @@ impl Reader<'_> {
                 }
             };
             let material = self.material(prim.get("material"))?;
+            if material.surface == Some(Surface::Impostor) && out.impostor.is_none() {
+                out.impostor = self.impostor_picture(prim.get("material"))?;
+            }
             let Some(colors) = prim["attributes"].get("COLOR_0") else {
                 out.primitives.push(Primitive {
                     material: out.materials.len(),
@@ -592,6 +595,32 @@ impl Reader<'_> {
             texture,
             surface,
         })
+    }
+
+    /// The PNG an impostor's material shows (its base colour texture's image), if it has one.
+    fn impostor_picture(
+        &self,
+        index: Option<&Value>,
+    ) -> Result<Option<std::sync::Arc<Vec<u8>>>, ImportError> {
+        let Some(index) = index else {
+            return Ok(None);
+        };
+        let info = &self.item("materials", index)?["pbrMetallicRoughness"]["baseColorTexture"];
+        if info["index"].is_null() {
+            return Ok(None);
+        }
+        let texture = self.item("textures", &info["index"])?;
+        let image = self.item("images", &texture["source"])?;
+        let view = self.item("bufferViews", &image["bufferView"])?;
+        let field = |key: &str| view[key].as_u64().and_then(|v| usize::try_from(v).ok());
+        let (start, length) = (field("byteOffset").unwrap_or(0), field("byteLength"));
+        let bytes = length
+            .and_then(|l| start.checked_add(l))
+            .and_then(|end| self.bin.get(start..end))
+            .ok_or_else(|| {
+                ImportError::Truncated("an impostor's image runs past the binary chunk".into())
+            })?;
+        Ok(Some(std::sync::Arc::new(bytes.to_vec())))
     }
 
     /// The Sylva picture behind a texture reference, if its image is one of Sylva's.
@@ -813,6 +842,7 @@ mod tests {
                 indices: vec![0, 1, 2],
             }],
             materials: vec![Material::of_kind(MaterialKind::Leaf)],
+            impostor: None,
         }
     }
 
@@ -1001,6 +1031,60 @@ mod tests {
             .collect();
         assert_eq!(read, surfaces.map(Some));
         assert_eq!(back.meshes[0].1.materials[2].texture, Some(7));
+    }
+
+    /// Two impostors' pictures are embedded once each, marked unlit, and read back into
+    /// their meshes; an impostor's material on a mesh without a picture is an error.
+    #[test]
+    fn impostor_pictures_are_written_unlit_and_read_back() {
+        use sylva_core::species::{LeafKind, Surface};
+        let picture = |kind| Picture::Leaves(kind).png().unwrap();
+        let card = |png: Option<std::sync::Arc<Vec<u8>>>| {
+            let mut mesh = triangle_mesh();
+            mesh.materials[0].surface = Some(Surface::Impostor);
+            mesh.impostor = png;
+            mesh
+        };
+        let (oak, pine) = (
+            card(Some(picture(LeafKind::Oak))),
+            card(Some(picture(LeafKind::Pine))),
+        );
+        let scene = Scene {
+            nodes: vec![
+                SceneNode::new("oak", &oak),
+                SceneNode::new("pine", &pine),
+                SceneNode::new("oak-again", &oak),
+            ],
+        };
+        let glb = to_glb(&scene).unwrap();
+        let (json, _) = crate::export::glb::tests::chunks(&glb);
+        assert_eq!(
+            json["extensionsUsed"],
+            serde_json::json!(["KHR_materials_unlit"])
+        );
+        assert_eq!(json["images"].as_array().unwrap().len(), 2);
+        assert_eq!(json["materials"].as_array().unwrap().len(), 2);
+        let m = &json["materials"][0];
+        assert_eq!(
+            m["extensions"]["KHR_materials_unlit"],
+            serde_json::json!({})
+        );
+        assert_eq!(m["alphaMode"], "MASK");
+        let back = read_glb(&glb).unwrap();
+        let pictures: Vec<_> = back
+            .meshes
+            .iter()
+            .map(|(_, m)| m.impostor.clone())
+            .collect();
+        assert_eq!(pictures, [&oak, &pine, &oak].map(|m| m.impostor.clone()));
+        assert_eq!(
+            back.meshes[1].1.materials[0].surface,
+            Some(Surface::Impostor)
+        );
+
+        let bare = card(None);
+        let error = to_glb(&Scene::single(SceneNode::new("bare", &bare))).unwrap_err();
+        assert!(error.to_string().contains("impostor"), "{error}");
     }
 
     #[test]

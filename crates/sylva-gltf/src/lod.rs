@@ -55,7 +55,7 @@ use sylva_mesh::mesher::{MeshError, MeshOptions, Mesher};
 /// Most levels in a chain (level 0 included).
 pub const MAX_LEVELS: usize = 8;
 /// The coverage below which the last level is culled.
-const CULL_COVERAGE: f32 = 0.01;
+pub const CULL_COVERAGE: f32 = 0.01;
 /// The coverage at which level 0's triangle density is the reference.
 const FULL_COVERAGE: f32 = 0.5;
 /// Most plants tried per level in the search for its detail number.

@@ -32,6 +32,10 @@ pub struct Mesh {
     pub primitives: Vec<Primitive>,
     /// The materials primitives refer to.
     pub materials: Vec<Material>,
+    /// The picture (a PNG, colour and alpha) a material whose surface is
+    /// [`Surface::Impostor`](sylva_core::species::Surface::Impostor) shows: an impostor card's
+    /// picture of its plant. `None` for every other mesh.
+    pub impostor: Option<std::sync::Arc<Vec<u8>>>,
 }
 
 impl Mesh {
@@ -64,5 +68,6 @@ impl Mesh {
         }
         self.primitives.clear();
         self.materials.clear();
+        self.impostor = None;
     }
 }

@@ -40,6 +40,10 @@ pub enum Picture {
     LeavesMask(LeafKind),
     /// A petal cut-out's alpha alone, as grey and as alpha (for OBJ's `map_d`).
     PetalMask(Option<u16>),
+    /// An impostor's picture of its plant (colour and alpha): not drawn here but carried by
+    /// its mesh ([`crate::Mesh::impostor`]), so [`Picture::image`] and [`Picture::png`] have
+    /// none: writers and the renderer take the mesh's.
+    Impostor,
 }
 
 /// The prefix of every image name Sylva writes (`sylva-texture-3`, `sylva-leaves-oak`).
@@ -52,6 +56,7 @@ impl Picture {
             Some(Surface::Leaves(kind) | Surface::Branchlets(kind)) => Some(Picture::Leaves(kind)),
             Some(Surface::Petals) => Some(Picture::Petal(m.texture)),
             Some(Surface::Bark(kind)) => Some(Picture::Bark(kind)),
+            Some(Surface::Impostor) => Some(Picture::Impostor),
             None => m.texture.map(Picture::Design),
         }
     }
@@ -78,7 +83,11 @@ impl Picture {
     pub fn has_alpha(self) -> bool {
         matches!(
             self,
-            Picture::Leaves(_) | Picture::Petal(_) | Picture::LeavesMask(_) | Picture::PetalMask(_)
+            Picture::Leaves(_)
+                | Picture::Petal(_)
+                | Picture::LeavesMask(_)
+                | Picture::PetalMask(_)
+                | Picture::Impostor
         )
     }
 
@@ -110,6 +119,7 @@ impl Picture {
             Picture::LeavesMask(k) => format!("{NAME_PREFIX}leaves-{}-mask", k.name()),
             Picture::PetalMask(None) => format!("{NAME_PREFIX}petal-mask"),
             Picture::PetalMask(Some(id)) => format!("{NAME_PREFIX}petal-{id}-mask"),
+            Picture::Impostor => format!("{NAME_PREFIX}impostor"),
         }
     }
 
@@ -141,6 +151,7 @@ impl Picture {
         match rest {
             "petal" => return Some(Picture::Petal(None)),
             "petal-mask" => return Some(Picture::PetalMask(None)),
+            "impostor" => return Some(Picture::Impostor),
             _ => {}
         }
         if let Some(id) = rest
@@ -169,6 +180,8 @@ impl Picture {
             Picture::BarkNormal(k) => DynamicImage::ImageRgb8((*bark::bark_normal(k)).clone()),
             Picture::LeavesMask(k) => DynamicImage::ImageLumaA8(mask(&atlas::leaf_atlas(k))),
             Picture::PetalMask(d) => DynamicImage::ImageLumaA8(mask(&atlas::petal_picture(d))),
+            // Its mesh carries it: one clear texel stands for it here.
+            Picture::Impostor => DynamicImage::ImageLumaA8(image::GrayAlphaImage::new(1, 1)),
         }
     }
 

@@ -231,11 +231,12 @@ impl Plant {
         Ok(Some(dict))
     }
 
-    /// Its levels of detail as GLB bytes: `levels` (2 to 8) meshes of falling detail as
-    /// sibling nodes named `NAME_LOD0` (the plant in full) to `NAME_LODn`, each with its
-    /// triangles and screen coverage in its extras, and the wind skin and clip on every
-    /// level when the plant has wind (as `sylva grow --lod` writes them). Grows the plant
-    /// again. Releases the GIL.
+    /// Its levels of detail as GLB bytes: `levels` (2 to 8) meshes of falling detail and
+    /// then an impostor (two crossed cards showing the plant's picture) as sibling nodes
+    /// named `NAME_LOD0` (the plant in full) to `NAME_LOD{levels}` (the impostor), each with
+    /// its triangles and screen coverage in its extras, and the wind skin and clip on every
+    /// meshed level when the plant has wind (as `sylva grow --lod` writes them). Grows the
+    /// plant again. Releases the GIL.
     #[pyo3(signature = (levels, name = "plant"))]
     fn lod_glb<'py>(
         &self,

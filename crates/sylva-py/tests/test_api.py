@@ -156,7 +156,11 @@ def test_wind_and_levels_of_detail_come_as_gltf():
     assert [a["name"] for a in gltf["animations"]] == ["wind"]
     assert "skins" not in glb_json(still.glb())
     lod = glb_json(still.lod_glb(3, name="tulip"))
-    assert [n["name"] for n in lod["nodes"] if "mesh" in n] == ["tulip_LOD0", "tulip_LOD1", "tulip_LOD2"]
+    # Three meshed levels, then the impostor: crossed cards showing the plant, unlit.
+    names = [n["name"] for n in lod["nodes"] if "mesh" in n]
+    assert names == ["tulip_LOD0", "tulip_LOD1", "tulip_LOD2", "tulip_LOD3"]
+    assert lod["nodes"][-1]["extras"]["lod"]["impostor"] is True
+    assert "KHR_materials_unlit" in lod["extensionsUsed"]
     assert still.lod_glb(3, name="tulip") == still.lod_glb(3, name="tulip")
     assert "skins" in glb_json(windy.lod_glb(2))
     for bad, names in [(dict(wind=11), "wind"), (dict(wind=-1), "wind"),

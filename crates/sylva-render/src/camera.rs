@@ -104,6 +104,16 @@ impl Camera {
         }
     }
 
+    /// [`Camera::looking`] from `distance` bounding radii away: far enough, the
+    /// perspective is all but gone (an impostor's picture).
+    pub(crate) fn looking_from(view: View, centre: Vec3, radius: f32, distance: f32) -> Camera {
+        let camera = Camera::looking(view, centre, radius);
+        Camera {
+            eye: centre - camera.forward * (distance * radius),
+            ..camera
+        }
+    }
+
     /// Depth of a point along the viewing direction.
     #[inline]
     pub(crate) fn depth(&self, p: Vec3) -> f32 {

@@ -5,7 +5,10 @@
 //! - [`contact_sheet`] lays out many small captioned renders in a grid.
 //! - [`overlay`] draws two outlines over each other (a plant on its target).
 //! - [`map`] draws a variety map: a thumbnail per filled cell, empty cells left empty.
-//! - [`encode_png`] and [`write_png`] (atomic) save the result.
+//! - [`impostor`] makes a plant's last level of detail: crossed cards showing its picture,
+//!   drawn by [`Renderer::cut_out`].
+//! - [`encode_png`] and [`write_png`] (atomic) save the result; [`encode_rgba_png`] a
+//!   picture with alpha.
 //!
 //! How a picture is made: a mild perspective camera looks at the scene from the chosen view
 //! and is framed on the projected points (every plant vertex, and the ground up to where it
@@ -39,6 +42,7 @@
 //!     primitives: vec![Primitive { material: 0, indices: vec![0, 1, 2] }],
 //!     // Texture 3 is a veined leaf (see sylva_mesh::texture).
 //!     materials: vec![Material { texture: Some(3), ..Material::of_kind(MaterialKind::Leaf) }],
+//!     impostor: None,
 //! };
 //! let scene = Scene::single(SceneNode::new("leaf", &mesh));
 //! let options = RenderOptions { width: 64, height: 48, view: View::Iso, ..Default::default() };
@@ -50,6 +54,7 @@
 //! ```
 
 mod camera;
+pub mod impostor;
 pub mod map;
 pub mod overlay;
 mod raster;
@@ -67,11 +72,12 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use image::RgbImage;
+use image::{RgbImage, RgbaImage};
 use serde::{Deserialize, Serialize};
 use sylva_core::{
     Aabb,
     glam::{Vec2, Vec3},
+    species::Surface,
 };
 use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::{Scene, SceneNode};
@@ -281,13 +287,25 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RgbImage, Render
 
 /// Encodes a picture as PNG bytes.
 pub fn encode_png(image: &RgbImage) -> Result<Vec<u8>, RenderError> {
+    encode(image, image::ExtendedColorType::Rgb8)
+}
+
+/// Encodes a picture with alpha (a cut-out's) as PNG bytes.
+pub fn encode_rgba_png(image: &RgbaImage) -> Result<Vec<u8>, RenderError> {
+    encode(image, image::ExtendedColorType::Rgba8)
+}
+
+fn encode<P: image::Pixel<Subpixel = u8>>(
+    image: &image::ImageBuffer<P, Vec<u8>>,
+    color: image::ExtendedColorType,
+) -> Result<Vec<u8>, RenderError> {
     use image::ImageEncoder;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes).write_image(
         image.as_raw(),
         image.width(),
         image.height(),
-        image::ExtendedColorType::Rgb8,
+        color,
     )?;
     Ok(bytes)
 }
@@ -300,6 +318,24 @@ pub fn write_png(path: &Path, image: &RgbImage) -> Result<(), RenderError> {
         source,
     })
 }
+
+/// What [`Renderer::cut_out`] frames: a rectangle across the view, metres along the view's
+/// right and up axes (for the front view, x and y; for the side view, −z and y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Least coordinate along the view's right axis.
+    pub left: f32,
+    /// Greatest coordinate along the view's right axis.
+    pub right: f32,
+    /// Least coordinate along the view's up axis.
+    pub bottom: f32,
+    /// Greatest coordinate along the view's up axis.
+    pub top: f32,
+}
+
+/// Eye distance of [`Renderer::cut_out`], in bounding radii: the nearest and farthest points
+/// of the scene differ in scale by about 1.3%.
+const CUT_OUT_DISTANCE: f32 = 150.0;
 
 /// A vertex after placement and projection.
 #[derive(Clone, Copy, Debug, Default)]
@@ -420,6 +456,111 @@ impl Renderer {
         Ok(self.resolve(options.width, options.height, ss))
     }
 
+    /// A picture of `scene` seen from `view` whose edges are exactly `frame`, on a clear
+    /// background (alpha is the share of each pixel's samples drawn), through a camera so
+    /// far away that the view is all but orthographic: what an impostor card shows. No
+    /// ground; the plant shadows itself; `supersample` as [`RenderOptions::supersample`].
+    pub fn cut_out(
+        &mut self,
+        scene: &Scene,
+        view: View,
+        frame: Frame,
+        (width, height): (u32, u32),
+        supersample: u32,
+    ) -> Result<RgbaImage, RenderError> {
+        let options = RenderOptions {
+            width,
+            height,
+            view,
+            supersample,
+            ..RenderOptions::default()
+        };
+        options.validate()?;
+        let ss = options.effective_supersample();
+        let (sw, sh) = (width * ss, height * ss);
+        let (w, h) = (sw as usize, sh as usize);
+        self.color.clear();
+        self.color.resize(w * h, 0);
+        self.depth.clear();
+        self.depth.resize(w * h, 0.0);
+        let plants = scene_bounds(scene);
+        if !plants.is_empty() {
+            let centre = plants.center();
+            let radius = (0.5 * plants.size().length()).max(1e-6);
+            let camera = Camera::looking_from(view, centre, radius, CUT_OUT_DISTANCE);
+            // The frame's corners in the plane through the scene's centre.
+            let depth = camera.forward * camera.forward.dot(centre);
+            let mut fit = camera::Fit::default();
+            for (u, v) in [
+                (frame.left, frame.bottom),
+                (frame.right, frame.bottom),
+                (frame.left, frame.top),
+                (frame.right, frame.top),
+            ] {
+                fit.add(camera.view_xy(camera.right * u + camera.up * v + depth));
+            }
+            let camera = camera.framed(&fit, sw, sh, 0.0);
+            let lights = Lights::for_camera(&camera);
+            let shadow_size = (sw.max(sh) as usize * 3 / 4).clamp(256, 2048);
+            self.shadow.reset(lights.key, centre, radius, shadow_size);
+            for node in &scene.nodes {
+                self.draw_shadow(node);
+            }
+            for node in &scene.nodes {
+                self.draw_node(node, &camera, &lights, w, h);
+            }
+        }
+        Ok(self.resolve_clear(width, height, ss))
+    }
+
+    /// Box-filters the samples down to a picture with alpha: each pixel's colour the mean of
+    /// its drawn samples (in linear light), its alpha their share; clear pixels take the
+    /// mean colour of the drawn ones, so filtering never darkens an edge.
+    fn resolve_clear(&self, width: u32, height: u32, ss: u32) -> RgbaImage {
+        let (w, ss) = (width as usize, ss as usize);
+        let sw = w * ss;
+        let srgb = shade::to_srgb_table();
+        let linear = shade::to_linear_table();
+        let colour = |c: u32| {
+            Vec3::new(
+                linear[(c & 0xff) as usize],
+                linear[(c >> 8 & 0xff) as usize],
+                linear[(c >> 16 & 0xff) as usize],
+            )
+        };
+        let (mut total, mut drawn) = (Vec3::ZERO, 0usize);
+        for (c, d) in self.color.iter().zip(&self.depth) {
+            if *d > 0.0 {
+                total += colour(*c);
+                drawn += 1;
+            }
+        }
+        let fill = if drawn > 0 {
+            total / drawn as f32
+        } else {
+            Vec3::ONE
+        };
+        let mut img = RgbaImage::new(width, height);
+        for (k, px) in img.chunks_exact_mut(4).enumerate() {
+            let (x, y) = (k % w, k / w);
+            let (mut sum, mut n) = (Vec3::ZERO, 0usize);
+            for sy in 0..ss {
+                let row = (y * ss + sy) * sw + x * ss;
+                for i in row..row + ss {
+                    if self.depth[i] > 0.0 {
+                        sum += colour(self.color[i]);
+                        n += 1;
+                    }
+                }
+            }
+            let c = if n > 0 { sum / n as f32 } else { fill };
+            let c = shade::pack(srgb, c);
+            let alpha = (255 * n / (ss * ss)) as u8;
+            px.copy_from_slice(&[c as u8, (c >> 8) as u8, (c >> 16) as u8, alpha]);
+        }
+        img
+    }
+
     /// Draws a node's depth into the shadow map. Only faces turned to the light are drawn:
     /// meshes are closed or double-sided (see [`sylva_mesh::mesh`]), so they are enough;
     /// but cut-out cards, one-sided, are drawn from both sides and cast only their shapes.
@@ -449,7 +590,11 @@ impl Renderer {
         }));
         let size = shadow.size;
         for prim in &node.mesh.primitives {
-            let cut = cut_out(node.mesh.materials.get(prim.material)).map(|p| textures.get(p));
+            let cut = texture_of(
+                textures,
+                node.mesh,
+                cut_out(node.mesh.materials.get(prim.material)),
+            );
             let cull = if cut.is_some() {
                 Cull::None
             } else {
@@ -592,7 +737,9 @@ impl Renderer {
             let material = mesh.materials.get(prim.material);
             let albedo = material.map_or(Vec3::splat(0.5), |m| shade::albedo(m.color));
             let cut = cut_out(material).is_some();
-            let texture = material.and_then(Picture::base_of).map(|p| textures.get(p));
+            // An impostor's picture was lit when it was made: it shows as it is.
+            let unlit = material.and_then(|m| m.surface) == Some(Surface::Impostor);
+            let texture = texture_of(textures, mesh, material.and_then(Picture::base_of));
             let cull = if cut { Cull::None } else { Cull::Back };
             for t in prim.indices.chunks_exact(3) {
                 let Some([a, b, c]) = triangle(verts, t) else {
@@ -641,10 +788,14 @@ impl Renderer {
                             if cut && tex.alpha(lod, uv.x, uv.y) < ALPHA_CUTOFF {
                                 return;
                             }
-                            albedo * tex.sample(lod, uv.x, uv.y)
+                            albedo * tex.sample_color(lod, uv.x, uv.y)
                         }
                     };
                     depth[i] = iz;
+                    if unlit {
+                        color[i] = shade::pack(srgb, albedo);
+                        return;
+                    }
                     let n = (na * l0 + nb * l1 + nc * l2).normalize_or(face);
                     let shade = if cut {
                         // Leaves and petals are lit through from behind as well.
@@ -705,12 +856,26 @@ impl Renderer {
 /// The alpha below which a cut-out shows nothing (as the GLB writer's `alphaCutoff`).
 const ALPHA_CUTOFF: f32 = 0.5;
 
-/// The picture a material cuts its shape out of, if it is a cut-out (leaves, petals).
+/// The picture a material cuts its shape out of, if it is a cut-out (leaves, petals,
+/// impostors).
 fn cut_out(material: Option<&sylva_core::Material>) -> Option<Picture> {
     let m = material?;
     m.surface
         .filter(|s| s.is_cut_out())
         .and(Picture::base_of(m))
+}
+
+/// The texture of a primitive's material in `mesh`, made the first time (an impostor's
+/// from the mesh's own picture; `None` when it has none).
+fn texture_of<'t>(
+    textures: &'t mut TextureCache,
+    mesh: &sylva_mesh::Mesh,
+    picture: Option<Picture>,
+) -> Option<&'t texel::MipTexture> {
+    match picture? {
+        Picture::Impostor => Some(textures.impostor(mesh.impostor.as_ref()?)),
+        p => Some(textures.get(p)),
+    }
 }
 
 /// The three vertices of a triangle, if its indices are in range and all are drawable.

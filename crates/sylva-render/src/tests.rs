@@ -771,3 +771,85 @@ fn cut_out_cards_show_their_shape_from_both_sides_and_cast_it() {
     .unwrap();
     assert_ne!(with, without, "the card casts a shadow");
 }
+
+/// A cut-out's edges are its frame: a red square filling the left half of the frame fills
+/// the left half of the picture, opaque, and leaves the right half clear.
+#[test]
+fn cut_outs_are_framed_exactly_on_a_clear_background() {
+    let mut mesh = empty(RED);
+    add_quad(
+        &mut mesh,
+        0,
+        Vec3::new(0.5, 1.0, 0.0),
+        Vec3::X * 0.5,
+        Vec3::Y * 1.0,
+    );
+    let frame = Frame {
+        left: 0.0,
+        right: 2.0,
+        bottom: 0.0,
+        top: 2.0,
+    };
+    let picture = Renderer::new()
+        .cut_out(&scene(&mesh), View::Front, frame, (64, 64), 2)
+        .unwrap();
+    for (x, _, p) in picture.enumerate_pixels() {
+        match x {
+            0..=30 => assert!(
+                p.0[3] == 255 && reddish([p.0[0], p.0[1], p.0[2]]),
+                "{x}: {p:?}"
+            ),
+            33.. => assert_eq!(p.0[3], 0, "{x}"),
+            _ => {}
+        }
+    }
+}
+
+/// An impostor's crossed cards, seen from the front and the side, show the markers where
+/// the plant has them, for a plant wider than tall (views one above the other in the
+/// picture) and one taller than wide (side by side); the cards hold the plant.
+#[test]
+fn impostor_cards_show_the_plant_as_it_stands() {
+    for tall in [false, true] {
+        let mut plant = markers();
+        if tall {
+            add_box(&mut plant, 0, Vec3::Y * 3.0, Vec3::new(0.3, 2.0, 0.3));
+        }
+        let cards = impostor::impostor(&scene(&plant)).unwrap().unwrap();
+        assert_eq!((cards.positions.len(), cards.triangle_count()), (8, 4));
+        let (p, c) = (scene(&plant).bounds(), scene(&cards).bounds());
+        assert!(
+            c.min.cmple(p.min).all() && c.max.cmpge(p.max).all(),
+            "{c:?} holds {p:?}"
+        );
+        assert_eq!(c.min.y, p.min.y, "the cards stand where the plant does");
+        let (u, v) = cards.uvs[..4]
+            .iter()
+            .fold((0f32, 0f32), |(u, v), t| (u.max(t[0]), v.max(t[1])));
+        assert_eq!((u, v), if tall { (0.5, 1.0) } else { (1.0, 0.5) });
+
+        let png = cards.impostor.as_deref().unwrap();
+        let picture = image::load_from_memory(png).unwrap().to_rgba8();
+        assert_eq!(picture.dimensions(), (512, 512));
+        let clear = picture.pixels().filter(|p| p.0[3] == 0).count();
+        assert!(clear > 512 * 512 / 2 && clear < 512 * 512, "{clear} clear");
+
+        for view in [View::Front, View::Side] {
+            let opts = plain(view);
+            let seen = render(&scene(&cards), &opts).unwrap();
+            let red = coverage(&seen, opts.background, reddish);
+            let green = coverage(&seen, opts.background, greenish);
+            assert!(red.count > 20 && green.count > 20, "{view}, tall {tall}");
+            match view {
+                View::Front => assert!(red.mean.0 > 55.0, "+X on the right"),
+                _ => assert!(green.mean.0 + 10.0 < red.mean.0, "+Z on the left"),
+            }
+        }
+        let again = impostor::impostor(&scene(&plant)).unwrap().unwrap();
+        assert_eq!(
+            again.impostor, cards.impostor,
+            "the same picture, byte for byte"
+        );
+    }
+    assert!(impostor::impostor(&scene(&empty(RED))).unwrap().is_none());
+}

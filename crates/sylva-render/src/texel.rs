@@ -16,6 +16,7 @@
 //! ```
 
 use std::collections::HashMap;
+use sylva_core::glam::Vec3;
 use sylva_mesh::picture::Picture;
 
 use super::shade::{floor_i64, to_linear_table};
@@ -27,6 +28,8 @@ struct Level {
     size: usize,
     texels: Vec<f32>,
     alpha: Vec<f32>,
+    /// Linear colour per texel, for colour pictures (an impostor's); empty for grey ones.
+    color: Vec<Vec3>,
 }
 
 /// A texture ready to sample.
@@ -38,14 +41,26 @@ pub(crate) struct MipTexture {
     repeat_v: bool,
 }
 
+/// What a texel holds: a grey level or a colour, averaged and blended alike.
+pub(crate) trait Texel:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<f32, Output = Self>
+{
+}
+
+impl Texel for f32 {}
+impl Texel for Vec3 {}
+
 /// Half of each 2 × 2 block's mean: the next level down.
-fn halve(texels: &[f32], size: usize) -> Vec<f32> {
+fn halve<T: Texel>(texels: &[T], size: usize) -> Vec<T> {
     let half = size / 2;
     let at = |x: usize, y: usize| texels[y * size + x];
     (0..half * half)
         .map(|k| {
             let (x, y) = (2 * (k % half), 2 * (k / half));
-            0.25 * (at(x, y) + at(x + 1, y) + at(x, y + 1) + at(x + 1, y + 1))
+            (at(x, y) + at(x + 1, y) + at(x, y + 1) + at(x + 1, y + 1)) * 0.25
         })
         .collect()
 }
@@ -95,12 +110,66 @@ impl MipTexture {
                 .unzip(),
             _ => (vec![1.0; size * size], Vec::new()),
         };
-        let target = coverage(&alpha, 1.0);
-        let mut levels = vec![Level {
-            size,
-            texels,
-            alpha,
-        }];
+        MipTexture::of_levels(
+            Level {
+                size,
+                texels,
+                alpha,
+                color: Vec::new(),
+            },
+            picture.repeats_u(),
+            picture.repeats_v(),
+        )
+    }
+
+    /// A colour picture with alpha (an impostor's, decoded from its PNG), clamped both ways;
+    /// a picture that does not decode, or is not square of a power of two, reads as clear.
+    pub(crate) fn of_png(png: &[u8]) -> MipTexture {
+        let linear = to_linear_table();
+        let image = image::load_from_memory_with_format(png, image::ImageFormat::Png)
+            .map(|i| i.to_rgba8())
+            .ok()
+            .filter(|i| i.width() == i.height() && i.width().is_power_of_two());
+        let Some(image) = image else {
+            return MipTexture::of_levels(
+                Level {
+                    size: 1,
+                    texels: vec![1.0],
+                    alpha: vec![0.0],
+                    color: vec![Vec3::ONE],
+                },
+                false,
+                false,
+            );
+        };
+        let size = image.width() as usize;
+        let mut color = Vec::with_capacity(size * size);
+        let mut alpha = Vec::with_capacity(size * size);
+        for p in image.pixels() {
+            let [r, g, b, a] = p.0;
+            color.push(Vec3::new(
+                linear[r as usize],
+                linear[g as usize],
+                linear[b as usize],
+            ));
+            alpha.push(f32::from(a) / 255.0);
+        }
+        MipTexture::of_levels(
+            Level {
+                size,
+                texels: vec![1.0; size * size],
+                alpha,
+                color,
+            },
+            false,
+            false,
+        )
+    }
+
+    /// The mip chain down from `first`, keeping its alpha's coverage level by level.
+    fn of_levels(first: Level, repeat_u: bool, repeat_v: bool) -> MipTexture {
+        let target = coverage(&first.alpha, 1.0);
+        let mut levels = vec![first];
         while let Some(last) = levels.last().filter(|l| l.size > 1) {
             let texels = halve(&last.texels, last.size);
             let mut alpha = if last.alpha.is_empty() {
@@ -109,16 +178,22 @@ impl MipTexture {
                 halve(&last.alpha, last.size)
             };
             keep_coverage(&mut alpha, target);
+            let color = if last.color.is_empty() {
+                Vec::new()
+            } else {
+                halve(&last.color, last.size)
+            };
             levels.push(Level {
                 size: last.size / 2,
                 texels,
                 alpha,
+                color,
             });
         }
         MipTexture {
             levels,
-            repeat_u: picture.repeats_u(),
-            repeat_v: picture.repeats_v(),
+            repeat_u,
+            repeat_v,
         }
     }
 
@@ -145,6 +220,15 @@ impl MipTexture {
         self.trilinear(lod, u, v, |l| &l.texels)
     }
 
+    /// The linear colour at `(u, v)`: a colour picture's colour, a grey one's grey.
+    #[inline]
+    pub(crate) fn sample_color(&self, lod: f32, u: f32, v: f32) -> Vec3 {
+        if self.levels[0].color.is_empty() {
+            return Vec3::splat(self.sample(lod, u, v));
+        }
+        self.trilinear(lod, u, v, |l| &l.color)
+    }
+
     /// The coverage at `(u, v)` (1 for a picture without alpha), as [`MipTexture::sample`].
     #[inline]
     pub(crate) fn alpha(&self, lod: f32, u: f32, v: f32) -> f32 {
@@ -155,7 +239,7 @@ impl MipTexture {
     }
 
     #[inline]
-    fn trilinear(&self, lod: f32, u: f32, v: f32, channel: impl Fn(&Level) -> &[f32]) -> f32 {
+    fn trilinear<T: Texel>(&self, lod: f32, u: f32, v: f32, channel: impl Fn(&Level) -> &[T]) -> T {
         let level = lod as usize;
         let t = lod - level as f32;
         let fine = self.bilinear(level, u, v, &channel);
@@ -167,7 +251,13 @@ impl MipTexture {
     }
 
     #[inline]
-    fn bilinear(&self, level: usize, u: f32, v: f32, channel: impl Fn(&Level) -> &[f32]) -> f32 {
+    fn bilinear<T: Texel>(
+        &self,
+        level: usize,
+        u: f32,
+        v: f32,
+        channel: impl Fn(&Level) -> &[T],
+    ) -> T {
         let l = &self.levels[level];
         let texels = channel(l);
         let n = l.size as i64;
@@ -193,10 +283,11 @@ impl MipTexture {
     }
 }
 
-/// Mip chains by picture, made on first use.
+/// Mip chains by picture, made on first use, and impostors' by their pictures' hashes.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TextureCache {
     textures: HashMap<Picture, MipTexture>,
+    impostors: HashMap<u64, MipTexture>,
 }
 
 impl TextureCache {
@@ -205,6 +296,18 @@ impl TextureCache {
         self.textures
             .entry(picture)
             .or_insert_with(|| MipTexture::new(picture))
+    }
+
+    /// The texture of an impostor's picture (a PNG), made the first time it is seen; the
+    /// few most recent are kept.
+    pub(crate) fn impostor(&mut self, png: &[u8]) -> &MipTexture {
+        let key = sylva_core::hash::stable_hash(png);
+        if !self.impostors.contains_key(&key) && self.impostors.len() >= 16 {
+            self.impostors.clear();
+        }
+        self.impostors
+            .entry(key)
+            .or_insert_with(|| MipTexture::of_png(png))
     }
 
     /// Pictures held.

@@ -50,6 +50,7 @@ fn quad(id: u16) -> Mesh {
             indices: vec![0, 1, 2, 0, 2, 3],
         }],
         materials: vec![material_for(id)],
+        impostor: None,
     }
 }
 

@@ -1,7 +1,8 @@
 //! What dressing costs: the oak preset (`examples/species/oak.toml`: an L-system oak, 17 m,
 //! oak leaves at real size, furrowed bark) grown and meshed in leaf, against the same plant
 //! at the same height grown and meshed bare, and the dress alone. The bar: in leaf
-//! within twice the bare plant.
+//! within twice the bare plant. And the impostor of the oak in leaf (the last level of its
+//! chain of detail): its two pictures drawn and its cards made.
 //!
 //! Run with `cargo bench -p sylva --bench dress`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -45,6 +46,10 @@ fn dress(c: &mut Criterion) {
     let (_, undressed) = Grown::plant(&preset.genome, &bare).unwrap();
     group.bench_function("the dress alone", |b| {
         b.iter(|| black_box(sylva::core::dress::dress(&undressed, &dressed.dress, 0).unwrap()))
+    });
+    let scene = grown.scene();
+    group.bench_function("the impostor of the oak in leaf", |b| {
+        b.iter(|| black_box(sylva::render::impostor::impostor(&scene).unwrap()))
     });
     group.finish();
 }

@@ -1,8 +1,13 @@
-//! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_gltf::lod`]),
-//! each alone in its own scene, or all of them as sibling nodes named `NAME_LOD0`,
-//! `NAME_LOD1`, … (the Unity naming convention) with each level's screen coverage in its
-//! node's extras. And a [`Preview`]: the one level a view of a given size needs, meshed
-//! without meshing the plant in full.
+//! A grown plant's levels of detail as assets: one mesh per level (see [`sylva_gltf::lod`])
+//! and, last, an impostor (crossed cards showing the plant's picture, see
+//! [`sylva_render::impostor`]) for trees far away; each alone in its own scene, or all of
+//! them as sibling nodes named `NAME_LOD0`, `NAME_LOD1`, … (the Unity naming convention)
+//! with each level's screen coverage in its node's extras. The last mesh level hands over to
+//! the impostor at [`IMPOSTOR_COVERAGE`] of the screen's height (or half the coverage of the
+//! level before, when that is less), and the impostor is drawn down to 1%.
+//!
+//! And a [`Preview`]: the one level a view of a given size needs, meshed without meshing
+//! the plant in full.
 
 use serde_json::json;
 use sylva_gltf::lod::{LodError, LodLevel, lod_levels};
@@ -15,6 +20,10 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 use sylva_core::Plant;
 
+/// The screen coverage (plant height over screen height) below which the impostor stands
+/// for the plant: 108 pixels of a 1080-pixel screen, a fifth of the picture's cells.
+pub const IMPOSTOR_COVERAGE: f32 = 0.1;
+
 /// One level, meshed.
 pub struct LodAsset {
     /// The level's plant, options, detail, triangles and screen coverage.
@@ -25,18 +34,28 @@ pub struct LodAsset {
     pub rig: Option<Rig>,
 }
 
+/// The chain's last level: crossed cards showing the plant's picture.
+pub struct Impostor {
+    /// The cards, their picture in [`Mesh::impostor`].
+    pub mesh: Mesh,
+    /// The smallest screen coverage it is drawn at (it is culled below).
+    pub screen_coverage: f32,
+}
+
 /// A grown plant's chain of levels of detail.
 pub struct LodAssets {
-    /// Level 0 (the plant as grown) first.
+    /// The meshed levels, level 0 (the plant as grown) first.
     pub levels: Vec<LodAsset>,
+    /// The impostor after them (none for a plant with nothing to draw).
+    pub impostor: Option<Impostor>,
     /// The extras every level's node carries (genome, seed, taper, wind), before its own.
     extras: serde_json::Value,
 }
 
 impl LodAssets {
-    /// The chain of `options.lod` levels of `grown` (level 0 is its own mesh and rig; one
-    /// level when `lod` is none), each further level rigged for `options.wind` when `grown`
-    /// has wind. `options` are those `grown` grew with.
+    /// The chain of `options.lod` meshed levels of `grown` (level 0 is its own mesh and
+    /// rig; one level when `lod` is none), each further level rigged for `options.wind` when
+    /// `grown` has wind, then the impostor. `options` are those `grown` grew with.
     pub fn new(grown: Grown, options: &GrowOptions) -> Result<Self, Error> {
         let (levels, wind) = (options.lod.unwrap_or(1), options.wind.as_ref());
         let options = mesh_options_for(grown.genome.mesh_hint(), &grown.dress.0);
@@ -74,23 +93,83 @@ impl LodAssets {
                 Ok(LodAsset { level, mesh, rig })
             })
             .collect::<Result<Vec<_>, Error>>()?;
-        Ok(LodAssets { levels, extras })
+        LodAssets::ending_in_impostor(levels, extras)
+    }
+
+    /// `levels` followed by the impostor of level 0, the last level's coverage moved to
+    /// where the impostor takes over.
+    fn ending_in_impostor(
+        mut levels: Vec<LodAsset>,
+        extras: serde_json::Value,
+    ) -> Result<Self, Error> {
+        let scene = Scene::single(SceneNode::new("plant", &levels[0].mesh));
+        let impostor = sylva_render::impostor::impostor(&scene)?;
+        if impostor.is_some() {
+            let n = levels.len();
+            let before = match n {
+                1 => f32::INFINITY,
+                _ => levels[n - 2].level.screen_coverage,
+            };
+            levels[n - 1].level.screen_coverage = IMPOSTOR_COVERAGE.min(0.5 * before);
+        }
+        let impostor = impostor.map(|mesh| Impostor {
+            mesh,
+            screen_coverage: sylva_gltf::lod::CULL_COVERAGE,
+        });
+        Ok(LodAssets {
+            levels,
+            impostor,
+            extras,
+        })
+    }
+
+    /// Levels in the chain: the meshed ones and the impostor.
+    pub fn len(&self) -> usize {
+        self.levels.len() + usize::from(self.impostor.is_some())
+    }
+
+    /// Whether the chain has no levels (never: level 0 is always there).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Level `k`'s mesh: a meshed level's, or the impostor's after them.
+    ///
+    /// # Panics
+    ///
+    /// When `k` is not below [`LodAssets::len`].
+    pub fn mesh(&self, k: usize) -> &Mesh {
+        match (self.levels.get(k), &self.impostor) {
+            (Some(level), _) => &level.mesh,
+            (None, Some(impostor)) => &impostor.mesh,
+            (None, None) => panic!("level {k} of a chain of {}", self.len()),
+        }
     }
 
     /// The node of level `k`, named `NAME_LODk`.
     fn node(&self, k: usize, name: &str) -> SceneNode<'_> {
-        let asset = &self.levels[k];
-        let mut node = SceneNode::new(format!("{name}_LOD{k}"), &asset.mesh);
+        let mesh = self.mesh(k);
+        let mut node = SceneNode::new(format!("{name}_LOD{k}"), mesh);
         let mut extras = self.extras.clone();
-        extras["lod"] = json!({
+        let mut lod = json!({
             "level": k,
-            "levels": self.levels.len(),
-            "screen_coverage": asset.level.screen_coverage,
-            "triangles": asset.mesh.triangle_count(),
-            "detail": asset.level.detail,
+            "levels": self.len(),
+            "triangles": mesh.triangle_count(),
         });
+        match (self.levels.get(k), &self.impostor) {
+            (Some(asset), _) => {
+                lod["screen_coverage"] = json!(asset.level.screen_coverage);
+                lod["detail"] = json!(asset.level.detail);
+                node.rig = asset.rig.as_ref();
+            }
+            (None, Some(impostor)) => {
+                lod["screen_coverage"] = json!(impostor.screen_coverage);
+                lod["impostor"] = json!(true);
+            }
+            (None, None) => {}
+        }
+        extras["lod"] = lod;
         node.extras = Some(extras);
-        node.rig = asset.rig.as_ref();
         node
     }
 
@@ -99,10 +178,10 @@ impl LodAssets {
         Scene::single(self.node(k, name))
     }
 
-    /// Every level as sibling nodes at the origin, `NAME_LOD0` first.
+    /// Every level as sibling nodes at the origin, `NAME_LOD0` first, the impostor last.
     pub fn group_scene(&self, name: &str) -> Scene<'_> {
         Scene {
-            nodes: (0..self.levels.len()).map(|k| self.node(k, name)).collect(),
+            nodes: (0..self.len()).map(|k| self.node(k, name)).collect(),
         }
     }
 }

@@ -36,8 +36,9 @@ pub struct GrowArgs {
     #[arg(long)]
     hide_roots: bool,
     /// Levels of detail, 2 to 8 (GLB only): writes NAME_LOD0.glb … beside the output, each
-    /// at about half the triangles of the one before, and the output as one scene with
-    /// every level as a sibling node (NAME_LOD0, …) carrying its screen coverage.
+    /// at about half the triangles of the one before, then NAME_LOD{N}.glb, an impostor
+    /// (crossed cards showing the plant's picture), and the output as one scene with every
+    /// level as a sibling node (NAME_LOD0, …) carrying its screen coverage.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=8))]
     lod: Option<u32>,
     /// Scale the plant so that its highest point stands this many metres above the
@@ -180,7 +181,7 @@ fn lod(args: &GrowArgs, grown: Grown, options: &GrowOptions) -> anyhow::Result<(
         .map_or("plant".into(), |s| s.to_string_lossy().into_owned());
     let mut out = Outputs::new();
     let mut files = Vec::new();
-    for k in 0..chain.levels.len() {
+    for k in 0..chain.len() {
         let path = args.output.with_file_name(format!("{name}_LOD{k}.glb"));
         out.add_scene_with(&path, &chain.level_scene(k, &name), glb)
             .in_file(&args.genome)?;
@@ -196,18 +197,29 @@ fn lod(args: &GrowArgs, grown: Grown, options: &GrowOptions) -> anyhow::Result<(
     }
     out.commit()?;
     println!(
-        "wrote {} ({} levels of detail as sibling nodes): {segments} segments, {organs} organs",
+        "wrote {} ({} levels of detail as sibling nodes, the last an impostor): {segments} \
+         segments, {organs} organs",
         args.output.display(),
-        chain.levels.len()
+        chain.len()
     );
     let full = chain.levels[0].mesh.triangle_count().max(1) as f64;
-    for (asset, path) in chain.levels.iter().zip(&files) {
-        let triangles = asset.mesh.triangle_count();
+    for (k, path) in files.iter().enumerate() {
+        let triangles = chain.mesh(k).triangle_count();
+        let (coverage, note) = match (chain.levels.get(k), &chain.impostor) {
+            (Some(asset), _) => (asset.level.screen_coverage, String::new()),
+            (None, Some(impostor)) => {
+                let bytes = impostor.mesh.impostor.as_ref().map_or(0, |png| png.len());
+                let note = format!(": crossed cards, a {} kB picture", bytes.div_ceil(1000));
+                (impostor.screen_coverage, note)
+            }
+            (None, None) => continue,
+        };
         println!(
-            "  {}: {triangles} triangles ({:.1}% of LOD0), drawn down to {:.1}% of the screen's height",
+            "  {}: {triangles} triangles ({:.1}% of LOD0{note}), drawn down to {:.1}% of the \
+             screen's height",
             path.display(),
             100.0 * triangles as f64 / full,
-            100.0 * asset.level.screen_coverage
+            100.0 * coverage
         );
     }
     Ok(())

@@ -149,12 +149,17 @@ fn lod_strip(
     (width, height): (u32, u32),
 ) -> anyhow::Result<Vec<u8>> {
     use sylva::render::{self, SheetCell, SheetOptions};
-    let cells: Vec<SheetCell> = (0..chain.levels.len())
+    let cells: Vec<SheetCell> = (0..chain.len())
         .map(|k| SheetCell {
             scene: chain.level_scene(k, "plant"),
             caption: format!(
-                "LOD{k}  {} triangles",
-                chain.levels[k].mesh.triangle_count()
+                "LOD{k}  {} triangles{}",
+                chain.mesh(k).triangle_count(),
+                if k < chain.levels.len() {
+                    ""
+                } else {
+                    " (impostor)"
+                }
             ),
         })
         .collect();

@@ -52,6 +52,10 @@
 //!   Meshes with a rig are not quantised (the dequantisation would have to move into the
 //!   inverse bind matrices).
 //!
+//! An impostor's material (a card showing a picture of its plant, the last level of detail)
+//! is marked `KHR_materials_unlit` (not required): its picture was lit when it was made. Its
+//! picture is the mesh's own ([`Mesh::impostor`]), embedded once per distinct picture.
+//!
 //! [`to_glb`] and [`to_glb_with`] build the file in memory in one pass. [`Glb`] streams it:
 //! a first pass over the meshes computes the JSON (offsets, bounds) and the binary chunk's
 //! length without keeping any data, then [`Glb::write_to`] writes the header, the JSON and the
@@ -64,6 +68,7 @@ use std::io::{self, BufWriter, Write};
 
 use serde_json::{Map, Value, json};
 use sylva_core::glam::{Quat, Vec3};
+use sylva_core::species::Surface;
 use sylva_mesh::mesh::Mesh;
 use sylva_mesh::picture::Picture;
 use sylva_mesh::scene::Scene;
@@ -91,6 +96,8 @@ const CLAMP_TO_EDGE: u32 = 33071;
 pub const EXT_MESH_GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
 /// The quantisation extension's name.
 pub const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+/// The extension marking a material unlit: an impostor's, whose picture was lit already.
+pub const KHR_MATERIALS_UNLIT: &str = "KHR_materials_unlit";
 /// Where a material's extras carry its [`Surface`], for [`crate::import`] to read back.
 pub(crate) const SURFACE_EXTRA: &str = "sylva_surface";
 /// The alpha below which a cut-out card (leaf or petal) shows nothing.
@@ -659,6 +666,9 @@ fn encode<S: Sink>(
     if instanced > 0 {
         used.push(EXT_MESH_GPU_INSTANCING);
     }
+    if w.unlit {
+        used.push(KHR_MATERIALS_UNLIT);
+    }
     if w.quantized {
         used.push(KHR_MESH_QUANTIZATION);
         root.insert("extensionsRequired".into(), json!([KHR_MESH_QUANTIZATION]));
@@ -815,6 +825,8 @@ struct Writer<S> {
     quantize: bool,
     /// A mesh was quantised, so the file uses (and requires) the extension.
     quantized: bool,
+    /// Some material is unlit (`KHR_materials_unlit`: an impostor's, whose picture was lit).
+    unlit: bool,
     views: Vec<Value>,
     accessors: Vec<Value>,
     meshes: Vec<Value>,
@@ -824,9 +836,12 @@ struct Writer<S> {
     samplers: Vec<Value>,
     /// (name, colour bits, texture, surface) to material index, to write identical
     /// materials once.
-    material_of: HashMap<MaterialKey, usize>,
+    material_of: HashMap<(MaterialKey, u64), usize>,
     /// Picture to glTF texture index, to embed each picture once.
-    texture_of: HashMap<Picture, usize>,
+    texture_of: HashMap<(Picture, u64), usize>,
+    /// The picture of the mesh being written, when it is an impostor's, and its hash (which
+    /// tells its materials and texture from another impostor's).
+    impostor: Option<(std::sync::Arc<Vec<u8>>, u64)>,
     /// The sampler of each wrapping, once written: index `2·(clamps u) + (clamps v)`.
     sampler_of: [Option<usize>; 4],
 }
@@ -837,6 +852,7 @@ impl<S: Sink> Writer<S> {
             bin,
             quantize,
             quantized: false,
+            unlit: false,
             views: Vec::new(),
             accessors: Vec::new(),
             meshes: Vec::new(),
@@ -846,6 +862,7 @@ impl<S: Sink> Writer<S> {
             samplers: Vec::new(),
             material_of: HashMap::new(),
             texture_of: HashMap::new(),
+            impostor: None,
             sampler_of: [None; 4],
         }
     }
@@ -854,6 +871,10 @@ impl<S: Sink> Writer<S> {
     /// dequantisation when it was quantised.
     fn mesh(&mut self, mesh: &Mesh, name: &str, rig: Option<&Rig>) -> Result<Written, ExportError> {
         let triangles = mesh.triangle_count() as u64;
+        self.impostor = mesh
+            .impostor
+            .as_ref()
+            .map(|png| (png.clone(), sylva_core::hash::stable_hash(png)));
         if mesh.primitives.iter().all(|p| p.indices.is_empty()) {
             return Ok(Written {
                 index: None,
@@ -1215,13 +1236,18 @@ impl<S: Sink> Writer<S> {
 
     /// The glTF texture showing `picture`, embedding its PNG the first time.
     fn texture(&mut self, picture: Picture) -> Result<usize, ExportError> {
-        if let Some(&t) = self.texture_of.get(&picture) {
+        let key = (picture, self.impostor_hash(picture));
+        if let Some(&t) = self.texture_of.get(&key) {
             return Ok(t);
         }
-        let png = picture.png().map_err(|source| ExportError::Png {
-            picture: picture.name(),
-            source,
-        })?;
+        let png = match (picture, &self.impostor) {
+            (Picture::Impostor, Some((png, _))) => png.clone(),
+            // (`check_mesh` refuses an impostor without a picture: it would be clear.)
+            _ => picture.png().map_err(|source| ExportError::Png {
+                picture: picture.name(),
+                source,
+            })?,
+        };
         let start = self.bin.len();
         self.bin.put(&png);
         let view = self.untargeted_view(start);
@@ -1256,7 +1282,7 @@ impl<S: Sink> Writer<S> {
             "sampler": sampler,
             "source": self.images.len() - 1,
         }));
-        self.texture_of.insert(picture, self.textures.len() - 1);
+        self.texture_of.insert(key, self.textures.len() - 1);
         Ok(self.textures.len() - 1)
     }
 
@@ -1265,8 +1291,17 @@ impl<S: Sink> Writer<S> {
         self.accessors.len() - 1
     }
 
+    /// The hash of the impostor picture `picture` stands for, 0 for any other picture.
+    fn impostor_hash(&self, picture: Picture) -> u64 {
+        match (picture, &self.impostor) {
+            (Picture::Impostor, Some((_, hash))) => *hash,
+            _ => 0,
+        }
+    }
+
     fn material(&mut self, m: &sylva_core::Material) -> Result<usize, ExportError> {
-        let key = material_key(m);
+        let shown = Picture::base_of(m).map_or(0, |p| self.impostor_hash(p));
+        let key = (material_key(m), shown);
         if let Some(&i) = self.material_of.get(&key) {
             return Ok(i);
         }
@@ -1291,6 +1326,10 @@ impl<S: Sink> Writer<S> {
                 material["alphaMode"] = json!("MASK");
                 material["alphaCutoff"] = json!(ALPHA_CUTOFF);
                 material["doubleSided"] = json!(true);
+            }
+            if surface == Surface::Impostor {
+                material["extensions"] = json!({ KHR_MATERIALS_UNLIT: {} });
+                self.unlit = true;
             }
             material["extras"] = json!({ SURFACE_EXTRA: surface });
         }

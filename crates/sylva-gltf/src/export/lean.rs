@@ -27,6 +27,7 @@ fn surface_name(kind: MaterialKind, surface: Surface, texture: Option<u16>) -> S
         Surface::Branchlets(k) => return format!("{}-{}-branchlets", kind.name(), k.name()),
         Surface::Bark(k) => k.name(),
         Surface::Petals => "petals",
+        Surface::Impostor => "impostor",
     };
     match texture {
         Some(t) if surface == Surface::Petals => format!("{}-{what}-t{t}", kind.name()),
@@ -182,6 +183,7 @@ mod tests {
                 })
                 .collect(),
             materials,
+            impostor: None,
         }
     }
 

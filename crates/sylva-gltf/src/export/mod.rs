@@ -115,6 +115,12 @@ pub enum ExportError {
         /// The scene node.
         node: usize,
     },
+    /// A mesh has an impostor's material but no picture for it.
+    #[error("node {node}: an impostor's material on a mesh without an impostor picture")]
+    NoImpostorPicture {
+        /// The scene node.
+        node: usize,
+    },
     /// A mesh has a different number of normals than positions.
     #[error("node {node}: {positions} positions but {normals} normals")]
     NormalCount {
@@ -358,6 +364,8 @@ fn used_pictures(scene: &Scene) -> std::collections::BTreeSet<Picture> {
                 })
                 .flatten()
         })
+        // An impostor's picture is its mesh's; only GLB carries it.
+        .filter(|p| !matches!(p, Picture::Impostor))
         .collect()
 }
 
@@ -442,6 +450,14 @@ fn check_mesh(node: usize, mesh: &Mesh) -> Result<(), ExportError> {
             node,
             what: "a material colour",
         });
+    }
+    if mesh.impostor.is_none()
+        && mesh
+            .materials
+            .iter()
+            .any(|m| m.surface == Some(sylva_core::species::Surface::Impostor))
+    {
+        return Err(ExportError::NoImpostorPicture { node });
     }
     let vertices = mesh.positions.len();
     for (primitive, p) in mesh.primitives.iter().enumerate() {

@@ -101,7 +101,9 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
                     taken.insert(n.clone());
                     written.insert(key, n.clone());
                     write_material(&mut mtl, &n, material.color);
-                    if let Some(picture) = Picture::base_of(material) {
+                    // An impostor's picture is its mesh's; only GLB carries it.
+                    let shown = Picture::base_of(material).filter(|p| *p != Picture::Impostor);
+                    if let Some(picture) = shown {
                         let clamp = if picture.repeats_v() {
                             ""
                         } else {
@@ -110,7 +112,7 @@ pub fn to_obj(scene: &Scene, mtl_file_name: &str) -> (String, String) {
                         let file = picture.file_name(&texture_stem);
                         let _ = writeln!(mtl, "map_Kd {clamp}{file}");
                     }
-                    if let Some(mask) = Picture::mask_of(material) {
+                    if let Some(mask) = Picture::mask_of(material).filter(|_| shown.is_some()) {
                         let file = mask.file_name(&texture_stem);
                         let _ = writeln!(mtl, "map_d -clamp on {file}");
                     }

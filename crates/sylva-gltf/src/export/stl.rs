@@ -93,6 +93,7 @@ mod tests {
                 indices: vec![0, 1, 2, 0, 1, 7],
             }],
             materials: vec![Material::of_kind(MaterialKind::Bark)],
+            impostor: None,
         };
         let mut node = SceneNode::new("a", &mesh);
         node.translation = Vec3::new(0.0, 2.0, 0.0);

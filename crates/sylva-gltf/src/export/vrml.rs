@@ -95,7 +95,11 @@ fn shapes(out: &mut String, mesh: &Mesh, id: usize, mut fresh: bool, stem: &str)
         );
         push_vec3(out, color);
         out.push_str(" }\n");
-        if let Some(picture) = material.and_then(Picture::base_of) {
+        // An impostor's picture is its mesh's; only GLB carries it.
+        if let Some(picture) = material
+            .and_then(Picture::base_of)
+            .filter(|p| *p != Picture::Impostor)
+        {
             let repeat = match (picture.repeats_u(), picture.repeats_v()) {
                 (true, true) => "",
                 (true, false) => " repeatT FALSE",

@@ -151,7 +151,8 @@ class Plant:
     def wind(self) -> dict[str, Any] | None:
         """The wind it grew with (strength, period, joints, left_out, clip), or None."""
     def lod_glb(self, levels: int, name: str = "plant") -> bytes:
-        """Its levels of detail (2 to 8) as one GLB of nodes NAME_LOD0 to NAME_LODn."""
+        """Its levels of detail (2 to 8), then its impostor, as one GLB of nodes NAME_LOD0 to
+        NAME_LOD{levels}."""
     def render(
         self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (800, 800)
     ) -> bytes:
