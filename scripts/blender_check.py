@@ -6,7 +6,8 @@ Run by scripts/check-blender; what is checked depends on the file's name:
   texture, whose base colour times the imported vertex colours gives back every colour the
   plant's own materials have;
 - NAME-lod.glb (a `sylva grow --lod N` scene): objects NAME-lod_LOD0 ... as siblings, each
-  with its level's screen coverage among its custom properties, triangles halving;
+  with its level's screen coverage among its custom properties, triangles halving, the last
+  the impostor (its `lod` custom property says so, its material shows a picture);
 - NAME-....-instanced.glb and NAME-....-quantized.glb (forests of variants with
   EXT_mesh_gpu_instancing or KHR_mesh_quantization): compared with NAME-plain.glb beside them
   (the same forest as plain nodes and floats): as many plant objects, sharing as many mesh
@@ -88,8 +89,18 @@ def lod(path):
             coverage.append(round(info["screen_coverage"], 4))
         obj.data.calc_loop_triangles()
         triangles.append(len(obj.data.loop_triangles))
-    if len(levels) < 2:
+    if len(levels) < 3:
         problems.append(f"{len(levels)} level objects")
+    # The last is the impostor: crossed cards whose material shows the plant's picture.
+    impostor = levels[-1] if levels else None
+    pictured = impostor is not None and any(
+        n.type == "TEX_IMAGE" and n.image is not None
+        for m in impostor.data.materials
+        if m and m.node_tree
+        for n in m.node_tree.nodes
+    )
+    if impostor is None or not (impostor.get("lod") or {}).get("impostor") or not pictured:
+        problems.append("the last level is not an impostor showing a picture")
     if any(b > a for a, b in zip(triangles, triangles[1:])):
         problems.append(f"triangles do not fall: {triangles}")
     if coverage != sorted(coverage, reverse=True):
