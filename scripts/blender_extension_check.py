@@ -4,6 +4,7 @@ properties, lineage, and the errors it reports. Prints the timings asked of it. 
 scripts/check-blender-extension with a fresh BLENDER_USER_RESOURCES.
 
     python scripts/blender_extension_check.py EXTENSION.zip [--sylva target/release/sylva] [--render DIR]
+        [--pictures extension,foliage]
 
 With --sylva, the studio archive is checked against a real studio: it makes the archive,
 and reads back what Blender wrote to it while it runs.
@@ -11,6 +12,7 @@ and reads back what Blender wrote to it while it runs.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -24,6 +26,7 @@ from mathutils import Vector
 zip_path = os.path.abspath(sys.argv[1])
 render_dir = sys.argv[sys.argv.index("--render") + 1] if "--render" in sys.argv else None
 sylva_cli = sys.argv[sys.argv.index("--sylva") + 1] if "--sylva" in sys.argv else None
+pictures = set(sys.argv[sys.argv.index("--pictures") + 1].split(",")) if "--pictures" in sys.argv else None
 failures = []
 
 
@@ -99,9 +102,16 @@ def triangles(obj):
     return len(obj.data.polygons)
 
 
-def check_plant(obj, genome, label):
-    """The object against the same genome grown by the package itself."""
-    plant = genome.grow()
+def image_of(mat, picture):
+    """The Image Texture node of `mat` showing Sylva's picture `picture`, packed, or None."""
+    return next((n for n in mat.node_tree.nodes if n.type == "TEX_IMAGE" and n.image is not None
+                 and n.image.packed_file is not None and n.image.get("sylva_picture") == picture), None)
+
+
+def check_plant(obj, genome, label, plant=None, **options):
+    """The object against the same genome grown by the package itself (with `options`, or
+    `plant` as grown)."""
+    plant = plant or genome.grow(**options)
     m = plant.mesh
     me = obj.data
     ok = check(len(me.vertices) == len(m.positions) and triangles(obj) == len(m.indices)
@@ -139,14 +149,15 @@ def check_plant(obj, genome, label):
     colours_ok = len(mats) == len(m.materials) and all(
         np.allclose(b.diffuse_color[:3], a["color"], atol=1e-6)
         and np.allclose(next(n for n in b.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
-                        .inputs["Base Color"].default_value[:3] if a["texture"] is None else
+                        .inputs["Base Color"].default_value[:3] if a["picture"] is None else
                         next(s for n in b.node_tree.nodes if n.type == "MIX" for s in n.inputs
                              if s.type == "RGBA" and not s.is_linked).default_value[:3],
                         a["color"], atol=1e-6)
         for a, b in zip(m.materials, mats))
     kinds = sorted({a["kind"] for a in m.materials})
     check(colours_ok, f"{label}: {len(mats)} materials ({', '.join(kinds)}), base colours as Sylva's")
-    textured = [(a, b) for a, b in zip(m.materials, mats) if a["texture"] is not None]
+    textured = [(a, b) for a, b in zip(m.materials, mats)
+                if a["texture"] is not None and a["picture"] == f"sylva-texture-{a['texture']}"]
     tex_ok = all(
         any(n.type == "TEX_IMAGE" and n.image is not None and n.image.packed_file is not None
             and n.image.size[0] == 256 and n.image.get("sylva_texture") == a["texture"]
@@ -154,6 +165,9 @@ def check_plant(obj, genome, label):
         for a, b in textured)
     if textured:
         check(tex_ok, f"{label}: {len(textured)} textured materials show Sylva's 256x256 texture, packed")
+    pictured = [(a, b) for a, b in zip(m.materials, mats) if a["picture"] is not None]
+    check(all(image_of(b, a["picture"]) is not None for a, b in pictured),
+          f"{label}: each of the {len(pictured)} materials with a picture shows it, packed")
     check(obj["sylva_genome"] == genome.to_json() and obj["sylva_model"] == genome.model
           and obj["sylva_seed"] == (plant.seed if plant.seed < 2**31 else str(plant.seed)) and obj["sylva_id"] == plants.genome_id(genome)
           and obj["sylva_version"] == sylva.__version__,
@@ -322,6 +336,195 @@ copy = bpy.context.active_object
 check(copy is not cells[2] and "sylva_cell" not in copy and copy["sylva_id"] == cells[2]["sylva_id"]
       and copy.data is not cells[2].data, "Keep: a copy out of the grid, with its own mesh")
 
+# -- Leaves and bark: Foliage, Bark, Height and Density regrow the plant, dressed -------------
+
+
+def bsdf_of(mat):
+    return next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+
+
+def feeds(socket, node_type, output=None):
+    """The node of `node_type` whose output (named `output`) reaches `socket` through the
+    node tree's links, or None."""
+    todo = [socket]
+    while todo:
+        for link in todo.pop().links:
+            node = link.from_node
+            if node.type == node_type and (output is None or link.from_socket.name == output):
+                return node
+            todo.extend(i for i in node.inputs if i.is_linked)
+    return None
+
+
+def alpha_of(image):
+    px = np.empty(len(image.pixels), np.float32)
+    image.pixels.foreach_get(px)
+    return px[3::image.channels] if image.channels == 4 else np.ones(1, np.float32)
+
+
+def check_dress(obj, plant, label):
+    """Cut-out materials show their picture's alpha as the BSDF's, from both sides; barks
+    their normal map. Returns the figures it saw."""
+    pairs = list(zip(plant.mesh.materials, obj.data.materials))
+    cut = [(a, b) for a, b in pairs if a["cut_out"]]
+    seen = {}
+    for a, b in cut:
+        bsdf = bsdf_of(b)
+        tex = feeds(bsdf.inputs["Alpha"], "TEX_IMAGE", "Alpha")
+        colour = feeds(bsdf.inputs["Base Color"], "TEX_IMAGE", "Color")
+        alpha = alpha_of(tex.image) if tex is not None else np.ones(1)
+        seen[a["picture"]] = float(np.mean(alpha < 0.5))
+        method = getattr(b, "surface_render_method", "DITHERED")
+        check(tex is not None and tex == colour and tex.image.get("sylva_picture") == a["picture"]
+              and tex.extension in ("EXTEND", "CLIP") and not b.use_backface_culling
+              and method == "DITHERED" and 0.05 < seen[a["picture"]] < 0.95,
+              f"{label}: {b.name} shows {a['picture']} ({tex.image.size[0] if tex else 0} px, "
+              f"{seen[a['picture']]:.0%} of it cut away), its alpha linked to the BSDF's Alpha "
+              f"(cut at 0.5), both faces drawn (backface culling off), render method {method}")
+    bark = [(a, b) for a, b in pairs if a["normal_map"] is not None]
+    for a, b in bark:
+        bsdf = bsdf_of(b)
+        normal = feeds(bsdf.inputs["Normal"], "NORMAL_MAP")
+        tex = feeds(normal.inputs["Color"], "TEX_IMAGE", "Color") if normal else None
+        colour = feeds(bsdf.inputs["Base Color"], "TEX_IMAGE", "Color")
+        check(normal is not None and normal.space == "TANGENT" and normal.uv_map == obj.data.uv_layers[0].name
+              and tex is not None and tex.image.get("sylva_picture") == a["normal_map"]
+              and tex.image.colorspace_settings.name == "Non-Color" and tex.extension == "REPEAT"
+              and colour is not None and colour.image.get("sylva_picture") == a["picture"]
+              and colour.extension == "REPEAT",
+              f"{label}: {b.name} shows {a['picture']}, repeating, and its normal map {a['normal_map']} "
+              f"(Non-Color) through a tangent-space Normal Map node on {normal.uv_map if normal else None}")
+    return cut, bark, seen
+
+
+dress_times = {}
+check(set(plants.grow_options(plants.settings_of(objects["tree"].sylva), plants.genome_of(objects["tree"])))
+      == {"seed", "roots", "taper"} and objects["tree"].sylva.foliage == "NONE"
+      and objects["tree"].sylva.bark == "FOLIAGE" and objects["tree"].sylva.height == 0.0
+      and objects["tree"].sylva.density == 1.0,
+      "Leaves and bark: a plant's defaults (as grown, foliage's own bark, height 0, density 1) "
+      "give Genome.grow no dress arguments: it grows as before them")
+oak_genome = sylva.Genome.load(dict(examples["bintree"])["oak"])
+dressed = grown("EXAMPLE", "bintree", example="oak")
+bare = triangles(dressed)
+t = time.perf_counter()
+dressed.sylva.foliage = "oak"
+dress_times["foliage"] = time.perf_counter() - t
+t = time.perf_counter()
+dressed.sylva.height = 12.0
+dress_times["height"] = time.perf_counter() - t
+reference = check_plant(dressed, oak_genome, "oak, Foliage oak, Height 12", foliage="oak", height=12.0)
+top = max(v.co.z for v in dressed.data.vertices)
+dress_figures = {"bare": bare, "dressed": triangles(dressed), "materials": len(dressed.data.materials),
+                 "height": reference.height, "top": top}
+check(abs(reference.height - 12.0) < 0.05 and abs(top - reference.bounds[1][1]) < 1e-4,
+      f"oak, Height 12: grown {reference.height:.2f} m tall (Sylva's height), the highest leaf "
+      f"{top:.2f} m up in Blender ({triangles(dressed)} triangles; {bare} as grown)")
+cut, bark, dress_figures["cut away"] = check_dress(dressed, reference, "oak dressed")
+check(len(cut) >= 1 and len(bark) >= 1 and {a["picture"] for a, _ in cut} == {"sylva-leaves-oak"}
+      and {a["normal_map"] for a, _ in bark} == {"sylva-bark-furrowed-normal"},
+      f"oak dressed: {len(cut)} cut-out leaf material(s) of sylva-leaves-oak, {len(bark)} bark "
+      "material(s) of sylva-bark-furrowed with its normal map (the oak's own bark)")
+leaf_images = [i for i in bpy.data.images if i.get("sylva_picture") == "sylva-leaves-oak"]
+materials_before = len(bpy.data.materials)
+twin = grown("EXAMPLE", "bintree", example="oak")
+twin.sylva.foliage, twin.sylva.height = "oak", 12.0
+check(list(twin.data.materials) == list(dressed.data.materials) and len(bpy.data.materials) == materials_before
+      and len(leaf_images) == 1 and leaf_images[0].packed_file is not None
+      and len([i for i in bpy.data.images if i.get("sylva_picture") == "sylva-leaves-oak"]) == 1,
+      f"a second dressed oak shares the first one's {len(twin.data.materials)} materials; the leaf atlas "
+      f"is one packed image ({leaf_images[0].size[0]} x {leaf_images[0].size[1]}) in the file")
+bpy.data.objects.remove(twin)
+t = time.perf_counter()
+dressed.sylva.foliage = "pine"
+dress_times["pine"] = time.perf_counter() - t
+pine = check_plant(dressed, oak_genome, "oak, Foliage pine", foliage="pine", height=12.0)
+cut, bark, _ = check_dress(dressed, pine, "oak as a pine")
+check({a["picture"] for a, _ in cut} == {"sylva-leaves-pine"} and all(
+      "sylva-leaves-oak" not in (m.get("sylva_material") or "") for m in dressed.data.materials),
+      f"Foliage pine regrows it with pine needles ({triangles(dressed)} triangles)")
+dressed.sylva.bark = "plated"
+plated = check_plant(dressed, oak_genome, "oak, Bark plated", foliage="pine", bark="plated", height=12.0)
+cut, bark, _ = check_dress(dressed, plated, "oak, Bark plated")
+check({a["normal_map"] for a, _ in bark} == {"sylva-bark-plated-normal"}, "Bark plated: its own normal map")
+dressed.sylva.foliage, dressed.sylva.bark = "oak", "FOLIAGE"
+before = triangles(dressed)
+dressed.sylva.density = 2.0
+check_plant(dressed, oak_genome, "oak, Density 2", foliage="oak", height=12.0, density=2.0)
+check(triangles(dressed) > before, f"Density 2: {before} -> {triangles(dressed)} triangles")
+dressed.sylva.density = 1.0
+dressed.sylva.foliage = "NONE"
+check_plant(dressed, oak_genome, "oak, Foliage as grown, Height 12", height=12.0)
+check(not any(m.get("sylva_material", "").endswith("|cut out") for m in dressed.data.materials),
+      "Foliage as grown: no cut-out materials left")
+dressed.sylva.height = 0.0
+check(triangles(dressed) == bare, f"Height 0: the oak as grown again ({bare} triangles)")
+dressed.sylva.foliage, dressed.sylva.height = "oak", 12.0
+
+
+# Breeding a dressed plant: the grid plants take its leaves and bark.
+select([dressed])
+bpy.ops.sylva.breed()
+cells = grid()
+check(len(cells) == 9 and all(o.sylva.foliage == "oak" and o.sylva.height == 12.0 and any(
+      (m.get("sylva_material") or "").endswith("|cut out") for m in o.data.materials) for o in cells.values()),
+      "Breed a dressed oak: the nine mutants grow with its Foliage and Height, cut-out leaves and all")
+check_plant(cells[0], plants.genome_of(cells[0]), "dressed variant 1", foliage="oak", height=12.0)
+# Wind on a dressed plant: Sylva's GLB of it, read by Blender's glTF importer.
+select([dressed])
+settings.wind_strength, settings.wind_period = 1.0, 4.0
+bpy.ops.sylva.wind()
+skinned = [c for c in bpy.context.active_object.children if c.type == "MESH"]
+expected = oak_genome.grow(foliage="oak", height=12.0, wind=1.0, wind_period=4.0)
+check(len(skinned) == 1 and triangles(skinned[0]) == len(expected.mesh.indices) and any(
+      not m.use_backface_culling and feeds(bsdf_of(m).inputs["Alpha"], "TEX_IMAGE", "Alpha") is not None
+      for m in skinned[0].data.materials),
+      f"Add Wind on the dressed oak: {triangles(skinned[0]) if skinned else 0} triangles skinned, as the "
+      "package's; Blender's glTF importer cuts its leaves out too (alpha to the BSDF, two-sided)")
+dressed.hide_set(False)
+dressed.hide_render = False
+
+# Species presets: a .toml from File, and the bundled ones in the Example menu.
+species_dir = os.path.abspath("examples/species")
+oak_toml = os.path.join(species_dir, "oak.toml")
+t = time.perf_counter()
+species_oak = grown("FILE", "lsystem", genome_file=oak_toml)
+dress_times["preset"] = time.perf_counter() - t
+reference = sylva.Genome.grow_preset(oak_toml)
+check_plant(species_oak, sylva.Genome.load(os.path.join(species_dir, "oak.genome.json")), "species oak (File)",
+            plant=reference)
+group = species_oak.sylva
+check(group.foliage == "oak" and group.bark == "FOLIAGE" and abs(group.height - 17.0) < 1e-6
+      and abs(group.density - 1.5) < 1e-6 and not group.roots and group.own_seed
+      and species_oak["sylva_source"] == oak_toml,
+      "species oak (File): the preset's Foliage oak, Height 17, Density 1.5, no roots kept in its settings")
+check_dress(species_oak, reference, "species oak")
+dress_figures["preset"] = (triangles(species_oak), species_oak.dimensions.z)
+select([species_oak])
+bpy.ops.sylva.regrow()
+co = np.empty(3 * len(species_oak.data.vertices), np.float32)
+species_oak.data.vertices.foreach_get("co", co)
+p = reference.mesh.positions
+check(len(co) == 3 * len(p) and np.allclose(co.reshape(-1, 3), np.stack([p[:, 0], -p[:, 2], p[:, 1]], 1), atol=1e-6),
+      "species oak: Regrow from its settings gives grow_preset's plant again, every vertex")
+bundled_species = os.path.join(os.path.dirname(plants.__file__), "examples", "species")
+bundled = sorted(f for f in os.listdir(bundled_species) if f.endswith(".toml"))
+check(bundled == sorted(f for f in os.listdir(species_dir) if f.endswith(".toml")),
+      f"the zip bundles every species preset: {', '.join(bundled)}")
+settings.model = "lsystem"
+items = [i[0] for i in ext._example_items(settings, bpy.context)]
+check({"species/oak", "species/birch", "species/spruce"} <= set(items) and "tree" in items,
+      f"Example menu of lsystem: {', '.join(items)}")
+birch = grown("EXAMPLE", "lsystem", example="species/birch")
+check_plant(birch, sylva.Genome.load(os.path.join(species_dir, "birch.genome.json")), "species birch (Example)",
+            plant=sylva.Genome.grow_preset(os.path.join(species_dir, "birch.toml")))
+check(birch.sylva.foliage == "birch" and birch["sylva_operator"] == "example"
+      and birch["sylva_source"] == "species/birch", f"species birch: grown as {birch.name}")
+with open(os.path.join(tmp, "bad.toml"), "w") as f:
+    f.write('genome = "oak.genome.json"\nfoliage = "palm"\n')
+fails(lambda: grown("FILE", genome_file=os.path.join(tmp, "bad.toml")), "bad.toml", "palm")
+settings.example = "tree"
+
 # -- A studio archive: plants grown from it, bred plants written back -----------------------------
 archive = sys.modules[module + ".archive"]
 if sylva_cli:
@@ -471,8 +674,10 @@ lod_collection = bpy.data.collections.get(f"{tulip.name}_LODs")
 levels = sorted(lod_collection.objects, key=lambda o: o.name) if lod_collection else []
 counts = [triangles(o) for o in levels]
 full = len(plants.genome_of(tulip).grow().mesh.indices)
-check([o.name for o in levels] == [f"{tulip.name}_LOD{k}" for k in range(3)]
-      and counts[0] == full and counts == sorted(counts, reverse=True) and counts[1] < counts[0],
+# Three meshed levels, then the impostor: two crossed cards showing the plant's picture.
+check([o.name for o in levels] == [f"{tulip.name}_LOD{k}" for k in range(4)]
+      and counts[0] == full and counts == sorted(counts, reverse=True) and counts[1] < counts[0]
+      and counts[3] == 4,
       f"Levels of Detail: {', '.join(o.name for o in levels)} in {lod_collection.name if lod_collection else None} "
       f"({', '.join(map(str, counts))} triangles; the plant's {full})")
 check(all(o.location == tulip.location for o in levels) and not levels[0].hide_get()
@@ -481,7 +686,7 @@ check(all(o.location == tulip.location for o in levels) and not levels[0].hide_g
 select([tulip])
 settings.lod_levels = 2
 bpy.ops.sylva.lod()
-check(len(bpy.data.collections[f"{tulip.name}_LODs"].objects) == 2, "Levels of Detail again: the old chain replaced")
+check(len(bpy.data.collections[f"{tulip.name}_LODs"].objects) == 3, "Levels of Detail again: the old chain replaced")
 
 # -- Forest: collection instances of variants over a ground mesh -----------------------------
 
@@ -706,6 +911,19 @@ try:
           f"Plant panel, with an error: {len(drawn)} items, the error wrapped over "
           f"{len(drawn[drawn.index('prop detail') + 1:drawn.index('sylva.regrow')])} lines")
     oak_obj.sylva.error = ""
+    check({"prop foliage", "prop bark", "prop height", "prop density"} <= set(drawn),
+          "Plant panel: Foliage, Bark, Height and Density")
+    hints = []
+    for obj in (objects["tulip"], oak_obj):
+        with plants.quiet():
+            obj.sylva.foliage = "oak"  # not regrown: the plant as grown, with a kind of leaves chosen
+        drawn = draw(bpy.types.SYLVA_PT_plant, obj, [obj])
+        with plants.quiet():
+            obj.sylva.foliage = "NONE"
+        hints.append(" ".join(d for d in drawn if "real size" in d or "it stands" in d))
+    check(hints[0] and not hints[1],
+          f"Plant panel, Foliage set at Height 0: on the tulip ({objects['tulip'].dimensions.z:.2f} m) "
+          f"'{hints[0]}'; none on the oak ({oak_obj.dimensions.z:.2f} m)")
     check(draw(bpy.types.SYLVA_PT_plant, None, []) is None, "Plant panel hidden with no plant active")
     drawn = draw(bpy.types.SYLVA_PT_breed, grid_plant, [grid_plant, grid()[2]])
     check({"sylva.breed", "sylva.mutate", "sylva.cross", "sylva.keep"} <= set(drawn)
@@ -759,6 +977,14 @@ for model, name in (("plantmaker", "tulip"), ("plantmaker", "conifer"), ("lsyste
         figure(max(steps), 1.0, f"{kind}: {what} {name} ({'k, '.join(map(str, sizes))}k triangles in the grid): "
                f"{', '.join(f'{x * 1000:.0f}' for x in steps)} ms (target under 1000)")
 
+print(f"     dressed: the binary oak ({dress_figures['bare']} triangles as grown) given Foliage oak "
+      f"{dress_times['foliage'] * 1000:.0f} ms, then Height 12 {dress_times['height'] * 1000:.0f} ms: "
+      f"{dress_figures['dressed']} triangles, {dress_figures['materials']} materials, "
+      f"{dress_figures['height']:.2f} m tall (leaves to {dress_figures['top']:.2f} m); the leaf atlas "
+      + ", ".join(f"{k} {v:.0%} cut away" for k, v in dress_figures["cut away"].items()))
+print(f"     dressed: Foliage pine {dress_times['pine'] * 1000:.0f} ms; the species oak preset from "
+      f"File {dress_times['preset'] * 1000:.0f} ms ({dress_figures['preset'][0]} triangles, "
+      f"{dress_figures['preset'][1]:.2f} m)")
 print(f"     evolve: 12 generations of 300 automata toward a sphere under a forbidden box, the best "
       f"shown as it improved: {evolve_s:.2f} s")
 figure(forest_s, 5.0, f"forest: 1000 conifers of 8 variants as instances on a hill: {forest_s:.2f} s (target under 5)")
@@ -804,7 +1030,7 @@ if render_dir:
     sys.path.insert(0, os.path.dirname(__file__))
     import blender_extension_render
 
-    blender_extension_render.render(render_dir, plants)
+    blender_extension_render.render(render_dir, plants, pictures)
 
 print(f"\n{len(failures)} failure(s)" + (": " + "; ".join(failures) if failures else ""))
 if slow:

@@ -68,12 +68,12 @@ def _frame(scene, objects, elevation=18.0, azimuth=-35.0, margin=1.15):
     cam.data.clip_end = distance * 10
 
 
-def _render(scene, path, samples):
+def _render(scene, path, samples, size=(960, 600)):
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     scene.cycles.samples = samples
     scene.cycles.use_denoising = True
-    scene.render.resolution_x, scene.render.resolution_y = 960, 600
+    scene.render.resolution_x, scene.render.resolution_y = size
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.compression = 100  # smallest file: these go into docs/
@@ -84,7 +84,8 @@ def _render(scene, path, samples):
 
 
 def _fresh(scene, example):
-    """An empty stage with the PlantMaker example grown at the cursor; returns it."""
+    """An empty stage with the example of the model chosen (PlantMaker's, unless set)
+    grown at the cursor; returns it."""
     _clear()
     _stage(scene)
     scene.sylva.example = example
@@ -92,8 +93,51 @@ def _fresh(scene, example):
     return bpy.context.active_object
 
 
-def render(out, plants):
+def render(out, plants, pictures=None):
+    """Renders the pictures into `out`: all of them, or those of `pictures`, a set of
+    "extension" (growing, breeding, assets and evolving) and "foliage" (dressed plants)."""
     os.makedirs(out, exist_ok=True)
+    if pictures is None or "extension" in pictures:
+        _extension(out, plants)
+    if pictures is None or "foliage" in pictures:
+        foliage(out, plants)
+
+
+def foliage(out, plants):
+    """Dressed plants: the binary oak as a user dresses it (Foliage oak and Height 12 on the
+    plant as grown) beside the species oak preset (examples/species/oak.toml, grown from
+    File), and a close look into the binary oak's crown: every leaf cut out of its card by
+    the atlas's alpha, not a square."""
+    scene = bpy.context.scene
+    settings = scene.sylva
+    scene.cursor.location = (0, 0, 0)
+    settings.source, settings.model = "EXAMPLE", "bintree"
+    oak = _fresh(scene, "oak")
+    oak.sylva.foliage = "oak"
+    oak.sylva.height = 12.0
+    scene.cursor.location = (19, 6, 0)
+    settings.model = "lsystem"  # the preset's genome's
+    settings.source, settings.genome_file = "FILE", os.path.abspath("examples/species/oak.toml")
+    bpy.ops.sylva.grow()
+    species = bpy.context.active_object
+    settings.source = "EXAMPLE"
+    # Seen through many leaves at once: Cycles stops a path after this many transparent
+    # surfaces (8 by default), which would darken the crowns' middles.
+    scene.cycles.transparent_max_bounces = 64
+    _frame(scene, [oak, species], elevation=6, azimuth=-8, margin=0.62)
+    _render(scene, os.path.join(out, "blender-foliage.png"), 48)
+    # The close look: a camera 2.5 m from a leafy twig at the binary oak's crown's front.
+    points = [oak.matrix_world @ v.co for v in oak.data.vertices]
+    top = max(p.z for p in points)
+    side = [p for p in points if top * 0.45 < p.z < top * 0.65]
+    edge = min(side, key=lambda p: p.y)
+    cam = scene.camera
+    cam.location = edge + Vector((0.6, -2.5, 0.3))
+    cam.rotation_euler = (edge - cam.location).to_track_quat("-Z", "Y").to_euler()
+    _render(scene, os.path.join(out, "blender-foliage-leaves.png"), 32, size=(640, 400))
+
+
+def _extension(out, plants):
     scene = bpy.context.scene
     settings = scene.sylva
     settings.breed_step = 0  # the same pictures whatever the scene went through before

@@ -39,7 +39,13 @@ def _model_items(self, context):
 def _example_items(self, context):
     found = plants.examples(self.model)
     items = [(name, name.replace("-", " ").capitalize(), f"examples/{self.model}/{name}.json")
-             for name, _ in found] or [("none", "(no bundled examples)", "")]
+             for name, _ in found]
+    # Species presets whose genome is of this model: a genome and how it grows (height,
+    # foliage, bark, density), grown with Genome.grow_preset.
+    items += [(plants.SPECIES_PREFIX + name, f"{name.replace('-', ' ').capitalize()} (species)",
+               f"examples/species/{name}.toml: a species preset, dressed")
+              for name, _ in plants.presets(self.model)]
+    items = items or [("none", "(no bundled examples)", "")]
     _items[("examples", self.model)] = items
     return items
 
@@ -169,6 +175,10 @@ def _detail(self, context):
         plants.apply_detail(self.id_data)
 
 
+def _leaves(kind):
+    return "needles" if kind in ("pine", "spruce", "fir") else "leaves"
+
+
 class SylvaPlantSettings(bpy.types.PropertyGroup):
     """How a plant object grows; changing any setting regrows it."""
 
@@ -186,6 +196,34 @@ class SylvaPlantSettings(bpy.types.PropertyGroup):
         name="Detail", min=0.02, max=1.0, default=1.0, subtype="FACTOR", update=_detail,
         description=("Share of the triangles kept, by a Decimate modifier (1: Sylva's full mesh). "
                      "Thin twigs and leaves go first at low values"),
+    )
+    # Leaves and bark (Genome.grow's foliage, bark, height and density). The enums' numbers
+    # are fixed, as the .blend stores them; an object saved before these existed reads the
+    # defaults, which grow it as it grew.
+    foliage: EnumProperty(
+        name="Foliage", update=_regrow, default="NONE",
+        items=[("NONE", "As grown", "The plant's own leaves, as its model grows them", 0)]
+        + [(kind, kind.capitalize(), f"{kind.capitalize()} {_leaves(kind)} at their real size, as "
+            "alpha-cut cards (give the plant a tree's height)", k + 1)
+           for k, kind in enumerate(plants.FOLIAGE_KINDS)],
+        description="Leaves or needles of a kind, at their real size, as alpha-cut cards",
+    )
+    bark: EnumProperty(
+        name="Bark", update=_regrow, default="FOLIAGE",
+        items=[("FOLIAGE", "Foliage's own", "The foliage kind's own bark (none without foliage)", 0)]
+        + [(kind, kind.capitalize(), f"{kind.capitalize()} bark, tiling, with its normal map", k + 1)
+           for k, kind in enumerate(plants.BARK_KINDS)],
+        description="A tiling bark with its normal map",
+    )
+    height: FloatProperty(
+        name="Height", min=0.0, max=1000.0, soft_max=60.0, default=0.0, unit="LENGTH",
+        subtype="DISTANCE", update=_regrow,
+        description=("Grow the plant to this height (0: as grown). Leaves keep their real size, "
+                     "so a dressed plant wants a tree's height, 12 m say"),
+    )
+    density: FloatProperty(
+        name="Density", min=0.25, max=4.0, default=1.0, update=_regrow,
+        description="Leaf cards per metre of twig, as a multiple of the kind's own",
     )
     error: StringProperty(name="Error", default="", description="Why the last growth failed")
 
@@ -255,6 +293,16 @@ class SYLVA_PT_plant(_Panel, bpy.types.Panel):
         sub.enabled = group.use_taper
         sub.prop(group, "taper")
         layout.prop(group, "roots")
+        col = layout.column(align=True)
+        col.prop(group, "foliage")
+        col.prop(group, "bark")
+        col.prop(group, "height")
+        sub = col.row(align=True)
+        sub.enabled = group.foliage != plants.AS_GROWN
+        sub.prop(group, "density")
+        if group.foliage != plants.AS_GROWN and group.height == 0.0 and obj.dimensions.z < 3.0:
+            _wrapped(layout, f"Leaves are at their real size: give the plant a tree's height "
+                     f"(it stands {obj.dimensions.z:.2f} m)", context, icon="INFO")
         layout.prop(group, "detail", slider=True)
         if group.error:
             box = layout.box()

@@ -137,8 +137,9 @@ def _remove_rig(armature):
 
 
 def lods(context, obj, levels):
-    """Sylva's chain of `levels` levels of detail of `obj` (as `sylva grow --lod` writes it),
-    imported as objects `NAME_LOD0` (the plant in full) to `NAME_LODn` in a collection
+    """Sylva's chain of `levels` levels of detail of `obj` and its impostor (as `sylva grow
+    --lod` writes them), imported as objects `NAME_LOD0` (the plant in full) to
+    `NAME_LOD{levels}` (the impostor: crossed cards showing its picture) in a collection
     `NAME_LODs` beside the plant's, standing where the plant stands; levels past the first
     are hidden in the viewport. A chain made before is replaced. Returns the objects."""
     genome, options = _grow_options(obj)
@@ -232,9 +233,8 @@ def forest(context, obj, ground, count, variants, seed, variety="SEEDS", scale_r
             variant = bpy.data.objects.new(f"{name} variant {k + 1}", obj.data)
         else:
             variant = plants.new_object(context, f"{name} variant {k + 1}", collection)
+            plants.copy_settings(obj, variant)
             with plants.quiet():
-                for setting in ("own_seed", "seed", "use_taper", "taper", "roots", "detail"):
-                    setattr(variant.sylva, setting, getattr(obj.sylva, setting))
                 if own_seed is not None:
                     variant.sylva.own_seed = False
                     variant.sylva.seed = own_seed

@@ -62,22 +62,32 @@ class SYLVA_OT_grow(bpy.types.Operator):
         except plants.Unavailable as e:
             return _fail(self, str(e))
         model = settings.model
+        preset = None  # a species preset's path, grown with Genome.grow_preset
         try:
             if settings.source == "EXAMPLE":
                 found = dict(plants.examples(model))
-                if settings.example not in found:
+                species = dict(plants.presets(model))
+                name = settings.example.removeprefix(plants.SPECIES_PREFIX)
+                if settings.example.startswith(plants.SPECIES_PREFIX) and name in species:
+                    preset = species[name]
+                elif settings.example not in found:
                     return _fail(self, f"No bundled example named '{settings.example}' for {model} "
-                                 f"(examples found: {', '.join(found) or 'none'})")
+                                 f"(examples found: {', '.join([*found, *species]) or 'none'})")
+                else:
+                    genome = s.Genome.load(found[settings.example])
                 source = settings.example
-                genome = s.Genome.load(found[source])
                 operator = "example"
             elif settings.source == "FILE":
                 path = bpy.path.abspath(settings.genome_file)
                 if not settings.genome_file:
-                    return _fail(self, "Choose a genome file (a .json of any Sylva model) first")
+                    return _fail(self, "Choose a genome file (a .json of any Sylva model, or a "
+                                 "species preset .toml) first")
                 if not os.path.isfile(path):
                     return _fail(self, f"Genome file not found: {path}")
-                genome = s.Genome.load(path)
+                if plants.is_preset(path):
+                    preset = path
+                else:
+                    genome = s.Genome.load(path)
                 source = path
                 operator = "file"
             elif settings.source == "ARCHIVE":
@@ -94,21 +104,27 @@ class SYLVA_OT_grow(bpy.types.Operator):
                 genome = s.Genome.random(model, settings.random_seed)
                 source = f"random {model} seed {settings.random_seed}"
                 operator = "random"
-        except (s.SylvaError, OSError, archive.ArchiveError) as e:  # where in the file and what
-            return _fail(self, f"Could not read the genome: {e}")
+            if preset is not None:
+                # The package reads the preset (every field checked, errors naming the file,
+                # line and column) and grows it; the object keeps how it grew in its settings.
+                plant = plants.grow_preset(preset)
+                genome, grown_with = plants.preset_settings(preset)
+        except (s.SylvaError, OSError, ValueError, KeyError, archive.ArchiveError) as e:
+            return _fail(self, f"Could not read the genome: {e}")  # where in the file and what
 
-        grow = plants.grow_options(plants.DEFAULT_SETTINGS, genome)
-        if settings.source == "ARCHIVE":
-            grow["seed"] = seed  # the seed the studio grew it with
-        try:
-            plant = plants.grow(genome, grow)
-        except s.SylvaError as e:
-            return _fail(self, f"Could not grow {source}: {e}")
+        if preset is None:
+            grown_with = dict(plants.DEFAULT_SETTINGS)
+            if settings.source == "ARCHIVE":
+                # The seed the studio grew it with.
+                grown_with.update(own_seed=seed == genome.default_seed, seed=seed)
+            try:
+                plant = plants.grow(genome, plants.grow_options(grown_with, genome))
+            except s.SylvaError as e:
+                return _fail(self, f"Could not grow {source}: {e}")
         obj = plants.new_object(context, f"{genome.model} {operator}")
         obj.location = context.scene.cursor.location
-        if grow["seed"] != genome.default_seed:
-            with plants.quiet():
-                obj.sylva.own_seed = False
+        if grown_with != plants.DEFAULT_SETTINGS:
+            plants.set_settings(obj, grown_with)
         plants.set_plant(obj, genome, plant, {"operator": operator, "generation": 0})
         obj[plants.SOURCE] = source
         if settings.source == "ARCHIVE":
@@ -170,10 +186,7 @@ class SYLVA_OT_save_genome(bpy.types.Operator, ExportHelper):
         return {"FINISHED"}
 
 
-def _copy_settings(source, target):
-    with plants.quiet():
-        for name in ("own_seed", "seed", "use_taper", "taper", "roots", "detail"):
-            setattr(target.sylva, name, getattr(source.sylva, name))
+_copy_settings = plants.copy_settings
 
 
 def _place(results, target, op):

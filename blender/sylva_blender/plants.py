@@ -102,27 +102,143 @@ def examples(model):
     )
 
 
+# Leaves and needles of a kind (Genome.grow's `foliage`), and the tiling barks (`bark`): the
+# identifiers of the object settings' enums, which hold the package's names.
+FOLIAGE_KINDS = ("oak", "birch", "aspen", "beech", "maple", "willow", "ash", "privet", "pine",
+                 "spruce", "fir")
+BARK_KINDS = ("smooth", "birch", "furrowed", "plated")
+AS_GROWN = "NONE"  # Foliage: the plant's own leaves
+FOLIAGE_BARK = "FOLIAGE"  # Bark: the foliage kind's own (none when there is no foliage)
+HEIGHT_MIN = 0.01  # Genome.grow's height, metres: 0.01 to 1000 (0 in the settings: as grown)
+
 # A new plant's settings: the defaults of the object's `sylva` group (see __init__.py).
-DEFAULT_SETTINGS = {"own_seed": True, "seed": 0, "roots": True, "taper": None}
+DEFAULT_SETTINGS = {"own_seed": True, "seed": 0, "roots": True, "taper": None,
+                    "height": None, "foliage": None, "bark": None, "density": 1.0}
+# The settings of the object's `sylva` group that say how it grows, copied with the plant
+# (breeding grid, forest variants).
+GROWTH_SETTINGS = ("own_seed", "seed", "use_taper", "taper", "roots", "detail",
+                   "foliage", "bark", "height", "density")
 
 
 def settings_of(group):
-    """An object's growth settings (its `sylva` group) as a plain dict, for worker threads."""
+    """An object's growth settings (its `sylva` group) as a plain dict, for worker threads.
+    Objects saved before the dress have its defaults: they grow as they did."""
     return {
         "own_seed": group.own_seed,
         "seed": group.seed,
         "roots": group.roots,
         "taper": group.taper if group.use_taper else None,
+        "height": max(group.height, HEIGHT_MIN) if group.height > 0 else None,
+        "foliage": None if group.foliage == AS_GROWN else group.foliage,
+        "bark": None if group.bark == FOLIAGE_BARK else group.bark,
+        "density": group.density,
     }
 
 
 def grow_options(settings, genome):
-    """Keyword arguments of Genome.grow for settings_of(...) and a genome."""
-    return {
+    """Keyword arguments of Genome.grow for settings_of(...) and a genome. The dress's are
+    given only when set, so a plain plant grows exactly as before they were."""
+    options = {
         "seed": genome.default_seed if settings["own_seed"] else settings["seed"],
         "roots": settings["roots"],
         "taper": settings["taper"],
     }
+    if settings.get("height") is not None:
+        options["height"] = settings["height"]
+    if settings.get("foliage") is not None:
+        options["foliage"] = settings["foliage"]
+        options["density"] = settings.get("density", 1.0)
+    if settings.get("bark") is not None:
+        options["bark"] = settings["bark"]
+    return options
+
+
+def copy_settings(source, target):
+    """Gives `target` the growth settings of `source` (plant objects), without regrowing it."""
+    with quiet():
+        for name in GROWTH_SETTINGS:
+            setattr(target.sylva, name, getattr(source.sylva, name))
+
+
+# Species presets (examples/species/*.toml): a genome and how it grows into a tree of a
+# species. Grown with Genome.grow_preset; the plant keeps the preset's settings in its own,
+# so it regrows, breeds and makes assets as the preset grows.
+PRESET_SUFFIX = ".toml"
+SPECIES_PREFIX = "species/"  # an Example item that is a species preset: species/oak
+
+
+def is_preset(path):
+    return path.lower().endswith(PRESET_SUFFIX)
+
+
+def preset_settings(path):
+    """(genome, settings dict as settings_of gives it) of a species preset. The package
+    checks the file when it grows it (grow_preset); this reads what the object keeps."""
+    import tomllib
+
+    with open(path, "rb") as f:
+        preset = tomllib.load(f)
+    genome = sylva().Genome.load(os.path.join(os.path.dirname(path), preset["genome"]))
+    dressed = preset.get("foliage") is not None or preset.get("bark") is not None
+    taper = preset.get("taper")
+    settings = {
+        "own_seed": preset.get("seed") is None or preset["seed"] == genome.default_seed,
+        "seed": int(preset.get("seed") or 0),
+        "roots": bool(preset.get("roots", True)),
+        # Dressed wood is thickened by the dress's own pipe model, exponent 2.5 (a dressed
+        # preset's own exponent is not kept: Genome.grow's taper is the plain plant's; none
+        # of examples/species sets one).
+        "taper": None if dressed else taper,
+        "height": preset.get("height"),
+        "foliage": preset.get("foliage"),
+        "bark": preset.get("bark"),
+        "density": float(preset.get("density", 1.0)),
+    }
+    return genome, settings
+
+
+def set_settings(obj, settings):
+    """Sets an object's `sylva` group from a settings dict (settings_of's), without regrowing."""
+    group = obj.sylva
+    with quiet():
+        group.own_seed = settings["own_seed"]
+        group.seed = settings["seed"] % (INT_MAX + 1)
+        group.roots = settings["roots"]
+        group.use_taper = settings["taper"] is not None
+        if settings["taper"] is not None:
+            group.taper = settings["taper"]
+        group.height = settings.get("height") or 0.0
+        group.foliage = settings.get("foliage") or AS_GROWN
+        group.bark = settings.get("bark") or FOLIAGE_BARK
+        group.density = settings.get("density", 1.0)
+
+
+_presets = {}
+
+
+def presets(model=None):
+    """(name, path) of the species presets bundled in examples/species, of `model` (the
+    model of the genome each names) or all, sorted by name."""
+    folder = os.path.join(examples_dir(), "species")
+    if "all" not in _presets:
+        found = []
+        if os.path.isdir(folder):
+            for name in sorted(os.listdir(folder)):
+                if not is_preset(name):
+                    continue
+                path = os.path.join(folder, name)
+                try:
+                    import tomllib
+
+                    with open(path, "rb") as f:
+                        genome = tomllib.load(f)["genome"]
+                    with open(os.path.join(folder, genome), encoding="utf-8") as f:
+                        kind = json.load(f)["model"]
+                except Exception:
+                    continue  # not a preset this version reads: left out of the menu
+                found.append((name[: -len(PRESET_SUFFIX)], path, kind))
+        _presets["all"] = found
+    return [(name, path) for name, path, kind in _presets["all"] if model in (None, kind)]
 
 
 def grow(genome, options):
@@ -130,6 +246,11 @@ def grow(genome, options):
     textures the plant's materials name (cached by the package), so that on a worker thread
     Blender's thread finds them made."""
     return _made_ready(genome.grow(**options))
+
+
+def grow_preset(path):
+    """Grows a species preset (a .toml: a genome and how it grows), as grow() grows."""
+    return _made_ready(sylva().Genome.grow_preset(path))
 
 
 def grow_member(run, member):
@@ -143,6 +264,10 @@ def _made_ready(plant):
     materials = plant.mesh.materials  # gathers the triangle arrays too, off Blender's thread
     for texture in {m["texture"] for m in materials if m["texture"] is not None}:
         sylva().texture_png(texture)
+    for m in materials:  # leaf atlases, bark and its normal map: made once per process
+        for name in (m.get("picture"), m.get("normal_map")):
+            if name is not None and not name.startswith(plantmesh.DESIGN_PREFIX):
+                sylva().picture_png(name)
     return plant
 
 
