@@ -268,3 +268,30 @@ fn every_species_preset_is_plausible_and_within_its_budget() {
         assert!(value("texture_bytes") <= 2_000_000.0, "{name}");
     }
 }
+
+/// The Sylva-mode tree example, `sylva evolve` without a config (written out in
+/// `examples/bintree/default.toml`): its best tree comes out in oak leaves and bark, passes
+/// the plausibility report and fits a broadleaf's budget.
+#[test]
+fn the_default_run_writes_a_dressed_plausible_tree() {
+    let dir = temp_dir("realism-default-run");
+    let run = dir.join("run");
+    ok(&["evolve", "--out", s(&run)]);
+    let glb = run.join("best.glb");
+    let report = ok(&["inspect", s(&glb), "--check", "--json"]);
+    let report: serde_json::Value = serde_json::from_str(&report).unwrap();
+    let figure = |name: &str| {
+        report["figures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["name"] == name)
+            .unwrap()["value"]
+            .as_f64()
+    };
+    assert!(figure("triangles").unwrap() <= 40_000.0);
+    assert!(figure("leaf_length").unwrap() < 0.15, "oak leaves");
+    let bytes = fs::read(&glb).unwrap();
+    assert!(bytes.windows(16).any(|w| w == b"sylva-leaves-oak"));
+    fs::remove_dir_all(&dir).unwrap();
+}

@@ -64,7 +64,16 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "left out when not asked for"
     );
     let default = Config::load(&example("bintree/default.toml")).unwrap();
-    assert_eq!(default.to_toml(), Config::default().to_toml());
+    assert_eq!(default.to_toml(), Config::builtin_run().to_toml());
+    let bare = default
+        .to_toml()
+        .replace("foliage = \"oak\"\n", "")
+        .replace("density = 1.5\n", "");
+    assert_eq!(
+        bare,
+        Config::default().to_toml(),
+        "the built-in run dresses, and no more"
+    );
     assert_eq!(config("").unwrap().to_toml(), Config::default().to_toml());
     let paper = Config::load(&example("bintree/paper.toml")).unwrap();
     let paper = paper.get::<sylva_bintree::BinTreeModel>().unwrap();

@@ -66,7 +66,7 @@ pub struct EvolveArgs {
 pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
     let mut config = match &args.config {
         Some(path) => Config::load(path)?,
-        None => Config::default(),
+        None => Config::builtin_run(),
     };
     let run = config.run_mut();
     run.generations = args.generations.unwrap_or(run.generations);
