@@ -18,7 +18,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sylva_automata::sim::reference::ReferenceSimulator;
+#[path = "../tests/reference/mod.rs"]
+mod reference;
+
+use reference::ReferenceSimulator;
 use sylva_automata::{
     AutomataGenome, Detail, GpConfig, GpTree, GrowOptions, Program, Semantics, Simulator,
 };

@@ -5,7 +5,9 @@
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use proptest::prelude::*;
-use sylva_automata::sim::reference::ReferenceSimulator;
+mod reference;
+
+use reference::ReferenceSimulator;
 use sylva_automata::{
     AtEnd, AutomataGenome, ChildVariables, Detail, ElseEnd, GpConfig, GpTree, GrowOptions,
     GrowthReport, Limits, Program, Semantics, Simulator, Stop, SubtreeCrossover, SubtreeMutation,

@@ -239,7 +239,7 @@ impl<X, M> Generational<X, M> {
     }
 }
 
-impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::map::Operators<G>
+impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::variation::Operators<G>
     for Generational<X, M>
 {
     type Crossover = X;

@@ -6,6 +6,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::fitness::Fitness;
 
+/// The last generation a run (or a map) may reach.
+pub const MAX_GENERATION: u32 = 1_000_000_000;
+
 /// A run-wide unique number, given in birth order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct IndividualId(pub u64);

@@ -45,6 +45,7 @@ use crate::fitness::{Fitness, MAX_TERMS};
 use crate::individual::{Individual, IndividualId, Origin};
 use crate::problem::{Problem, evaluate};
 use crate::rng;
+pub use crate::variation::Operators;
 use crate::variation::{Crossover, Mutate};
 
 /// Most descriptors a map has.
@@ -67,19 +68,6 @@ pub trait Describe<P: Problem>: Send + Sync {
     /// Writes the descriptors of `genome` into `out` (one per axis); `false` if it cannot be
     /// described (it then stays out of the map). Must be a pure function of the genome.
     fn describe(&self, problem: &P, genome: &P::Genome, out: &mut [f64]) -> bool;
-}
-
-/// The variation operators a strategy breeds with, for a search that chooses its own
-/// parents (MAP-Elites breeds with the model's operators, not its generation step).
-pub trait Operators<G> {
-    /// Makes a child of two parents.
-    type Crossover: Crossover<G> + Sync;
-    /// Changes a genome.
-    type Mutation: Mutate<G> + Sync;
-    /// The crossover.
-    fn crossover(&self) -> &Self::Crossover;
-    /// The mutation.
-    fn mutation(&self) -> &Self::Mutation;
 }
 
 /// A problem's genomes as vectors of numbers, each entry within its bounds: what a CMA-ME
@@ -458,11 +446,11 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
                 checkpoint.format
             ));
         }
-        if checkpoint.generation > crate::run::MAX_GENERATION {
+        if checkpoint.generation > crate::individual::MAX_GENERATION {
             return bad(format!(
                 "generation {} is past the last, {}",
                 checkpoint.generation,
-                crate::run::MAX_GENERATION
+                crate::individual::MAX_GENERATION
             ));
         }
         if checkpoint.stats.len() != checkpoint.generation as usize + 1 {
@@ -571,7 +559,7 @@ impl<P: Problem, S: Operators<P::Genome> + Sync> MapRun<P, S> {
     /// while they are (a front end's stop unwinding out of the pool) leaves it as it was.
     pub fn step(&mut self) -> &MapStats {
         let start = Instant::now();
-        let generation = (self.generation + 1).min(crate::run::MAX_GENERATION);
+        let generation = (self.generation + 1).min(crate::individual::MAX_GENERATION);
         let improved = match self.settings.emitter {
             Emitter::Operators => {
                 let offered = self.breed(generation);

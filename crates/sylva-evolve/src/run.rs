@@ -100,8 +100,7 @@ pub const CHECKPOINT_FORMAT: u32 = 1;
 /// Most generations a run keeps for browsing.
 pub const MAX_HISTORY: usize = 10_000;
 
-/// The last generation a run may reach.
-pub const MAX_GENERATION: u32 = 1_000_000_000;
+pub use crate::individual::MAX_GENERATION;
 
 /// An evolving population.
 pub struct Run<P: Problem, S> {

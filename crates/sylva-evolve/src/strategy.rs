@@ -204,7 +204,7 @@ where
     }
 }
 
-impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::map::Operators<G>
+impl<G, X: Crossover<G> + Sync, M: Mutate<G> + Sync> crate::variation::Operators<G>
     for MeanReplacement<X, M>
 {
     type Crossover = X;

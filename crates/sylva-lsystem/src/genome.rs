@@ -32,18 +32,14 @@ use std::fmt;
 use rand::{Rng, RngExt};
 use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use sylva_core::Plant;
-use sylva_core::par::Pool;
 use sylva_evolve::Mutate;
 
-use crate::garden::{Garden, GrowSettings, Sowing};
 use crate::grammar::{
     Axis, Compartment, MAX_RULES, Module, Rule, RuleSet, Symbol, Word, parse_rule, parse_word,
 };
 use crate::interpret::{Angles, ModuleShape};
 use crate::mutate::{MutationRates, mutate_rules};
 use crate::physiology::Physiology;
-use sylva_model::DevelopError;
 use sylva_model::{FormatV1, model_tag};
 
 /// Model name in genome files.
@@ -417,40 +413,6 @@ impl LSystemGenome {
             Compartment::Shoot => &self.shoot.rules,
             Compartment::Root => &self.root.rules,
         }
-    }
-
-    /// Grows the plant alone in the default world for the default time
-    /// ([`GrowSettings::default`]); `seed` is recorded in the plant (growth is
-    /// deterministic).
-    pub fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
-        self.develop_with(&GrowSettings::default(), seed)
-    }
-
-    /// Grows the plant alone with the given world and time; refused before the first step
-    /// when that would take longer than the time budget ([`crate::work`]).
-    pub fn develop_with(&self, settings: &GrowSettings, seed: u64) -> Result<Plant, DevelopError> {
-        let sowings = vec![Sowing::new(self.clone(), sylva_core::glam::Vec2::ZERO)];
-        crate::work::garden(
-            &settings.world,
-            &sowings,
-            settings.steps,
-            crate::work::Rules::Known,
-        )
-        .check(
-            1,
-            format_args!(
-                "growing a plant {} steps, up to {}",
-                settings.steps,
-                crate::work::bounds(&self.physiology)
-            ),
-            "lower `max_symbols` and `max_modules` in its `physiology`",
-        )
-        .map_err(crate::garden::GardenError::from)?;
-        let mut garden = Garden::new(settings.world, sowings)?;
-        garden.run(settings.steps, &Pool::Serial)?;
-        let mut plant = garden.into_plants().swap_remove(0);
-        plant.meta_mut().seed = seed;
-        Ok(plant)
     }
 }
 

@@ -10,7 +10,8 @@
 //! - [`physiology`]: Thornley's two-substrate transport-resistance model.
 //! - [`growth`]: one plant growing: apexes paying for their rules, rewriting, re-interpreting.
 //! - [`garden`]: plants growing together in a [`sylva_core::environment::Environment`].
-//! - [`genome`]: [`LSystemGenome`], its file format, `develop` and the mutation operator.
+//! - [`genome`]: [`LSystemGenome`], its file format and the mutation operator; it grows
+//!   alone ([`LSystemGenome::develop`]) as a garden of one, within the time budget.
 //! - [`breed`]: the biomorph design loop.
 //! - [`problem`]: runs without a person: the model's settings (the `[lsystem]` config) and
 //!   an [`sylva_evolve::Problem`] that grows each genome alone and scores it.
@@ -34,6 +35,7 @@
 //! ```
 
 pub mod breed;
+mod develop;
 pub mod experiments;
 pub mod garden;
 pub mod genome;

@@ -302,7 +302,7 @@ pub fn regrow(
         )
     })?;
     let text = genome.to_string();
-    let genome = crate::genome::parse_genome(path, &text)?;
+    let genome = crate::registry::parse_genome(path, &text)?;
     let field = |name: &str, why: String| InputError::file(path, format!("extras `{name}`: {why}"));
     let mut options = GrowOptions {
         seed: extras["seed"].as_u64(),

@@ -26,7 +26,8 @@ use crate::Work;
 use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
 use crate::files::read_text;
-use crate::genome::{Genome, expect_model, load_genome};
+use crate::genome::{Genome, expect_model};
+use crate::registry::load_genome;
 
 /// An experiment config with the genomes it names, ready to run.
 pub struct Experiment {

@@ -1,25 +1,150 @@
 //! A genome of any model ([`Genome`]), read from files, grown, and varied by hand.
 //!
-//! A `Genome` holds a model's typed genome beside the model's handle (the crate's one
-//! object-safe face of a model, `erased.rs`), so front ends handle genomes of any model
-//! alike while every operation runs the model's own code. [`Genome::get`] gives the typed genome back for model-specific work.
+//! A `Genome` holds a model's typed genome beside the model that made it, behind one small
+//! object-safe face implemented once for every model (`Face`, below), so front ends handle
+//! genomes of any model alike while every operation runs the model's own code.
+//! [`Genome::get`] gives the typed genome back for model-specific work; a genome of another
+//! model gives `None`, never a panic.
 
+use std::any::Any;
 use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
 use sylva_core::Plant;
-use sylva_model::{Evolve, GenomeError, Knobs, MeshHint, Model, VariationError};
+use sylva_core::rng::ChaCha8Rng;
+use sylva_model::{
+    Bred, DevelopError, GenomeError, Knobs, MeshHint, Model, Parent, VariationError,
+};
 
-use crate::erased::{DynModel, Value};
 use crate::error::{Error, InputError};
-use crate::registry::Registry;
 
 /// A genome of any model.
 #[derive(Clone)]
-pub struct Genome {
-    model: Arc<dyn DynModel>,
-    genome: Arc<Value>,
+pub struct Genome(Arc<dyn Face>);
+
+/// Model `M`'s genome, held with the model that made it.
+struct Typed<M: Model> {
+    model: M,
+    genome: M::Genome,
+}
+
+/// What a genome of any model does, each on its own typed value.
+trait Face: Send + Sync {
+    fn as_any(&self) -> &dyn Any;
+    fn model(&self) -> &'static str;
+    fn title(&self) -> &'static str;
+    fn mesh_hint(&self) -> MeshHint;
+    fn write(&self) -> String;
+    fn to_value(&self) -> serde_json::Value;
+    fn packed(&self) -> Option<String>;
+    fn develop(&self, seed: u64) -> Result<Plant, DevelopError>;
+    fn default_seed(&self) -> u64;
+    fn growth_seconds(&self) -> Option<f64>;
+    /// Whether `other` (of any model) is the same genome.
+    fn same(&self, other: &Genome) -> bool;
+    fn reparse(&self, text: &str) -> Result<Genome, GenomeError>;
+    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError>;
+    /// A child of `parents` (this genome first), which may be of any model: another
+    /// model's is refused, naming the parent.
+    fn cross(
+        &self,
+        parents: &[(&Genome, f64)],
+        settings: Settings<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<(Genome, Vec<usize>), Error>;
+}
+
+impl<M: Model> Typed<M> {
+    /// A genome of this genome's model.
+    fn sibling(&self, genome: M::Genome) -> Genome {
+        Genome::new(self.model.clone(), genome)
+    }
+}
+
+impl<M: Model> Face for Typed<M> {
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn model(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn title(&self) -> &'static str {
+        M::TITLE
+    }
+
+    fn mesh_hint(&self) -> MeshHint {
+        self.model.mesh_hint()
+    }
+
+    fn write(&self) -> String {
+        self.model.write(&self.genome)
+    }
+
+    fn to_value(&self) -> serde_json::Value {
+        // Genomes are plain data: they serialise.
+        serde_json::to_value(&self.genome).unwrap_or(serde_json::Value::Null)
+    }
+
+    fn packed(&self) -> Option<String> {
+        self.model.packed(&self.genome)
+    }
+
+    fn develop(&self, seed: u64) -> Result<Plant, DevelopError> {
+        self.model.develop(&self.genome, seed)
+    }
+
+    fn default_seed(&self) -> u64 {
+        self.model.default_seed(&self.genome)
+    }
+
+    fn growth_seconds(&self) -> Option<f64> {
+        self.model.growth_seconds(&self.genome)
+    }
+
+    fn same(&self, other: &Genome) -> bool {
+        other.get::<M>().is_some_and(|other| *other == self.genome)
+    }
+
+    fn reparse(&self, text: &str) -> Result<Genome, GenomeError> {
+        Ok(self.sibling(self.model.parse(text)?))
+    }
+
+    fn mutate(&self, settings: Settings<'_>, rng: &mut ChaCha8Rng) -> Result<Genome, InputError> {
+        let settings = settings_of(&self.model, settings)?;
+        Ok(self.sibling(self.model.mutate(&self.genome, &settings, rng)))
+    }
+
+    fn cross(
+        &self,
+        parents: &[(&Genome, f64)],
+        settings: Settings<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<(Genome, Vec<usize>), Error> {
+        let settings = settings_of(&self.model, settings)?;
+        let mut typed = Vec::with_capacity(parents.len());
+        for (i, (g, dominance)) in parents.iter().enumerate() {
+            let genome = g.get::<M>().ok_or_else(|| {
+                InputError::new(
+                    format!("parent {i}"),
+                    format!(
+                        "a `{}` genome cannot be crossed with `{}` genomes",
+                        g.model(),
+                        M::NAME
+                    ),
+                )
+            })?;
+            typed.push(Parent {
+                genome,
+                dominance: *dominance,
+            });
+        }
+        let Bred { genome, parents } = (self.model.cross(&typed, &settings, rng))
+            .map_err(|e| InputError::new("parents", e))?;
+        Ok((self.sibling(genome), parents))
+    }
 }
 
 /// What breeding by hand follows.
@@ -64,95 +189,77 @@ pub(crate) fn settings_of<M: Model>(
 
 impl Genome {
     /// A genome of `model`.
-    pub fn new<M: Evolve + Default>(model: M, genome: M::Genome) -> Genome {
-        Genome::erased(Arc::new(model), Box::new(genome))
-    }
-
-    /// `genome`, made by `model`.
-    pub(crate) fn erased(model: Arc<dyn DynModel>, genome: Box<Value>) -> Genome {
-        Genome {
-            model,
-            genome: genome.into(),
-        }
-    }
-
-    /// A genome of this genome's model.
-    fn sibling(&self, genome: Box<Value>) -> Genome {
-        Genome::erased(self.model.clone(), genome)
+    pub fn new<M: Model>(model: M, genome: M::Genome) -> Genome {
+        Genome(Arc::new(Typed { model, genome }))
     }
 
     /// The model's name in files.
     pub fn model(&self) -> &'static str {
-        self.model.name()
+        self.0.model()
     }
 
     /// The model's title.
     pub fn title(&self) -> &'static str {
-        self.model.title()
+        self.0.title()
     }
 
     /// A short text form a person can copy and paste, for a model that has one
     /// ([`sylva_model::Model::packed`]).
     pub fn packed(&self) -> Option<String> {
-        self.model.packed(&*self.genome)
+        self.0.packed()
     }
 
     /// The typed genome, if this is a genome of model `M`.
     pub fn get<M: Model>(&self) -> Option<&M::Genome> {
-        if self.model() != M::NAME {
-            return None;
-        }
-        self.genome.downcast_ref::<M::Genome>()
+        let typed = self.0.as_any().downcast_ref::<Typed<M>>()?;
+        Some(&typed.genome)
     }
 
     /// The genome file's text: pretty JSON ending with a newline.
     pub fn to_json(&self) -> String {
-        self.model.write(&*self.genome)
+        self.0.write()
     }
 
     /// The genome as a JSON value (for the extras of exported assets).
     pub fn to_value(&self) -> serde_json::Value {
-        self.model.to_value(&*self.genome)
+        self.0.to_value()
     }
 
     /// A genome of the same model from a genome file's text (a field changed by hand);
     /// errors carry the line and column.
     pub fn reparse(&self, text: &str) -> Result<Genome, GenomeError> {
-        Ok(self.sibling(self.model.parse_genome(text)?))
+        self.0.reparse(text)
     }
 
     /// Grows the plant with `seed`.
     pub fn develop(&self, seed: u64) -> Result<Plant, Error> {
-        self.model
-            .develop(&*self.genome, seed)
-            .map_err(|source| Error::Develop {
-                model: self.model(),
-                source,
-            })
+        self.0.develop(seed).map_err(|source| Error::Develop {
+            model: self.model(),
+            source,
+        })
     }
 
     /// The seed the genome grows with when none is given.
     pub fn default_seed(&self) -> u64 {
-        self.model.default_seed(&*self.genome)
+        self.0.default_seed()
     }
 
     /// How the model's plants are best meshed.
     pub fn mesh_hint(&self) -> MeshHint {
-        self.model.mesh_hint()
+        self.0.mesh_hint()
     }
 
     /// Seconds growing it may take on one core, for models whose growth can take long
     /// (L-system plants); `None` for the others.
     pub fn growth_seconds(&self) -> Option<f64> {
-        self.model.growth_seconds(&*self.genome)
+        self.0.growth_seconds()
     }
 
     /// A mutated copy, made by the model's own mutation with `settings` (the model's
     /// settings as JSON, or its defaults), drawing from the stream of `seed`.
     pub fn mutate(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, Error> {
         let mut rng = sylva_core::rng::seeded(seed);
-        let child = self.model.mutate(&*self.genome, settings, &mut rng)?;
-        Ok(self.sibling(child))
+        Ok(self.0.mutate(settings, &mut rng)?)
     }
 
     /// A child of two or more parents of one model, each with a dominance weight, made by
@@ -166,14 +273,13 @@ impl Genome {
             return Err(InputError::new("parents", VariationError::TooFewParents(0)).into());
         };
         let mut rng = sylva_core::rng::seeded(seed);
-        let (child, gave) = first.model.cross(parents, settings, &mut rng)?;
-        Ok((first.sibling(child), gave))
+        first.0.cross(parents, settings, &mut rng)
     }
 }
 
 impl PartialEq for Genome {
     fn eq(&self, other: &Genome) -> bool {
-        self.model() == other.model() && self.model.same(&*self.genome, &*other.genome)
+        self.0.same(other)
     }
 }
 
@@ -184,26 +290,6 @@ impl fmt::Debug for Genome {
             .field("genome", &self.to_value())
             .finish()
     }
-}
-
-/// Reads a genome file of any model the standard registry knows; errors point at the line
-/// and column.
-pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
-    Registry::standard().load_genome(path)
-}
-
-/// Parses a genome file already read from `path`.
-pub fn parse_genome(path: &Path, text: &str) -> Result<Genome, InputError> {
-    Registry::standard()
-        .parse_genome(text)
-        .map_err(|e: GenomeError| InputError::genome(path, text, e))
-}
-
-/// Reads a genome file that must be of model `M`; `purpose` says what it is for in the
-/// error (like "gardens grow").
-pub fn load_genome_of<M: Model>(path: &Path, purpose: &str) -> Result<M::Genome, InputError> {
-    let genome = load_genome(path)?;
-    expect_model::<M>(path, &genome, purpose)
 }
 
 /// The typed genome of model `M`, or an error naming `path` and the model it is.

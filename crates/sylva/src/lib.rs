@@ -48,7 +48,6 @@
 
 pub mod assets;
 pub mod biomorph;
-mod erased;
 pub mod error;
 pub mod evolution;
 pub mod experiment;
@@ -70,9 +69,10 @@ pub use evolution::{
     RunConfig, RunHooks, Varieties, Variety,
 };
 pub use experiment::Experiment;
-pub use genome::{Genome, Settings, load_genome, parse_genome};
+pub use genome::{Genome, Settings};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
+pub use registry::{load_genome, parse_genome};
 pub use skeleton::Skeleton;
 pub use sylva_core::dress::{Dress, Dressed};
 pub use sylva_core::species::{BarkKind, LeafKind};

@@ -124,7 +124,7 @@ impl Preset {
         let file: PresetFile =
             toml::from_str(&text).map_err(|e| InputError::toml(path, &text, &e))?;
         let genome_path = path.parent().unwrap_or(Path::new(".")).join(&file.genome);
-        let genome = crate::genome::load_genome(&genome_path)?;
+        let genome = crate::registry::load_genome(&genome_path)?;
         let mut options = GrowOptions {
             seed: file.seed,
             roots: file.roots,

@@ -13,19 +13,85 @@ use serde::Deserialize;
 use sylva_automata::AutomataModel;
 use sylva_bintree::BinTreeModel;
 use sylva_lsystem::LSystemModel;
-use sylva_model::{Evolve, GenomeError};
+use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
 
-use crate::erased::DynModel;
 use crate::error::{FieldError, InputError};
-use crate::evolution::Config;
-use crate::genome::{Genome, Settings};
+use crate::evolution::{Config, EvolveConfig};
+use crate::genome::{Genome, Settings, expect_model, settings_of};
 
 /// A model the library knows: its name and title, how to read its genome files, configs
 /// and checkpoints, make random genomes and run its evolution.
 #[derive(Clone)]
 pub struct ModelEntry {
-    model: Arc<dyn DynModel>,
+    model: Arc<dyn ModelFace>,
+}
+
+/// How many genomes [`ModelEntry::random`] draws, at most, to find one that grows.
+const RANDOM_DRAWS: u32 = 100;
+
+/// What the registry does with a model: read its files and make its first values.
+trait ModelFace: Send + Sync {
+    fn name(&self) -> &'static str;
+    fn title(&self) -> &'static str;
+    fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError>;
+    fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError>;
+    fn parse_config(&self, path: &Path, text: &str) -> Result<Config, InputError>;
+    fn config_from_value(&self, value: serde_json::Value) -> Result<Config, FieldError>;
+    fn default_config(&self) -> Config;
+}
+
+impl<M: Evolve + Default> ModelFace for M {
+    fn name(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn title(&self) -> &'static str {
+        M::TITLE
+    }
+
+    fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError> {
+        Ok(Genome::new(self.clone(), self.parse(text)?))
+    }
+
+    fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
+        let settings = settings_of(self, settings)?;
+        let mut rng = sylva_core::rng::seeded(seed);
+        // Some models' random genomes often grow nothing (the L-system's paper starts from
+        // a genome that does not germinate): draw on from the same stream until one grows.
+        for _ in 0..RANDOM_DRAWS {
+            let genome = Model::random(self, &settings, &mut rng);
+            let seed = Model::default_seed(self, &genome);
+            let grows = Model::develop(self, &genome, seed).is_ok_and(|p| !p.segments().is_empty());
+            if grows {
+                return Ok(Genome::new(self.clone(), genome));
+            }
+        }
+        Err(InputError::new(
+            "settings",
+            format!(
+                "none of the {RANDOM_DRAWS} random {} genomes drawn from seed {seed} grows a \
+                 segment with these settings; expected settings under which some grow",
+                M::NAME
+            ),
+        ))
+    }
+
+    fn parse_config(&self, path: &Path, text: &str) -> Result<Config, InputError> {
+        Ok(Config::new(EvolveConfig::<M>::parse(path, text)?))
+    }
+
+    fn config_from_value(&self, value: serde_json::Value) -> Result<Config, FieldError> {
+        let sent = value.clone();
+        match serde_path_to_error::deserialize::<_, EvolveConfig<M>>(value) {
+            Ok(config) => Ok(Config::new(config)),
+            Err(e) => Err(FieldError::of(&e, &sent)),
+        }
+    }
+
+    fn default_config(&self) -> Config {
+        Config::new(EvolveConfig::<M>::default())
+    }
 }
 
 impl ModelEntry {
@@ -51,18 +117,12 @@ impl ModelEntry {
     /// least one segment with its default seed. After 100 draws that grow nothing (settings
     /// under which nothing can grow) it is an error.
     pub fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError> {
-        let genome = self.model.random(settings, seed)?;
-        Ok(Genome::erased(self.model.clone(), genome))
+        self.model.random(settings, seed)
     }
 
     /// The model's default config.
     pub fn default_config(&self) -> Config {
-        Config::erased(self.model.clone(), self.model.default_config())
-    }
-
-    fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError> {
-        let genome = self.model.parse_genome(text)?;
-        Ok(Genome::erased(self.model.clone(), genome))
+        self.model.default_config()
     }
 }
 
@@ -210,7 +270,7 @@ impl Registry {
         let name = HeaderSeed(self).deserialize(&mut de)?;
         de.end()?;
         match name.and_then(|n| self.get(n)) {
-            Some(entry) => entry.parse_genome(text),
+            Some(entry) => entry.model.parse_genome(text),
             None => Err(GenomeError {
                 message: format!(
                     "missing field `model`: a genome file names its model, one of: {}",
@@ -247,7 +307,7 @@ impl Registry {
             None => self.first().map_err(|e| InputError::file(path, e))?,
         };
         let config = entry.model.parse_config(path, text)?;
-        Ok(Config::erased(entry.model.clone(), config).read_with(Some(path), self))
+        Ok(config.read_with(Some(path), self))
     }
 
     /// A config of any model, built as values rather than read from a file (a front end's
@@ -272,7 +332,7 @@ impl Registry {
             }
         };
         let config = entry.model.config_from_value(value)?;
-        Ok(Config::erased(entry.model.clone(), config).read_with(None, self))
+        Ok(config.read_with(None, self))
     }
 
     /// The default config of the first model (none if the registry is empty).
@@ -286,4 +346,24 @@ impl Registry {
             .first()
             .ok_or_else(|| "this registry has no models".to_owned())
     }
+}
+
+/// Reads a genome file of any model the standard registry knows; errors point at the line
+/// and column.
+pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
+    Registry::standard().load_genome(path)
+}
+
+/// Parses a genome file already read from `path`.
+pub fn parse_genome(path: &Path, text: &str) -> Result<Genome, InputError> {
+    Registry::standard()
+        .parse_genome(text)
+        .map_err(|e: GenomeError| InputError::genome(path, text, e))
+}
+
+/// Reads a genome file that must be of model `M`; `purpose` says what it is for in the
+/// error (like "gardens grow").
+pub fn load_genome_of<M: Model>(path: &Path, purpose: &str) -> Result<M::Genome, InputError> {
+    let genome = load_genome(path)?;
+    expect_model::<M>(path, &genome, purpose)
 }

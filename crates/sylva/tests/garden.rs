@@ -10,7 +10,7 @@ use sylva::garden::{
     Garden, GardenEstimate, GardenLayout, GardenNodes, estimate_garden, garden_glb,
     garden_glb_options, garden_placements, json_heap_bytes,
 };
-use sylva::genome::load_genome_of;
+use sylva::registry::load_genome_of;
 use sylva_plantmaker::PlantMakerModel;
 
 fn conifer() -> sylva_plantmaker::PlantMaker {

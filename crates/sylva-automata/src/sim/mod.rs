@@ -44,8 +44,8 @@
 //! Evolution grows tens of thousands of individuals a second, so the simulator is built for
 //! speed, and each of the following changes the speed and nothing else: `tests/
 //! automata_reference.rs` grows random programs, evolved ones and hand-made corner cases
-//! with this simulator and with [`reference::ReferenceSimulator`], the plain interpreter it
-//! replaced, and requires the same plant and report bit for bit.
+//! with this simulator and with `tests/reference`, the plain interpreter it replaced (kept
+//! with the tests), and requires the same plant and report bit for bit.
 //!
 //! - Blocks: the program's states are regrouped, as they are first reached, so that one
 //!   dispatch runs a loop test, the turns, variable updates and `Repeat` entries after it,
@@ -78,8 +78,6 @@ use sylva_core::{Frame, Organ, OrganKind, Plant, Segment, SegmentId};
 use crate::compile::Program;
 
 mod blocks;
-#[doc(hidden)]
-pub mod reference;
 
 use blocks::{Axis, Block, Blocks, Pure, Term, UNBUILT, Update};
 
@@ -87,8 +85,6 @@ use blocks::{Axis, Block, Blocks, Pure, Term, UNBUILT, Update};
 pub const VARIABLE_LIMIT: f32 = 1e6;
 
 const NONE: u32 = u32::MAX;
-const LENGTH: usize = 0;
-const THICKNESS: usize = 1;
 /// A frame is made orthonormal again when it moves after this many turns (or when anything
 /// else may have disturbed it). One turn with exact sine and cosine moves the vectors off
 /// unit length by about one ulp, so 16 turns stay within 1e-6 and each move costs a few

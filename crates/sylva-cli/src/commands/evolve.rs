@@ -9,31 +9,16 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sylva::assets::{guide_mesh, picture};
-use sylva::core::Plant;
 use sylva::core::budget::Seconds;
 use sylva::evolution::SearchStrategy;
 use sylva::lod::Preview;
-use sylva::mesh::SceneNode;
 use sylva::render::{self, SheetCell, SheetOptions};
 use sylva::report::{fitness_svg, stats_csv};
-use sylva::{Config, Evolution, Genome, GrowOptions, Grown, InputError};
+use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
 
 use sylva::files::Outputs;
 
-pub(super) const CHECKPOINT: &str = "checkpoint.json";
-
-/// Every file a run writes in its folder.
-pub(super) const FILES: [&str; 8] = [
-    CHECKPOINT,
-    "config.toml",
-    "stats.csv",
-    "fitness.svg",
-    "best.json",
-    "best.glb",
-    "best.png",
-    "population.png",
-];
+use super::run_files::{CHECKPOINT, FILES, add_best};
 
 /// Arguments of `sylva evolve`; a flag left out keeps the config's value.
 #[derive(clap::Args)]
@@ -292,31 +277,6 @@ pub(super) fn write_results(
         out.display()
     );
     Ok(())
-}
-
-/// Adds the best plant's files: `best.json`, `best.glb` (with the config's taper, wind and
-/// height) and `best.png` (with `guides`, if any). Returns the plant grown.
-pub(super) fn add_best(
-    files: &mut Outputs,
-    out: &Path,
-    best: &Genome,
-    config: &Config,
-    guides: Option<Plant>,
-) -> anyhow::Result<Grown> {
-    files.add(&out.join("best.json"), best.to_json().as_bytes())?;
-    let grown = Grown::grow(best.clone(), &config.grow_options()?)?;
-    files.add_scene(&out.join("best.glb"), &grown.scene())?;
-    let guides = guides.map(|p| guide_mesh(&p)).transpose()?;
-    let mut scene = grown.scene();
-    if let Some(mesh) = &guides {
-        scene.nodes.push(SceneNode::new("guides", mesh));
-    }
-    let size = config.output().image_size;
-    files.add(
-        &out.join("best.png"),
-        &picture(&scene, config.output().view, (size, size))?,
-    )?;
-    Ok(grown)
 }
 
 /// The most triangles a plant of the contact sheet is drawn with, about: a cell a few

@@ -15,7 +15,8 @@ use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution, InputError, Registry};
 
-use super::evolve::{CHECKPOINT, FILES, write_results};
+use super::evolve::write_results;
+use super::run_files::{CHECKPOINT, FILES};
 
 /// Arguments of `sylva match`.
 #[derive(clap::Args)]

@@ -8,6 +8,7 @@ pub mod grow;
 pub mod inspect;
 pub mod matching;
 pub mod render;
+mod run_files;
 pub mod simulate;
 pub mod studio;
 pub mod varieties;

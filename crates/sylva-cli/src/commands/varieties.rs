@@ -11,7 +11,7 @@ use sylva::render::map::{MapAxis, MapPicture, map_picture};
 use sylva::report::map_stats_csv;
 use sylva::{Config, GrowOptions, Grown, InputError, Varieties, Variety};
 
-use super::evolve::CHECKPOINT;
+use super::run_files::{CHECKPOINT, add_best};
 
 /// Every file a map run writes in its folder (and `archive/cell-N.json`, one per elite).
 pub(super) const FILES: [&str; 8] = [
@@ -209,7 +209,7 @@ fn write_results(map: &Varieties, config: &Config, out: &Path, pool: &Pool) -> a
         &out.join("archive.png"),
         &archive_png(map, &varieties, config, pool)?,
     )?;
-    super::evolve::add_best(&mut files, out, &best.member.genome, config, map.guides())?;
+    add_best(&mut files, out, &best.member.genome, config, map.guides())?;
     files.commit()?;
     remove_stale_cells(out, &varieties);
 

@@ -1,28 +1,22 @@
-//! A config of any model ([`Config`]), and what it takes to start or resume a run of it.
+//! A config of any model ([`Config`]): read, built in code, changed, and written back.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
-use sylva_core::par::Pool;
-use sylva_evolve::{Run, RunSettings, WithTerm};
 use sylva_model::Evolve;
 
 use crate::assets::GrowOptions;
-use crate::erased::{DynModel, Value};
-use crate::error::{Error, FieldError, InputError};
+use crate::error::{FieldError, InputError};
 use crate::genome::Genome;
 use crate::registry::Registry;
 
-use super::checkpoint::SavedRun;
-use super::hooks::{RunHooks, Scored, check_resumed, check_term, first_generation};
-use super::run::{Hooked, TypedRun};
-use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig, SearchStrategy};
+use super::face::{ConfigFace, Where};
+use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig};
+use super::typed::GenerationTime;
 
 /// An evolution config of any model.
 pub struct Config {
-    model: Arc<dyn DynModel>,
     /// The model's `EvolveConfig`.
-    config: Box<Value>,
+    face: Box<dyn ConfigFace>,
     /// The file it was read from, named in errors.
     source: Option<PathBuf>,
     /// The registry it was read with, which reads its start genomes; `None`: the standard.
@@ -38,273 +32,10 @@ pub fn evaluations_done() -> u64 {
     sylva_evolve::problem::evaluations()
 }
 
-/// How long a generation of a run may take ([`Config::generation_time`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct GenerationTime {
-    /// Seconds, at the settings' bounds.
-    pub seconds: f64,
-    /// What a generation does, naming the settings it follows.
-    pub what: String,
-    /// What to change to make it shorter.
-    pub advice: String,
-}
-
-/// Starts a run of `config`: generation 0 made and evaluated. A refusal names the config
-/// (`source`).
-pub(crate) fn start<M: Evolve + Default>(
-    config: &EvolveConfig<M>,
-    source: &str,
-    base: &Path,
-    start: Vec<Genome>,
-    pool: Pool,
-    hooks: RunHooks,
-) -> Result<TypedRun<M>, Error> {
-    if config.run.strategy == SearchStrategy::MapElites {
-        return Err(InputError::new(
-            source,
-            "`[run] strategy = \"map-elites\"` fills a map of varieties: run it with `sylva \
-             evolve`, or as varieties (sylva.varieties in Python), not as one population",
-        )
-        .into());
-    }
-    let typed = typed_start::<M>(&start)?;
-    let (seed, population) = (config.run.seed, config.run.population as usize);
-    // A population and its offspring, each genome at the settings' bounds.
-    let genome = config.model.genome_bytes(&config.settings);
-    sylva_core::budget::check(
-        (population as u64).saturating_mul(genome).saturating_mul(2),
-        format_args!("a population of {population} (`population`)"),
-        "breed a smaller population, or smaller genomes",
-    )
-    .map_err(|e| InputError::new(source, e).over_limit())?;
-    let made = |start: Vec<M::Genome>| {
-        setup(
-            &config.model,
-            &config.settings,
-            start,
-            seed,
-            population,
-            source,
-        )
-    };
-    // With an own term, the model is set up twice more: to make generation 0 once without its
-    // fitness, and to foresee each generation's genomes (`hooks.rs`).
-    let again = hooks.term.as_ref().map(|_| typed.clone());
-    let setup = made(typed)?;
-    let scout = || Ok(made(again.clone().unwrap_or_default())?.strategy);
-    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
-    // The settings are valid; generation 0 grows as the run is made.
-    if let Some(t) = config.generation_time(&start, hooked.pool.threads()) {
-        sylva_core::budget::check_time(t.seconds, t.what, t.advice)
-            .map_err(|e| InputError::new(source, e).over_limit())?;
-    }
-    let settings = RunSettings {
-        seed,
-        population,
-        keep_history: 0,
-    };
-    let refused = |e| InputError::new("[run]", e);
-    if let Some(scored) = &hooked.scored {
-        // Generation 0 made once more without the model's fitness, to score it in batches.
-        let again = made(again.unwrap_or_default())?;
-        let first = first_generation(
-            &problem.problem,
-            again.strategy,
-            &hooked.pool,
-            settings.clone(),
-            again.first,
-        )
-        .map_err(refused)?;
-        scored.prepare(&problem.problem, &first, &hooked.pool)?;
-    }
-    let run = Run::with_genomes(
-        problem,
-        setup.strategy,
-        hooked.pool.clone(),
-        settings,
-        setup.first,
-    )
-    .map_err(refused)?;
-    let typed = TypedRun {
-        config: config.clone(),
-        run,
-        hooked,
-    };
-    typed.failure()?;
-    Ok(typed)
-}
-
-/// The problem of `config` with its added term (the `[match]` outline or `hooks`' own term,
-/// not both), and the hooks at work; with an own term, a second breeding of the model made
-/// by `scout`, to foresee what generations evaluate.
-fn with_hooks<M: Evolve + Default>(
-    config: &EvolveConfig<M>,
-    problem: M::Problem,
-    base: &Path,
-    pool: Pool,
-    hooks: RunHooks,
-    scout: impl FnOnce() -> Result<M::Strategy, InputError>,
-) -> Result<(WithTerm<M::Problem>, Hooked<M>), InputError> {
-    let mut hooked = Hooked::none(pool);
-    hooked.stop = hooks.stop;
-    let Some(own) = hooks.term else {
-        return Ok((with_term(config, problem, base)?, hooked));
-    };
-    if config.outline.is_some() {
-        return Err(InputError::new(
-            "fitness",
-            "the config's `[match]` section adds its outline term already, and a run takes one \
-             term of its own: leave `[match]` out, or score the outline in the function",
-        ));
-    }
-    check_term(&own, &sylva_evolve::Problem::term_names(&problem))?;
-    let scored = Arc::new(Scored::new(&config.model, &own));
-    hooked.scored = Some(scored.clone());
-    hooked.scout = Some(scout()?);
-    let added = sylva_evolve::Added {
-        term: scored as Arc<dyn sylva_evolve::Term<M::Problem>>,
-        weight: own.weight,
-        beside: own.beside,
-    };
-    Ok((
-        WithTerm {
-            problem,
-            added: Some(added),
-        },
-        hooked,
-    ))
-}
-
-/// The start genomes as model `M`'s; another model's is refused.
-pub(super) fn typed_start<M: Evolve>(start: &[Genome]) -> Result<Vec<M::Genome>, InputError> {
-    start
-        .iter()
-        .enumerate()
-        .map(|(i, g)| {
-            g.get::<M>().cloned().ok_or_else(|| {
-                InputError::new(
-                    format!("start genome {}", i + 1),
-                    format!(
-                        "this run evolves `{}` genomes; this is a `{}` genome",
-                        M::NAME,
-                        g.model()
-                    ),
-                )
-            })
-        })
-        .collect()
-}
-
-/// Resumes the run of `config` saved in a checkpoint's `text` (read from `path`).
-#[allow(clippy::too_many_arguments)] // The erased model's call, one argument each.
-pub(crate) fn resume<M: Evolve + Default>(
-    config: &EvolveConfig<M>,
-    source: &str,
-    base: &Path,
-    path: &Path,
-    text: &str,
-    pool: Pool,
-    hooks: RunHooks,
-) -> Result<TypedRun<M>, Error> {
-    let saved = SavedRun::<M>::parse(path, text)?;
-    if saved.config.resumable() != config.resumable() {
-        return Err(InputError::file(
-            path,
-            "the checkpoint was written by a different config (only `generations`, \
-             `threads` and `checkpoint_seconds` may change when resuming)",
-        )
-        .into());
-    }
-    check_resumed(saved.own_term.as_ref(), hooks.term.as_ref())
-        .map_err(|e| InputError::file(path, e))?;
-    let made = || setup(&config.model, &config.settings, Vec::new(), 0, 0, source);
-    let setup = made()?;
-    let scout = || Ok(made()?.strategy);
-    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
-    if let Some(scored) = &hooked.scored {
-        // The engine scores a resumed population again.
-        let genomes = saved.checkpoint.population.iter().map(|i| &i.genome);
-        scored.prepare(&problem.problem, genomes, &hooked.pool)?;
-    }
-    let run = Run::resume(
-        problem,
-        setup.strategy,
-        hooked.pool.clone(),
-        saved.checkpoint,
-    )
-    .map_err(|e| InputError::file(path, e))?;
-    let typed = TypedRun {
-        config: config.clone(),
-        run,
-        hooked,
-    };
-    typed.failure()?;
-    Ok(typed)
-}
-
-impl<M: Evolve + Default> EvolveConfig<M> {
-    /// How long a generation may take on `threads` threads ([`Config::generation_time`]).
-    pub(crate) fn generation_time(
-        &self,
-        start: &[Genome],
-        threads: usize,
-    ) -> Option<GenerationTime> {
-        let first = start.first().and_then(|g| g.get::<M>());
-        let t = self.model.evaluation_time(&self.settings, first)?;
-        let population = self.run.population as usize;
-        // A generation evaluates up to `population` genomes, side by side on the threads.
-        let threads = threads.clamp(1, population.max(1));
-        let rounds = population.div_ceil(threads);
-        let on = match threads {
-            1 => "1 thread".to_owned(),
-            n => format!("{n} threads"),
-        };
-        Some(GenerationTime {
-            seconds: t.seconds * rounds as f64,
-            what: format!(
-                "a generation of {population} genomes (`population`) on {on}, each {}",
-                t.what
-            ),
-            advice: t.advice,
-        })
-    }
-}
-
-/// The model's problem with the config's `[match]` term, if it has one, its pictures read
-/// relative to `base`.
-pub(super) fn with_term<M: Evolve>(
-    config: &EvolveConfig<M>,
-    problem: M::Problem,
-    base: &Path,
-) -> Result<WithTerm<M::Problem>, InputError> {
-    let added = config
-        .outline
-        .as_ref()
-        .map(|outline| super::outline::added(&config.model, outline, base))
-        .transpose()?;
-    Ok(WithTerm { problem, added })
-}
-
-/// The model's problem and strategy for `settings`; a refusal names the config (`source`)
-/// and the model's section.
-pub(super) fn setup<M: Evolve>(
-    model: &M,
-    settings: &M::Settings,
-    start: Vec<M::Genome>,
-    seed: u64,
-    population: usize,
-    source: &str,
-) -> Result<sylva_model::Setup<M>, InputError> {
-    model
-        .setup(settings, start, seed, population)
-        .map_err(|e| InputError::new(source, format!("[{}.{}]: {}", M::NAME, e.field, e.message)))
-}
-
 impl Clone for Config {
     fn clone(&self) -> Self {
         Config {
-            model: self.model.clone(),
-            config: self.model.clone_config(&*self.config),
+            face: self.face.clone_face(),
             source: self.source.clone(),
             registry: self.registry.clone(),
             base: self.base.clone(),
@@ -347,23 +78,30 @@ impl std::fmt::Debug for Config {
 impl Config {
     /// A config of model `M`.
     pub fn new<M: Evolve + Default>(config: EvolveConfig<M>) -> Config {
-        Config::erased(Arc::new(config.model.clone()), Box::new(config))
+        Config::of(Box::new(config))
     }
 
-    /// `config`, of `model`.
-    pub(crate) fn erased(model: Arc<dyn DynModel>, config: Box<Value>) -> Config {
+    /// The config `face` stands for.
+    pub(super) fn of(face: Box<dyn ConfigFace>) -> Config {
         Config {
-            model,
-            config,
+            face,
             source: None,
             registry: None,
             base: None,
         }
     }
 
-    /// The model's handle and its typed config, for starting and resuming runs.
-    pub(super) fn parts(&self) -> (&Arc<dyn DynModel>, &Value) {
-        (&self.model, &*self.config)
+    /// The typed config's face, for starting and resuming runs.
+    pub(super) fn face(&self) -> &dyn ConfigFace {
+        &*self.face
+    }
+
+    /// How errors name the config and where its files are found.
+    pub(super) fn at(&self) -> Where {
+        Where {
+            source: self.source(),
+            base: self.base(),
+        }
     }
 
     /// This config, read from `path` with `registry` (which reads its start genomes).
@@ -422,27 +160,27 @@ impl Config {
 
     /// The model evolved.
     pub fn model(&self) -> &'static str {
-        self.model.name()
+        self.face.model()
     }
 
     /// Run size and seed.
     pub fn run(&self) -> &RunConfig {
-        self.model.run_settings(&*self.config)
+        self.face.run()
     }
 
     /// Run size and seed, to change (the command line's flags do).
     pub fn run_mut(&mut self) -> &mut RunConfig {
-        self.model.run_settings_mut(&mut *self.config)
+        self.face.run_mut()
     }
 
     /// What a run writes.
     pub fn output(&self) -> &OutputConfig {
-        self.model.output(&*self.config)
+        self.face.output()
     }
 
     /// The `[match]` section, if any.
     pub fn outline(&self) -> Option<&MatchConfig> {
-        self.model.outline(&*self.config)
+        self.face.outline()
     }
 
     /// How the run's best plant is grown for its files: `[output]`'s taper, wind and
@@ -451,7 +189,7 @@ impl Config {
     pub fn grow_options(&self) -> Result<GrowOptions, InputError> {
         let output = self.output();
         let pruned_to = match self.outline() {
-            Some(outline) => super::outline::space(outline, &self.base())?,
+            Some(outline) => super::silhouette::space(outline, &self.base())?,
             None => None,
         };
         Ok(GrowOptions {
@@ -466,29 +204,29 @@ impl Config {
 
     /// What a run writes, to change (`sylva match --height` does).
     pub fn output_mut(&mut self) -> &mut OutputConfig {
-        self.model.output_mut(&mut *self.config)
+        self.face.output_mut()
     }
 
     /// The model's settings (its section of the config) as JSON: what breeding by hand
     /// keeps of a run's settings ([`crate::Settings::KnobsOver`]).
     pub fn model_settings(&self) -> serde_json::Value {
-        self.model.settings_value(&*self.config)
+        self.face.settings_value()
     }
 
     /// The config as TOML.
     pub fn to_toml(&self) -> String {
-        self.model.to_toml(&*self.config)
+        self.face.to_toml()
     }
 
     /// The typed config, if this is a config of model `M`.
     pub fn get<M: Evolve + Default>(&self) -> Option<&EvolveConfig<M>> {
-        self.config.downcast_ref()
+        self.face.as_any().downcast_ref()
     }
 
     /// Genome files the model's settings name as the first generation's origin, relative
     /// to the config file.
     pub fn start_files(&self) -> Vec<PathBuf> {
-        self.model.start_files(&*self.config)
+        self.face.start_files()
     }
 
     /// How long a generation of this run may take on `threads` threads, for models whose
@@ -496,7 +234,7 @@ impl Config {
     /// the start genomes ([`Config::load_start`]). [`Evolution::start`](super::Evolution::start) refuses a run whose
     /// generation is over the time budget.
     pub fn generation_time(&self, start: &[Genome], threads: usize) -> Option<GenerationTime> {
-        self.model.generation_time(&*self.config, start, threads)
+        self.face.generation_time(start, threads)
     }
 
     /// Reads the genome files of [`Config::start_files`] from `base` (the config file's

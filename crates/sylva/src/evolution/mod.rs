@@ -33,41 +33,47 @@
 //!
 //! - `schema.rs`: what a config file holds ([`EvolveConfig`] of one model, its `[run]` and
 //!   `[output]`), read with every number checked.
-//! - `config.rs`: [`Config`], a config of any model, and what it takes to start or resume
-//!   a run of it.
-//! - `run.rs`: [`Evolution`], a run of any model, and its [`Member`]s.
-//!
-//! Each holds its model's handle (`erased.rs`) beside the typed value.
+//! - `config.rs`: [`Config`], a config of any model.
+//! - `run.rs`: [`Evolution`], a run of any model.
+//! - `typed.rs`: a run of one model, typed: started from its config or resumed, and its
+//!   population as [`Member`]s.
+//! - `face.rs`: the object-safe faces by which [`Config`], [`Evolution`] and
+//!   [`Varieties`] hold a config, a run and a map of one model as any model's, each
+//!   implemented once for the typed value it stands for.
 //! - `checkpoint.rs`: the checkpoint file a run resumes from.
 //! - `hooks.rs`: what a front end adds to a run ([`RunHooks`]): a [`Stop`] that cuts a long
 //!   generation short, and a fitness term of its own scored a batch of plants at a time.
-//! - `outline.rs`: the `[match]` term, a plant's silhouette against target pictures.
-//! - `varieties.rs`: [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
+//! - `silhouette.rs`: the `[match]` term, a plant's silhouette against target pictures.
+//! - `outline.rs`: matches, runs towards target pictures, and `auto` across the models.
+//! - `typed_map.rs` and `varieties.rs`: a MAP-Elites run of one model, typed, and
+//!   [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
 //!   "map-elites"` and `[map]`): a map of the fittest plant of every kind.
-//! - `space.rs`: [`GenomeSpace`], any model's genomes as vectors of numbers, decoded and
-//!   scored as a map run scores them, for optimisers outside Sylva.
+//! - `typed_space.rs` and `space.rs`: [`GenomeSpace`], any model's genomes as vectors of
+//!   numbers, decoded and scored as a map run scores them, for optimisers outside Sylva.
 
 mod checkpoint;
 mod config;
+mod face;
 mod hooks;
 pub mod outline;
 mod run;
 mod schema;
+mod silhouette;
 mod space;
+mod typed;
+mod typed_map;
+mod typed_space;
 mod varieties;
 
 pub use checkpoint::checkpoint_model;
-pub use config::{Config, GenerationTime, evaluations_done};
-pub(crate) use config::{resume, start};
+pub use config::{Config, evaluations_done};
 pub use hooks::{OwnTerm, PlantScorer, RunHooks, ScorerError, Stop, Stopped};
-pub(crate) use run::TypedRun;
-pub use run::{Evolution, Member};
+pub use run::Evolution;
 pub use schema::{
     AxisConfig, EmitterKind, EvolveConfig, MapConfig, MatchConfig, OutputConfig, RunConfig,
     SearchStrategy, WindConfig,
 };
 pub use space::{Coding, Codons, GenomeSpace, MAX_DIM, Scores, SpaceOptions};
-pub(crate) use space::{SpaceValue, new_space};
 pub use sylva_fitness::descriptors::Descriptor;
-pub(crate) use varieties::{MapValue, resume_map, start_map};
+pub use typed::{GenerationTime, Member};
 pub use varieties::{Varieties, Variety};

@@ -3,20 +3,31 @@
 //! test) and nothing else.
 //!
 //! It is kept, unchanged, as the baseline and the test oracle of
-//! [`Simulator`](super::Simulator): `tests/automata_reference.rs` grows random, evolved and
-//! hand-made programs with both and requires the same [`Plant`] and [`GrowthReport`] bit for
-//! bit, and every group of `benches/automata.rs` measures both in one run. It is not meant
-//! for other uses.
+//! [`Simulator`](sylva_automata::sim::Simulator): `tests/automata_reference.rs` grows random,
+//! evolved and hand-made programs with both and requires the same [`Plant`] and
+//! [`GrowthReport`] bit for bit, and every group of `benches/automata.rs` measures both in one
+//! run (it includes this file). It lives with the tests, outside the crate it checks.
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 use sylva_core::{Frame, Organ, OrganKind, Plant, SegmentId};
 
-use super::{
-    ChildVariables, Detail, GOLDEN_ANGLE, GrowOptions, GrowthReport, LEAF_DROOP, LENGTH, NONE,
-    RENORMALISE, Stop, THICKNESS, VARIABLE_LIMIT, map_thickness,
+use sylva_automata::compile::{Op, Program, State};
+use sylva_automata::sim::{
+    ChildVariables, Detail, GrowOptions, GrowthReport, Stop, VARIABLE_LIMIT, map_thickness,
 };
-use crate::compile::{Op, Program, State};
-use crate::tree::{VARIABLES, Var};
+use sylva_automata::tree::{VARIABLES, Var};
+
+// The simulator's own constants, repeated: the oracle stands apart from what it checks (a
+// change to one of them shows as a difference in the tests).
+const NONE: u32 = u32::MAX;
+const LENGTH: usize = 0;
+const THICKNESS: usize = 1;
+/// Turns after which a frame is made orthonormal again.
+const RENORMALISE: u8 = 16;
+/// The golden angle, radians.
+const GOLDEN_ANGLE: f32 = 2.399_963_2;
+/// Leaves droop this far below horizontal, radians (10°).
+const LEAF_DROOP: f32 = 0.174_532_93;
 
 /// One live or dead automaton instance.
 #[derive(Clone, Copy, Debug)]
