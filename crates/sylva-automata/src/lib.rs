@@ -201,6 +201,13 @@ impl Evolve for AutomataModel {
     type Problem = AutomataProblem;
     type Strategy = AutomataStrategy;
 
+    /// Most offspring are mutants (Koza's 88% crossover finds a shape's kind; an outline
+    /// is fitted by small steps). Measured on the tuning outlines (`examples/match`,
+    /// docs/match.md), the outline term's mean rose from 0.595 to 0.704 (20 s a target).
+    fn fitting(&self, settings: &mut AutomataSettings) {
+        settings.breeding = sylva_evolve::GenerationalSettings::mostly_mutants();
+    }
+
     fn setup(
         &self,
         settings: &AutomataSettings,

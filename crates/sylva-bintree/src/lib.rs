@@ -117,6 +117,13 @@ impl Evolve for BinTreeModel {
     type Problem = BinTreeProblem;
     type Strategy = BinTreeStrategy;
 
+    /// Flips 5% of the bits rather than Susinno's 2%. Measured on the tuning outlines
+    /// (`examples/match`, docs/match.md), the outline term's mean rose from 0.661 to 0.696
+    /// (20 s a target).
+    fn fitting(&self, settings: &mut BinTreeSettings) {
+        settings.mutation_rate = 0.05;
+    }
+
     fn setup(
         &self,
         settings: &BinTreeSettings,

@@ -84,16 +84,20 @@ fn main() -> ExitCode {
     let command = cli.command;
     // A panic would be a bug in Sylva: it is reported as one, in one line, with exit code 1.
     std::panic::set_hook(Box::new(diagnostic::report_bug));
-    let result = std::panic::catch_unwind(|| match command {
-        Command::Evolve(args) => commands::evolve::run(&args),
-        Command::Grow(args) => commands::grow::run(&args),
-        Command::Match(args) => commands::matching::run(&args),
-        Command::Garden(args) => commands::garden::run(&args),
-        Command::Simulate(args) => commands::simulate::run(&args),
-        Command::Breed(args) => commands::breed::run(&args),
-        Command::Render(args) => commands::render::run(&args),
-        Command::Inspect(args) => commands::inspect::run(&args),
-        Command::Studio(args) => commands::studio::run(&args),
+    let result = std::panic::catch_unwind(|| {
+        // The models this program knows, built once here and passed to every command.
+        let models = sylva::Registry::standard();
+        match command {
+            Command::Evolve(args) => commands::evolve::run(&models, &args),
+            Command::Grow(args) => commands::grow::run(&models, &args),
+            Command::Match(args) => commands::matching::run(&models, &args),
+            Command::Garden(args) => commands::garden::run(&models, &args),
+            Command::Simulate(args) => commands::simulate::run(&models, &args),
+            Command::Breed(args) => commands::breed::run(&models, &args),
+            Command::Render(args) => commands::render::run(&models, &args),
+            Command::Inspect(args) => commands::inspect::run(&models, &args),
+            Command::Studio(args) => commands::studio::run(models, &args),
+        }
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

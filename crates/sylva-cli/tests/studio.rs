@@ -1821,7 +1821,9 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
             pruned_to,
             ..sylva::GrowOptions::default()
         };
-        let genome = sylva::parse_genome(Path::new("genome.json"), text).unwrap();
+        let genome = sylva::Registry::standard()
+            .parse_genome_at(Path::new("genome.json"), text)
+            .unwrap();
         sylva::Grown::grow(genome, &options)
             .unwrap()
             .mesh
@@ -1953,11 +1955,12 @@ fn plants_branched_from_a_match_breed_in_its_colours() {
         .unwrap();
     let genome_of = |plant: i64| -> sylva::Genome {
         let row = get(&server, &format!("/api/plants/{plant}"));
-        sylva::parse_genome(
-            Path::new("genome.json"),
-            row["genome_text"].as_str().unwrap(),
-        )
-        .unwrap()
+        sylva::Registry::standard()
+            .parse_genome_at(
+                Path::new("genome.json"),
+                row["genome_text"].as_str().unwrap(),
+            )
+            .unwrap()
     };
     let in_foliage = |g: &sylva::Genome| {
         let g: &PlantMaker = g.get::<PlantMakerModel>().unwrap();

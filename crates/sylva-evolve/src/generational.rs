@@ -175,6 +175,20 @@ impl Default for GenerationalSettings {
 }
 
 impl GenerationalSettings {
+    /// Breeding that fits a target by many small steps from good members: 70% of offspring
+    /// mutants and 30% crossovers, none copied, the five best kept as they are and not
+    /// re-evaluated (what a match of the generational models breeds with: `Evolve::fitting`).
+    pub fn mostly_mutants() -> GenerationalSettings {
+        GenerationalSettings {
+            crossover: 0.3,
+            mutation: 0.7,
+            reproduction: 0.0,
+            elitism: 5,
+            reevaluate: false,
+            ..GenerationalSettings::default()
+        }
+    }
+
     /// Checks the tournament size and that the rates are in 0..=1 and add up to 1.
     pub fn validate(&self) -> Result<(), GenerationalError> {
         if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {

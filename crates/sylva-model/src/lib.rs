@@ -379,6 +379,13 @@ pub trait Evolve: Model {
         + Send
         + 'static;
 
+    /// The settings a match breeds with (a run towards target outlines, `sylva match`):
+    /// `settings`, the model's defaults, changed where fitting an outline wants otherwise.
+    /// An outline is fitted by many small steps from good plants rather than by recombining
+    /// distant ones, so a model whose defaults are the papers' (made to find a shape's kind)
+    /// breeds mostly mutants here. The default changes nothing.
+    fn fitting(&self, _settings: &mut Self::Settings) {}
+
     /// Genome files the settings name (relative to the config file), read by the caller and
     /// given to [`Evolve::setup`] as `start`.
     fn start_files(&self, _settings: &Self::Settings) -> Vec<PathBuf> {

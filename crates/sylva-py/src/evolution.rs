@@ -44,7 +44,7 @@ impl Config {
             run.insert(field.to_owned(), value);
         }
         let text = toml::to_string(&table).map_err(|e| bad_value(field, e))?;
-        let inner = (self.inner.registry())
+        let inner = crate::registry()
             .parse_config(Path::new(DICT), &text)
             .map_err(|e| field_error(e, &text))
             .map_err(|e| input_error(&e))?;
@@ -538,7 +538,10 @@ impl Evolution {
         let fitness = Fitness::of(fitness, fitness_weight, fitness_mode, fitness_batch)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
-            None => config.inner.load_start(&config.base).py()?,
+            None => config
+                .inner
+                .load_start(crate::registry(), &config.base)
+                .py()?,
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;

@@ -218,8 +218,8 @@ impl Genome {
         bark: Option<&str>,
         density: Option<f32>,
     ) -> PyResult<Plant> {
-        let preset =
-            sylva::preset::Preset::load(&path).map_err(|e| crate::errors::input_error(&e))?;
+        let preset = sylva::preset::Preset::load(crate::registry(), &path)
+            .map_err(|e| crate::errors::input_error(&e))?;
         let options = sylva::GrowOptions {
             seed: seed.or(preset.options.seed),
             height: height_value(height)?.or(preset.options.height),

@@ -43,14 +43,14 @@ static MODELS: OnceLock<Registry> = OnceLock::new();
 /// The models genome files, configs and random genomes are read and made with: the
 /// registry the module was made with, or Sylva's four.
 pub(crate) fn registry() -> &'static Registry {
-    MODELS.get().unwrap_or(Registry::standard())
+    MODELS.get_or_init(Registry::standard)
 }
 
 /// Sylva's native module, with Sylva's four models.
 #[cfg(feature = "module")]
 #[pymodule]
 fn _sylva(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    init(m, Registry::standard().clone())
+    init(m, Registry::standard())
 }
 
 /// Fills `m` with Sylva's classes and functions, reading and making genomes and configs
@@ -60,7 +60,7 @@ fn _sylva(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// ```ignore
 /// #[pymodule]
 /// fn _mytrees(m: &Bound<'_, PyModule>) -> PyResult<()> {
-///     let models = sylva::Registry::standard().clone().with(ModelEntry::of::<MyModel>());
+///     let models = sylva::Registry::standard().with(ModelEntry::of::<MyModel>());
 ///     _sylva::init(m, models)
 /// }
 /// ```

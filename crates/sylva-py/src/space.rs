@@ -143,7 +143,10 @@ impl GenomeSpace {
         };
         let options = SpaceOptions { coding, dim, seed };
         let pool = Evolution::pool(&config.inner, threads)?;
-        let start = config.inner.load_start(&config.base).py()?;
+        let start = config
+            .inner
+            .load_start(crate::registry(), &config.base)
+            .py()?;
         let inner = &config.inner;
         let space = py
             .detach(|| sylva::GenomeSpace::new(inner, start, &options))

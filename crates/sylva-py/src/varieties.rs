@@ -197,7 +197,10 @@ impl Varieties {
         let config = Config::from_any(config)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
-            None => config.inner.load_start(&config.base).py()?,
+            None => config
+                .inner
+                .load_start(crate::registry(), &config.base)
+                .py()?,
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;

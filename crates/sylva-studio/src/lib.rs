@@ -79,7 +79,7 @@ impl Default for Options {
             port: 8417,
             db: PathBuf::from("sylva-studio.db"),
             allow_hosts: Vec::new(),
-            registry: Registry::standard().clone(),
+            registry: Registry::standard(),
         }
     }
 }
@@ -154,7 +154,7 @@ impl Deref for Studio {
 impl Studio {
     /// A studio of the standard models on an archive, guarded by `guard`.
     pub fn new(archive: Archive, guard: guard::Guard) -> Studio {
-        Studio::with_registry(archive, guard, Registry::standard().clone())
+        Studio::with_registry(archive, guard, Registry::standard())
     }
 
     /// A studio of the models of `registry` (the standard ones and a user's own).

@@ -16,7 +16,11 @@ use sylva::{Dress, GrowOptions, Grown};
 
 fn dress(c: &mut Criterion) {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let preset = Preset::load(&here.join("../../examples/species/oak.toml")).unwrap();
+    let preset = Preset::load(
+        &sylva::Registry::standard(),
+        &here.join("../../examples/species/oak.toml"),
+    )
+    .unwrap();
     let dressed = preset.options.clone();
     let bare = GrowOptions {
         dress: Dress::default(),

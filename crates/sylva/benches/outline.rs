@@ -18,7 +18,9 @@ use sylva_fitness::silhouette::{Outline, SPACE_ROWS, Scratch, Side, prune, score
 
 fn outline(c: &mut Criterion) {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let genome = sylva::load_genome(&here.join("benches/umbrella-plantmaker.json")).unwrap();
+    let genome = sylva::Registry::standard()
+        .load_genome(&here.join("benches/umbrella-plantmaker.json"))
+        .unwrap();
     let seed = genome.default_seed();
     let plant = genome.develop(seed).unwrap();
     let picture = here.join("../../examples/match/umbrella.png");

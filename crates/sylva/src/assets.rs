@@ -27,6 +27,7 @@ use sylva_render::{RenderOptions, View};
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
+use crate::registry::Registry;
 
 /// How plants of a model are meshed: the defaults, with the model's hints applied.
 pub fn mesh_options(hint: MeshHint) -> MeshOptions {
@@ -92,7 +93,7 @@ impl Origin {
 ///
 /// ```no_run
 /// # use sylva::assets::{GrowOptions, Grown};
-/// # let genome = sylva::load_genome("examples/plantmaker/fern.json".as_ref())?;
+/// # let genome = sylva::Registry::standard().load_genome("examples/plantmaker/fern.json".as_ref())?;
 /// let grown = Grown::grow(genome, &GrowOptions { seed: Some(7), roots: false, ..Default::default() })?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -292,6 +293,7 @@ pub fn dress_extras(extras: &mut serde_json::Value, dress: &Dress) {
 /// [`Grown::scene`] adds: seed, taper, height, foliage, bark, density), as the genome and
 /// the options that grow it again. `path` names the file in errors.
 pub fn regrow(
+    registry: &Registry,
     extras: &serde_json::Value,
     path: &Path,
 ) -> Result<(Genome, GrowOptions), InputError> {
@@ -302,7 +304,7 @@ pub fn regrow(
         )
     })?;
     let text = genome.to_string();
-    let genome = crate::registry::parse_genome(path, &text)?;
+    let genome = registry.parse_genome_at(path, &text)?;
     let field = |name: &str, why: String| InputError::file(path, format!("extras `{name}`: {why}"));
     let mut options = GrowOptions {
         seed: extras["seed"].as_u64(),

@@ -7,7 +7,7 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use sylva::biomorph::{BiomorphOptions, Biomorphs};
 //! let path = std::path::Path::new("examples/lsystem/herb.json");
-//! let mother = sylva::load_genome(path)?;
+//! let mother = sylva::Registry::standard().load_genome(path)?;
 //! let sown = Biomorphs::sow(&mother, path, &BiomorphOptions::default(), 1)?;
 //! let pool = sylva::core::par::Pool::with_threads(0)?;
 //! let garden = sown.grow(&pool, &mut |_step| {})?;

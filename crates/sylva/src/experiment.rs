@@ -4,7 +4,7 @@
 //!
 //! ```no_run
 //! # fn main() -> Result<(), sylva::Error> {
-//! let experiment = sylva::Experiment::load("examples/lsystem/herbs-under-tree.toml".as_ref())?;
+//! let experiment = sylva::Experiment::load(&sylva::Registry::standard(), "examples/lsystem/herbs-under-tree.toml".as_ref())?;
 //! let pool = sylva::core::par::Pool::with_threads(0)?;
 //! let result = experiment.run(&pool, &mut |_step| {})?;
 //! print!("{}", result.report);
@@ -27,7 +27,7 @@ use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
 use crate::files::read_text;
 use crate::genome::{Genome, expect_model};
-use crate::registry::load_genome;
+use crate::registry::Registry;
 
 /// An experiment config with the genomes it names, ready to run.
 pub struct Experiment {
@@ -52,7 +52,7 @@ pub struct ExperimentResult {
 impl Experiment {
     /// Reads an experiment config (`[herbs-under-tree]`, `[lateral-light]` or
     /// `[empty-rules]`) and the L-system genome files it names, relative to it.
-    pub fn load(path: &Path) -> Result<Experiment, InputError> {
+    pub fn load(registry: &Registry, path: &Path) -> Result<Experiment, InputError> {
         let text = read_text(path)?;
         let simulation: Simulation =
             toml::from_str(&text).map_err(|e| InputError::toml(path, &text, &e))?;
@@ -62,7 +62,7 @@ impl Experiment {
             .iter()
             .map(|file| {
                 let file = base.join(file);
-                let genome = load_genome(&file)?;
+                let genome = registry.load_genome(&file)?;
                 expect_model::<LSystemModel>(&file, &genome, "experiments grow")
             })
             .collect::<Result<Vec<_>, _>>()?;

@@ -72,7 +72,6 @@ pub use experiment::Experiment;
 pub use genome::{Genome, Settings};
 pub use lod::{LodAssets, Preview};
 pub use registry::{ModelEntry, Registry};
-pub use registry::{load_genome, parse_genome};
 pub use skeleton::Skeleton;
 pub use sylva_core::dress::{Dress, Dressed};
 pub use sylva_core::species::{BarkKind, LeafKind};

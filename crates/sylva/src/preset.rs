@@ -28,6 +28,7 @@ use sylva_core::taper::PipeTaper;
 use crate::assets::{GrowOptions, HEIGHTS};
 use crate::error::InputError;
 use crate::genome::Genome;
+use crate::registry::Registry;
 
 /// How a preset file's name ends.
 pub const SUFFIX: &str = ".toml";
@@ -119,12 +120,12 @@ impl Preset {
     }
 
     /// Reads a preset and the genome it names.
-    pub fn load(path: &Path) -> Result<Preset, InputError> {
+    pub fn load(registry: &Registry, path: &Path) -> Result<Preset, InputError> {
         let text = crate::files::read_text(path)?;
         let file: PresetFile =
             toml::from_str(&text).map_err(|e| InputError::toml(path, &text, &e))?;
         let genome_path = path.parent().unwrap_or(Path::new(".")).join(&file.genome);
-        let genome = crate::registry::load_genome(&genome_path)?;
+        let genome = registry.load_genome(&genome_path)?;
         let mut options = GrowOptions {
             seed: file.seed,
             roots: file.roots,

@@ -7,7 +7,7 @@
 //! of its own ([`Registry::with`]), as the test that adds a toy model does.
 
 use std::path::Path;
-use std::sync::{Arc, LazyLock};
+use std::sync::Arc;
 
 use serde::Deserialize;
 use sylva_automata::AutomataModel;
@@ -17,7 +17,7 @@ use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
 
 use crate::error::{FieldError, InputError};
-use crate::evolution::{Config, EvolveConfig};
+use crate::evolution::{Config, EvolveConfig, MatchConfig, RunConfig};
 use crate::genome::{Genome, Settings, expect_model, settings_of};
 
 /// A model the library knows: its name and title, how to read its genome files, configs
@@ -39,6 +39,7 @@ trait ModelFace: Send + Sync {
     fn parse_config(&self, path: &Path, text: &str) -> Result<Config, InputError>;
     fn config_from_value(&self, value: serde_json::Value) -> Result<Config, FieldError>;
     fn default_config(&self) -> Config;
+    fn match_config(&self, run: &RunConfig, outline: &MatchConfig) -> Result<Config, FieldError>;
 }
 
 impl<M: Evolve + Default> ModelFace for M {
@@ -91,6 +92,20 @@ impl<M: Evolve + Default> ModelFace for M {
 
     fn default_config(&self) -> Config {
         Config::new(EvolveConfig::<M>::default())
+    }
+
+    fn match_config(&self, run: &RunConfig, outline: &MatchConfig) -> Result<Config, FieldError> {
+        let mut settings = EvolveConfig::<M>::default().settings;
+        self.fitting(&mut settings);
+        let field = |name: &'static str| move |e: serde_json::Error| FieldError::new(name, e);
+        // Built as values, so the run and outline a front end gave meet a config file's
+        // checks, with errors naming the field.
+        self.config_from_value(serde_json::json!({
+            "model": M::NAME,
+            "run": serde_json::to_value(run).map_err(field("run"))?,
+            "match": serde_json::to_value(outline).map_err(field("match"))?,
+            M::NAME: serde_json::to_value(settings).map_err(field(M::NAME))?,
+        }))
     }
 }
 
@@ -155,14 +170,6 @@ pub mod names {
     pub const LSYSTEM: &str = sylva_lsystem::LSystemModel::NAME;
 }
 
-static STANDARD: LazyLock<Registry> = LazyLock::new(|| {
-    Registry::new()
-        .with(ModelEntry::of::<BinTreeModel>())
-        .with(ModelEntry::of::<AutomataModel>())
-        .with(ModelEntry::of::<PlantMakerModel>())
-        .with(ModelEntry::of::<LSystemModel>())
-});
-
 /// Reads the header of a genome file (`model` and `format`; every other field is the
 /// model's), refusing an unknown model or format where it stands.
 struct HeaderSeed<'r>(&'r Registry);
@@ -216,9 +223,15 @@ impl Default for Registry {
 
 impl Registry {
     /// The four models of Sylva: the binary tree (first: the default run's), automata,
-    /// PlantMaker and L-systems.
-    pub fn standard() -> &'static Registry {
-        &STANDARD
+    /// PlantMaker and L-systems. There is no global registry: whoever starts (the command
+    /// line's `main`, the studio's server, the Python module's init, a test) builds this once
+    /// and passes it to what reads genomes and configs.
+    pub fn standard() -> Registry {
+        Registry::new()
+            .with(ModelEntry::of::<BinTreeModel>())
+            .with(ModelEntry::of::<AutomataModel>())
+            .with(ModelEntry::of::<PlantMakerModel>())
+            .with(ModelEntry::of::<LSystemModel>())
     }
 
     /// An empty registry.
@@ -252,8 +265,24 @@ impl Registry {
     /// column.
     pub fn load_genome(&self, path: &Path) -> Result<Genome, InputError> {
         let text = crate::files::read_text(path)?;
-        self.parse_genome(&text)
-            .map_err(|e| InputError::genome(path, &text, e))
+        self.parse_genome_at(path, &text)
+    }
+
+    /// Parses a genome file already read from `path`; errors name the file, line and column.
+    pub fn parse_genome_at(&self, path: &Path, text: &str) -> Result<Genome, InputError> {
+        self.parse_genome(text)
+            .map_err(|e| InputError::genome(path, text, e))
+    }
+
+    /// Reads a genome file that must be of model `M`; `purpose` says what it is for in the
+    /// error (like "gardens grow").
+    pub fn load_genome_of<M: Model>(
+        &self,
+        path: &Path,
+        purpose: &str,
+    ) -> Result<M::Genome, InputError> {
+        let genome = self.load_genome(path)?;
+        expect_model::<M>(path, &genome, purpose)
     }
 
     /// Reads an evolution config file of any model this registry knows that evolves.
@@ -307,7 +336,7 @@ impl Registry {
             None => self.first().map_err(|e| InputError::file(path, e))?,
         };
         let config = entry.model.parse_config(path, text)?;
-        Ok(config.read_with(Some(path), self))
+        Ok(config.read_from(path))
     }
 
     /// A config of any model, built as values rather than read from a file (a front end's
@@ -331,8 +360,24 @@ impl Registry {
                 ));
             }
         };
-        let config = entry.model.config_from_value(value)?;
-        Ok(config.read_with(None, self))
+        entry.model.config_from_value(value)
+    }
+
+    /// The config of a run that evolves `model`'s plants towards `outline` alone: the
+    /// model's defaults as it fits an outline (`Evolve::fitting`), and `run`.
+    pub fn match_config(
+        &self,
+        model: &str,
+        run: &RunConfig,
+        outline: &MatchConfig,
+    ) -> Result<Config, FieldError> {
+        let entry = self.get(model).ok_or_else(|| {
+            FieldError::new(
+                "model",
+                format!("unknown model `{model}`; expected one of: {}", self.names()),
+            )
+        })?;
+        entry.model.match_config(run, outline)
     }
 
     /// The default config of the first model (none if the registry is empty).
@@ -346,24 +391,4 @@ impl Registry {
             .first()
             .ok_or_else(|| "this registry has no models".to_owned())
     }
-}
-
-/// Reads a genome file of any model the standard registry knows; errors point at the line
-/// and column.
-pub fn load_genome(path: &Path) -> Result<Genome, InputError> {
-    Registry::standard().load_genome(path)
-}
-
-/// Parses a genome file already read from `path`.
-pub fn parse_genome(path: &Path, text: &str) -> Result<Genome, InputError> {
-    Registry::standard()
-        .parse_genome(text)
-        .map_err(|e: GenomeError| InputError::genome(path, text, e))
-}
-
-/// Reads a genome file that must be of model `M`; `purpose` says what it is for in the
-/// error (like "gardens grow").
-pub fn load_genome_of<M: Model>(path: &Path, purpose: &str) -> Result<M::Genome, InputError> {
-    let genome = load_genome(path)?;
-    expect_model::<M>(path, &genome, purpose)
 }

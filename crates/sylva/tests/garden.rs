@@ -10,7 +10,6 @@ use sylva::garden::{
     Garden, GardenEstimate, GardenLayout, GardenNodes, estimate_garden, garden_glb,
     garden_glb_options, garden_placements, json_heap_bytes,
 };
-use sylva::registry::load_genome_of;
 use sylva_plantmaker::PlantMakerModel;
 
 fn conifer() -> sylva_plantmaker::PlantMaker {
@@ -18,7 +17,8 @@ fn conifer() -> sylva_plantmaker::PlantMaker {
         env!("CARGO_MANIFEST_DIR"),
         "/../../examples/plantmaker/conifer.json"
     );
-    load_genome_of::<PlantMakerModel>(Path::new(path), "gardens grow")
+    sylva::Registry::standard()
+        .load_genome_of::<PlantMakerModel>(Path::new(path), "gardens grow")
         .expect("the example is a PlantMaker genome")
 }
 

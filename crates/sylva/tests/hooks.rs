@@ -10,11 +10,14 @@ use sylva::{Config, Error, Evolution, Grown, OwnTerm, PlantScorer, RunHooks};
 use sylva_core::par::Pool;
 
 fn small(model: &str, extra: &str) -> Config {
-    Config::parse(
-        Path::new("c.toml"),
-        &format!("model = \"{model}\"\n[run]\ngenerations = 4\npopulation = 8\nseed = 5\n{extra}"),
-    )
-    .unwrap()
+    sylva::Registry::standard()
+        .parse_config(
+            Path::new("c.toml"),
+            &format!(
+                "model = \"{model}\"\n[run]\ngenerations = 4\npopulation = 8\nseed = 5\n{extra}"
+            ),
+        )
+        .unwrap()
 }
 
 /// Every figure of a run's statistics but the wall-clock seconds.

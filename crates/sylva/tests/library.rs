@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use sylva::assets::export;
 use sylva::{
     Config, Evolution, Genome, GrowOptions, Grown, InputError, ModelEntry, Registry, Settings,
-    load_genome,
 };
 
 /// Growing with `seed`, everything else at its default.
@@ -27,7 +26,7 @@ fn example(path: &str) -> PathBuf {
 }
 
 fn config(text: &str) -> Result<Config, InputError> {
-    Config::parse(Path::new("c.toml"), text)
+    sylva::Registry::standard().parse_config(Path::new("c.toml"), text)
 }
 
 #[test]
@@ -49,7 +48,9 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "lsystem/varieties.toml",
         "match/varieties.toml",
     ] {
-        let c = Config::load(&example(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let c = sylva::Registry::standard()
+            .load_config(&example(name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
         // What a run records reads back as the same config.
         assert_eq!(
             config(&c.to_toml()).unwrap().to_toml(),
@@ -63,7 +64,9 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         !Config::default().to_toml().contains("taper"),
         "left out when not asked for"
     );
-    let default = Config::load(&example("bintree/default.toml")).unwrap();
+    let default = sylva::Registry::standard()
+        .load_config(&example("bintree/default.toml"))
+        .unwrap();
     assert_eq!(default.to_toml(), Config::builtin_run().to_toml());
     let bare = default
         .to_toml()
@@ -75,7 +78,9 @@ fn every_example_config_reads_and_the_default_is_written_out() {
         "the built-in run dresses, and no more"
     );
     assert_eq!(config("").unwrap().to_toml(), Config::default().to_toml());
-    let paper = Config::load(&example("bintree/paper.toml")).unwrap();
+    let paper = sylva::Registry::standard()
+        .load_config(&example("bintree/paper.toml"))
+        .unwrap();
     let paper = paper.get::<sylva_bintree::BinTreeModel>().unwrap();
     assert_eq!(paper.settings.weights.pipe_model, 0.0);
     assert!(!paper.settings.cull_clones);
@@ -227,13 +232,17 @@ fn a_member_s_family_is_browsed_through_kept_generations() {
 #[test]
 fn start_genomes_must_be_of_the_run_s_model() {
     let c = small("plantmaker", "");
-    let herb = load_genome(&example("lsystem/herb.json")).unwrap();
+    let herb = sylva::Registry::standard()
+        .load_genome(&example("lsystem/herb.json"))
+        .unwrap();
     let e = Evolution::start(&c, vec![herb], Pool::Serial).unwrap_err();
     assert!(
         e.is_input() && e.to_string().contains("`plantmaker`"),
         "{e}"
     );
-    let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
+    let tulip = sylva::Registry::standard()
+        .load_genome(&example("plantmaker/tulip.json"))
+        .unwrap();
     let run = Evolution::start(&c, vec![tulip.clone()], Pool::Serial).unwrap();
     assert_eq!(run.population()[0].genome, tulip);
 }
@@ -263,9 +272,10 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
         "plantmaker/fern.json",
         "lsystem/herb.json",
     ] {
-        let a = load_genome(&example(name)).unwrap();
+        let models = Registry::standard();
+        let a = models.load_genome(&example(name)).unwrap();
         let model = a.model();
-        let entry = Registry::standard().get(model).unwrap();
+        let entry = models.get(model).unwrap();
         let b = entry.random(Settings::Default, 3).unwrap();
         assert_eq!(b.model(), model);
         // Mutation and crossover are the model's, deterministic in the seed.
@@ -284,8 +294,12 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
         let text = child.to_json();
         assert_eq!(Registry::standard().parse_genome(&text).unwrap(), child);
     }
-    let oak = load_genome(&example("bintree/oak.json")).unwrap();
-    let fern = load_genome(&example("plantmaker/fern.json")).unwrap();
+    let oak = sylva::Registry::standard()
+        .load_genome(&example("bintree/oak.json"))
+        .unwrap();
+    let fern = sylva::Registry::standard()
+        .load_genome(&example("plantmaker/fern.json"))
+        .unwrap();
     let e = Genome::cross(&[(&oak, 1.0), (&fern, 1.0)], Settings::Default, 1).unwrap_err();
     assert!(
         e.is_input() && e.to_string().contains("cannot be crossed"),
@@ -337,8 +351,12 @@ fn every_model_breeds_by_hand_with_its_own_operators() {
     let e = over(&serde_json::json!({ "palette": "blue" }), 1).unwrap_err();
     assert!(e.to_string().contains("plantmaker settings"), "{e}");
     // PlantMaker crosses every parent by dominance, at the settings' level.
-    let bush = load_genome(&example("plantmaker/flowering-bush.json")).unwrap();
-    let tulip = load_genome(&example("plantmaker/tulip.json")).unwrap();
+    let bush = sylva::Registry::standard()
+        .load_genome(&example("plantmaker/flowering-bush.json"))
+        .unwrap();
+    let tulip = sylva::Registry::standard()
+        .load_genome(&example("plantmaker/tulip.json"))
+        .unwrap();
     let high = serde_json::json!({ "crossover": "high" });
     let (_, parents) = Genome::cross(
         &[(&fern, 1.0), (&bush, 1.0), (&tulip, 1.0)],
@@ -405,10 +423,12 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     let config = registry.load_config(&dir.join("c.toml")).unwrap();
     assert_eq!(config.model(), "cylinder");
     assert!(
-        Config::load(&dir.join("c.toml")).is_err(),
+        sylva::Registry::standard()
+            .load_config(&dir.join("c.toml"))
+            .is_err(),
         "the standard registry does not know it"
     );
-    let start = config.load_start(&dir).unwrap();
+    let start = config.load_start(&registry, &dir).unwrap();
     assert_eq!(start, vec![genome.clone()]);
     let pool = || Pool::with_threads(2).unwrap();
     let mut straight = Evolution::start(&config, start.clone(), pool()).unwrap();
@@ -544,7 +564,9 @@ fn a_height_scales_the_plant_to_it_and_travels_with_the_asset() {
         "bintree/oak.json",
         "lsystem/tree.json",
     ] {
-        let genome = load_genome(&example(file)).unwrap();
+        let genome = sylva::Registry::standard()
+            .load_genome(&example(file))
+            .unwrap();
         let options = GrowOptions {
             height: Some(7.5),
             ..seeded(0)
@@ -572,7 +594,9 @@ fn the_pipe_taper_keeps_the_pipes_and_travels_with_the_asset() {
     let e = 2.5;
     let taper = sylva_core::taper::PipeTaper::new(e).unwrap();
     for file in ["lsystem/tree.json", "automata/helix.json"] {
-        let genome = load_genome(&example(file)).unwrap();
+        let genome = sylva::Registry::standard()
+            .load_genome(&example(file))
+            .unwrap();
         let options = GrowOptions {
             roots: false,
             ..seeded(0)

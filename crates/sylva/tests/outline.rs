@@ -118,7 +118,7 @@ fn a_match_breeds_for_fitting() {
     let target = round_target();
     let registry = Registry::standard();
     let toml = |model: &str| {
-        match_config(registry, model, &RunConfig::default(), &target)
+        match_config(&registry, model, &RunConfig::default(), &target)
             .unwrap()
             .to_toml()
     };
@@ -149,7 +149,7 @@ fn a_match_grows_green_leaves_and_the_forms_any_colours_would() {
         population: 12,
         ..RunConfig::default()
     };
-    let foliage = match_config(Registry::standard(), "plantmaker", &run, &round_target())
+    let foliage = match_config(&Registry::standard(), "plantmaker", &run, &round_target())
         .unwrap()
         .to_toml();
     assert!(foliage.contains("palette = \"foliage\""), "{foliage}");
@@ -254,7 +254,7 @@ fn auto_tries_every_model_then_runs_off_the_best_two() {
         let mut trials = Vec::new();
         let limit = Limit::Generations(generations);
         let (evolution, _) = start_auto(
-            Registry::standard(),
+            &Registry::standard(),
             &target,
             &run,
             limit,
@@ -330,7 +330,9 @@ fn the_tree_examples_pass_the_stem_factors() {
         "plantmaker/tulip.json",
     ];
     let plausibility = |example: &str, scratch: &mut Scratch| {
-        let genome = sylva::load_genome(&examples().join(example)).unwrap();
+        let genome = sylva::Registry::standard()
+            .load_genome(&examples().join(example))
+            .unwrap();
         let plant = genome.develop(genome.default_seed()).unwrap();
         plausibility(&plant, scratch)
     };
@@ -358,7 +360,7 @@ fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
         ..RunConfig::default()
     };
     let grown = |target: &MatchConfig| {
-        let config = match_config(Registry::standard(), "plantmaker", &run, target).unwrap();
+        let config = match_config(&Registry::standard(), "plantmaker", &run, target).unwrap();
         let mut evolution = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap();
         while evolution.generation() < 2 {
             evolution.step().unwrap();
@@ -406,4 +408,53 @@ fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
         plant,
         best.genome.develop(best.genome.default_seed()).unwrap()
     );
+}
+
+#[test]
+fn a_matchs_pictures_are_read_once_and_carried_to_its_files() {
+    use sylva::evolution::outline::{Target, match_config, overlay};
+    use sylva::evolution::{MatchConfig, RunConfig};
+    // The pictures live in a folder of their own, which goes once they are read: whatever
+    // needs them later (the run's term, its checkpoint's resume, the best plant's pruning,
+    // the overlay) uses the pictures carried; read again, they are missing, named.
+    let dir = std::env::temp_dir().join(format!("sylva-target-once-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(examples().join("match/round.png"), dir.join("round.png")).unwrap();
+    let target = MatchConfig {
+        front: dir.join("round.png"),
+        ..round_target()
+    };
+    let pictures = Target::read(&target, Path::new("")).unwrap();
+    let run = RunConfig {
+        generations: 2,
+        population: 8,
+        ..RunConfig::default()
+    };
+    let registry = Registry::standard();
+    let fresh = match_config(&registry, "bintree", &run, &target).unwrap();
+    let config = fresh.clone().with_target(Some(pictures.clone()));
+    std::fs::remove_dir_all(&dir).unwrap();
+    let gone = fresh.grow_options().unwrap_err();
+    assert!(gone.to_string().contains("round.png"), "{gone}");
+    let mut evolution = Evolution::start(&config, Vec::new(), Pool::Serial).unwrap();
+    evolution.step().unwrap();
+    let checkpoint = evolution.checkpoint().unwrap();
+    let resumed = Evolution::resume(&config, Path::new("c.json"), &checkpoint, Pool::Serial);
+    assert_eq!(resumed.unwrap().generation(), 1);
+    // The run's config carries them on to the files' plant and the overlay.
+    let options = evolution.config().grow_options().unwrap();
+    assert!(options.pruned_to.is_some());
+    let best = evolution.best().genome.clone();
+    let (png, iou) = pictures.overlay(&target, &best).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && (0.0..=1.0).contains(&iou));
+    assert!(
+        overlay(&target, Path::new(""), &best).is_err(),
+        "read again: gone"
+    );
+    // Carried pictures are used only for the files they were read from.
+    let other = MatchConfig {
+        front: examples().join("match/cone.png"),
+        ..target.clone()
+    };
+    assert!(!pictures.is_of(&other) && pictures.is_of(&target));
 }

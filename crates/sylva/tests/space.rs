@@ -33,7 +33,9 @@ fn codons_are_the_draws_then_the_stream() {
 }
 
 fn config(toml: &str) -> Config {
-    Config::parse(Path::new("space.toml"), toml).expect("a valid config")
+    sylva::Registry::standard()
+        .parse_config(Path::new("space.toml"), toml)
+        .expect("a valid config")
 }
 
 #[test]

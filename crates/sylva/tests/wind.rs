@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use sylva::assets::{Placed, SceneAssets};
-use sylva::{GrowOptions, Grown, load_genome};
+use sylva::{GrowOptions, Grown};
 use sylva_core::glam::Vec3;
 use sylva_mesh::wind::WindOptions;
 
@@ -42,7 +42,9 @@ fn wind_glbs_of_every_model_are_validator_clean() {
         "plantmaker/flowering-bush.json",
         "lsystem/tree.json",
     ] {
-        let genome = load_genome(&example(name)).unwrap();
+        let genome = sylva::Registry::standard()
+            .load_genome(&example(name))
+            .unwrap();
         let seed = genome.default_seed();
         let grown = Grown::grow(genome, &windy(seed, false, Some(WindOptions::default()))).unwrap();
         let rig = grown.rig.as_ref().unwrap();
@@ -71,7 +73,9 @@ fn wind_glbs_of_every_model_are_validator_clean() {
         files.push(file);
     }
     // A garden: each plant its own skin, one clip moving them all, places kept by the rigs.
-    let genome = load_genome(&example("bintree/oak.json")).unwrap();
+    let genome = sylva::Registry::standard()
+        .load_genome(&example("bintree/oak.json"))
+        .unwrap();
     let plant = genome.develop(0).unwrap();
     let placed: Vec<Placed> = (0..3)
         .map(|i| Placed {
@@ -113,7 +117,9 @@ fn wind_glbs_of_every_model_are_validator_clean() {
 
 #[test]
 fn without_wind_the_bytes_are_unchanged() {
-    let genome = load_genome(&example("bintree/oak.json")).unwrap();
+    let genome = sylva::Registry::standard()
+        .load_genome(&example("bintree/oak.json"))
+        .unwrap();
     let plain = Grown::grow(genome.clone(), &windy(0, true, None)).unwrap();
     let none = Grown::grow(genome, &windy(0, true, None)).unwrap();
     assert_eq!(
@@ -132,7 +138,9 @@ fn wind_strips() {
         ("bintree/oak.json", 8.0),
         ("plantmaker/palm.json", 2.0),
     ] {
-        let genome = load_genome(&example(name)).unwrap();
+        let genome = sylva::Registry::standard()
+            .load_genome(&example(name))
+            .unwrap();
         let seed = genome.default_seed();
         let wind = WindOptions::new(strength, 4.0).unwrap();
         let grown = Grown::grow(genome, &windy(seed, false, Some(wind))).unwrap();

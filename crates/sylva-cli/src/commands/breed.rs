@@ -6,10 +6,10 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use sylva::InputError;
+use sylva::Registry;
 use sylva::assets::picture;
 use sylva::biomorph::{BiomorphOptions, Biomorphs};
 use sylva::files::Outputs;
-use sylva::load_genome;
 use sylva::mesh::{Scene, SceneNode};
 use sylva::render::{self, SheetCell, SheetOptions, View};
 
@@ -38,8 +38,8 @@ pub struct BreedArgs {
 }
 
 /// `sylva breed`.
-pub fn run(args: &BreedArgs) -> anyhow::Result<()> {
-    let mother = load_genome(&args.mother)?;
+pub fn run(models: &Registry, args: &BreedArgs) -> anyhow::Result<()> {
+    let mother = models.load_genome(&args.mother)?;
     let options = BiomorphOptions {
         children: args.children,
         roots: !args.hide_roots,

@@ -14,7 +14,7 @@ use sylva::evolution::SearchStrategy;
 use sylva::lod::Preview;
 use sylva::render::{self, SheetCell, SheetOptions};
 use sylva::report::{fitness_svg, stats_csv};
-use sylva::{Config, Evolution, GrowOptions, Grown, InputError};
+use sylva::{Config, Evolution, GrowOptions, Grown, InputError, Registry};
 
 use sylva::files::Outputs;
 
@@ -48,9 +48,9 @@ pub struct EvolveArgs {
 }
 
 /// `sylva evolve`.
-pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &EvolveArgs) -> anyhow::Result<()> {
     let mut config = match &args.config {
-        Some(path) => Config::load(path)?,
+        Some(path) => models.load_config(path)?,
         None => Config::builtin_run(),
     };
     let run = config.run_mut();
@@ -70,7 +70,7 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
         .and_then(|p| p.parent())
         .unwrap_or(Path::new("."));
     if config.run().strategy == SearchStrategy::MapElites {
-        return super::varieties::run(&config, &out, base, args.resume, &pool);
+        return super::varieties::run(models, &config, &out, base, args.resume, &pool);
     }
     let checkpoint = out.join(CHECKPOINT);
     let target = config.run().generations;
@@ -79,7 +79,7 @@ pub fn run(args: &EvolveArgs) -> anyhow::Result<()> {
         let text = sylva::files::read_text(&checkpoint)?;
         Evolution::resume(&config, &checkpoint, &text, pool.clone())?
     } else {
-        let start = config.load_start(base)?;
+        let start = config.load_start(models, base)?;
         if let Some(t) = config.generation_time(&start, pool.threads()) {
             super::announce(
                 t.seconds * (f64::from(target) + 1.0),

@@ -11,7 +11,7 @@ use sylva::garden::{
 };
 use sylva::gltf::export::Format;
 use sylva::render::View;
-use sylva::{Genome, InputError, load_genome, parse_genome};
+use sylva::{Genome, InputError, Registry};
 
 use super::{InFile, SCENE_PICTURE};
 
@@ -53,7 +53,7 @@ pub struct GardenArgs {
 /// `sylva garden`: grows a garden file, or plants genomes into a new one, and writes the
 /// scene (one node per plant, or per variant when instanced, each carrying its genome and
 /// seed) and the garden file.
-pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &GardenArgs) -> anyhow::Result<()> {
     let format = asset_format(&args.output)?;
     let wind = args.wind.options(&args.output)?;
     let quantize = args.quantize.check(&args.output, wind.is_some())?;
@@ -81,9 +81,9 @@ pub fn run(args: &GardenArgs) -> anyhow::Result<()> {
         sylva::garden::read(first, &text)?
     } else {
         // The first file is already read.
-        let mut genomes: Vec<Genome> = vec![parse_genome(first, &text)?];
+        let mut genomes: Vec<Genome> = vec![models.parse_genome_at(first, &text)?];
         for path in &args.inputs[1..] {
-            genomes.push(load_genome(path)?);
+            genomes.push(models.load_genome(path)?);
         }
         let area = [args.area.0, args.area.1];
         let mut garden = sylva::garden::plant(&genomes, args.count as usize, area, args.seed)

@@ -8,7 +8,7 @@ use sylva::evolution::outline::Outline;
 use sylva::files::Outputs;
 use sylva::render::View;
 use sylva::skeleton::{GrowOutput, Skeleton};
-use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets};
+use sylva::{Genome, GrowOptions, Grown, InputError, LodAssets, Registry};
 
 use super::InFile;
 
@@ -58,10 +58,10 @@ pub struct GrowArgs {
 }
 
 /// `sylva grow`.
-pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &GrowArgs) -> anyhow::Result<()> {
     let output = GrowOutput::of(&args.output)?;
     let wind = args.wind.options(&args.output)?;
-    let (genome, base) = super::load_input(&args.genome)?;
+    let (genome, base) = super::load_input(models, &args.genome)?;
     let flags = super::GrowFlags {
         seed: args.seed,
         hide_roots: args.hide_roots,
@@ -74,7 +74,7 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
         lod: args.lod.map(|n| n as usize),
         wind,
         pruned_to: match &args.pruned_to {
-            Some(path) => Some(outlines_of(path)?),
+            Some(path) => Some(outlines_of(models, path)?),
             None => None,
         },
         ..flags.over(base)
@@ -157,8 +157,8 @@ pub fn run(args: &GrowArgs) -> anyhow::Result<()> {
 }
 
 /// The outlines the match run of config `path` prunes its plants to.
-fn outlines_of(path: &std::path::Path) -> anyhow::Result<Arc<[Outline]>> {
-    let options = sylva::Config::load(path)?.grow_options()?;
+fn outlines_of(models: &Registry, path: &std::path::Path) -> anyhow::Result<Arc<[Outline]>> {
+    let options = models.load_config(path)?.grow_options()?;
     let outlines = options.pruned_to.ok_or_else(|| {
         InputError::file(
             path,

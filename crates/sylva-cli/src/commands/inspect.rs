@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use sylva::inspect::{AssetFacts, Report};
 use sylva::skeleton::{SUFFIX, Skeleton};
-use sylva::{Grown, InputError};
+use sylva::{Grown, InputError, Registry};
 
 use super::InFile;
 
@@ -67,7 +67,7 @@ fn input_of(path: &Path) -> Result<Input, InputError> {
 }
 
 /// `sylva inspect`.
-pub fn run(args: &InspectArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &InspectArgs) -> anyhow::Result<()> {
     let input = input_of(&args.file)?;
     let given = [
         (args.seed.is_some(), "--seed"),
@@ -98,7 +98,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<()> {
     };
     let report = match input {
         Input::Genome => {
-            let (genome, base) = super::load_input(&args.file)?;
+            let (genome, base) = super::load_input(models, &args.file)?;
             let options = super::GrowFlags {
                 seed: args.seed,
                 hide_roots: false,
@@ -114,7 +114,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<()> {
             let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
             let extras = sylva::gltf::import::first_extras(&bytes)
                 .map_err(|e| InputError::file_error(&args.file, &e))?;
-            let (genome, options) = sylva::assets::regrow(&extras, &args.file)?;
+            let (genome, options) = sylva::assets::regrow(models, &extras, &args.file)?;
             let grown = Grown::grow(genome, &options).in_file(&args.file)?;
             let asset =
                 AssetFacts::of_glb(&bytes).map_err(|e| InputError::file_error(&args.file, &e))?;

@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
 use sylva::core::par::Stop;
 use sylva::evolution::outline::{
-    Limit, Trial, best_iou, breed_until, match_config, outlines, overlay, start_auto, start_within,
+    Limit, Target, Trial, best_iou, breed_until, match_config, start_auto, start_within,
 };
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
@@ -108,7 +108,7 @@ fn parse_threshold(text: &str) -> Result<Threshold, String> {
 }
 
 /// `sylva match`.
-pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
+pub fn run(registry: &Registry, args: &MatchArgs) -> anyhow::Result<()> {
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
     let target = MatchConfig {
         front: absolute(&args.target),
@@ -120,8 +120,8 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         closeness: args.closeness,
         prune: Some(!args.no_prune),
     };
-    // The pictures are read first: a bad one is refused before anything is written.
-    outlines(&target, Path::new(""))?;
+    // The pictures are read first, once: a bad one is refused before anything is written.
+    let pictures = Target::read(&target, Path::new(""))?;
     let limit = match (args.generations, args.seconds) {
         (Some(n), _) => Limit::Generations(n),
         (None, seconds) => Limit::Seconds(seconds.unwrap_or(60.0)),
@@ -145,13 +145,13 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
         threads: args.threads,
         ..RunConfig::default()
     };
-    let registry = Registry::standard();
     let pool = super::pool(args.threads)?;
     let checkpoint = out.join(CHECKPOINT);
     // The match's seconds bound its first generations too, however large the population.
     let stop = Stop::new();
     let config_of = |model: &str| {
         match_config(registry, model, &run, &target)
+            .map(|config| config.with_target(Some(pictures.clone())))
             .map_err(|e| InputError::new("--model", format!("{}: {}", e.field, e.message)))
     };
     let (mut evolution, config, elsewhere) = if args.resume {
@@ -218,7 +218,7 @@ pub fn run(args: &MatchArgs) -> anyhow::Result<()> {
     config.output_mut().height = args.height;
     args.dress.apply(config.output_mut());
     let best = evolution.best();
-    let (picture, iou) = overlay(&target, Path::new(""), &best.genome)?;
+    let (picture, iou) = pictures.overlay(&target, &best.genome)?;
     write_results(
         &evolution,
         &config,

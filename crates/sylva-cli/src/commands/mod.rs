@@ -147,12 +147,15 @@ impl<T> InFile<T> for Result<T, sylva::Error> {
 
 /// The genome a command grows from `path` and the options its file gives: a species
 /// preset's (`.toml`, [`sylva::preset::Preset`]), or a genome file's defaults.
-pub fn load_input(path: &Path) -> Result<(sylva::Genome, sylva::GrowOptions), sylva::InputError> {
+pub fn load_input(
+    models: &sylva::Registry,
+    path: &Path,
+) -> Result<(sylva::Genome, sylva::GrowOptions), sylva::InputError> {
     if sylva::preset::Preset::is_preset(path) {
-        let preset = sylva::preset::Preset::load(path)?;
+        let preset = sylva::preset::Preset::load(models, path)?;
         Ok((preset.genome, preset.options))
     } else {
-        Ok((sylva::load_genome(path)?, sylva::GrowOptions::default()))
+        Ok((models.load_genome(path)?, sylva::GrowOptions::default()))
     }
 }
 

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use sylva::assets::{check_png, write_picture};
 use sylva::render::View;
-use sylva::{GrowOptions, Grown, InputError};
+use sylva::{GrowOptions, Grown, InputError, Registry};
 
 use super::InFile;
 
@@ -70,7 +70,7 @@ fn grow_options(args: &RenderArgs, base: GrowOptions) -> GrowOptions {
 }
 
 /// `sylva render`.
-pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &RenderArgs) -> anyhow::Result<()> {
     check_png(&args.output)?;
     let is_glb = args
         .file
@@ -84,7 +84,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let (genome, base) = super::load_input(&args.file)?;
+        let (genome, base) = super::load_input(models, &args.file)?;
         let options = GrowOptions {
             lod: Some(levels as usize),
             ..grow_options(args, base)
@@ -103,7 +103,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let (genome, base) = super::load_input(&args.file)?;
+        let (genome, base) = super::load_input(models, &args.file)?;
         let options = GrowOptions {
             wind: args.wind.options(&args.output)?,
             ..grow_options(args, base)
@@ -132,7 +132,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             .map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
-        let (genome, base) = super::load_input(&args.file)?;
+        let (genome, base) = super::load_input(models, &args.file)?;
         let growing = super::growing(&genome);
         let grown = Grown::grow(genome, &grow_options(args, base)).in_file(&args.file)?;
         drop(growing);

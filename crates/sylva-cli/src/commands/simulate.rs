@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use sylva::Experiment;
 use sylva::assets::picture;
 use sylva::files::Outputs;
 use sylva::render::View;
+use sylva::{Experiment, Registry};
 
 use super::{InFile, SCENE_PICTURE};
 
@@ -24,9 +24,9 @@ pub struct SimulateArgs {
 }
 
 /// `sylva simulate`.
-pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+pub fn run(models: &Registry, args: &SimulateArgs) -> anyhow::Result<()> {
     let path = &args.config;
-    let experiment = Experiment::load(path)?;
+    let experiment = Experiment::load(models, path)?;
     let pool = super::pool(args.threads)?;
     let work = experiment.work()?;
     super::announce(

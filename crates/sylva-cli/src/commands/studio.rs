@@ -23,13 +23,13 @@ pub struct StudioArgs {
 }
 
 /// `sylva studio`.
-pub fn run(args: &StudioArgs) -> anyhow::Result<()> {
+pub fn run(models: sylva::Registry, args: &StudioArgs) -> anyhow::Result<()> {
     sylva_studio::serve(sylva_studio::Options {
         host: args.host.clone(),
         port: args.port,
         db: args.db.clone(),
         allow_hosts: args.allow_hosts.clone(),
-        registry: sylva::Registry::standard().clone(),
+        registry: models,
     })?;
     Ok(())
 }

@@ -9,7 +9,7 @@ use sylva::core::par::Pool;
 use sylva::files::Outputs;
 use sylva::render::map::{MapAxis, MapPicture, map_picture};
 use sylva::report::map_stats_csv;
-use sylva::{Config, GrowOptions, Grown, InputError, Varieties, Variety};
+use sylva::{Config, GrowOptions, Grown, InputError, Registry, Varieties, Variety};
 
 use super::run_files::{CHECKPOINT, add_best};
 
@@ -27,6 +27,7 @@ pub(super) const FILES: [&str; 8] = [
 
 /// Runs the map of `config` into `out` (resuming its checkpoint if `resume`).
 pub(super) fn run(
+    models: &Registry,
     config: &Config,
     out: &Path,
     start_base: &Path,
@@ -38,7 +39,7 @@ pub(super) fn run(
         let text = sylva::files::read_text(&checkpoint)?;
         Varieties::resume(config, &checkpoint, &text, pool.clone())?
     } else {
-        let start = config.load_start(start_base)?;
+        let start = config.load_start(models, start_base)?;
         Varieties::start(config, start, pool.clone())?
     };
     sylva::files::create_dir(out)?;

@@ -11,7 +11,7 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::Config;
+use sylva::{Config, Registry};
 
 use crate::Studio;
 use crate::archive::{self, ModeName, Operator, RunRow};
@@ -96,7 +96,7 @@ fn range(value: u32, lo: u32, hi: u32, field: &str) -> Result<u32, ApiError> {
 /// with the design's target, grid, weights and size.
 /// Errors name fields under `at`, the design's JSON path in the request (`design` when
 /// creating a session, "" when the body is the design).
-fn config_of(design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
+fn config_of(registry: &Registry, design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
     let field = |name: &str| join(at, name);
     let population = range(
         design.population.unwrap_or(1000),
@@ -170,7 +170,8 @@ fn config_of(design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
             "fitness": fitness,
         },
     });
-    let config = Config::from_value(doc)
+    let config = registry
+        .config_from_value(doc)
         .map_err(|e| ApiError::unprocessable(join(at, &design_field(&e.field)), e.message))?;
     Ok((config, generations))
 }
@@ -232,7 +233,7 @@ fn check_cells(grid: &GridDesign, at: &str) -> Result<(), ApiError> {
 
 /// Creates a design session and starts its run.
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let (config, generations) = config_of(&start.design, "design")?;
+    let (config, generations) = config_of(&studio.registry, &start.design, "design")?;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let id = archive::insert_session(c, ModeName::Design, AUTOMATA, "Design", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -257,7 +258,7 @@ pub(crate) async fn redesign(
     let lock = studio.session_lock(id);
     let _guard = lock.lock().await;
     let before = design_state(&studio, id)?;
-    let (config, generations) = config_of(&design, "")?;
+    let (config, generations) = config_of(&studio.registry, &design, "")?;
     runs::stop_run(&studio, before.run)?;
     let run = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -324,8 +325,9 @@ pub fn resume_all(studio: &Studio) {
 impl Background for DesignMode {
     const OPERATOR: Operator = Operator::Design;
 
-    fn config(_: &Studio, row: &RunRow) -> Result<Config, ApiError> {
-        Config::parse(FilePath::new("design"), &row.config)
+    fn config(studio: &Studio, row: &RunRow) -> Result<Config, ApiError> {
+        (studio.registry)
+            .parse_config(FilePath::new("design"), &row.config)
             .map_err(|e| ApiError::internal(e.message))
     }
 }

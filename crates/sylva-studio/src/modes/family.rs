@@ -14,7 +14,7 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::{Config, Evolution, Member};
+use sylva::{Config, Evolution, Member, Registry};
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, ModeName, Operator};
@@ -106,7 +106,7 @@ pub struct FamilyState {
 }
 
 /// The config a family request asks for: the example's defaults under its sections.
-fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
+fn config_of(registry: &Registry, request: &FamilyConfig) -> Result<Config, ApiError> {
     if let Some(null) = request
         .run
         .as_ref()
@@ -142,7 +142,8 @@ fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     if let Some(b) = &request.bintree {
         doc["bintree"] = b.clone();
     }
-    Config::from_value(doc)
+    registry
+        .config_from_value(doc)
         .map_err(|e| ApiError::unprocessable(join("config", &e.field), e.message))
 }
 
@@ -160,7 +161,7 @@ fn members(run: &Evolution) -> Vec<MemberView> {
 
 /// Creates a family session: generation 0 made and evaluated.
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let config = config_of(&start.config)?;
+    let config = config_of(&studio.registry, &start.config)?;
     let pool = studio.pool.clone();
     let (run, checkpoint, toml) = tokio::task::spawn_blocking(move || -> Result<_, ApiError> {
         let run = Evolution::start(&config, Vec::new(), pool)
@@ -221,7 +222,9 @@ fn evolution(
         ))
     })?;
     let path = FilePath::new("checkpoint");
-    let config = Config::parse(path, &row.config).map_err(|e| ApiError::internal(e.message))?;
+    let config = (studio.registry)
+        .parse_config(path, &row.config)
+        .map_err(|e| ApiError::internal(e.message))?;
     let run = Evolution::resume(&config, path, &checkpoint, studio.pool.clone())
         .map_err(ApiError::internal)?;
     Ok(studio.families.put(id, run))

@@ -5,12 +5,13 @@ use std::path::{Path, PathBuf};
 use sylva_model::Evolve;
 
 use crate::assets::GrowOptions;
-use crate::error::{FieldError, InputError};
+use crate::error::InputError;
 use crate::genome::Genome;
 use crate::registry::Registry;
 
 use super::face::{ConfigFace, Where};
 use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig};
+use super::silhouette::Target;
 use super::typed::GenerationTime;
 
 /// An evolution config of any model.
@@ -19,11 +20,11 @@ pub struct Config {
     face: Box<dyn ConfigFace>,
     /// The file it was read from, named in errors.
     source: Option<PathBuf>,
-    /// The registry it was read with, which reads its start genomes; `None`: the standard.
-    registry: Option<Registry>,
     /// The folder its files (start genomes, target pictures) are found in, when it is not
     /// the config file's.
     base: Option<PathBuf>,
+    /// Its `[match]` pictures, when they were read already (a clone shares them).
+    target: Option<Target>,
 }
 
 /// Evaluations made so far by every run of this process, for a progress bar to read from
@@ -37,8 +38,8 @@ impl Clone for Config {
         Config {
             face: self.face.clone_face(),
             source: self.source.clone(),
-            registry: self.registry.clone(),
             base: self.base.clone(),
+            target: self.target.clone(),
         }
     }
 }
@@ -63,9 +64,7 @@ impl Default for Config {
     /// default: what an empty config reads as. (`sylva evolve` without a config runs
     /// [`Config::builtin_run`].)
     fn default() -> Self {
-        Registry::standard()
-            .default_config()
-            .unwrap_or_else(|| Config::new(EvolveConfig::<sylva_bintree::BinTreeModel>::default()))
+        Config::new(EvolveConfig::<sylva_bintree::BinTreeModel>::default())
     }
 }
 
@@ -86,8 +85,8 @@ impl Config {
         Config {
             face,
             source: None,
-            registry: None,
             base: None,
+            target: None,
         }
     }
 
@@ -96,20 +95,36 @@ impl Config {
         &*self.face
     }
 
-    /// How errors name the config and where its files are found.
-    pub(super) fn at(&self) -> Where {
-        Where {
+    /// How errors name the config, and its `[match]` pictures, read if they were not.
+    pub(super) fn at(&self) -> Result<Where, InputError> {
+        Ok(Where {
             source: self.source(),
-            base: self.base(),
+            target: self.target()?,
+        })
+    }
+
+    /// The pictures of its `[match]` (none without one): those it carries when they are the
+    /// ones it names ([`Config::with_target`]), else read now from [`Config::base`].
+    pub fn target(&self) -> Result<Option<Target>, InputError> {
+        let Some(outline) = self.outline() else {
+            return Ok(None);
+        };
+        match &self.target {
+            Some(target) if target.is_of(outline) => Ok(Some(target.clone())),
+            _ => Target::read(outline, &self.base()).map(Some),
         }
     }
 
-    /// This config, read from `path` with `registry` (which reads its start genomes).
-    pub(crate) fn read_with(mut self, path: Option<&Path>, registry: &Registry) -> Config {
-        self.source = path.map(Path::to_owned);
-        if !std::ptr::eq(registry, Registry::standard()) {
-            self.registry = Some(registry.clone());
-        }
+    /// This config carrying `target`, its `[match]` pictures as read already, so that runs,
+    /// pictures and files made from it do not read them again.
+    pub fn with_target(mut self, target: Option<Target>) -> Config {
+        self.target = target;
+        self
+    }
+
+    /// This config, read from `path` (named in errors; its folder holds the files it names).
+    pub(crate) fn read_from(mut self, path: &Path) -> Config {
+        self.source = Some(path.to_owned());
         self
     }
 
@@ -129,33 +144,11 @@ impl Config {
         self.base = Some(base.into());
     }
 
-    /// The registry the config was read with.
-    pub fn registry(&self) -> &Registry {
-        self.registry.as_ref().unwrap_or(Registry::standard())
-    }
-
-    /// A config of any model the standard registry knows, built as values (a front end's
-    /// form) with the checks of a config file ([`Registry::config_from_value`]).
-    pub fn from_value(value: serde_json::Value) -> Result<Config, FieldError> {
-        Registry::standard().config_from_value(value)
-    }
-
-    /// Parses a config of any model the standard registry knows; errors point into `text`.
-    pub fn parse(path: &Path, text: &str) -> Result<Config, InputError> {
-        Registry::standard().parse_config(path, text)
-    }
-
     /// How errors name the config: its file, or "config" for one built in code.
     pub(super) fn source(&self) -> String {
         self.source
             .as_ref()
             .map_or_else(|| "config".to_owned(), |p| p.display().to_string())
-    }
-
-    /// Reads and parses a config file.
-    pub fn load(path: &Path) -> Result<Config, InputError> {
-        let text = crate::files::read_text(path)?;
-        Config::parse(path, &text)
     }
 
     /// The model evolved.
@@ -188,9 +181,9 @@ impl Config {
     /// [`Config::base`]).
     pub fn grow_options(&self) -> Result<GrowOptions, InputError> {
         let output = self.output();
-        let pruned_to = match self.outline() {
-            Some(outline) => super::silhouette::space(outline, &self.base())?,
-            None => None,
+        let pruned_to = match (self.outline(), self.target()?) {
+            (Some(outline), Some(target)) => target.space(outline)?,
+            _ => None,
         };
         Ok(GrowOptions {
             taper: output.pipe_taper(),
@@ -238,14 +231,14 @@ impl Config {
     }
 
     /// Reads the genome files of [`Config::start_files`] from `base` (the config file's
-    /// folder), with the registry the config was read with.
-    pub fn load_start(&self, base: &Path) -> Result<Vec<Genome>, InputError> {
+    /// folder) with `registry` (the one the config was read with).
+    pub fn load_start(&self, registry: &Registry, base: &Path) -> Result<Vec<Genome>, InputError> {
         let model = self.model();
         self.start_files()
             .iter()
             .map(|file| {
                 let path = base.join(file);
-                let genome = self.registry().load_genome(&path)?;
+                let genome = registry.load_genome(&path)?;
                 if genome.model() == model {
                     Ok(genome)
                 } else {

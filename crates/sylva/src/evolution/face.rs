@@ -19,6 +19,7 @@ use crate::genome::Genome;
 
 use super::hooks::RunHooks;
 use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig};
+use super::silhouette::Target;
 use super::typed::{GenerationTime, Member, TypedRun, resume, start};
 use super::typed_map::{TypedMap, Variety, resume_map, start_map};
 use super::typed_space::{SpaceOptions, SpaceValue, new_space};
@@ -72,10 +73,10 @@ pub(crate) trait ConfigFace: Send + Sync {
     ) -> Result<Box<dyn SpaceValue>, Error>;
 }
 
-/// Where a config came from: how errors name it, and the folder its files are found in.
+/// Where a config came from: how errors name it, and its `[match]` pictures as read.
 pub(crate) struct Where {
     pub(crate) source: String,
-    pub(crate) base: PathBuf,
+    pub(crate) target: Option<Target>,
 }
 
 /// A run of one model, as any model's.
@@ -174,7 +175,12 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         hooks: RunHooks,
     ) -> Result<Box<dyn RunFace>, Error> {
         Ok(Box::new(start(
-            self, &at.source, &at.base, first, pool, hooks,
+            self,
+            &at.source,
+            at.target.as_ref(),
+            first,
+            pool,
+            hooks,
         )?))
     }
 
@@ -186,7 +192,13 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         hooks: RunHooks,
     ) -> Result<Box<dyn RunFace>, Error> {
         Ok(Box::new(resume(
-            self, &at.source, &at.base, path, text, pool, hooks,
+            self,
+            &at.source,
+            at.target.as_ref(),
+            path,
+            text,
+            pool,
+            hooks,
         )?))
     }
 
@@ -197,7 +209,11 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         pool: Pool,
     ) -> Result<Box<dyn MapFace>, Error> {
         Ok(Box::new(start_map(
-            self, &at.source, &at.base, first, pool,
+            self,
+            &at.source,
+            at.target.as_ref(),
+            first,
+            pool,
         )?))
     }
 
@@ -208,7 +224,12 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         pool: Pool,
     ) -> Result<Box<dyn MapFace>, Error> {
         Ok(Box::new(resume_map(
-            self, &at.source, &at.base, path, text, pool,
+            self,
+            &at.source,
+            at.target.as_ref(),
+            path,
+            text,
+            pool,
         )?))
     }
 
@@ -218,7 +239,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         first: Vec<Genome>,
         options: &SpaceOptions,
     ) -> Result<Box<dyn SpaceValue>, Error> {
-        new_space(self, &at.source, &at.base, first, options)
+        new_space(self, &at.source, at.target.as_ref(), first, options)
     }
 }
 

@@ -12,7 +12,7 @@ use sylva_core::par::{Pool, Stop};
 use crate::error::{Error, FieldError, InputError};
 use crate::registry::Registry;
 
-pub use super::silhouette::{Outline, TERM, outlines, overlay, prune, score_pruned, space};
+pub use super::silhouette::{Outline, TERM, Target, outlines, overlay, prune, score_pruned, space};
 
 use super::config::Config;
 use super::hooks::RunHooks;
@@ -20,8 +20,8 @@ use super::run::Evolution;
 use super::schema::{MatchConfig, RunConfig};
 
 /// The config of a run that evolves `model`'s plants towards the outline of `outline`
-/// alone (what `sylva match` runs): the model's defaults, `run`, and `outline` with
-/// `beside = false`, bred for fitting ([`fitting_breeding`]). Errors name the field.
+/// alone (what `sylva match` runs): the model's defaults as the model fits an outline
+/// (`Evolve::fitting`), `run`, and `outline` with `beside = false`. Errors name the field.
 pub fn match_config(
     registry: &Registry,
     model: &str,
@@ -32,46 +32,7 @@ pub fn match_config(
         beside: false,
         ..outline.clone()
     };
-    let mut value = serde_json::json!({
-        "model": model,
-        "run": serde_json::to_value(run).map_err(|e| FieldError::new("run", e))?,
-        "match": serde_json::to_value(&outline).map_err(|e| FieldError::new("match", e))?,
-    });
-    if let Some(settings) = fitting_breeding(model) {
-        value[model] = settings;
-    }
-    registry.config_from_value(value)
-}
-
-/// The model settings a match breeds with, where they differ from the model's defaults:
-/// an outline is fitted by many small steps from good plants rather than by recombining
-/// distant ones. The defaults are the papers' (Koza's 88% crossover and 2% mutation for
-/// the generational models; Susinno's 2% of bits flipped), made to find a shape's kind;
-/// here most offspring are mutants, PlantMaker's mutants move less, the five best
-/// survive, and copies are not grown again (growth is deterministic). PlantMaker's fans
-/// keep to leaf greens and bark browns (`palette = "foliage"`): the outline cannot see
-/// colour, and left to drift a match's leaves came out blue, purple and red. Measured on the
-/// tuning outlines (`examples/match`, docs/match.md): the term's mean rose from 0.731 to
-/// 0.828 (PlantMaker, 40 s a target), 0.595 to 0.704 (automata, 20 s) and 0.661 to 0.696
-/// (binary trees, 20 s).
-pub fn fitting_breeding(model: &str) -> Option<serde_json::Value> {
-    let mostly_mutants = serde_json::json!({
-        "crossover": 0.3,
-        "mutation": 0.7,
-        "reproduction": 0.0,
-        "elitism": 5,
-        "reevaluate": false,
-    });
-    match model {
-        "plantmaker" => Some(serde_json::json!({
-            "mutation_spread": 0.05,
-            "palette": "foliage",
-            "breeding": mostly_mutants,
-        })),
-        "automata" => Some(serde_json::json!({ "breeding": mostly_mutants })),
-        "bintree" => Some(serde_json::json!({ "mutation_rate": 0.05 })),
-        _ => None,
-    }
+    registry.match_config(model, run, &outline)
 }
 
 /// How long a match breeds.
@@ -278,10 +239,13 @@ pub fn start_auto_at(
         Limit::Generations(_) => 60.0 * TRIAL_SHARE,
         Limit::Seconds(s) => s * TRIAL_SHARE,
     };
+    // The pictures are read once, for every model's trial.
+    let pictures = Target::read(target, base)?;
     let mut entrants: Vec<(f64, &'static str, Evolution)> = Vec::new();
     for entry in registry.models() {
         let mut config = match_config(registry, entry.name(), run, target)
-            .map_err(|e| InputError::new(e.field, e.message))?;
+            .map_err(|e| InputError::new(e.field, e.message))?
+            .with_target(Some(pictures.clone()));
         config.set_base(base);
         if let Some(t) = config.generation_time(&[], pool.threads())
             && t.seconds > allowance

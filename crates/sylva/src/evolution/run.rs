@@ -10,14 +10,17 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::config::Config;
-use super::face::RunFace;
+use super::face::{RunFace, Where};
 use super::hooks::RunHooks;
+use super::silhouette::Target;
 use super::typed::Member;
 
 /// An evolution run of any model.
 pub struct Evolution {
     /// The model's `TypedRun`.
     run: Box<dyn RunFace>,
+    /// Its config's `[match]` pictures, as read when it started.
+    target: Option<Target>,
 }
 
 impl std::fmt::Debug for Evolution {
@@ -45,14 +48,14 @@ impl Evolution {
         pool: Pool,
         hooks: RunHooks,
     ) -> Result<Evolution, Error> {
-        let at = config.at();
+        let at = config.at()?;
         let stop = hooks.stop.clone();
         let make = || config.face().start(&at, start, pool, hooks);
         let run = match &stop {
             Some(stop) => stop.watch(make)??,
             None => make()?,
         };
-        Evolution::checked(run, &at.source)
+        Evolution::checked(run, at)
     }
 
     /// Resumes the run saved in a checkpoint's `text` (read from `path`), which must have
@@ -77,14 +80,14 @@ impl Evolution {
         pool: Pool,
         hooks: RunHooks,
     ) -> Result<Evolution, Error> {
-        let at = config.at();
+        let at = config.at()?;
         let stop = hooks.stop.clone();
         let make = || config.face().resume(&at, (path, text), pool, hooks);
         let run = match &stop {
             Some(stop) => stop.watch(make)??,
             None => make()?,
         };
-        Evolution::checked(run, &at.source)
+        Evolution::checked(run, at)
     }
 
     /// Sets the stop that cuts the run's steps short from now on ([`RunHooks::stop`]).
@@ -93,15 +96,18 @@ impl Evolution {
     }
 
     /// The run, if its generation has a member with a finite fitness.
-    fn checked(run: Box<dyn RunFace>, source: &str) -> Result<Self, Error> {
-        let evolution = Evolution { run };
-        evolution.check_finite(source)?;
+    fn checked(run: Box<dyn RunFace>, at: Where) -> Result<Self, Error> {
+        let evolution = Evolution {
+            run,
+            target: at.target,
+        };
+        evolution.check_finite(&at.source)?;
         Ok(evolution)
     }
 
-    /// The effective config.
+    /// The effective config, carrying its `[match]` pictures as read.
     pub fn config(&self) -> Config {
-        Config::of(self.run.config())
+        Config::of(self.run.config()).with_target(self.target.clone())
     }
 
     /// The model's title, for plots.

@@ -3,18 +3,18 @@
 //! ([`sylva_evolve::WithTerm`]), and the overlay picture that shows it.
 
 use std::cell::RefCell;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use sylva_evolve::{Added, Problem, Term};
 pub use sylva_fitness::silhouette::Outline;
-use sylva_fitness::silhouette::{SPACE_ROWS, Scratch, Side};
+use sylva_fitness::silhouette::{Bitmap, SPACE_ROWS, Scratch, Side};
 pub use sylva_fitness::silhouette::{prune, score_pruned};
 use sylva_model::Evolve;
 
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
-use crate::picture;
+use crate::picture::{self, Threshold};
 
 use super::schema::MatchConfig;
 
@@ -62,21 +62,130 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
     }
 }
 
+/// A match's target pictures, each read, decoded and thresholded once, then carried by value
+/// (a clone shares them) through the problem's term, the pruning space, the overlay and the
+/// outputs. Which files and threshold it holds are [`MatchConfig`]'s `front`, `side` and
+/// `threshold`; its outlines are made at whatever rows are asked.
+#[derive(Clone, Debug)]
+pub struct Target {
+    /// The front view, then the side view if there is one: each picture's path (named in
+    /// errors) and its ink.
+    views: Arc<[(Side, PathBuf, Bitmap)]>,
+    threshold: Threshold,
+    /// The folder the config's file names were found in.
+    base: PathBuf,
+}
+
+impl Target {
+    /// Reads the pictures `config` names, relative to `base`.
+    pub fn read(config: &MatchConfig, base: &Path) -> Result<Target, InputError> {
+        let views = [
+            (Side::Front, Some(&config.front)),
+            (Side::Side, config.side.as_ref()),
+        ];
+        let mut read: Vec<(Side, PathBuf, Bitmap)> = Vec::new();
+        for (side, path) in views
+            .into_iter()
+            .filter_map(|(side, file)| file.map(|f| (side, base.join(f))))
+        {
+            // A side view of the front's own picture (`sylva match`'s default) is read once.
+            let ink = match read.iter().find(|(_, p, _)| *p == path) {
+                Some((_, _, ink)) => ink.clone(),
+                None => picture::load_target(&path, config.threshold)?,
+            };
+            read.push((side, path, ink));
+        }
+        let views = read;
+        Ok(Target {
+            views: views.into(),
+            threshold: config.threshold,
+            base: base.to_owned(),
+        })
+    }
+
+    /// Whether these are the pictures `config` names, at its threshold (its file names
+    /// found in the folder these were read from).
+    pub fn is_of(&self, config: &MatchConfig) -> bool {
+        let files = [Some(&config.front), config.side.as_ref()];
+        let wanted = files.iter().flatten().map(|f| self.base.join(f));
+        self.threshold == config.threshold
+            && self.views.len() == wanted.clone().count()
+            && self
+                .views
+                .iter()
+                .zip(wanted)
+                .all(|((_, path, _), w)| *path == w)
+    }
+
+    /// The outlines of the views at `rows` rows.
+    pub fn outlines(&self, rows: u32) -> Result<Vec<Outline>, InputError> {
+        self.views
+            .iter()
+            .map(|(side, path, ink)| {
+                Outline::new(ink, *side, rows).map_err(|e| InputError::file(path, e))
+            })
+            .collect()
+    }
+
+    /// The outlines plants grow inside (at [`SPACE_ROWS`] rows) when `config` prunes
+    /// (`[match] prune`); none when it does not.
+    pub fn space(&self, config: &MatchConfig) -> Result<Option<Arc<[Outline]>>, InputError> {
+        if !config.prunes() {
+            return Ok(None);
+        }
+        Ok(Some(self.outlines(SPACE_ROWS)?.into()))
+    }
+
+    /// The term `config` adds to model `M`'s problem.
+    pub(super) fn added<M: Evolve>(
+        &self,
+        model: &M,
+        config: &MatchConfig,
+    ) -> Result<Added<M::Problem>, InputError> {
+        Ok(Added {
+            term: Arc::new(OutlineTerm {
+                model: model.clone(),
+                outlines: self.outlines(config.rows)?,
+                closeness: config.closeness,
+                space: self.space(config)?,
+            }),
+            weight: config.weight,
+            beside: config.beside,
+        })
+    }
+
+    /// `overlay.png`: the front target and `genome`'s silhouette (grown with its own seed,
+    /// pruned as `config` prunes) over each other, normalised as the term compares them, with
+    /// their IoU; and that IoU.
+    pub fn overlay(&self, config: &MatchConfig, genome: &Genome) -> Result<(Vec<u8>, f64), Error> {
+        let (side, path, ink) = &self.views[0];
+        let target =
+            Outline::new(ink, *side, OVERLAY_ROWS).map_err(|e| InputError::file(path, e))?;
+        let mut plant = genome.develop(genome.default_seed())?;
+        if let Some(space) = self.space(config)? {
+            plant = prune(&space, &plant);
+        }
+        let mut scratch = Scratch::default();
+        let iou = target.iou(&plant, &mut scratch);
+        let (canvas, wanted) = (scratch.canvas(), target.normalised());
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let caption =
+            format!("IoU {iou:.3} (front)   blue: {name}   orange: the plant   green: both");
+        let image = sylva_render::overlay::overlay(
+            wanted.width(),
+            wanted.height(),
+            2,
+            |x, y| wanted.get(x, y),
+            |x, y| canvas.get(x, y),
+            &caption,
+        );
+        Ok((sylva_render::encode_png(&image)?, iou))
+    }
+}
+
 /// The targets of `config`, read from pictures relative to `base`.
 pub fn outlines(config: &MatchConfig, base: &Path) -> Result<Vec<Outline>, InputError> {
-    let threshold = config.threshold;
-    let views = [
-        (Side::Front, Some(&config.front)),
-        (Side::Side, config.side.as_ref()),
-    ];
-    views
-        .into_iter()
-        .filter_map(|(side, file)| file.map(|f| (side, base.join(f))))
-        .map(|(side, path)| {
-            let picture = picture::load_target(&path, threshold)?;
-            Outline::new(&picture, side, config.rows).map_err(|e| InputError::file(&path, e))
-        })
-        .collect()
+    Target::read(config, base)?.outlines(config.rows)
 }
 
 /// The outlines of `config` that its plants grow inside (at [`SPACE_ROWS`] rows), read
@@ -85,36 +194,14 @@ pub fn space(config: &MatchConfig, base: &Path) -> Result<Option<Arc<[Outline]>>
     if !config.prunes() {
         return Ok(None);
     }
-    let fine = MatchConfig {
-        rows: SPACE_ROWS,
-        ..config.clone()
-    };
-    Ok(Some(outlines(&fine, base)?.into()))
-}
-
-/// The term `config` adds to model `M`'s problem, its pictures read relative to `base`.
-pub(super) fn added<M: Evolve>(
-    model: &M,
-    config: &MatchConfig,
-    base: &Path,
-) -> Result<Added<M::Problem>, InputError> {
-    Ok(Added {
-        term: Arc::new(OutlineTerm {
-            model: model.clone(),
-            outlines: outlines(config, base)?,
-            closeness: config.closeness,
-            space: space(config, base)?,
-        }),
-        weight: config.weight,
-        beside: config.beside,
-    })
+    Target::read(config, base)?.space(config)
 }
 
 /// Rows of the overlay picture's outlines.
 const OVERLAY_ROWS: u32 = 256;
 
-/// `overlay.png`: the front target and `genome`'s silhouette (grown with its own seed)
-/// over each other, normalised as the term compares them, with their IoU; and that IoU.
+/// `overlay.png` of `genome` against the pictures of `outline`, read relative to `base`
+/// ([`Target::overlay`]).
 pub fn overlay(
     outline: &MatchConfig,
     base: &Path,
@@ -122,30 +209,7 @@ pub fn overlay(
 ) -> Result<(Vec<u8>, f64), Error> {
     let front = MatchConfig {
         side: None,
-        rows: OVERLAY_ROWS,
         ..outline.clone()
     };
-    let target = outlines(&front, base)?.remove(0);
-    let mut plant = genome.develop(genome.default_seed())?;
-    if let Some(space) = space(outline, base)? {
-        plant = prune(&space, &plant);
-    }
-    let mut scratch = Scratch::default();
-    let iou = target.iou(&plant, &mut scratch);
-    let (canvas, wanted) = (scratch.canvas(), target.normalised());
-    let name = outline
-        .front
-        .file_name()
-        .unwrap_or_default()
-        .to_string_lossy();
-    let caption = format!("IoU {iou:.3} (front)   blue: {name}   orange: the plant   green: both");
-    let image = sylva_render::overlay::overlay(
-        wanted.width(),
-        wanted.height(),
-        2,
-        |x, y| wanted.get(x, y),
-        |x, y| canvas.get(x, y),
-        &caption,
-    );
-    Ok((sylva_render::encode_png(&image)?, iou))
+    Target::read(&front, base)?.overlay(outline, genome)
 }

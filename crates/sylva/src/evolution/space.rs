@@ -59,7 +59,7 @@ impl GenomeSpace {
         start: Vec<Genome>,
         options: &SpaceOptions,
     ) -> Result<GenomeSpace, Error> {
-        let space = config.face().space(&config.at(), start, options)?;
+        let space = config.face().space(&config.at()?, start, options)?;
         Ok(GenomeSpace { space })
     }
 

@@ -20,6 +20,7 @@ use super::hooks::{
     OwnRecord, RunHooks, Scored, check_resumed, check_term, first_generation, foreseen,
 };
 use super::schema::{EvolveConfig, SearchStrategy};
+use super::silhouette::Target;
 
 /// A member of a run's population (or of a kept generation), its genome as a genome file.
 #[derive(Clone, Debug, PartialEq)]
@@ -327,7 +328,7 @@ pub struct GenerationTime {
 pub(crate) fn start<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
-    base: &Path,
+    target: Option<&Target>,
     start: Vec<Genome>,
     pool: Pool,
     hooks: RunHooks,
@@ -365,7 +366,7 @@ pub(crate) fn start<M: Evolve + Default>(
     let again = hooks.term.as_ref().map(|_| typed.clone());
     let setup = made(typed)?;
     let scout = || Ok(made(again.clone().unwrap_or_default())?.strategy);
-    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
+    let (problem, hooked) = with_hooks(config, setup.problem, target, pool, hooks, scout)?;
     // The settings are valid; generation 0 grows as the run is made.
     if let Some(t) = config.generation_time(&start, hooked.pool.threads()) {
         sylva_core::budget::check_time(t.seconds, t.what, t.advice)
@@ -407,7 +408,7 @@ pub(crate) fn start<M: Evolve + Default>(
 fn with_hooks<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     problem: M::Problem,
-    base: &Path,
+    target: Option<&Target>,
     pool: Pool,
     hooks: RunHooks,
     scout: impl FnOnce() -> Result<M::Strategy, InputError>,
@@ -415,7 +416,7 @@ fn with_hooks<M: Evolve + Default>(
     let mut hooked = Hooked::none(pool);
     hooked.stop = hooks.stop;
     let Some(own) = hooks.term else {
-        return Ok((with_term(config, problem, base)?, hooked));
+        return Ok((with_term(config, problem, target)?, hooked));
     };
     if config.outline.is_some() {
         return Err(InputError::new(
@@ -467,7 +468,7 @@ pub(super) fn typed_start<M: Evolve>(start: &[Genome]) -> Result<Vec<M::Genome>,
 pub(crate) fn resume<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
-    base: &Path,
+    target: Option<&Target>,
     path: &Path,
     text: &str,
     pool: Pool,
@@ -487,7 +488,7 @@ pub(crate) fn resume<M: Evolve + Default>(
     let made = || setup(&config.model, &config.settings, Vec::new(), 0, 0, source);
     let setup = made()?;
     let scout = || Ok(made()?.strategy);
-    let (problem, hooked) = with_hooks(config, setup.problem, base, pool, hooks, scout)?;
+    let (problem, hooked) = with_hooks(config, setup.problem, target, pool, hooks, scout)?;
     if let Some(scored) = &hooked.scored {
         // The engine scores a resumed population again.
         let genomes = saved.checkpoint.population.iter().map(|i| &i.genome);
@@ -531,18 +532,17 @@ impl<M: Evolve + Default> EvolveConfig<M> {
     }
 }
 
-/// The model's problem with the config's `[match]` term, if it has one, its pictures read
-/// relative to `base`.
+/// The model's problem with the config's `[match]` term, if it has one: `target` holds its
+/// pictures as read ([`Config::at`](super::Config) reads them for a config with a `[match]`).
 pub(super) fn with_term<M: Evolve>(
     config: &EvolveConfig<M>,
     problem: M::Problem,
-    base: &Path,
+    target: Option<&Target>,
 ) -> Result<WithTerm<M::Problem>, InputError> {
-    let added = config
-        .outline
-        .as_ref()
-        .map(|outline| super::silhouette::added(&config.model, outline, base))
-        .transpose()?;
+    let added = match (&config.outline, target) {
+        (Some(outline), Some(target)) => Some(target.added(&config.model, outline)?),
+        _ => None,
+    };
     Ok(WithTerm { problem, added })
 }
 

@@ -20,6 +20,7 @@ use crate::genome::Genome;
 
 use super::checkpoint;
 use super::schema::{EmitterKind, EvolveConfig, MapConfig, SearchStrategy};
+use super::silhouette::Target;
 use super::typed::{Member, member_of, setup, typed_start, with_term};
 
 thread_local! {
@@ -221,7 +222,7 @@ pub(super) fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings,
 pub(crate) fn start_map<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
-    base: &Path,
+    target: Option<&Target>,
     start: Vec<Genome>,
     pool: Pool,
 ) -> Result<TypedMap<M>, Error> {
@@ -256,7 +257,7 @@ pub(crate) fn start_map<M: Evolve + Default>(
         settings.initial,
         source,
     )?;
-    let problem = with_term(&config, setup.problem, base)?;
+    let problem = with_term(&config, setup.problem, target)?;
     let coding = emitter_coding(&config, &problem, source)?;
     let describer = Arc::new(PlantDescriber {
         model: config.model.clone(),
@@ -283,7 +284,7 @@ pub(crate) fn start_map<M: Evolve + Default>(
 pub(crate) fn resume_map<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
-    base: &Path,
+    target: Option<&Target>,
     path: &Path,
     text: &str,
     pool: Pool,
@@ -303,7 +304,7 @@ pub(crate) fn resume_map<M: Evolve + Default>(
         return Err(InputError::file(path, "the checkpoint's map differs from its config").into());
     }
     let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
-    let problem = with_term(&config, setup.problem, base)?;
+    let problem = with_term(&config, setup.problem, target)?;
     let coding = emitter_coding(&config, &problem, source)?;
     let describer = Arc::new(PlantDescriber {
         model: config.model.clone(),

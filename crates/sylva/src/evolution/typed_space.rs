@@ -2,7 +2,6 @@
 //! decoding, encoding and scoring behind [`GenomeSpace`](super::GenomeSpace).
 
 use std::convert::Infallible;
-use std::path::Path;
 
 use rand::TryRng;
 use sylva_core::par::Pool;
@@ -16,6 +15,7 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::schema::EvolveConfig;
+use super::silhouette::Target;
 use super::typed::{setup, typed_start, with_term};
 use super::typed_map::{PlantDescriber, as_map, map_settings};
 
@@ -298,7 +298,7 @@ impl<M: Evolve + Default> SpaceValue for TypedSpace<M> {
 pub(crate) fn new_space<M: Evolve + Default>(
     config: &EvolveConfig<M>,
     source: &str,
-    base: &Path,
+    target: Option<&Target>,
     start: Vec<Genome>,
     options: &SpaceOptions,
 ) -> Result<Box<dyn SpaceValue>, Error> {
@@ -307,7 +307,7 @@ pub(crate) fn new_space<M: Evolve + Default>(
     let seed = options.seed.unwrap_or(config.run.seed);
     let typed = typed_start::<M>(&start)?;
     let setup = setup(&config.model, &config.settings, typed, seed, 0, source)?;
-    let problem = with_term(&config, setup.problem, base)?;
+    let problem = with_term(&config, setup.problem, target)?;
     let direct = match options.coding {
         Some(Coding::Codons) => None,
         Some(Coding::Direct) => Some(

@@ -36,7 +36,7 @@ impl Varieties {
     /// default map): generation 0 made, evaluated and placed. `start` holds the first
     /// genomes (of the config's model); the rest are random.
     pub fn start(config: &Config, start: Vec<Genome>, pool: Pool) -> Result<Varieties, Error> {
-        let run = config.face().start_map(&config.at(), start, pool)?;
+        let run = config.face().start_map(&config.at()?, start, pool)?;
         Ok(Varieties { run })
     }
 
@@ -49,7 +49,9 @@ impl Varieties {
         text: &str,
         pool: Pool,
     ) -> Result<Varieties, Error> {
-        let run = config.face().resume_map(&config.at(), (path, text), pool)?;
+        let run = config
+            .face()
+            .resume_map(&config.at()?, (path, text), pool)?;
         Ok(Varieties { run })
     }
 
