@@ -79,10 +79,105 @@ pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
 pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 
-// The layers below, for front ends that need their types (plants, meshes, scenes, files,
-// pictures, the thread pool, budgets): a front end depends on `sylva` alone.
-pub use sylva_core as core;
-pub use sylva_gltf as gltf;
-pub use sylva_mesh as mesh;
-pub use sylva_model as model;
-pub use sylva_render as render;
+// What front ends need of the layers below, item by item (a front end depends on `sylva`
+// alone; `scripts/check-layers` refuses a whole crate re-exported here).
+
+/// Plants, the thread pool, budgets, seeds and measures (`sylva-core`).
+pub mod core {
+    pub use sylva_core::{MaterialKind, Plant, PlantMeta};
+
+    /// Memory and time budgets of a process.
+    pub mod budget {
+        pub use sylva_core::budget::{
+            Seconds, default_budget, max_memory, max_time, parse_bytes, parse_duration,
+            set_max_memory, set_max_time,
+        };
+    }
+    /// Leaves and bark on any plant.
+    pub mod dress {
+        pub use sylva_core::dress::dress;
+    }
+    /// Placement in a scene.
+    pub mod glam {
+        pub use sylva_core::glam::{Quat, Vec3};
+    }
+    /// Hashes that do not change between runs or machines.
+    pub mod hash {
+        pub use sylva_core::hash::stable_hash;
+    }
+    /// Susinno's tree measures.
+    pub mod measures {
+        pub use sylva_core::measures::TreeMeasures;
+    }
+    /// The one parallel seam: a pool of threads and the stop that cuts work short.
+    pub mod par {
+        pub use sylva_core::par::{Pool, Stop};
+    }
+    /// Seeded random streams.
+    pub mod rng {
+        pub use sylva_core::rng::seeded;
+    }
+    /// Foliage and bark kinds.
+    pub mod species {
+        pub use sylva_core::species::UnknownKind;
+    }
+    /// The pipe model's taper.
+    pub mod taper {
+        pub use sylva_core::taper::PipeTaper;
+    }
+}
+
+/// Files: GLB, OBJ and STL writers, the GLB reader, levels of detail (`sylva-gltf`).
+pub mod gltf {
+    /// Writers.
+    pub mod export {
+        pub use sylva_gltf::export::{Format, check_scene, scene_files, to_glb, to_obj, to_stl};
+    }
+    /// The GLB reader.
+    pub mod import {
+        pub use sylva_gltf::import::{ImportedScene, first_extras, read_glb, texture_ids};
+    }
+    /// Levels of detail.
+    pub mod lod {
+        pub use sylva_gltf::lod::MAX_LEVELS;
+    }
+}
+
+/// Meshes, scenes, textures and wind rigs (`sylva-mesh`).
+pub mod mesh {
+    pub use sylva_mesh::{Mesh, Scene, SceneNode};
+
+    /// The pictures a material shows.
+    pub mod picture {
+        pub use sylva_mesh::picture::Picture;
+    }
+    /// Procedural textures.
+    pub mod texture {
+        pub use sylva_mesh::texture::texture_png;
+    }
+    /// Wind rigs.
+    pub mod wind {
+        pub use sylva_mesh::wind::{MAX_JOINTS, WindError, WindOptions};
+    }
+}
+
+/// Pictures: the renderer's views, contact sheets, overlays, impostors and variety maps
+/// (`sylva-render`).
+pub mod render {
+    pub use sylva_render::{
+        CAPTION_HEIGHT, SheetCell, SheetOptions, View, contact_sheet, encode_png,
+    };
+
+    /// Impostors' pictures.
+    pub mod impostor {
+        pub use sylva_render::impostor::impostor;
+    }
+    /// Variety maps' pictures.
+    pub mod map {
+        pub use sylva_render::map::{MapAxis, MapPicture, map_picture};
+    }
+    /// Outline overlays.
+    pub mod overlay {
+        pub use sylva_render::overlay::overlay;
+    }
+}

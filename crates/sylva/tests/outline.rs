@@ -142,7 +142,7 @@ fn a_match_breeds_for_fitting() {
 /// whose fans take any colour.
 #[test]
 fn a_match_grows_green_leaves_and_the_forms_any_colours_would() {
-    use sylva::core::plant::MaterialKind;
+    use sylva::core::MaterialKind;
     use sylva::evolution::RunConfig;
     use sylva::evolution::outline::match_config;
     let run = RunConfig {
