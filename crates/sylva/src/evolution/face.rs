@@ -174,14 +174,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         pool: Pool,
         hooks: RunHooks,
     ) -> Result<Box<dyn RunFace>, Error> {
-        Ok(Box::new(start(
-            self,
-            &at.source,
-            at.target.as_ref(),
-            first,
-            pool,
-            hooks,
-        )?))
+        Ok(Box::new(start(self, at, first, pool, hooks)?))
     }
 
     fn resume(
@@ -191,15 +184,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         pool: Pool,
         hooks: RunHooks,
     ) -> Result<Box<dyn RunFace>, Error> {
-        Ok(Box::new(resume(
-            self,
-            &at.source,
-            at.target.as_ref(),
-            path,
-            text,
-            pool,
-            hooks,
-        )?))
+        Ok(Box::new(resume(self, at, path, text, pool, hooks)?))
     }
 
     fn start_map(
@@ -208,13 +193,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         first: Vec<Genome>,
         pool: Pool,
     ) -> Result<Box<dyn MapFace>, Error> {
-        Ok(Box::new(start_map(
-            self,
-            &at.source,
-            at.target.as_ref(),
-            first,
-            pool,
-        )?))
+        Ok(Box::new(start_map(self, at, first, pool)?))
     }
 
     fn resume_map(
@@ -223,14 +202,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         (path, text): (&Path, &str),
         pool: Pool,
     ) -> Result<Box<dyn MapFace>, Error> {
-        Ok(Box::new(resume_map(
-            self,
-            &at.source,
-            at.target.as_ref(),
-            path,
-            text,
-            pool,
-        )?))
+        Ok(Box::new(resume_map(self, at, path, text, pool)?))
     }
 
     fn space(
@@ -239,7 +211,7 @@ impl<M: Evolve + Default> ConfigFace for EvolveConfig<M> {
         first: Vec<Genome>,
         options: &SpaceOptions,
     ) -> Result<Box<dyn SpaceValue>, Error> {
-        new_space(self, &at.source, at.target.as_ref(), first, options)
+        new_space(self, at, first, options)
     }
 }
 

@@ -16,6 +16,7 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::checkpoint::{SavedRun, SavedRunRef};
+use super::face::Where;
 use super::hooks::{
     OwnRecord, RunHooks, Scored, check_resumed, check_term, first_generation, foreseen,
 };
@@ -327,12 +328,12 @@ pub struct GenerationTime {
 /// (`source`).
 pub(crate) fn start<M: Evolve + Default>(
     config: &EvolveConfig<M>,
-    source: &str,
-    target: Option<&Target>,
+    at: &Where,
     start: Vec<Genome>,
     pool: Pool,
     hooks: RunHooks,
 ) -> Result<TypedRun<M>, Error> {
+    let (source, target) = (at.source.as_str(), at.target.as_ref());
     if config.run.strategy == SearchStrategy::MapElites {
         return Err(InputError::new(
             source,
@@ -464,16 +465,15 @@ pub(super) fn typed_start<M: Evolve>(start: &[Genome]) -> Result<Vec<M::Genome>,
 }
 
 /// Resumes the run of `config` saved in a checkpoint's `text` (read from `path`).
-#[allow(clippy::too_many_arguments)] // The erased model's call, one argument each.
 pub(crate) fn resume<M: Evolve + Default>(
     config: &EvolveConfig<M>,
-    source: &str,
-    target: Option<&Target>,
+    at: &Where,
     path: &Path,
     text: &str,
     pool: Pool,
     hooks: RunHooks,
 ) -> Result<TypedRun<M>, Error> {
+    let (source, target) = (at.source.as_str(), at.target.as_ref());
     let saved = SavedRun::<M>::parse(path, text)?;
     if saved.config.resumable() != config.resumable() {
         return Err(InputError::file(

@@ -19,8 +19,8 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::checkpoint;
+use super::face::Where;
 use super::schema::{EmitterKind, EvolveConfig, MapConfig, SearchStrategy};
-use super::silhouette::Target;
 use super::typed::{Member, member_of, setup, typed_start, with_term};
 
 thread_local! {
@@ -221,11 +221,11 @@ pub(super) fn map_settings<M: Evolve>(config: &EvolveConfig<M>) -> (MapSettings,
 /// the config (`source`).
 pub(crate) fn start_map<M: Evolve + Default>(
     config: &EvolveConfig<M>,
-    source: &str,
-    target: Option<&Target>,
+    at: &Where,
     start: Vec<Genome>,
     pool: Pool,
 ) -> Result<TypedMap<M>, Error> {
+    let (source, target) = (at.source.as_str(), at.target.as_ref());
     let config = as_map(config);
     let (settings, descriptors) = map_settings(&config);
     let typed = typed_start::<M>(&start)?;
@@ -283,12 +283,12 @@ pub(crate) fn start_map<M: Evolve + Default>(
 /// Resumes the map run of `config` saved in a checkpoint's `text` (read from `path`).
 pub(crate) fn resume_map<M: Evolve + Default>(
     config: &EvolveConfig<M>,
-    source: &str,
-    target: Option<&Target>,
+    at: &Where,
     path: &Path,
     text: &str,
     pool: Pool,
 ) -> Result<TypedMap<M>, Error> {
+    let (source, target) = (at.source.as_str(), at.target.as_ref());
     let config = as_map(config);
     let (saved, engine): (EvolveConfig<M>, MapCheckpoint<_>) = checkpoint::parse(path, text)?;
     if saved.resumable() != config.resumable() {

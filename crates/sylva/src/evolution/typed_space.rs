@@ -14,8 +14,8 @@ use sylva_model::{Evolve, VectorCoding};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
+use super::face::Where;
 use super::schema::EvolveConfig;
-use super::silhouette::Target;
 use super::typed::{setup, typed_start, with_term};
 use super::typed_map::{PlantDescriber, as_map, map_settings};
 
@@ -297,11 +297,11 @@ impl<M: Evolve + Default> SpaceValue for TypedSpace<M> {
 /// or the option.
 pub(crate) fn new_space<M: Evolve + Default>(
     config: &EvolveConfig<M>,
-    source: &str,
-    target: Option<&Target>,
+    at: &Where,
     start: Vec<Genome>,
     options: &SpaceOptions,
 ) -> Result<Box<dyn SpaceValue>, Error> {
+    let (source, target) = (at.source.as_str(), at.target.as_ref());
     let config = as_map(config);
     let (_, descriptors) = map_settings(&config);
     let seed = options.seed.unwrap_or(config.run.seed);
