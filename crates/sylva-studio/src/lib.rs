@@ -11,6 +11,8 @@
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
 //! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
+//! - [`pruning`]: plants pruned to a match run's outlines, as breed, match and the plant
+//!   routes show them.
 //! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
 //! - [`guard`]: who may talk to the studio: Host names, other sites' pages, content types,
 //!   the access token.
@@ -37,6 +39,7 @@ pub mod http;
 pub mod listen;
 pub mod modes;
 pub mod plants;
+pub mod pruning;
 pub mod runs;
 pub mod sessions;
 

@@ -14,7 +14,7 @@ use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::core::Plant;
-use sylva::evolution::outline::{Outline, prune};
+use sylva::evolution::outline::Outline;
 use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
@@ -22,10 +22,8 @@ use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
 use crate::modes::Mode;
-use crate::modes::matching::{PRUNED_TO, match_settings, pruned_run, pruned_to};
-use crate::plants::{
-    Form, PreviewSize, genome_of, grow_shown, parse_genome, plant_bytes, preview_glb,
-};
+use crate::plants::{Form, PreviewSize, genome_of, parse_genome, plant_bytes, preview_glb};
+use crate::pruning::{PRUNED_TO, grow_shown, match_settings, pruned_run, pruned_to};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// The model a new session breeds when the request names none: PlantMaker's, whose main
@@ -134,10 +132,7 @@ impl Made {
         parents: Vec<ParentRow>,
         pruned_to: Option<&[Outline]>,
     ) -> Result<Made, ApiError> {
-        let mut plant = grow_shown(&genome, seed)?;
-        if let Some(outlines) = pruned_to {
-            plant = prune(outlines, &plant);
-        }
+        let plant = grow_shown(&genome, seed, pruned_to)?;
         let glb = preview_glb(&genome, seed, &plant, PreviewSize::GRID)?;
         Ok(Made {
             genome,
