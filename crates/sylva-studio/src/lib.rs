@@ -8,6 +8,8 @@
 //!   picture) and map (variety maps of any model); sessions start, branch,
 //!   undo and redo through it.
 //! - [`sessions`]: sessions as stored and viewed, examples, step seeds.
+//! - [`settings`]: model settings a page's form asks for, built typed and read with their
+//!   own checks.
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
 //! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
@@ -42,6 +44,7 @@ pub mod plants;
 pub mod pruning;
 pub mod runs;
 pub mod sessions;
+pub mod settings;
 
 use modes::{design, family, map, matching};
 

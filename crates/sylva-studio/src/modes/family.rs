@@ -14,15 +14,17 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::{Config, Evolution, Member};
+use sylva::models::BinTreeModel;
+use sylva::{Config, Evolution, EvolveConfig, Member};
 
 use crate::Studio;
 use crate::archive::{self, GenerationRow, ModeName, Operator};
 use crate::error::ApiError;
-use crate::http::{Body, first_null, join};
+use crate::http::{Body, first_null};
 use crate::modes::Mode;
 use crate::runs::{archive_member, finite, generation_row};
 use crate::sessions::{SessionView, session_of, view};
+use crate::settings;
 
 const BINTREE: &str = sylva::registry::names::BINTREE;
 
@@ -73,7 +75,7 @@ pub struct Start {
     config: FamilyConfig,
 }
 
-/// The `[run]` and `[bintree]` sections of an evolution config, as JSON.
+/// The `[run]` and `[bintree]` sections of an evolution config, as the page sends them.
 #[derive(Deserialize, Serialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 pub struct FamilyConfig {
@@ -105,7 +107,12 @@ pub struct FamilyState {
     pub members: Vec<MemberView>,
 }
 
-/// The config a family request asks for: the example's defaults under its sections.
+/// Trees in a family whose request names no population.
+const POPULATION: u32 = 100;
+
+/// The config a family request asks for: the binary-tree model's typed config, read from
+/// the request's sections with their own checks (the model's defaults for what they leave
+/// out), a hundred trees unless it says otherwise.
 fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     if let Some(null) = request
         .run
@@ -128,22 +135,32 @@ fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
         ));
     }
     let mut run = request.run.clone().unwrap_or_default();
-    let population = run.entry("population").or_insert(json!(100));
     // The page lists every member: a family is a browsable population, not a large search.
-    if population.as_u64().is_some_and(|p| p > MAX_POPULATION) {
+    if let Some(population) = run.get("population")
+        && population.as_u64().is_some_and(|p| p > MAX_POPULATION)
+    {
         return Err(ApiError::bad(
             "config.run.population",
             format!("a family holds at most {MAX_POPULATION} trees, got {population}"),
         ));
     }
-    // The studio steps the run by hand; `generations` only has to be valid.
-    run.insert("generations".into(), json!(1));
-    let mut doc = json!({ "model": BINTREE, "run": run });
-    if let Some(b) = &request.bintree {
-        doc["bintree"] = b.clone();
+    // The studio steps the run by hand; the config's `generations` is its own.
+    run.remove("generations");
+    let asked = FamilyConfig {
+        run: Some(run),
+        bintree: request.bintree.clone(),
+    };
+    let sections = serde_json::to_value(&asked).map_err(ApiError::internal)?;
+    let mut typed: EvolveConfig<BinTreeModel> = settings::read(sections, "config")?;
+    if !asked
+        .run
+        .as_ref()
+        .is_some_and(|r| r.contains_key("population"))
+    {
+        typed.run.population = POPULATION;
     }
-    Config::from_value(doc)
-        .map_err(|e| ApiError::unprocessable(join("config", &e.field), e.message))
+    typed.run.generations = 1;
+    Ok(Config::new(typed))
 }
 
 fn members(run: &Evolution) -> Vec<MemberView> {
@@ -435,5 +452,41 @@ impl Mode for FamilyMode {
     fn moved(studio: &Studio, session: i64) {
         // The run in memory may be at another generation now; it reloads when needed.
         studio.families.forget(session);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(value: serde_json::Value) -> Result<Config, ApiError> {
+        config_of(&serde_json::from_value(value).expect("a family config"))
+    }
+
+    #[test]
+    fn a_family_is_a_hundred_trees_stepped_by_hand_unless_it_asks() {
+        let typed = config(json!({})).unwrap();
+        let run = &typed.get::<BinTreeModel>().unwrap().run;
+        assert_eq!((run.population, run.generations), (POPULATION, 1));
+        let asked = json!({"run": {"population": 12, "generations": 500, "seed": 4},
+                           "bintree": {"mutation_rate": 0.1}});
+        let typed = config(asked).unwrap();
+        let typed = typed.get::<BinTreeModel>().unwrap();
+        assert_eq!(
+            (typed.run.population, typed.run.generations, typed.run.seed),
+            (12, 1, 4)
+        );
+        assert_eq!(typed.settings.mutation_rate, 0.1);
+        let e = config(json!({"bintree": {"mutation_rate": 7}})).unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "config.bintree.mutation_rate")
+        );
+        let e = config(json!({"bintree": [0.02]})).unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "config.bintree"),
+            "{e}"
+        );
     }
 }
