@@ -19,11 +19,11 @@ use sylva::models::{
 use sylva::{Config, EvolveConfig, RunConfig};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, Operator, RunRow};
+use crate::archive::{self, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::{Body, first_null, join};
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::runs::{self, Background};
 use crate::sessions::{SessionView, session_of, view};
 use crate::settings;
@@ -252,7 +252,7 @@ fn check_cells(grid: &GridDesign, at: &str) -> Result<(), ApiError> {
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let (config, generations) = config_of(&start.design, "design")?;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Design, AUTOMATA, "Design", &json!({}))?;
+        let id = archive::insert_session(c, DesignMode::NAME, AUTOMATA, "Design", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
         let state = DesignState {
             run,
@@ -291,7 +291,7 @@ pub(crate) async fn redesign(
 }
 
 fn design_state(studio: &Studio, id: i64) -> Result<DesignState, ApiError> {
-    let row = session_of(studio, id, ModeName::Design)?;
+    let row = session_of(studio, id, DesignMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -334,11 +334,6 @@ pub(crate) async fn run(
     Ok(Json(runs::run_view(&studio, state.run)?))
 }
 
-/// Resumes every design run that was running when the studio stopped (or was killed).
-pub fn resume_all(studio: &Studio) {
-    runs::resume_all::<DesignMode>(studio, ModeName::Design);
-}
-
 impl Background for DesignMode {
     const OPERATOR: Operator = Operator::Design;
 
@@ -352,7 +347,7 @@ impl Background for DesignMode {
 pub struct DesignMode;
 
 impl Mode for DesignMode {
-    const NAME: ModeName = ModeName::Design;
+    const NAME: &'static str = "design";
     type Start = Start;
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
@@ -363,18 +358,23 @@ impl Mode for DesignMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/design", post(redesign))
-            .route("/sessions/{id}/stop", post(stop))
-            .route("/sessions/{id}/resume", post(resume))
-            .route("/sessions/{id}/run", get(run))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/design", redesign),
+            Route::post("/sessions/{id}/stop", stop),
+            Route::post("/sessions/{id}/resume", resume),
+            Route::get("/sessions/{id}/run", run),
+        ]
     }
 
     fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
         let state = design_state(studio, session)?;
         runs::status_event(studio, state.run).map(Some)
+    }
+
+    /// Resumes every design run that was running when the studio stopped (or was killed).
+    fn resume(studio: &Studio) {
+        runs::resume_all::<DesignMode>(studio, Self::NAME);
     }
 }
 

@@ -18,10 +18,10 @@ use sylva::models::BinTreeModel;
 use sylva::{Config, Evolution, EvolveConfig, Member};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, ModeName, Operator};
+use crate::archive::{self, GenerationRow, Operator};
 use crate::error::ApiError;
 use crate::http::{Body, first_null};
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::runs::{archive_member, finite, generation_row};
 use crate::sessions::{SessionView, session_of, view};
 use crate::settings;
@@ -187,7 +187,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     })
     .await??;
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Family, BINTREE, "Family", &json!({}))?;
+        let id = archive::insert_session(c, FamilyMode::NAME, BINTREE, "Family", &json!({}))?;
         let run_id = archive::insert_run(c, id, &toml, 0)?;
         archive::save_run(c, run_id, Some(&checkpoint), 0, "stopped", None)?;
         archive::insert_checkpoint(c, run_id, 0, &checkpoint)?;
@@ -201,12 +201,12 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         archive::set_state(c, id, &json!(state))?;
         Ok(id)
     })?;
-    studio.families.put(id, run);
+    studio.kept::<Families>().put(id, run);
     Ok(id)
 }
 
 fn family_state(studio: &Studio, id: i64) -> Result<FamilyState, ApiError> {
-    let row = session_of(studio, id, ModeName::Family)?;
+    let row = session_of(studio, id, FamilyMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -218,7 +218,7 @@ fn evolution(
     id: i64,
     state: &FamilyState,
 ) -> Result<Arc<Mutex<Evolution>>, ApiError> {
-    if let Some(run) = studio.families.get(id) {
+    if let Some(run) = studio.kept::<Families>().get(id) {
         let at = run.lock().unwrap_or_else(|p| p.into_inner()).generation();
         if at == state.generation {
             return Ok(run);
@@ -241,7 +241,7 @@ fn evolution(
     let config = Config::parse(path, &row.config).map_err(|e| ApiError::internal(e.message))?;
     let run = Evolution::resume(&config, path, &checkpoint, studio.pool.clone())
         .map_err(ApiError::internal)?;
-    Ok(studio.families.put(id, run))
+    Ok(studio.kept::<Families>().put(id, run))
 }
 
 /// `POST /api/sessions/{id}/generations`.
@@ -305,7 +305,7 @@ pub(crate) async fn generations(
     });
     if committed.is_err() {
         // The run in memory is ahead of the archive now.
-        studio.families.forget(id);
+        studio.kept::<Families>().forget(id);
     }
     committed?;
     Ok(Json(view(&studio, id)?))
@@ -429,7 +429,7 @@ pub(crate) async fn member(
 pub struct FamilyMode;
 
 impl Mode for FamilyMode {
-    const NAME: ModeName = ModeName::Family;
+    const NAME: &'static str = "family";
     type Start = Start;
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
@@ -440,18 +440,18 @@ impl Mode for FamilyMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/generations", post(generations))
-            .route("/sessions/{id}/batch", post(batch))
-            .route("/sessions/{id}/stats", get(stats))
-            .route("/sessions/{id}/member", post(member))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/generations", generations),
+            Route::post("/sessions/{id}/batch", batch),
+            Route::get("/sessions/{id}/stats", stats),
+            Route::post("/sessions/{id}/member", member),
+        ]
     }
 
     fn moved(studio: &Studio, session: i64) {
         // The run in memory may be at another generation now; it reloads when needed.
-        studio.families.forget(session);
+        studio.kept::<Families>().forget(session);
     }
 }
 

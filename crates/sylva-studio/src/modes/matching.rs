@@ -23,11 +23,11 @@ use sylva::picture::Threshold;
 use sylva::{Config, Evolution};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, Operator, RunRow};
+use crate::archive::{self, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::plants::{genome_of, plant_row};
 use crate::pruning::{self, picture_dir};
 use crate::runs::{self, Background};
@@ -195,7 +195,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let _ = std::fs::remove_dir_all(&check);
     let generations = run.generations;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Match, config.model(), "Match", &json!({}))?;
+        let id = archive::insert_session(c, MatchMode::NAME, config.model(), "Match", &json!({}))?;
         archive::insert_picture(c, id, "front", &front)?;
         archive::insert_picture(c, id, "side", &side)?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -226,7 +226,7 @@ fn tempfile_dir() -> Result<PathBuf, ApiError> {
 }
 
 fn match_state(studio: &Studio, id: i64) -> Result<MatchState, ApiError> {
-    let row = session_of(studio, id, ModeName::Match)?;
+    let row = session_of(studio, id, MatchMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -396,16 +396,11 @@ pub(crate) async fn overlay_png(
         .into_response())
 }
 
-/// Resumes every match that was running when the studio stopped (or was killed).
-pub fn resume_all(studio: &Studio) {
-    runs::resume_all::<MatchMode>(studio, ModeName::Match);
-}
-
 /// Match mode, behind the studio's mode seam.
 pub struct MatchMode;
 
 impl Mode for MatchMode {
-    const NAME: ModeName = ModeName::Match;
+    const NAME: &'static str = "match";
     type Start = Start;
 
     fn models(registry: &sylva::Registry) -> Vec<&'static str> {
@@ -416,18 +411,23 @@ impl Mode for MatchMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/match/stop", post(stop))
-            .route("/sessions/{id}/match/resume", post(resume))
-            .route("/sessions/{id}/match/run", get(run))
-            .route("/sessions/{id}/match/picture", get(picture))
-            .route("/sessions/{id}/match/overlay.png", get(overlay_png))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/match/stop", stop),
+            Route::post("/sessions/{id}/match/resume", resume),
+            Route::get("/sessions/{id}/match/run", run),
+            Route::get("/sessions/{id}/match/picture", picture),
+            Route::get("/sessions/{id}/match/overlay.png", overlay_png),
+        ]
     }
 
     fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
         let state = match_state(studio, session)?;
         runs::status_event(studio, state.run).map(Some)
+    }
+
+    /// Resumes every match that was running when the studio stopped (or was killed).
+    fn resume(studio: &Studio) {
+        runs::resume_all::<MatchMode>(studio, Self::NAME);
     }
 }
