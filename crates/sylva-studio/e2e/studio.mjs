@@ -219,8 +219,17 @@ async function main() {
     await noError("page load");
   });
 
-  await step("open each mode", async () => {
-    for (const mode of ["garden", "family", "design", "breed"]) {
+  await step("the tabs are the studio's modes, each opening its view", async () => {
+    const listed = await api("/api/modes");
+    check(listed.length > 0, "the studio lists no modes");
+    const tabs = await page.locator('.modes [role="tab"]').evaluateAll((bs) =>
+      bs.map((b) => ({ name: b.dataset.mode, label: b.textContent, hint: b.title })));
+    const want = listed.map((m) => ({ name: m.name, label: m.label, hint: m.hint }));
+    check(JSON.stringify(tabs) === JSON.stringify(want),
+      `the tabs are not the studio's modes: ${JSON.stringify(tabs)} against ${JSON.stringify(want)}`);
+    const names = listed.map((m) => m.name);
+    check(names[0] === "breed", `the first mode is ${names[0]}, not breed`);
+    for (const mode of [...names.slice(1), names[0]]) {
       await byTestId(`mode-${mode}`).click();
       await page.locator(`#view-${mode}`).waitFor({ state: "visible" });
       check(await byTestId(`mode-${mode}`).getAttribute("aria-selected") === "true", `the ${mode} tab is not selected`);

@@ -161,60 +161,6 @@ pub struct ParentRow {
     pub dominance: f64,
 }
 
-/// A session's mode: its `mode` in the archive, requests and the page.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ModeName {
-    /// PlantMaker's main window.
-    Breed,
-    /// The biomorph garden.
-    Garden,
-    /// The binary-tree family.
-    Family,
-    /// The GP designer.
-    Design,
-    /// A variety map.
-    Map,
-    /// Design from a picture.
-    Match,
-}
-
-impl ModeName {
-    /// Every mode, in the order the page lists them.
-    pub const ALL: [ModeName; 6] = [
-        ModeName::Breed,
-        ModeName::Garden,
-        ModeName::Family,
-        ModeName::Design,
-        ModeName::Match,
-        ModeName::Map,
-    ];
-
-    /// Its name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            ModeName::Breed => "breed",
-            ModeName::Garden => "garden",
-            ModeName::Family => "family",
-            ModeName::Design => "design",
-            ModeName::Map => "map",
-            ModeName::Match => "match",
-        }
-    }
-
-    /// The mode of a name.
-    pub fn parse(name: &str) -> Option<ModeName> {
-        ModeName::ALL.into_iter().find(|m| m.as_str() == name)
-    }
-
-    /// The names, for an error: `breed, garden, family, design, match or map`.
-    pub fn expected() -> String {
-        let names: Vec<&str> = ModeName::ALL.iter().map(|m| m.as_str()).collect();
-        let (last, rest) = names.split_last().unwrap_or((&"", &[]));
-        format!("{} or {last}", rest.join(", "))
-    }
-}
-
 /// How a plant was made: its `operator` in the archive and in its exports' extras.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Operator {
@@ -587,14 +533,14 @@ pub fn parents(c: &Connection, child: i64) -> rusqlite::Result<Vec<ParentRow>> {
 /// Inserts a session; returns its id.
 pub fn insert_session(
     c: &Connection,
-    mode: ModeName,
+    mode: &str,
     model: &str,
     title: &str,
     state: &serde_json::Value,
 ) -> rusqlite::Result<i64> {
     c.execute(
         "INSERT INTO sessions (mode, model, title, state, created) VALUES (?1, ?2, ?3, ?4, ?5)",
-        params![mode.as_str(), model, title, state.to_string(), now()],
+        params![mode, model, title, state.to_string(), now()],
     )?;
     Ok(c.last_insert_rowid())
 }
@@ -790,7 +736,7 @@ pub fn runs_with_status(c: &Connection, status: &str) -> rusqlite::Result<Vec<Ru
 }
 
 /// Runs of sessions of `mode` with a status.
-pub fn runs_of_mode(c: &Connection, mode: ModeName, status: &str) -> rusqlite::Result<Vec<RunRow>> {
+pub fn runs_of_mode(c: &Connection, mode: &str, status: &str) -> rusqlite::Result<Vec<RunRow>> {
     let columns: Vec<String> = RUN_COLUMNS
         .split(", ")
         .map(|c| format!("runs.{c}"))
@@ -800,8 +746,7 @@ pub fn runs_of_mode(c: &Connection, mode: ModeName, status: &str) -> rusqlite::R
          WHERE runs.status = ?1 AND sessions.mode = ?2 ORDER BY runs.id",
         columns.join(", ")
     ))?;
-    stmt.query_map(params![status, mode.as_str()], run_row)?
-        .collect()
+    stmt.query_map(params![status, mode], run_row)?.collect()
 }
 
 /// Keeps a session's target picture of `view` (`front`, `side`).
@@ -1040,7 +985,7 @@ mod tests {
         let v = |n: i64| serde_json::json!({ "n": n });
         archive
             .transaction(|c| -> Result<(), ArchiveError> {
-                let s = insert_session(c, ModeName::Breed, "plantmaker", "t", &v(0))?;
+                let s = insert_session(c, "breed", "plantmaker", "t", &v(0))?;
                 record_step(c, s, &v(1), &v(0), &v(1))?;
                 record_step(c, s, &v(2), &v(1), &v(2))?;
                 set_undone(c, s, 2, true)?;

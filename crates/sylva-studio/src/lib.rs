@@ -2,15 +2,20 @@
 //! the four ways the papers did, with every plant and choice kept in an SQLite archive.
 //!
 //! - [`archive`]: the SQLite archive ([`Archive`]): sessions, plants, parentage, steps, runs.
-//! - [`modes`]: the modes behind one seam ([`modes::Mode`]): breed (PlantMaker's main
-//!   window, for any model), garden (the biomorph loop of L-system plants), family (the
-//!   binary-tree population), design (the GP designer's runs), match (design from a
-//!   picture) and map (variety maps of any model); sessions start, branch,
-//!   undo and redo through it.
+//! - [`modes`]: the modes behind one seam ([`modes::Mode`]), listed once in
+//!   [`modes::MODES`]: breed (PlantMaker's main window, for any model), garden (the
+//!   biomorph loop of L-system plants), family (the binary-tree population), design (the
+//!   GP designer's runs), match (design from a picture) and map (variety maps of any
+//!   model); sessions start, branch, undo and redo through it, and `GET /api/modes` gives
+//!   the page its tabs from it.
 //! - [`sessions`]: sessions as stored and viewed, examples, step seeds.
+//! - [`settings`]: model settings a page's form asks for, built typed and read with their
+//!   own checks.
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
 //! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
+//! - [`pruning`]: plants pruned to a match run's outlines, as breed, match and the plant
+//!   routes show them.
 //! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
 //! - [`guard`]: who may talk to the studio: Host names, other sites' pages, content types,
 //!   the access token.
@@ -37,11 +42,12 @@ pub mod http;
 pub mod listen;
 pub mod modes;
 pub mod plants;
+pub mod pruning;
 pub mod runs;
 pub mod sessions;
+pub mod settings;
 
-use modes::{design, family, map, matching};
-
+use std::any::{Any, TypeId};
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::ops::Deref;
@@ -136,8 +142,9 @@ pub struct Inner {
     pub pool: sylva::core::par::Pool,
     /// One lock per session, so that two tabs' steps on one session queue up.
     locks: Mutex<HashMap<i64, Arc<tokio::sync::Mutex<()>>>>,
-    /// Family runs in memory.
-    pub families: family::Families,
+    /// What the modes keep in memory beside the archive, one value of each type
+    /// ([`Studio::kept`]).
+    kept: Mutex<HashMap<TypeId, Arc<dyn Any + Send + Sync>>>,
     /// Design runs and maps going on.
     pub runs: runs::Runs,
     /// The channels of the pages watching sessions.
@@ -167,7 +174,7 @@ impl Studio {
             plants: plants::plant_cache(),
             pool: sylva::core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
-            families: family::Families::default(),
+            kept: Mutex::default(),
             runs: runs::Runs::default(),
             events: events::Events::default(),
         }))
@@ -178,11 +185,24 @@ impl Studio {
         let mut locks = self.locks.lock().unwrap_or_else(|p| p.into_inner());
         locks.entry(session).or_default().clone()
     }
+
+    /// What a mode keeps in memory beside the archive (family mode's runs), by its type:
+    /// one value of each type per studio, made empty when first asked for.
+    pub fn kept<T: Any + Default + Send + Sync>(&self) -> Arc<T> {
+        let mut kept = self.kept.lock().unwrap_or_else(|p| p.into_inner());
+        let value = kept
+            .entry(TypeId::of::<T>())
+            .or_insert_with(|| Arc::new(T::default()))
+            .clone();
+        // Each value is kept under its own type's id, so this is always that type.
+        value.downcast().unwrap_or_default()
+    }
 }
 
 /// The studio's routes.
 pub fn router(studio: Studio) -> Router {
     let api = Router::new()
+        .route("/modes", get(modes::modes))
         .route("/models", get(modes::models))
         .route("/examples", get(sessions::examples))
         .route("/sessions", get(sessions::list).post(modes::create))
@@ -264,9 +284,7 @@ pub fn serve(options: Options) -> Result<(), StartError> {
                 source,
             })?;
         let bound: SocketAddr = listener.local_addr().map_err(StartError::Runtime)?;
-        design::resume_all(&studio);
-        map::resume_all(&studio);
-        matching::resume_all(&studio);
+        modes::resume_all(&studio);
         warm_textures();
         let query = token.map(|t| format!("?token={t}")).unwrap_or_default();
         // Written, not printed: a closed stdout must not stop the server.

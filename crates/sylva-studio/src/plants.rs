@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::assets::Origin;
 use sylva::core::Plant;
-use sylva::evolution::outline::{Outline, prune};
+use sylva::evolution::outline::Outline;
 use sylva::mesh::SceneNode;
 use sylva::render::View;
 use sylva::{Genome, GrowOptions, Grown, LodAssets, Preview, Registry};
@@ -25,7 +25,7 @@ use crate::Studio;
 use crate::archive::{self, ParentRow, PlantRow};
 use crate::cache::Bounded;
 use crate::error::ApiError;
-use crate::modes::matching::pruned_to;
+use crate::pruning::{grow_shown, pruned_to};
 
 /// GLBs kept in memory, by plant and form: at most 256, and 512 MB (a random PlantMaker
 /// plant's GLB in full can be 40 MB).
@@ -140,23 +140,15 @@ pub fn preview_glb(
     sylva::gltf::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
 }
 
-/// Grows a genome as the views show it: roots left out.
-pub fn grow_shown(genome: &Genome, seed: u64) -> Result<Plant, ApiError> {
-    sylva::assets::grow_plant(genome, seed, false, None).map_err(|e| ApiError::library("genome", e))
-}
-
 /// A plant grown as the views show it (pruned to its match's outlines, if it grew inside
 /// them): from memory, or grown again (and kept).
 fn shown_plant(studio: &Studio, row: &PlantRow) -> Result<Arc<Plant>, ApiError> {
     if let Some(plant) = studio.plants.get(row.id) {
         return Ok(plant);
     }
-    let mut plant = grow_shown(&genome_of(&studio.registry, row)?, row.seed)?;
-    if let Some(outlines) = pruned_to(studio, row)? {
-        // Roots are not pruned, so pruning after they are left out cuts the same.
-        plant = prune(&outlines, &plant);
-    }
-    let plant = Arc::new(plant);
+    let outlines = pruned_to(studio, row)?;
+    let genome = genome_of(&studio.registry, row)?;
+    let plant = Arc::new(grow_shown(&genome, row.seed, outlines.as_deref())?);
     studio
         .plants
         .put(row.id, plant.clone(), plant_bytes(&plant));

@@ -14,7 +14,7 @@ use serde_json::json;
 use sylva::{Config, Evolution, Member};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, ModeName, NewPlant, Operator, RunRow};
+use crate::archive::{self, GenerationRow, NewPlant, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 
@@ -477,7 +477,7 @@ pub fn run_view(studio: &Studio, run: i64) -> Result<RunView, ApiError> {
 
 /// Resumes every run of the sessions of `mode` that was running when the studio stopped
 /// (or was killed).
-pub fn resume_all<B: Background>(studio: &Studio, mode: ModeName) {
+pub fn resume_all<B: Background>(studio: &Studio, mode: &str) {
     let Ok(runs) = studio
         .archive
         .read(|c| archive::runs_of_mode(c, mode, "running"))

@@ -11,7 +11,7 @@ use serde::Serialize;
 use sylva::{Genome, Registry};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, StepRow};
+use crate::archive::{self, StepRow};
 use crate::error::ApiError;
 
 /// A session as the page sees it.
@@ -19,7 +19,7 @@ use crate::error::ApiError;
 pub struct SessionView {
     /// Its id.
     pub id: i64,
-    /// breed, garden, family or design.
+    /// Its mode's name ([`crate::modes::MODES`]).
     pub mode: String,
     /// The model of its plants.
     pub model: String,
@@ -65,20 +65,15 @@ pub fn session_row(studio: &Studio, id: i64) -> Result<archive::SessionRow, ApiE
 }
 
 /// A session that must be of `mode`.
-pub fn session_of(
-    studio: &Studio,
-    id: i64,
-    mode: ModeName,
-) -> Result<archive::SessionRow, ApiError> {
+pub fn session_of(studio: &Studio, id: i64, mode: &str) -> Result<archive::SessionRow, ApiError> {
     let row = studio
         .archive
         .read(|c| archive::session(c, id))?
         .ok_or_else(|| ApiError::not_found(format!("session {id}")))?;
-    if row.mode != mode.as_str() {
+    if row.mode != mode {
         return Err(ApiError::conflict(format!(
-            "session {id} is a {} session, not {}",
-            row.mode,
-            mode.as_str()
+            "session {id} is a {} session, not {mode}",
+            row.mode
         )));
     }
     Ok(row)

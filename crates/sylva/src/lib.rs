@@ -28,6 +28,7 @@
 //! - [`files`]: reading input with limits, writing output atomically.
 //! - [`error`]: typed errors; [`InputError`] names the file, line, column and what was
 //!   expected.
+//! - [`models`]: the models' settings types, item by item, for settings built in code.
 //!
 //! ```
 //! use sylva::{Genome, GrowOptions, Grown, Registry, Settings};
@@ -79,6 +80,19 @@ pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
 pub use sylva_lsystem::work::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 
+/// Model settings a front end builds in code (the studio's design and family forms), item
+/// by item: the models' handles, their settings types and the parts those are made of.
+/// Each reads and writes as its section of an evolution config does, with the same checks.
+pub mod models {
+    pub use sylva_automata::{AutomataModel, AutomataSettings, Growth};
+    pub use sylva_bintree::BinTreeModel;
+    pub use sylva_evolve::GenerationalSettings;
+    pub use sylva_fitness::poncin::{
+        DensityGrid, EndpointRule, GridCell, GridConfig, NumTarget, PAPER_TARGET, PoncinFitness,
+        PoncinWeights, TargetShape,
+    };
+}
+
 // What front ends need of the layers below, item by item (a front end depends on `sylva`
 // alone; `scripts/check-layers` refuses a whole crate re-exported here).
 
@@ -99,7 +113,7 @@ pub mod core {
     }
     /// Placement in a scene.
     pub mod glam {
-        pub use sylva_core::glam::{Quat, Vec3};
+        pub use sylva_core::glam::{DVec3, Quat, Vec3};
     }
     /// Hashes that do not change between runs or machines.
     pub mod hash {

@@ -14,18 +14,16 @@ use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::core::Plant;
-use sylva::evolution::outline::{Outline, prune};
+use sylva::evolution::outline::Outline;
 use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
+use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
-use crate::modes::Mode;
-use crate::modes::matching::{PRUNED_TO, match_settings, pruned_run, pruned_to};
-use crate::plants::{
-    Form, PreviewSize, genome_of, grow_shown, parse_genome, plant_bytes, preview_glb,
-};
+use crate::modes::{Mode, Route};
+use crate::plants::{Form, PreviewSize, genome_of, parse_genome, plant_bytes, preview_glb};
+use crate::pruning::{PRUNED_TO, grow_shown, match_settings, pruned_run, pruned_to};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
 /// The model a new session breeds when the request names none: PlantMaker's, whose main
@@ -134,10 +132,7 @@ impl Made {
         parents: Vec<ParentRow>,
         pruned_to: Option<&[Outline]>,
     ) -> Result<Made, ApiError> {
-        let mut plant = grow_shown(&genome, seed)?;
-        if let Some(outlines) = pruned_to {
-            plant = prune(outlines, &plant);
-        }
+        let plant = grow_shown(&genome, seed, pruned_to)?;
         let glb = preview_glb(&genome, seed, &plant, PreviewSize::GRID)?;
         Ok(Made {
             genome,
@@ -528,7 +523,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     };
     let (id, ids) = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let title = format!("Breed {model}");
-        let id = archive::insert_session(c, ModeName::Breed, model, &title, &json!({}))?;
+        let id = archive::insert_session(c, BreedMode::NAME, model, &title, &json!({}))?;
         let mut ids = store(c, id, &made)?;
         let mut mutants = mutants;
         for (i, m) in mutants.iter_mut().enumerate() {
@@ -569,7 +564,7 @@ async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
 
 /// The breed session and its state.
 fn breed_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, BreedState), ApiError> {
-    let row = session_of(studio, id, ModeName::Breed)?;
+    let row = session_of(studio, id, BreedMode::NAME)?;
     let state: BreedState = serde_json::from_value(row.state.clone())
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
     Ok((row, state))
@@ -1003,7 +998,7 @@ pub(crate) async fn edit(
 pub struct BreedMode;
 
 impl Mode for BreedMode {
-    const NAME: ModeName = ModeName::Breed;
+    const NAME: &'static str = "breed";
     type Start = Start;
 
     fn models(registry: &Registry) -> Vec<&'static str> {
@@ -1018,13 +1013,13 @@ impl Mode for BreedMode {
         branch(studio, plant).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::post;
-        axum::Router::new()
-            .route("/sessions/{id}/cross", post(cross))
-            .route("/sessions/{id}/mutate", post(mutate))
-            .route("/sessions/{id}/add", post(add))
-            .route("/sessions/{id}/edit", post(edit))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/cross", cross),
+            Route::post("/sessions/{id}/mutate", mutate),
+            Route::post("/sessions/{id}/add", add),
+            Route::post("/sessions/{id}/edit", edit),
+        ]
     }
 }
 

@@ -11,16 +11,22 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::{Config, Registry};
+use sylva::core::glam::DVec3;
+use sylva::models::{
+    AutomataModel, AutomataSettings, DensityGrid, EndpointRule, GenerationalSettings, GridCell,
+    GridConfig, Growth, NumTarget, PAPER_TARGET, PoncinFitness, PoncinWeights, TargetShape,
+};
+use sylva::{Config, EvolveConfig, RunConfig};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, Operator, RunRow};
+use crate::archive::{self, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::{Body, first_null, join};
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::runs::{self, Background};
 use crate::sessions::{SessionView, session_of, view};
+use crate::settings;
 
 const AUTOMATA: &str = sylva::registry::names::AUTOMATA;
 
@@ -93,10 +99,10 @@ fn range(value: u32, lo: u32, hi: u32, field: &str) -> Result<u32, ApiError> {
 }
 
 /// The config a design stands for: Poncin's typical run (`examples/automata/sphere.toml`)
-/// with the design's target, grid, weights and size.
-/// Errors name fields under `at`, the design's JSON path in the request (`design` when
-/// creating a session, "" when the body is the design).
-fn config_of(registry: &Registry, design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
+/// with the design's target, grid, weights and size, built as the automata model's typed
+/// settings. Errors name fields under `at`, the design's JSON path in the request (`design`
+/// when creating a session, "" when the body is the design).
+fn config_of(design: &Design, at: &str) -> Result<(Config, u32), ApiError> {
     let field = |name: &str| join(at, name);
     let population = range(
         design.population.unwrap_or(1000),
@@ -116,14 +122,6 @@ fn config_of(registry: &Registry, design: &Design, at: &str) -> Result<(Config, 
         1000,
         &field("num_target"),
     )?;
-    let mut fitness = json!({
-        "unit": 0.1,
-        "num_target": num_target,
-        "endpoints": "axes",
-        "weights": { "pos": 5.0, "num": 50.0, "dist": 200.0, "thick": 0.0, "angle": 0.0,
-                     "grid": if design.grid.is_some() { 10.0 } else { 0.0 } },
-        "target": { "shape": "sphere", "center": [0.0, 200.0, 0.0], "radius": 150.0 },
-    });
     for (part, value) in [("target", &design.target), ("weights", &design.weights)] {
         if let Some(null) = value.as_ref().and_then(|v| first_null(v, &field(part))) {
             return Err(ApiError::bad(
@@ -135,72 +133,91 @@ fn config_of(registry: &Registry, design: &Design, at: &str) -> Result<(Config, 
     if let Some(grid) = &design.grid {
         check_cells(grid, &field("grid"))?;
     }
-    if let Some(target) = &design.target {
-        fitness["target"] = target.clone();
-    }
-    if let Some(serde_json::Value::Object(weights)) = &design.weights {
-        for (k, v) in weights {
-            fitness["weights"][k] = v.clone();
+    let target = match &design.target {
+        Some(target) => settings::read(target.clone(), &field("target"))?,
+        None => TargetShape::default(),
+    };
+    // Table 2's weights; the grid's counts only when there is a grid.
+    let weights = PoncinWeights {
+        grid: if design.grid.is_some() { 10.0 } else { 0.0 },
+        ..PoncinWeights::TABLE_2
+    };
+    let weights = match &design.weights {
+        None => weights,
+        Some(serde_json::Value::Object(changes)) => {
+            settings::overlay(&weights, changes, &field("weights"))?
         }
-    } else if design.weights.is_some() {
-        return Err(ApiError::bad(
-            field("weights"),
-            "expected an object of weights",
-        ));
-    }
-    if let Some(grid) = &design.grid {
-        let cells: Vec<serde_json::Value> = grid
-            .cells
-            .iter()
-            .map(|c| json!({ "at": c.cell, "weight": c.weight }))
-            .collect();
-        fitness["grid"] = json!({
-            "min": grid.min, "max": grid.max, "divisions": grid.divisions,
-            "weight": 0.0, "target": grid.target.unwrap_or(15), "cells": cells,
-        });
-    }
-    let doc = json!({
-        "model": AUTOMATA,
-        "run": { "generations": generations, "population": population,
-                 "seed": design.seed.unwrap_or(1) },
-        "automata": {
-            "automata": 2,
-            "breeding": { "mutation": 0.1, "reproduction": 0.02, "reevaluate": false },
-            "growth": { "iterations": 100, "root_length": 2.5, "leaf_length": 10.0 },
-            "fitness": fitness,
+        Some(_) => {
+            return Err(ApiError::bad(
+                field("weights"),
+                "expected an object of weights",
+            ));
+        }
+    };
+    let grid = match &design.grid {
+        Some(grid) => Some(settings::checked_as::<DensityGrid>(
+            &grid_config(grid),
+            &field("grid"),
+        )?),
+        None => None,
+    };
+    let typed = EvolveConfig::<AutomataModel> {
+        run: RunConfig {
+            generations,
+            population,
+            seed: design.seed.unwrap_or(1),
+            ..RunConfig::default()
         },
-    });
-    let config = registry
-        .config_from_value(doc)
-        .map_err(|e| ApiError::unprocessable(join(at, &design_field(&e.field)), e.message))?;
-    Ok((config, generations))
+        settings: AutomataSettings {
+            automata: 2,
+            breeding: GenerationalSettings {
+                mutation: 0.1,
+                reproduction: 0.02,
+                reevaluate: false,
+                ..GenerationalSettings::default()
+            },
+            growth: Growth {
+                iterations: 100,
+                root_length: 2.5,
+                leaf_length: 10.0,
+                ..Growth::default()
+            },
+            fitness: PoncinFitness {
+                unit: 0.1,
+                num_target: NumTarget::Total(num_target),
+                endpoints: EndpointRule::Axes,
+                weights,
+                target,
+                grid,
+                ..PoncinFitness::default()
+            },
+            ..AutomataSettings::default()
+        },
+        ..EvolveConfig::default()
+    };
+    Ok((Config::new(typed), generations))
 }
 
-/// The design's field behind a field of the config it becomes (`automata.fitness.target.radius`
-/// is `target.radius`, `automata.fitness.grid.cells[2].at` is `grid.cells[2].cell`); the
-/// design as a whole for a field the studio sets itself.
-fn design_field(config: &str) -> String {
-    let field = match config {
-        "run.population" => "population",
-        "run.generations" => "generations",
-        "run.seed" => "seed",
-        "automata.fitness.num_target" => "num_target",
-        path => match path.strip_prefix("automata.fitness.") {
-            Some(rest)
-                if ["target", "weights", "grid"].iter().any(|part| {
-                    rest == *part
-                        || rest.starts_with(&format!("{part}."))
-                        || rest.starts_with(&format!("{part}["))
-                }) =>
-            {
-                return rest
-                    .strip_suffix(".at")
-                    .map_or_else(|| rest.to_owned(), |cell| format!("{cell}.cell"));
-            }
-            _ => "",
-        },
-    };
-    field.to_owned()
+/// The density grid a painted grid stands for: every cell unweighted, the painted ones
+/// favoured or forbidden.
+fn grid_config(grid: &GridDesign) -> GridConfig {
+    GridConfig {
+        min: DVec3::from_array(grid.min),
+        max: DVec3::from_array(grid.max),
+        divisions: grid.divisions,
+        weight: 0.0,
+        target: grid.target.unwrap_or(PAPER_TARGET),
+        boxes: Vec::new(),
+        cells: grid
+            .cells
+            .iter()
+            .map(|c| GridCell {
+                at: c.cell,
+                weight: c.weight,
+                target: None,
+            })
+            .collect(),
+    }
 }
 
 /// Checks painted cells against the grid, naming the cell (the config would only know the
@@ -233,9 +250,9 @@ fn check_cells(grid: &GridDesign, at: &str) -> Result<(), ApiError> {
 
 /// Creates a design session and starts its run.
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let (config, generations) = config_of(&studio.registry, &start.design, "design")?;
+    let (config, generations) = config_of(&start.design, "design")?;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Design, AUTOMATA, "Design", &json!({}))?;
+        let id = archive::insert_session(c, DesignMode::NAME, AUTOMATA, "Design", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
         let state = DesignState {
             run,
@@ -258,7 +275,7 @@ pub(crate) async fn redesign(
     let lock = studio.session_lock(id);
     let _guard = lock.lock().await;
     let before = design_state(&studio, id)?;
-    let (config, generations) = config_of(&studio.registry, &design, "")?;
+    let (config, generations) = config_of(&design, "")?;
     runs::stop_run(&studio, before.run)?;
     let run = studio.archive.transaction(|c| -> Result<_, ApiError> {
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -274,7 +291,7 @@ pub(crate) async fn redesign(
 }
 
 fn design_state(studio: &Studio, id: i64) -> Result<DesignState, ApiError> {
-    let row = session_of(studio, id, ModeName::Design)?;
+    let row = session_of(studio, id, DesignMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -317,11 +334,6 @@ pub(crate) async fn run(
     Ok(Json(runs::run_view(&studio, state.run)?))
 }
 
-/// Resumes every design run that was running when the studio stopped (or was killed).
-pub fn resume_all(studio: &Studio) {
-    runs::resume_all::<DesignMode>(studio, ModeName::Design);
-}
-
 impl Background for DesignMode {
     const OPERATOR: Operator = Operator::Design;
 
@@ -336,7 +348,7 @@ impl Background for DesignMode {
 pub struct DesignMode;
 
 impl Mode for DesignMode {
-    const NAME: ModeName = ModeName::Design;
+    const NAME: &'static str = "design";
     type Start = Start;
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
@@ -347,17 +359,98 @@ impl Mode for DesignMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/design", post(redesign))
-            .route("/sessions/{id}/stop", post(stop))
-            .route("/sessions/{id}/resume", post(resume))
-            .route("/sessions/{id}/run", get(run))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/design", redesign),
+            Route::post("/sessions/{id}/stop", stop),
+            Route::post("/sessions/{id}/resume", resume),
+            Route::get("/sessions/{id}/run", run),
+        ]
     }
 
     fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
         let state = design_state(studio, session)?;
         runs::status_event(studio, state.run).map(Some)
+    }
+
+    /// Resumes every design run that was running when the studio stopped (or was killed).
+    fn resume(studio: &Studio) {
+        runs::resume_all::<DesignMode>(studio, Self::NAME);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn design(value: serde_json::Value) -> Design {
+        serde_json::from_value(value).expect("a design")
+    }
+
+    #[test]
+    fn the_default_design_is_poncin_s_typical_run_with_longer_leaves() {
+        let (config, generations) = config_of(&design(json!({})), "design").unwrap();
+        let example = sylva::Registry::standard()
+            .parse_config(
+                FilePath::new("sphere.toml"),
+                include_str!("../../../../examples/automata/sphere.toml"),
+            )
+            .unwrap();
+        let (ours, theirs) = (
+            config.get::<AutomataModel>().unwrap(),
+            example.get::<AutomataModel>().unwrap(),
+        );
+        assert_eq!(generations, 50);
+        assert_eq!(ours.run, theirs.run);
+        let mut expected = theirs.settings.clone();
+        // Leaves long enough to see in the studio's views.
+        expected.growth.leaf_length = 10.0;
+        assert_eq!(ours.settings, expected);
+    }
+
+    #[test]
+    fn a_painted_grid_weighs_in_and_is_held_to_its_ranges() {
+        let grid = json!({"min": [-150, 0, -150], "max": [150, 375, 150], "divisions": [5, 5, 5],
+                          "cells": [{"cell": [2, 2, 2], "weight": 1}, {"cell": [0, 4, 0], "weight": -1}]});
+        let (config, _) = config_of(
+            &design(json!({"grid": grid, "weights": {"pos": 7}})),
+            "design",
+        )
+        .unwrap();
+        let fitness = &config.get::<AutomataModel>().unwrap().settings.fitness;
+        assert_eq!(
+            (
+                fitness.weights.grid,
+                fitness.weights.pos,
+                fitness.weights.dist
+            ),
+            (10.0, 7.0, 200.0)
+        );
+        let grid = fitness.grid.as_ref().unwrap().config();
+        assert_eq!((grid.weight, grid.target), (0.0, PAPER_TARGET));
+        let painted: Vec<_> = grid.cells.iter().map(|c| (c.at, c.weight)).collect();
+        assert_eq!(painted, [([2, 2, 2], 1.0), ([0, 4, 0], -1.0)]);
+
+        let far = json!({"grid": {"min": [-2e6, 0, 0], "max": [1, 1, 1], "divisions": [2, 2, 2]}});
+        let e = config_of(&design(far), "design").unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "design.grid.min"),
+            "{e}"
+        );
+        let fine = json!({"grid": {"min": [0, 0, 0], "max": [1, 1, 1], "divisions": [2000, 1, 1]}});
+        let e = config_of(&design(fine), "").unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "grid.divisions"),
+            "{e}"
+        );
+        let flat = json!({"grid": {"min": [0, 0, 0], "max": [1, 0, 1], "divisions": [2, 2, 2]}});
+        let e = config_of(&design(flat), "design").unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "design.grid.max"),
+            "{e}"
+        );
     }
 }

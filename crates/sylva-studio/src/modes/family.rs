@@ -14,15 +14,17 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::{Config, Evolution, Member, Registry};
+use sylva::models::BinTreeModel;
+use sylva::{Config, Evolution, EvolveConfig, Member};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, ModeName, Operator};
+use crate::archive::{self, GenerationRow, Operator};
 use crate::error::ApiError;
-use crate::http::{Body, first_null, join};
-use crate::modes::Mode;
+use crate::http::{Body, first_null};
+use crate::modes::{Mode, Route};
 use crate::runs::{archive_member, finite, generation_row};
 use crate::sessions::{SessionView, session_of, view};
+use crate::settings;
 
 const BINTREE: &str = sylva::registry::names::BINTREE;
 
@@ -73,7 +75,7 @@ pub struct Start {
     config: FamilyConfig,
 }
 
-/// The `[run]` and `[bintree]` sections of an evolution config, as JSON.
+/// The `[run]` and `[bintree]` sections of an evolution config, as the page sends them.
 #[derive(Deserialize, Serialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 pub struct FamilyConfig {
@@ -105,8 +107,13 @@ pub struct FamilyState {
     pub members: Vec<MemberView>,
 }
 
-/// The config a family request asks for: the example's defaults under its sections.
-fn config_of(registry: &Registry, request: &FamilyConfig) -> Result<Config, ApiError> {
+/// Trees in a family whose request names no population.
+const POPULATION: u32 = 100;
+
+/// The config a family request asks for: the binary-tree model's typed config, read from
+/// the request's sections with their own checks (the model's defaults for what they leave
+/// out), a hundred trees unless it says otherwise.
+fn config_of(request: &FamilyConfig) -> Result<Config, ApiError> {
     if let Some(null) = request
         .run
         .as_ref()
@@ -128,23 +135,32 @@ fn config_of(registry: &Registry, request: &FamilyConfig) -> Result<Config, ApiE
         ));
     }
     let mut run = request.run.clone().unwrap_or_default();
-    let population = run.entry("population").or_insert(json!(100));
     // The page lists every member: a family is a browsable population, not a large search.
-    if population.as_u64().is_some_and(|p| p > MAX_POPULATION) {
+    if let Some(population) = run.get("population")
+        && population.as_u64().is_some_and(|p| p > MAX_POPULATION)
+    {
         return Err(ApiError::bad(
             "config.run.population",
             format!("a family holds at most {MAX_POPULATION} trees, got {population}"),
         ));
     }
-    // The studio steps the run by hand; `generations` only has to be valid.
-    run.insert("generations".into(), json!(1));
-    let mut doc = json!({ "model": BINTREE, "run": run });
-    if let Some(b) = &request.bintree {
-        doc["bintree"] = b.clone();
+    // The studio steps the run by hand; the config's `generations` is its own.
+    run.remove("generations");
+    let asked = FamilyConfig {
+        run: Some(run),
+        bintree: request.bintree.clone(),
+    };
+    let sections = serde_json::to_value(&asked).map_err(ApiError::internal)?;
+    let mut typed: EvolveConfig<BinTreeModel> = settings::read(sections, "config")?;
+    if !asked
+        .run
+        .as_ref()
+        .is_some_and(|r| r.contains_key("population"))
+    {
+        typed.run.population = POPULATION;
     }
-    registry
-        .config_from_value(doc)
-        .map_err(|e| ApiError::unprocessable(join("config", &e.field), e.message))
+    typed.run.generations = 1;
+    Ok(Config::new(typed))
 }
 
 fn members(run: &Evolution) -> Vec<MemberView> {
@@ -161,7 +177,7 @@ fn members(run: &Evolution) -> Vec<MemberView> {
 
 /// Creates a family session: generation 0 made and evaluated.
 async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
-    let config = config_of(&studio.registry, &start.config)?;
+    let config = config_of(&start.config)?;
     let pool = studio.pool.clone();
     let (run, checkpoint, toml) = tokio::task::spawn_blocking(move || -> Result<_, ApiError> {
         let run = Evolution::start(&config, Vec::new(), pool)
@@ -171,7 +187,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     })
     .await??;
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Family, BINTREE, "Family", &json!({}))?;
+        let id = archive::insert_session(c, FamilyMode::NAME, BINTREE, "Family", &json!({}))?;
         let run_id = archive::insert_run(c, id, &toml, 0)?;
         archive::save_run(c, run_id, Some(&checkpoint), 0, "stopped", None)?;
         archive::insert_checkpoint(c, run_id, 0, &checkpoint)?;
@@ -185,12 +201,12 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         archive::set_state(c, id, &json!(state))?;
         Ok(id)
     })?;
-    studio.families.put(id, run);
+    studio.kept::<Families>().put(id, run);
     Ok(id)
 }
 
 fn family_state(studio: &Studio, id: i64) -> Result<FamilyState, ApiError> {
-    let row = session_of(studio, id, ModeName::Family)?;
+    let row = session_of(studio, id, FamilyMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -202,7 +218,7 @@ fn evolution(
     id: i64,
     state: &FamilyState,
 ) -> Result<Arc<Mutex<Evolution>>, ApiError> {
-    if let Some(run) = studio.families.get(id) {
+    if let Some(run) = studio.kept::<Families>().get(id) {
         let at = run.lock().unwrap_or_else(|p| p.into_inner()).generation();
         if at == state.generation {
             return Ok(run);
@@ -227,7 +243,7 @@ fn evolution(
         .map_err(|e| ApiError::internal(e.message))?;
     let run = Evolution::resume(&config, path, &checkpoint, studio.pool.clone())
         .map_err(ApiError::internal)?;
-    Ok(studio.families.put(id, run))
+    Ok(studio.kept::<Families>().put(id, run))
 }
 
 /// `POST /api/sessions/{id}/generations`.
@@ -291,7 +307,7 @@ pub(crate) async fn generations(
     });
     if committed.is_err() {
         // The run in memory is ahead of the archive now.
-        studio.families.forget(id);
+        studio.kept::<Families>().forget(id);
     }
     committed?;
     Ok(Json(view(&studio, id)?))
@@ -415,7 +431,7 @@ pub(crate) async fn member(
 pub struct FamilyMode;
 
 impl Mode for FamilyMode {
-    const NAME: ModeName = ModeName::Family;
+    const NAME: &'static str = "family";
     type Start = Start;
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
@@ -426,17 +442,53 @@ impl Mode for FamilyMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/generations", post(generations))
-            .route("/sessions/{id}/batch", post(batch))
-            .route("/sessions/{id}/stats", get(stats))
-            .route("/sessions/{id}/member", post(member))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/generations", generations),
+            Route::post("/sessions/{id}/batch", batch),
+            Route::get("/sessions/{id}/stats", stats),
+            Route::post("/sessions/{id}/member", member),
+        ]
     }
 
     fn moved(studio: &Studio, session: i64) {
         // The run in memory may be at another generation now; it reloads when needed.
-        studio.families.forget(session);
+        studio.kept::<Families>().forget(session);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(value: serde_json::Value) -> Result<Config, ApiError> {
+        config_of(&serde_json::from_value(value).expect("a family config"))
+    }
+
+    #[test]
+    fn a_family_is_a_hundred_trees_stepped_by_hand_unless_it_asks() {
+        let typed = config(json!({})).unwrap();
+        let run = &typed.get::<BinTreeModel>().unwrap().run;
+        assert_eq!((run.population, run.generations), (POPULATION, 1));
+        let asked = json!({"run": {"population": 12, "generations": 500, "seed": 4},
+                           "bintree": {"mutation_rate": 0.1}});
+        let typed = config(asked).unwrap();
+        let typed = typed.get::<BinTreeModel>().unwrap();
+        assert_eq!(
+            (typed.run.population, typed.run.generations, typed.run.seed),
+            (12, 1, 4)
+        );
+        assert_eq!(typed.settings.mutation_rate, 0.1);
+        let e = config(json!({"bintree": {"mutation_rate": 7}})).unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "config.bintree.mutation_rate")
+        );
+        let e = config(json!({"bintree": [0.02]})).unwrap_err();
+        assert_eq!(
+            (e.status.as_u16(), e.field.as_str()),
+            (422, "config.bintree"),
+            "{e}"
+        );
     }
 }

@@ -16,10 +16,10 @@ use sylva::biomorph::{self, BiomorphOptions, Biomorphs};
 use sylva::mesh::{Scene, SceneNode};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, NewPlant, Operator, ParentRow, PlantRow};
+use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::ApiError;
 use crate::http::Body;
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::plants::{extras, genome_of, parse_genome, plant_row};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
@@ -257,7 +257,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         }
     };
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Garden, LSYSTEM, "Garden", &json!({}))?;
+        let id = archive::insert_session(c, GardenMode::NAME, LSYSTEM, "Garden", &json!({}))?;
         let mother_id = match &made {
             Came::Made(operator, settings) => archive::insert_plant(
                 c,
@@ -316,7 +316,7 @@ async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
 }
 
 fn garden_state(studio: &Studio, id: i64) -> Result<(archive::SessionRow, GardenState), ApiError> {
-    let row = session_of(studio, id, ModeName::Garden)?;
+    let row = session_of(studio, id, GardenMode::NAME)?;
     let state: GardenState = serde_json::from_value(row.state.clone())
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))?;
     Ok((row, state))
@@ -548,7 +548,7 @@ pub(crate) async fn scene(
 pub struct GardenMode;
 
 impl Mode for GardenMode {
-    const NAME: ModeName = ModeName::Garden;
+    const NAME: &'static str = "garden";
     type Start = Start;
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
@@ -563,11 +563,11 @@ impl Mode for GardenMode {
         branch(studio, plant).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/grow", post(grow))
-            .route("/sessions/{id}/pick", post(pick))
-            .route("/sessions/{id}/garden.glb", get(scene))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/grow", grow),
+            Route::post("/sessions/{id}/pick", pick),
+            Route::get("/sessions/{id}/garden.glb", scene),
+        ]
     }
 }

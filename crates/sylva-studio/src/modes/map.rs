@@ -24,11 +24,11 @@ use sylva::evolution::{AxisConfig, Descriptor};
 use sylva::{Config, Genome, Varieties};
 
 use crate::Studio;
-use crate::archive::{self, GenerationRow, ModeName, Operator, RunRow};
+use crate::archive::{self, GenerationRow, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::runs::{self, archive_member, finite};
 use crate::sessions::{SessionView, example, session_of, view};
 
@@ -223,7 +223,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let (config, axes, generations) = config_of(studio, &start.map)?;
     let model = config.model();
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Map, model, "Map", &json!({}))?;
+        let id = archive::insert_session(c, MapMode::NAME, model, "Map", &json!({}))?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
         let state = MapState {
             run,
@@ -238,7 +238,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
 }
 
 fn map_state(studio: &Studio, id: i64) -> Result<MapState, ApiError> {
-    let row = session_of(studio, id, ModeName::Map)?;
+    let row = session_of(studio, id, MapMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -556,24 +556,11 @@ pub(crate) async fn descriptors() -> Json<Vec<DescriptorInfo>> {
     )
 }
 
-/// Resumes every map that was filling when the studio stopped (or was killed).
-pub fn resume_all(studio: &Studio) {
-    let Ok(runs) = studio
-        .archive
-        .read(|c| archive::runs_of_mode(c, ModeName::Map, "running"))
-    else {
-        return;
-    };
-    for run in runs {
-        let _ = spawn(studio, run.id);
-    }
-}
-
 /// Map mode, behind the studio's mode seam.
 pub struct MapMode;
 
 impl Mode for MapMode {
-    const NAME: ModeName = ModeName::Map;
+    const NAME: &'static str = "map";
     type Start = Start;
 
     fn models(registry: &sylva::Registry) -> Vec<&'static str> {
@@ -584,13 +571,13 @@ impl Mode for MapMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/map", get(get_map))
-            .route("/sessions/{id}/map/stop", post(stop))
-            .route("/sessions/{id}/map/resume", post(resume))
-            .route("/descriptors", get(descriptors))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::get("/sessions/{id}/map", get_map),
+            Route::post("/sessions/{id}/map/stop", stop),
+            Route::post("/sessions/{id}/map/resume", resume),
+            Route::get("/descriptors", descriptors),
+        ]
     }
 
     fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
@@ -600,5 +587,18 @@ impl Mode for MapMode {
             name: "status",
             data: status_data(&row),
         }))
+    }
+
+    /// Resumes every map that was filling when the studio stopped (or was killed).
+    fn resume(studio: &Studio) {
+        let Ok(runs) = studio
+            .archive
+            .read(|c| archive::runs_of_mode(c, Self::NAME, "running"))
+        else {
+            return;
+        };
+        for run in runs {
+            let _ = spawn(studio, run.id);
+        }
     }
 }

@@ -8,8 +8,7 @@
 //! resumed after a kill to the bytes of a run never stopped. Each generation's best is
 //! archived as a plant, to open, branch into breeding and export.
 
-use std::path::{Path as FilePath, PathBuf};
-use std::sync::Arc;
+use std::path::PathBuf;
 
 use axum::Json;
 use axum::extract::{Path, Query, State};
@@ -18,20 +17,19 @@ use axum::response::{IntoResponse, Response};
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::evolution::outline::{
-    Limit, Outline, match_config, outlines, overlay, space, start_auto_at,
-};
+use sylva::evolution::outline::{self, Limit, outlines, overlay, start_auto_at};
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution};
 
 use crate::Studio;
-use crate::archive::{self, ModeName, Operator, PlantRow, RunRow};
+use crate::archive::{self, Operator, RunRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
-use crate::modes::Mode;
+use crate::modes::{Mode, Route};
 use crate::plants::{genome_of, plant_row};
+use crate::pruning::{self, picture_dir};
 use crate::runs::{self, Background};
 use crate::sessions::{SessionView, session_of, view};
 
@@ -87,9 +85,6 @@ pub struct MatchState {
     pub auto: bool,
 }
 
-/// The two views a match keeps pictures of, as files in its folder.
-const VIEWS: [&str; 2] = ["front", "side"];
-
 /// A picture's bytes from base64 (bare or a `data:` URL), naming `field` when it is not.
 fn picture_bytes(text: &str, field: &str) -> Result<Vec<u8>, ApiError> {
     let data = match text.split_once(";base64,") {
@@ -113,27 +108,6 @@ fn target(threshold: Threshold, prune: bool) -> MatchConfig {
         closeness: 0.0,
         prune: Some(prune),
     }
-}
-
-/// The folder a session's pictures are found in by its run: written from the archive when
-/// a file is missing.
-fn picture_dir(studio: &Studio, session: i64) -> Result<PathBuf, ApiError> {
-    let dir = std::env::temp_dir()
-        .join(format!("sylva-studio-{}", std::process::id()))
-        .join(format!("match-{session}"));
-    let failed = |e: std::io::Error| ApiError::internal(format!("the pictures' folder: {e}"));
-    if VIEWS.iter().all(|v| dir.join(v).is_file()) {
-        return Ok(dir);
-    }
-    std::fs::create_dir_all(&dir).map_err(failed)?;
-    for v in VIEWS {
-        let bytes = studio
-            .archive
-            .read(|c| archive::picture(c, session, v))?
-            .ok_or_else(|| ApiError::internal(format!("session {session} has no {v} picture")))?;
-        std::fs::write(dir.join(v), bytes).map_err(failed)?;
-    }
-    Ok(dir)
 }
 
 /// Checks a match's numbers, naming their fields; its run's size.
@@ -168,7 +142,7 @@ fn config_for(
     threshold: Threshold,
     prune: bool,
 ) -> Result<Config, ApiError> {
-    match_config(&studio.registry, model, run, &target(threshold, prune)).map_err(|e| {
+    outline::match_config(&studio.registry, model, run, &target(threshold, prune)).map_err(|e| {
         match e.field.as_str() {
             "model" => ApiError::bad("match.model", e.message),
             field => ApiError::unprocessable(format!("match ({field})"), e.message),
@@ -221,7 +195,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     let _ = std::fs::remove_dir_all(&check);
     let generations = run.generations;
     let (id, run) = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, ModeName::Match, config.model(), "Match", &json!({}))?;
+        let id = archive::insert_session(c, MatchMode::NAME, config.model(), "Match", &json!({}))?;
         archive::insert_picture(c, id, "front", &front)?;
         archive::insert_picture(c, id, "side", &side)?;
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
@@ -252,7 +226,7 @@ fn tempfile_dir() -> Result<PathBuf, ApiError> {
 }
 
 fn match_state(studio: &Studio, id: i64) -> Result<MatchState, ApiError> {
-    let row = session_of(studio, id, ModeName::Match)?;
+    let row = session_of(studio, id, MatchMode::NAME)?;
     serde_json::from_value(row.state)
         .map_err(|e| ApiError::internal(format!("session {id}'s state: {e}")))
 }
@@ -267,67 +241,11 @@ fn prune_of(state: &MatchState) -> bool {
     state.design["prune"].as_bool().unwrap_or(true)
 }
 
-/// The outlines a plant grows inside: those of the match run it comes from (a generation's
-/// best, or such a plant branched into another session, whose settings name the run as
-/// `pruned_to`), when that match prunes; none for any other plant.
-pub(crate) fn pruned_to(
-    studio: &Studio,
-    row: &PlantRow,
-) -> Result<Option<Arc<[Outline]>>, ApiError> {
-    let Some(run) = pruned_run(row) else {
-        return Ok(None);
-    };
-    let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
-        return Ok(None);
-    };
-    let config = MatchMode::config(studio, &run)?;
-    match config.outline() {
-        Some(outline) => space(outline, &config.base())
-            .map_err(|e| ApiError::internal(format!("match run {}'s pictures: {e}", run.id))),
-        None => Ok(None),
-    }
-}
-
-/// The settings of `model` in match run `run` (its config's model section), which breeding
-/// by hand keeps for plants taken from it; none when the run is not archived or evolved
-/// another model.
-pub(crate) fn match_settings(
-    studio: &Studio,
-    run: i64,
-    model: &str,
-) -> Result<Option<serde_json::Value>, ApiError> {
-    let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
-        return Ok(None);
-    };
-    let config = MatchMode::config(studio, &run)?;
-    Ok((config.model() == model).then(|| config.model_settings()))
-}
-
-/// The match run whose outlines `row`'s plant may grow inside: its own run for a
-/// generation's best, the run its settings name as `pruned_to` for one taken elsewhere.
-pub(crate) fn pruned_run(row: &PlantRow) -> Option<i64> {
-    let key = if row.operator == Operator::Match.as_str() {
-        "run"
-    } else {
-        PRUNED_TO
-    };
-    row.settings.get(key).and_then(|r| r.as_i64())
-}
-
-/// The key of a plant's settings naming the match run whose outlines it grows inside, for
-/// a plant of a match taken into another session.
-pub(crate) const PRUNED_TO: &str = "pruned_to";
-
 impl Background for MatchMode {
     const OPERATOR: Operator = Operator::Match;
 
     fn config(studio: &Studio, row: &RunRow) -> Result<Config, ApiError> {
-        let mut config = studio
-            .registry
-            .parse_config(FilePath::new("match"), &row.config)
-            .map_err(|e| ApiError::internal(e.to_string()))?;
-        config.set_base(picture_dir(studio, row.session)?);
-        Ok(config)
+        pruning::match_config(studio, row)
     }
 
     /// Auto: each model briefly, then on with the best, whose config the run keeps.
@@ -478,16 +396,11 @@ pub(crate) async fn overlay_png(
         .into_response())
 }
 
-/// Resumes every match that was running when the studio stopped (or was killed).
-pub fn resume_all(studio: &Studio) {
-    runs::resume_all::<MatchMode>(studio, ModeName::Match);
-}
-
 /// Match mode, behind the studio's mode seam.
 pub struct MatchMode;
 
 impl Mode for MatchMode {
-    const NAME: ModeName = ModeName::Match;
+    const NAME: &'static str = "match";
     type Start = Start;
 
     fn models(registry: &sylva::Registry) -> Vec<&'static str> {
@@ -498,18 +411,23 @@ impl Mode for MatchMode {
         create(studio, start).await
     }
 
-    fn routes() -> axum::Router<Studio> {
-        use axum::routing::{get, post};
-        axum::Router::new()
-            .route("/sessions/{id}/match/stop", post(stop))
-            .route("/sessions/{id}/match/resume", post(resume))
-            .route("/sessions/{id}/match/run", get(run))
-            .route("/sessions/{id}/match/picture", get(picture))
-            .route("/sessions/{id}/match/overlay.png", get(overlay_png))
+    fn routes() -> Vec<Route> {
+        vec![
+            Route::post("/sessions/{id}/match/stop", stop),
+            Route::post("/sessions/{id}/match/resume", resume),
+            Route::get("/sessions/{id}/match/run", run),
+            Route::get("/sessions/{id}/match/picture", picture),
+            Route::get("/sessions/{id}/match/overlay.png", overlay_png),
+        ]
     }
 
     fn first_event(studio: &Studio, session: i64) -> Result<Option<SessionEvent>, ApiError> {
         let state = match_state(studio, session)?;
         runs::status_event(studio, state.run).map(Some)
+    }
+
+    /// Resumes every match that was running when the studio stopped (or was killed).
+    fn resume(studio: &Studio) {
+        runs::resume_all::<MatchMode>(studio, Self::NAME);
     }
 }

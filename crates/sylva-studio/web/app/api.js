@@ -151,6 +151,7 @@ export const getBytes = (path, opts) => request("GET", path, undefined, { raw: t
 const enc = encodeURIComponent;
 
 export const api = {
+  modes: () => get("/api/modes"),
   models: () => get("/api/models"),
   examples: () => get("/api/examples"),
 

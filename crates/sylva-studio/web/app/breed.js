@@ -10,7 +10,7 @@ import { stats } from "./stats.js";
 const CELLS = 9;
 const MAX_UPLOAD = 1024 * 1024;
 
-export function createBreedMode(ctx, root) {
+export default function createBreedMode(ctx, root) {
   const status = h("span", { class: "hint", testid: "breed-status" });
   const level = h(
     "select",

@@ -36,7 +36,7 @@ const WEIGHTS = [
 ];
 const RUNNING = "running";
 
-export function createDesignMode(ctx, root) {
+export default function createDesignMode(ctx, root) {
   // ---- the form ------------------------------------------------------------------------------
   const shape = h("select", { testid: "design-shape" });
   for (const s of Object.keys(SHAPES)) shape.append(h("option", { value: s }, s));

@@ -8,7 +8,7 @@ import { h, add, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { drawChart } from "./chart.js";
 import { stats as probes } from "./stats.js";
 
-export function createFamilyMode(ctx, root) {
+export default function createFamilyMode(ctx, root) {
   const genLabel = h("span", { class: "big", testid: "family-generation" }, "–");
   const batchLabel = h("span", { testid: "family-batch" }, "–");
   const memberLabel = h("span", { testid: "family-member" }, "–");

@@ -7,7 +7,7 @@ import { Stage, loadGlb, THREE } from "./viewer.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { stats } from "./stats.js";
 
-export function createGardenMode(ctx, root) {
+export default function createGardenMode(ctx, root) {
   // the server's defaults for a new garden: neighbours meet and shade each other
   const STEPS = 150;
   const SPACING = 1.0;

@@ -1,20 +1,19 @@
 // The studio page: modes as tabs, sessions, undo and redo, the population and the history of the
 // open session, the plant panel, the lineage view, and the message area where every error from
 // the studio is shown.
+//
+// The modes are the studio's list (`GET /api/modes`): a tab and a view for each, in its order,
+// made by the default export of the mode's page module, imported when the page starts. This
+// page names no mode: it opens in the first one listed.
 
 import { api, onBusy } from "./api.js";
 import { h, clear, summarize } from "./dom.js";
 import { stats } from "./stats.js";
-import { createBreedMode } from "./breed.js";
-import { createGardenMode } from "./garden.js";
-import { createFamilyMode } from "./family.js";
-import { createDesignMode } from "./design.js";
-import { createMapMode } from "./map.js";
-import { createMatchMode } from "./match.js";
 import { createDetail } from "./detail.js";
 import { createLineage } from "./lineage.js";
 
-const MODES = ["breed", "garden", "family", "design", "match", "map"];
+/** The modes' names, in the order of their tabs (filled from the studio's list). */
+const MODES = [];
 const $ = (id) => document.getElementById(id);
 
 const ui = {
@@ -101,14 +100,8 @@ const ctx = {
 };
 stats.session = () => ctx.session;
 
-const modes = {
-  breed: createBreedMode(ctx, $("view-breed")),
-  garden: createGardenMode(ctx, $("view-garden")),
-  family: createFamilyMode(ctx, $("view-family")),
-  design: createDesignMode(ctx, $("view-design")),
-  match: createMatchMode(ctx, $("view-match")),
-  map: createMapMode(ctx, $("view-map")),
-};
+/** Each mode's view, by name, as its page module made it. */
+const modes = {};
 const detail = createDetail(ctx, $("detail"));
 const lineage = createLineage(ctx, $("lineage"));
 const lastByMode = {};
@@ -336,9 +329,41 @@ function afterSessionClosed(mode) {
   setHash(mode, null);
 }
 
+/**
+ * Makes a tab and a view for each mode the studio lists, each view by the default export of
+ * the mode's page module (`export default function (ctx, root)`). A module that fails to load
+ * is reported and its mode left out; the others work.
+ */
+async function loadModes(list) {
+  const roots = list.map((m) => {
+    const root = h("section", { class: "mode-view", id: `view-${m.name}`, dataset: { view: m.name }, hidden: true });
+    $("main").append(root);
+    return root;
+  });
+  const pages = await Promise.allSettled(list.map((m) => import(m.page)));
+  list.forEach((m, i) => {
+    const page = pages[i];
+    const make = page.status === "fulfilled" ? page.value.default : null;
+    if (typeof make !== "function") {
+      roots[i].remove();
+      showError(page.reason || new Error(`${m.page} has no default export making its view`), `the ${m.label} mode`);
+      return;
+    }
+    modes[m.name] = make(ctx, roots[i]);
+    MODES.push(m.name);
+    const tab = h("button", { role: "tab", testid: `mode-${m.name}`, title: m.hint, dataset: { mode: m.name } }, m.label);
+    tab.addEventListener("click", () => {
+      // the plant panel belongs to what was on screen; another mode gets the room
+      if (m.name !== ctx.mode) detail.close();
+      switchMode(m.name);
+    });
+    $("modes").append(tab);
+  });
+}
+
 /** Shows mode `mode`; with `open`, opens its last (or newest) session or the new-session form. */
 function switchMode(mode, { open = true } = {}) {
-  if (!MODES.includes(mode)) mode = "breed";
+  if (!MODES.includes(mode)) mode = MODES[0];
   const previous = ctx.mode;
   ctx.mode = mode;
   for (const b of document.querySelectorAll(".modes [data-mode]")) {
@@ -363,13 +388,6 @@ function switchMode(mode, { open = true } = {}) {
   }
 }
 
-for (const b of document.querySelectorAll(".modes [data-mode]")) {
-  b.addEventListener("click", () => {
-    // the plant panel belongs to what was on screen; another mode gets the room
-    if (b.dataset.mode !== ctx.mode) detail.close();
-    switchMode(b.dataset.mode);
-  });
-}
 ui.newSession.addEventListener("click", () => showNewSessionForm(ctx.mode));
 
 // ---- undo and redo -------------------------------------------------------------------------------
@@ -431,19 +449,22 @@ async function navigate() {
     const ok = await openSession(id);
     if (ok !== false && ctx.session) return;
   }
-  switchMode(MODES.includes(mode) ? mode : "breed");
+  switchMode(mode);
 }
 
 // ---- start ---------------------------------------------------------------------------------------
 
 async function init() {
-  const [models, examples] = await Promise.all([
+  const [list, models, examples] = await Promise.all([
+    ctx.act(() => api.modes()),
     ctx.act(() => api.models()),
     ctx.act(() => api.examples()),
     refreshSessions(),
   ]);
   ctx.models = models || [];
   ctx.examples = examples || [];
+  if (list) await ctx.act(() => loadModes(list));
+  if (MODES.length === 0) return;
   await navigate();
   stats.ready = true;
   document.body.dataset.ready = "true";

@@ -12,7 +12,7 @@ import { follow } from "./follow.js";
 const RUNNING = "running";
 const THUMB = 72;
 
-export function createMapMode(ctx, root) {
+export default function createMapMode(ctx, root) {
   // ---- the form ------------------------------------------------------------------------------
   const model = h("select", { testid: "map-model" });
   const xName = h("select", { testid: "map-x" });

@@ -15,7 +15,7 @@ const RUNNING = "running";
 const MAX_BYTES = 700_000;
 const MAX_SIDE = 1024;
 
-export function createMatchMode(ctx, root) {
+export default function createMatchMode(ctx, root) {
   // ---- the form ------------------------------------------------------------------------------
   const file = h("input", { type: "file", accept: "image/png,image/jpeg", testid: "match-file" });
   const drop = h("div", { class: "match-drop", testid: "match-drop" }, "Drop a picture here, or choose one:", h("br"), file);
