@@ -137,7 +137,7 @@ pub fn preview_glb(
 ) -> Result<Vec<u8>, ApiError> {
     let preview = Preview::of(genome, seed, plant, size.triangles())
         .map_err(|e| ApiError::library("genome", e))?;
-    sylva::gltf::export::to_glb(&preview.scene()).map_err(|e| ApiError::library("genome", e.into()))
+    preview.glb().map_err(|e| ApiError::library("genome", e))
 }
 
 /// A plant grown as the views show it (pruned to its match's outlines, if it grew inside
@@ -148,7 +148,7 @@ fn shown_plant(studio: &Studio, row: &PlantRow) -> Result<Arc<Plant>, ApiError> 
     }
     let outlines = pruned_to(studio, row)?;
     let genome = genome_of(&studio.registry, row)?;
-    let plant = Arc::new(grow_shown(&genome, row.seed, outlines.as_deref())?);
+    let plant = Arc::new(grow_shown(&genome, row.seed, outlines)?);
     studio
         .plants
         .put(row.id, plant.clone(), plant_bytes(&plant));

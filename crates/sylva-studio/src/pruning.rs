@@ -13,7 +13,8 @@ use std::sync::Arc;
 use sylva::Config;
 use sylva::Genome;
 use sylva::core::Plant;
-use sylva::evolution::outline::{Outline, prune, space};
+use sylva::evolution::outline::{Outline, space};
+use sylva::{GrowOptions, Grown};
 
 use crate::Studio;
 use crate::archive::{self, Operator, PlantRow, RunRow};
@@ -100,17 +101,19 @@ pub fn match_settings(
     Ok((config.model() == model).then(|| config.model_settings()))
 }
 
-/// Grows a genome as the views show it: roots left out, then pruned to `outlines` if
-/// given (roots are never pruned, so leaving them out first cuts the same).
+/// Grows a genome as the views show it, as the library grows any plant
+/// ([`Grown::plant`]): roots left out, pruned to `outlines` if given.
 pub fn grow_shown(
     genome: &Genome,
     seed: u64,
-    outlines: Option<&[Outline]>,
+    outlines: Option<Arc<[Outline]>>,
 ) -> Result<Plant, ApiError> {
-    let plant = sylva::assets::grow_plant(genome, seed, false, None)
-        .map_err(|e| ApiError::library("genome", e))?;
-    Ok(match outlines {
-        Some(outlines) => prune(outlines, &plant),
-        None => plant,
-    })
+    let options = GrowOptions {
+        seed: Some(seed),
+        roots: false,
+        pruned_to: outlines,
+        ..GrowOptions::default()
+    };
+    let (_, plant) = Grown::plant(genome, &options).map_err(|e| ApiError::library("genome", e))?;
+    Ok(plant)
 }

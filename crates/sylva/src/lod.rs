@@ -257,4 +257,9 @@ impl Preview {
         node.extras = Some(self.extras.clone());
         Scene::single(node)
     }
+
+    /// The preview as a GLB file's bytes: what a front end's 3D view loads.
+    pub fn glb(&self) -> Result<Vec<u8>, Error> {
+        Ok(sylva_gltf::export::to_glb(&self.scene())?)
+    }
 }

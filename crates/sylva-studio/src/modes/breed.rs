@@ -130,7 +130,7 @@ impl Made {
         operator: Operator,
         settings: serde_json::Value,
         parents: Vec<ParentRow>,
-        pruned_to: Option<&[Outline]>,
+        pruned_to: Option<Arc<[Outline]>>,
     ) -> Result<Made, ApiError> {
         let plant = grow_shown(&genome, seed, pruned_to)?;
         let glb = preview_glb(&genome, seed, &plant, PreviewSize::GRID)?;
@@ -407,7 +407,6 @@ async fn blocking_grow(studio: &Studio, sprouts: Vec<Sprout>) -> Result<Vec<Made
                     field,
                 } = sprouts[i].clone();
                 let seed = seed.unwrap_or_else(|| genome.default_seed());
-                let pruned_to = pruned_to.as_deref();
                 Made::grow_with(genome, seed, operator, settings, parents, pruned_to).map_err(
                     |mut e| {
                         e.field = field;

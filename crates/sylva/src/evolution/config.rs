@@ -9,10 +9,11 @@ use crate::error::InputError;
 use crate::genome::Genome;
 use crate::registry::Registry;
 
-use super::face::{ConfigFace, Where};
+use super::face::ConfigFace;
 use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig};
 use super::silhouette::Target;
 use super::typed::GenerationTime;
+use super::typed::Where;
 
 /// An evolution config of any model.
 pub struct Config {

@@ -19,8 +19,7 @@ use crate::genome::Genome;
 
 use super::hooks::RunHooks;
 use super::schema::{EvolveConfig, MatchConfig, OutputConfig, RunConfig};
-use super::silhouette::Target;
-use super::typed::{GenerationTime, Member, TypedRun, resume, start};
+use super::typed::{GenerationTime, Member, TypedRun, Where, resume, start};
 use super::typed_map::{TypedMap, Variety, resume_map, start_map};
 use super::typed_space::{SpaceOptions, SpaceValue, new_space};
 
@@ -71,12 +70,6 @@ pub(crate) trait ConfigFace: Send + Sync {
         start: Vec<Genome>,
         options: &SpaceOptions,
     ) -> Result<Box<dyn SpaceValue>, Error>;
-}
-
-/// Where a config came from: how errors name it, and its `[match]` pictures as read.
-pub(crate) struct Where {
-    pub(crate) source: String,
-    pub(crate) target: Option<Target>,
 }
 
 /// A run of one model, as any model's.

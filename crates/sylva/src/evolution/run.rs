@@ -10,10 +10,11 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::config::Config;
-use super::face::{RunFace, Where};
+use super::face::RunFace;
 use super::hooks::RunHooks;
 use super::silhouette::Target;
 use super::typed::Member;
+use super::typed::Where;
 
 /// An evolution run of any model.
 pub struct Evolution {

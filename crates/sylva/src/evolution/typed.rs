@@ -16,7 +16,6 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::checkpoint::{SavedRun, SavedRunRef};
-use super::face::Where;
 use super::hooks::{
     OwnRecord, RunHooks, Scored, check_resumed, check_term, first_generation, foreseen,
 };
@@ -59,6 +58,12 @@ pub(super) fn member_of<M: Evolve + Default>(
 
 /// The genome model `M` evolves.
 type Evolved<M> = <<M as Evolve>::Problem as Problem>::Genome;
+
+/// Where a config came from: how errors name it, and its `[match]` pictures as read.
+pub(crate) struct Where {
+    pub(crate) source: String,
+    pub(crate) target: Option<Target>,
+}
 
 /// A run of model `M` with the config it follows.
 pub(crate) struct TypedRun<M: Evolve> {

@@ -19,9 +19,8 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
 use super::checkpoint;
-use super::face::Where;
 use super::schema::{EmitterKind, EvolveConfig, MapConfig, SearchStrategy};
-use super::typed::{Member, member_of, setup, typed_start, with_term};
+use super::typed::{Member, Where, member_of, setup, typed_start, with_term};
 
 thread_local! {
     /// Per-thread measuring buffers; they carry nothing between plants.

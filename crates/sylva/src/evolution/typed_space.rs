@@ -14,9 +14,8 @@ use sylva_model::{Evolve, VectorCoding};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
 
-use super::face::Where;
 use super::schema::EvolveConfig;
-use super::typed::{setup, typed_start, with_term};
+use super::typed::{Where, setup, typed_start, with_term};
 use super::typed_map::{PlantDescriber, as_map, map_settings};
 
 /// Most entries a codon vector has.
