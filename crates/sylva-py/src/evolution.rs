@@ -11,7 +11,7 @@ use sylva::{Evolution as Run, Member as RunMember};
 use sylva::{GenerationStats, IndividualId};
 
 use crate::errors::{IntoPy, bad_value, input_error};
-use crate::genome::Genome;
+use crate::handle::Genome;
 use crate::json::{from_py, to_py};
 use crate::plant::Plant;
 use crate::work::{PyFitness, Serving, work};

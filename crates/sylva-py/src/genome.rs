@@ -1,4 +1,5 @@
-//! `Genome`: a genome of any model, its fields, growth and breeding by hand.
+//! `Genome`'s methods: a genome of any model, its fields, growth and breeding by hand (the
+//! class's data is [`crate::handle::Genome`], which the classes that hold genomes share).
 
 use std::path::{Path, PathBuf};
 
@@ -6,18 +7,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{IntoPy, bad_value};
+use crate::handle::Genome;
 use crate::json::{from_py, pointer, to_py};
 use crate::plant::Plant;
-
-/// A genome of any of Sylva's models. Load it from a file (`Genome.load`), a dict
-/// (`Genome.from_dict`) or JSON text (`Genome.from_json`); read and set its fields with
-/// `genome["field"]` (dotted paths reach into nested fields: `genome["rotation1.angle"]`);
-/// grow it with `grow`; breed it with `mutate` and `sylva.cross`.
-#[pyclass(module = "sylva", name = "Genome", from_py_object)]
-#[derive(Clone)]
-pub struct Genome {
-    pub inner: sylva::Genome,
-}
 
 impl Genome {
     fn parse(text: &str, source: &str) -> PyResult<Genome> {

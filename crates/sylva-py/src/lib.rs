@@ -4,7 +4,8 @@
 //! `sylva::Config`, `sylva::Evolution`), as the command line does; this crate only turns
 //! Python values into the library's and back:
 //!
-//! - [`genome`]: `Genome` (load, fields, grow, mutate), `cross`, `models`;
+//! - [`genome`]: `Genome`'s methods (load, fields, grow, mutate), `cross`, `models`; the
+//!   class's data is [`handle`]'s, which every module holding genomes shares;
 //! - [`plant`]: `Plant` (measures, export, render), `Mesh` (numpy arrays), `Scene`, `garden`;
 //! - [`evolution`]: `Config`, `Evolution` (step, browse, checkpoint, migrants), `Member`;
 //! - [`varieties`]: `Varieties` (maps of varieties: step, archive, checkpoint), `Variety`,
@@ -24,6 +25,7 @@
 mod errors;
 mod evolution;
 mod genome;
+mod handle;
 mod json;
 mod mask;
 mod pair;
@@ -79,7 +81,7 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
             wanted.join(", ")
         )));
     }
-    m.add_class::<genome::Genome>()?;
+    m.add_class::<handle::Genome>()?;
     m.add_class::<plant::Plant>()?;
     m.add_class::<plant::Mesh>()?;
     m.add_class::<plant::Scene>()?;

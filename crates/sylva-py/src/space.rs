@@ -13,7 +13,7 @@ use sylva::evolution::{Coding, SpaceOptions};
 
 use crate::errors::{IntoPy, bad_value};
 use crate::evolution::{Config, Evolution};
-use crate::genome::Genome;
+use crate::handle::Genome;
 
 /// `value` as float64 numbers and their shape; anything but numbers (an array of another
 /// kind, text, ragged lists) raises `TypeError` naming the argument `name`.

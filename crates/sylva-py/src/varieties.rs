@@ -13,7 +13,7 @@ use sylva::evolution::Stop;
 
 use crate::errors::IntoPy;
 use crate::evolution::{Config, Evolution, checkpoint_text};
-use crate::genome::Genome;
+use crate::handle::Genome;
 use crate::work::{Serving, work};
 
 /// One filled cell of a map: where it is, and its elite.
