@@ -16,7 +16,8 @@
 //!   function is served; [`mask`]: numpy masks as match targets.
 //!
 //! The module reads and makes genomes and configs with the models it was made with
-//! ([`init`]): Sylva's four, or a registry of a crate's own.
+//! ([`init`]): Sylva's four, or a registry of a crate's own, kept by the module and its
+//! classes ([`models`]); there is no registry of the process's.
 //!
 //! Calls that grow, mesh, render, write or breed release the GIL; runs stop on Ctrl-C within
 //! one member's evaluation. The pure-Python half
@@ -28,25 +29,15 @@ mod genome;
 mod handle;
 mod json;
 mod mask;
+mod models;
 mod pair;
 mod plant;
 mod space;
 mod varieties;
 mod work;
 
-use std::sync::OnceLock;
-
 use pyo3::prelude::*;
 use sylva::Registry;
-
-/// The models this module knows, given when the module is made ([`init`]).
-static MODELS: OnceLock<Registry> = OnceLock::new();
-
-/// The models genome files, configs and random genomes are read and made with: the
-/// registry the module was made with, or Sylva's four.
-pub(crate) fn registry() -> &'static Registry {
-    MODELS.get().unwrap_or(Registry::standard())
-}
 
 /// Sylva's native module, with Sylva's four models.
 #[cfg(feature = "module")]
@@ -67,31 +58,29 @@ fn _sylva(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// }
 /// ```
 ///
-/// A process holds one registry: making a second module with other models raises
+/// The module keeps `registry` (as `_models`), and so do the classes it adds: its functions
+/// and the classes' constructors read and make genomes and configs with it, and with nothing
+/// else. A class is one per process, so a second module with other models raises
 /// `ImportError`.
 pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
-    let names = |r: &Registry| r.models().iter().map(|e| e.name()).collect::<Vec<_>>();
-    let wanted = names(&registry);
-    let held = names(MODELS.get_or_init(|| registry));
-    if held != wanted {
-        return Err(pyo3::exceptions::PyImportError::new_err(format!(
-            "Sylva's native module is already loaded in this process with the models {}; \
-             it cannot also be loaded with {}",
-            held.join(", "),
-            wanted.join(", ")
-        )));
+    let py = m.py();
+    let classes = [
+        py.get_type::<handle::Genome>(),
+        py.get_type::<plant::Plant>(),
+        py.get_type::<plant::Mesh>(),
+        py.get_type::<plant::Scene>(),
+        py.get_type::<evolution::Config>(),
+        py.get_type::<evolution::Evolution>(),
+        py.get_type::<evolution::Member>(),
+        py.get_type::<varieties::Varieties>(),
+        py.get_type::<varieties::Variety>(),
+        py.get_type::<varieties::Archive>(),
+        py.get_type::<space::GenomeSpace>(),
+    ];
+    models::Models::install(m, &classes, registry)?;
+    for class in classes {
+        m.add(class.name()?, class)?;
     }
-    m.add_class::<handle::Genome>()?;
-    m.add_class::<plant::Plant>()?;
-    m.add_class::<plant::Mesh>()?;
-    m.add_class::<plant::Scene>()?;
-    m.add_class::<evolution::Config>()?;
-    m.add_class::<evolution::Evolution>()?;
-    m.add_class::<evolution::Member>()?;
-    m.add_class::<varieties::Varieties>()?;
-    m.add_class::<varieties::Variety>()?;
-    m.add_class::<varieties::Archive>()?;
-    m.add_class::<space::GenomeSpace>()?;
     m.add_function(wrap_pyfunction!(varieties::varieties, m)?)?;
     m.add_function(wrap_pyfunction!(genome::cross, m)?)?;
     m.add_function(wrap_pyfunction!(genome::models, m)?)?;

@@ -92,4 +92,7 @@ config_path = os.path.join(folder, "cylinder.toml")
 with open(config_path, "w") as f:
     f.write(config.to_toml())
 assert sylva.Evolution(config_path).best().genome.model == "cylinder"
+
+# The module and its classes hold the one registry it was made with.
+assert sylva.Genome._models is sylva._models and sylva.Config._models is sylva._models
 "#;

@@ -15,17 +15,17 @@ _Path = str | os.PathLike[str]
 class Genome:
     """A genome of any of Sylva's models; ``genome["field"]`` reads and sets its fields."""
 
-    @staticmethod
-    def load(path: _Path) -> Genome:
+    @classmethod
+    def load(cls, path: _Path) -> Genome:
         """Reads a genome file of any model."""
-    @staticmethod
-    def from_dict(data: dict[str, Any]) -> Genome:
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Genome:
         """A genome from a dict shaped like a genome file (with its ``model`` and ``format``)."""
-    @staticmethod
-    def from_json(text: str, source: str = "<json>") -> Genome:
+    @classmethod
+    def from_json(cls, text: str, source: str = "<json>") -> Genome:
         """A genome from a genome file's JSON text; ``source`` names it in errors."""
-    @staticmethod
-    def random(model: str, seed: int, settings: dict[str, Any] | None = None) -> Genome:
+    @classmethod
+    def random(cls, model: str, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A random genome of ``model``, made by the model with ``settings``."""
     @property
     def model(self) -> str:
@@ -181,14 +181,16 @@ class Scene:
 class Config:
     """An evolution config of any model that evolves."""
 
-    @staticmethod
-    def load(path: _Path) -> Config: ...
-    @staticmethod
-    def from_toml(text: str, source: str = "<toml>", base: _Path | None = None) -> Config: ...
-    @staticmethod
-    def from_dict(data: dict[str, Any], base: _Path | None = None) -> Config: ...
-    @staticmethod
-    def default() -> Config: ...
+    @classmethod
+    def load(cls, path: _Path) -> Config: ...
+    @classmethod
+    def from_toml(
+        cls, text: str, source: str = "<toml>", base: _Path | None = None
+    ) -> Config: ...
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], base: _Path | None = None) -> Config: ...
+    @classmethod
+    def default(cls) -> Config: ...
     @property
     def model(self) -> str: ...
     @property
@@ -334,8 +336,9 @@ class Varieties:
         start: Sequence[Genome] | None = None,
         threads: int | None = None,
     ) -> None: ...
-    @staticmethod
+    @classmethod
     def resume(
+        cls,
         config: Config | dict[str, Any] | _Path,
         path: _Path | None = None,
         text: str | None = None,
