@@ -10,6 +10,8 @@
 //! - [`evolution`]: `Config`, `Evolution` (step, browse, checkpoint, migrants), `Member`;
 //! - [`varieties`]: `Varieties` (maps of varieties: step, archive, checkpoint), `Variety`,
 //!   `Archive`;
+//! - [`archive`]: `StudioArchive`, the studio's archive (`sylva studio --db`) on the
+//!   library's: plants listed and read, bred plants written back with their parents;
 //! - [`space`]: `GenomeSpace`, genomes as numpy vectors for optimisers outside Sylva;
 //! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`;
 //! - [`work`]: long calls off the calling thread, so Ctrl-C is heard and a Python fitness
@@ -23,6 +25,7 @@
 //! one member's evaluation. The pure-Python half
 //! (`python/sylva`) adds island evolution on Ray or a local process pool.
 
+mod archive;
 mod errors;
 mod evolution;
 mod genome;
@@ -76,6 +79,8 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
         py.get_type::<varieties::Variety>(),
         py.get_type::<varieties::Archive>(),
         py.get_type::<space::GenomeSpace>(),
+        py.get_type::<archive::StudioArchive>(),
+        py.get_type::<archive::ArchivedPlant>(),
     ];
     models::Models::install(m, &classes, registry)?;
     for class in classes {
