@@ -3,7 +3,6 @@ cross the favourites. Every one that changes the scene is REGISTER and UNDO, so 
 it back as one step; errors are reported naming what was wrong."""
 
 import os
-import sqlite3
 import time
 
 import bpy
@@ -97,8 +96,7 @@ class SYLVA_OT_grow(bpy.types.Operator):
                 if settings.archive_plant in ("", "none"):
                     return _fail(self, f"Choose a plant of {os.path.basename(path)} (it has none of {model})")
                 row = int(settings.archive_plant)
-                text, seed, _, operator = archive.plant(path, row)
-                genome = s.Genome.from_json(text, source=f"{path} plant {row}")
+                genome, seed, operator = archive.plant(path, row)
                 source = f"{os.path.basename(path)} plant {row}"
             else:
                 genome = s.Genome.random(model, settings.random_seed)
@@ -221,7 +219,7 @@ def _record(context, op, children):
     path = bpy.path.abspath(settings.archive)
     try:
         return len(archive.record(path, children))
-    except (archive.ArchiveError, sqlite3.Error) as e:
+    except (archive.ArchiveError, ValueError, KeyError) as e:  # ValueError: the package's InputError
         op.report({"WARNING"}, f"The bred plants were not written to {path}: {e}")
         return 0
 

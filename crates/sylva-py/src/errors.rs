@@ -127,6 +127,37 @@ pub fn error(e: sylva::Error) -> PyErr {
     }
 }
 
+/// An archive's error as its Python exception: a genome that does not read as the
+/// `InputError` it is (its file the archive and the plant), a plant `StudioArchive.add` cannot
+/// write as an `InputError` naming it, the rest as `sylva.ArchiveError` with its file.
+pub fn archive_error(e: sylva::archive::ArchiveError) -> PyErr {
+    use sylva::archive::ArchiveError;
+    match e {
+        ArchiveError::Genome { error, .. } => input_error(&error),
+        ArchiveError::Addition { index, problem, .. } => {
+            bad_value(format!("plants[{index}]"), problem)
+        }
+        e => raise_archive(e.to_string(), e.path()),
+    }
+}
+
+/// `sylva.ArchiveError` for an archive already closed.
+pub fn archive_closed(path: &std::path::Path) -> PyErr {
+    raise_archive(format!("{} is closed", path.display()), path)
+}
+
+fn raise_archive(message: String, path: &std::path::Path) -> PyErr {
+    Python::attach(|py| {
+        let made = (|| -> PyResult<PyErr> {
+            let class = py.import("sylva.errors")?.getattr("ArchiveError")?;
+            let kwargs = PyDict::new(py);
+            kwargs.set_item("path", path.display().to_string())?;
+            Ok(PyErr::from_value(class.call((message,), Some(&kwargs))?))
+        })();
+        made.unwrap_or_else(|e| e)
+    })
+}
+
 /// Bad input of a value given from Python: `location` names the argument or field.
 pub fn bad_value(location: impl Into<String>, message: impl ToString) -> PyErr {
     input_error(&sylva::InputError::new(location, message))

@@ -5,14 +5,15 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, TryLockError};
 
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict};
+use pyo3::types::{PyBytes, PyDict, PyType};
 use sylva::evolution::Stop;
 use sylva::{Evolution as Run, Member as RunMember};
-use sylva::{GenerationStats, IndividualId};
+use sylva::{GenerationStats, IndividualId, Registry};
 
 use crate::errors::{IntoPy, bad_value, input_error};
-use crate::genome::Genome;
+use crate::handle::Genome;
 use crate::json::{from_py, to_py};
+use crate::models::Models;
 use crate::plant::Plant;
 use crate::work::{PyFitness, Serving, work};
 
@@ -31,20 +32,25 @@ pub struct Config {
 const DICT: &str = "<config dict>";
 
 impl Config {
-    fn parse(text: &str, source: &Path, base: PathBuf) -> PyResult<Config> {
-        let inner = crate::registry().parse_config(source, text).py()?;
+    fn parse(registry: &Registry, text: &str, source: &Path, base: PathBuf) -> PyResult<Config> {
+        let inner = registry.parse_config(source, text).py()?;
         Ok(Config { inner, base })
     }
 
     /// The config with its run section changed through TOML, so the same range checks apply.
-    fn with_run_field(&self, field: &str, value: toml::Value) -> PyResult<Config> {
+    fn with_run_field(
+        &self,
+        registry: &Registry,
+        field: &str,
+        value: toml::Value,
+    ) -> PyResult<Config> {
         let mut table: toml::Table =
             toml::from_str(&self.inner.to_toml()).map_err(|e| bad_value(field, e))?;
         if let Some(toml::Value::Table(run)) = table.get_mut("run") {
             run.insert(field.to_owned(), value);
         }
         let text = toml::to_string(&table).map_err(|e| bad_value(field, e))?;
-        let inner = crate::registry()
+        let inner = registry
             .parse_config(Path::new(DICT), &text)
             .map_err(|e| field_error(e, &text))
             .map_err(|e| input_error(&e))?;
@@ -83,12 +89,12 @@ fn field_error(e: sylva::InputError, text: &str) -> sylva::InputError {
 
 impl Config {
     /// A config given as Python code gives one: a `Config`, a dict shaped like the file,
-    /// or the path of a config file.
-    pub fn from_any(config: &Bound<'_, PyAny>) -> PyResult<Config> {
+    /// or the path of a config file; the dict and the file read with `registry`.
+    pub fn from_any(registry: &Registry, config: &Bound<'_, PyAny>) -> PyResult<Config> {
         if let Ok(config) = config.cast::<Config>() {
             Ok(config.borrow().clone())
         } else if config.is_instance_of::<pyo3::types::PyDict>() {
-            Config::from_dict(config, None)
+            Config::read_dict(registry, config, None)
         } else {
             let path: PathBuf = config.extract().map_err(|_| {
                 pyo3::exceptions::PyTypeError::new_err(format!(
@@ -99,38 +105,25 @@ impl Config {
                         .map_or_else(|_| "?".into(), |n| n.to_string())
                 ))
             })?;
-            Config::load(path)
+            Config::read_file(registry, path)
         }
     }
-}
 
-#[pymethods]
-impl Config {
-    /// Reads a config file; genome files it names are found next to it.
-    #[staticmethod]
-    pub(crate) fn load(path: PathBuf) -> PyResult<Config> {
-        let inner = crate::registry().load_config(&path).py()?;
+    fn read_file(registry: &Registry, path: PathBuf) -> PyResult<Config> {
+        let inner = registry.load_config(&path).py()?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(Config { inner, base })
     }
 
-    /// A config from TOML text; `source` names it in errors, and genome files it names are
-    /// found in `base` (the current folder by default).
-    #[staticmethod]
-    #[pyo3(signature = (text, source = "<toml>", base = None))]
-    fn from_toml(text: &str, source: &str, base: Option<PathBuf>) -> PyResult<Config> {
-        Config::parse(text, Path::new(source), base.unwrap_or_default())
-    }
-
-    /// A config from a dict shaped like the file: `{"model": "automata", "run":
-    /// {"population": 500}, "automata": {...}}`. Errors name the field.
-    #[staticmethod]
-    #[pyo3(signature = (data, base = None))]
-    pub(crate) fn from_dict(data: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<Config> {
+    fn read_dict(
+        registry: &Registry,
+        data: &Bound<'_, PyAny>,
+        base: Option<PathBuf>,
+    ) -> PyResult<Config> {
         let value = from_py(data, "config dict")?;
         let text =
             toml::to_string(&value).map_err(|e| bad_value(DICT, format!("not a config: {e}")))?;
-        let inner = crate::registry()
+        let inner = registry
             .parse_config(Path::new(DICT), &text)
             .map_err(|e| input_error(&field_error(e, &text)))?;
         Ok(Config {
@@ -138,15 +131,61 @@ impl Config {
             base: base.unwrap_or_default(),
         })
     }
+}
+
+#[pymethods]
+impl Config {
+    /// Reads a config file; genome files it names are found next to it.
+    #[classmethod]
+    fn load(cls: &Bound<'_, PyType>, path: PathBuf) -> PyResult<Config> {
+        Config::read_file(Models::of(cls)?.get().registry(), path)
+    }
+
+    /// A config from TOML text; `source` names it in errors, and genome files it names are
+    /// found in `base` (the current folder by default).
+    #[classmethod]
+    #[pyo3(signature = (text, source = "<toml>", base = None))]
+    fn from_toml(
+        cls: &Bound<'_, PyType>,
+        text: &str,
+        source: &str,
+        base: Option<PathBuf>,
+    ) -> PyResult<Config> {
+        let models = Models::of(cls)?;
+        Config::parse(
+            models.get().registry(),
+            text,
+            Path::new(source),
+            base.unwrap_or_default(),
+        )
+    }
+
+    /// A config from a dict shaped like the file: `{"model": "automata", "run":
+    /// {"population": 500}, "automata": {...}}`. Errors name the field.
+    #[classmethod]
+    #[pyo3(signature = (data, base = None))]
+    fn from_dict(
+        cls: &Bound<'_, PyType>,
+        data: &Bound<'_, PyAny>,
+        base: Option<PathBuf>,
+    ) -> PyResult<Config> {
+        Config::read_dict(Models::of(cls)?.get().registry(), data, base)
+    }
 
     /// The default config (of the first model, binary trees, every setting at its
     /// default).
-    #[staticmethod]
-    fn default() -> Config {
-        Config {
-            inner: crate::registry().default_config().unwrap_or_default(),
+    #[classmethod]
+    fn default(cls: &Bound<'_, PyType>) -> PyResult<Config> {
+        let models = Models::of(cls)?;
+        let inner = models
+            .get()
+            .registry()
+            .default_config()
+            .ok_or_else(|| bad_value("model", "this module has no models"))?;
+        Ok(Config {
+            inner,
             base: PathBuf::new(),
-        }
+        })
     }
 
     /// The model evolved.
@@ -201,14 +240,16 @@ impl Config {
     /// A copy with `[run]` fields changed (generations, population, seed, threads,
     /// checkpoint_seconds), each checked against its range.
     #[pyo3(signature = (**fields))]
-    fn with_run(&self, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+    fn with_run(&self, py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+        let models = Models::of(py.get_type::<Config>().as_any())?;
+        let registry = models.get().registry();
         let mut config = self.clone();
         if let Some(fields) = fields {
             for (k, v) in fields.iter() {
                 let key: String = k.extract()?;
                 let value = from_py(&v, &key)?;
                 let value = toml::Value::try_from(value).map_err(|e| bad_value(&key, e))?;
-                config = config.with_run_field(&key, value)?;
+                config = config.with_run_field(registry, &key, value)?;
             }
         }
         Ok(config)
@@ -474,7 +515,11 @@ impl Evolution {
         config: &sylva::Config,
         threads: Option<u32>,
     ) -> PyResult<sylva::core::par::Pool> {
-        let threads = threads.unwrap_or(config.run().threads);
+        Evolution::pool_of(threads.unwrap_or(config.run().threads))
+    }
+
+    /// A pool of `threads` threads (0: one per core).
+    pub(crate) fn pool_of(threads: u32) -> PyResult<sylva::core::par::Pool> {
         if threads > 1024 {
             return Err(bad_value(
                 "threads",
@@ -521,10 +566,12 @@ impl Evolution {
     /// 0 is made raises `KeyboardInterrupt` (within one member's evaluation), and makes
     /// nothing.
     #[new]
+    #[classmethod]
     #[pyo3(signature = (config, start = None, threads = None, *, fitness = None,
                         fitness_weight = 1.0, fitness_mode = "add", fitness_batch = 16))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn new(
+        cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
@@ -534,14 +581,13 @@ impl Evolution {
         fitness_mode: &str,
         fitness_batch: usize,
     ) -> PyResult<Evolution> {
-        let config = &Config::from_any(config)?;
+        let models = Models::of(cls)?;
+        let registry = models.get().registry();
+        let config = &Config::from_any(registry, config)?;
         let fitness = Fitness::of(fitness, fitness_weight, fitness_mode, fitness_batch)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
-            None => config
-                .inner
-                .load_start(crate::registry(), &config.base)
-                .py()?,
+            None => config.inner.load_start(registry, &config.base).py()?,
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
@@ -817,10 +863,12 @@ impl Evolution {
 /// the best so). Releases the GIL while it breeds; Ctrl-C raises `KeyboardInterrupt` within
 /// one member's evaluation.
 #[pyfunction(name = "match")]
-#[pyo3(signature = (target, side = None, model = "auto", generations = None, seconds = None,
-                    population = 100, seed = 1, threshold = None, threads = 0, prune = true))]
+#[pyo3(pass_module, signature = (target, side = None, model = "auto", generations = None,
+                    seconds = None, population = 100, seed = 1, threshold = None, threads = 0,
+                    prune = true))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
 pub fn match_outline(
+    module: &Bound<'_, PyModule>,
     py: Python<'_>,
     target: &Bound<'_, PyAny>,
     side: Option<&Bound<'_, PyAny>>,
@@ -881,7 +929,8 @@ pub fn match_outline(
         threads,
         ..sylva::RunConfig::default()
     };
-    let registry = crate::registry();
+    let models = Models::of(module.as_any())?;
+    let registry = models.get().registry();
     let config = match model {
         "auto" => None,
         model => Some(
@@ -889,10 +938,7 @@ pub fn match_outline(
                 .map_err(|e| bad_value(e.field, e.message))?,
         ),
     };
-    let pool = Evolution::pool(
-        config.as_ref().unwrap_or(&sylva::Config::default()),
-        Some(threads),
-    )?;
+    let pool = Evolution::pool_of(threads)?;
     let stop = Stop::new();
     let (evolution, elsewhere) = work(py, &stop, None, &Serving::default(), || {
         match &config {

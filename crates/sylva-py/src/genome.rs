@@ -1,27 +1,22 @@
-//! `Genome`: a genome of any model, its fields, growth and breeding by hand.
+//! `Genome`'s methods: a genome of any model, its fields, growth and breeding by hand (the
+//! class's data is [`crate::handle::Genome`], which the classes that hold genomes share).
 
 use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
+use sylva::Registry;
 
 use crate::errors::{IntoPy, bad_value};
+use crate::handle::Genome;
 use crate::json::{from_py, pointer, to_py};
+use crate::models::Models;
 use crate::plant::Plant;
 
-/// A genome of any of Sylva's models. Load it from a file (`Genome.load`), a dict
-/// (`Genome.from_dict`) or JSON text (`Genome.from_json`); read and set its fields with
-/// `genome["field"]` (dotted paths reach into nested fields: `genome["rotation1.angle"]`);
-/// grow it with `grow`; breed it with `mutate` and `sylva.cross`.
-#[pyclass(module = "sylva", name = "Genome", from_py_object)]
-#[derive(Clone)]
-pub struct Genome {
-    pub inner: sylva::Genome,
-}
-
 impl Genome {
-    fn parse(text: &str, source: &str) -> PyResult<Genome> {
-        let inner = crate::registry()
+    /// A genome file's text, read with `registry`; `source` names it in errors.
+    fn parse(registry: &Registry, text: &str, source: &str) -> PyResult<Genome> {
+        let inner = registry
             .parse_genome(text)
             .map_err(|e| sylva::InputError::genome(Path::new(source), text, e))
             .py()?;
@@ -38,33 +33,39 @@ impl Genome {
 #[pymethods]
 impl Genome {
     /// Reads a genome file of any model.
-    #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Genome> {
-        let inner = crate::registry().load_genome(&path).py()?;
+    #[classmethod]
+    fn load(cls: &Bound<'_, PyType>, path: PathBuf) -> PyResult<Genome> {
+        let inner = Models::of(cls)?.get().registry().load_genome(&path).py()?;
         Ok(Genome { inner })
     }
 
     /// A genome from a dict shaped like a genome file (with its `model` and `format`).
-    #[staticmethod]
-    fn from_dict(data: &Bound<'_, PyAny>) -> PyResult<Genome> {
+    #[classmethod]
+    fn from_dict(cls: &Bound<'_, PyType>, data: &Bound<'_, PyAny>) -> PyResult<Genome> {
         let value = from_py(data, "genome dict")?;
         let text = serde_json::to_string_pretty(&value).unwrap_or_default();
-        Genome::parse(&text, "<genome dict>")
+        Genome::parse(Models::of(cls)?.get().registry(), &text, "<genome dict>")
     }
 
     /// A genome from a genome file's JSON text; `source` names it in errors.
-    #[staticmethod]
+    #[classmethod]
     #[pyo3(signature = (text, source = "<json>"))]
-    fn from_json(text: &str, source: &str) -> PyResult<Genome> {
-        Genome::parse(text, source)
+    fn from_json(cls: &Bound<'_, PyType>, text: &str, source: &str) -> PyResult<Genome> {
+        Genome::parse(Models::of(cls)?.get().registry(), text, source)
     }
 
     /// A random genome of `model` ("bintree", "automata", "plantmaker" or "lsystem"),
     /// made by the model with `settings` (a dict of its settings, or its defaults).
-    #[staticmethod]
+    #[classmethod]
     #[pyo3(signature = (model, seed, settings = None))]
-    fn random(model: &str, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
-        let registry = crate::registry();
+    fn random(
+        cls: &Bound<'_, PyType>,
+        model: &str,
+        seed: u64,
+        settings: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Genome> {
+        let models = Models::of(cls)?;
+        let registry = models.get().registry();
         let entry = registry.get(model).ok_or_else(|| {
             let names: Vec<&str> = registry.models().iter().map(|m| m.name()).collect();
             bad_value(
@@ -207,9 +208,11 @@ impl Genome {
 
     /// Loads a species preset (`.toml`: a genome and how it grows, as
     /// `examples/species/oak.toml`) and grows it; the arguments given override the file's.
-    #[staticmethod]
+    #[classmethod]
     #[pyo3(signature = (path, seed = None, height = None, foliage = None, bark = None, density = None))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn grow_preset(
+        cls: &Bound<'_, PyType>,
         py: Python<'_>,
         path: std::path::PathBuf,
         seed: Option<u64>,
@@ -218,7 +221,7 @@ impl Genome {
         bark: Option<&str>,
         density: Option<f32>,
     ) -> PyResult<Plant> {
-        let preset = sylva::preset::Preset::load(crate::registry(), &path)
+        let preset = sylva::preset::Preset::load(Models::of(cls)?.get().registry(), &path)
             .map_err(|e| crate::errors::input_error(&e))?;
         let options = sylva::GrowOptions {
             seed: seed.or(preset.options.seed),
@@ -336,9 +339,10 @@ pub fn _rust_grow_seconds(
 
 /// The models Sylva knows: a dict of name to title.
 #[pyfunction]
-pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let dict = PyDict::new(py);
-    for m in crate::registry().models() {
+#[pyo3(pass_module)]
+pub fn models<'py>(module: &Bound<'py, PyModule>) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(module.py());
+    for m in Models::of(module.as_any())?.get().registry().models() {
         dict.set_item(m.name(), m.title())?;
     }
     Ok(dict)

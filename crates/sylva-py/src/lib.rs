@@ -4,47 +4,43 @@
 //! `sylva::Config`, `sylva::Evolution`), as the command line does; this crate only turns
 //! Python values into the library's and back:
 //!
-//! - [`genome`]: `Genome` (load, fields, grow, mutate), `cross`, `models`;
+//! - [`genome`]: `Genome`'s methods (load, fields, grow, mutate), `cross`, `models`; the
+//!   class's data is [`handle`]'s, which every module holding genomes shares;
 //! - [`plant`]: `Plant` (measures, export, render), `Mesh` (numpy arrays), `Scene`, `garden`;
 //! - [`evolution`]: `Config`, `Evolution` (step, browse, checkpoint, migrants), `Member`;
 //! - [`varieties`]: `Varieties` (maps of varieties: step, archive, checkpoint), `Variety`,
 //!   `Archive`;
+//! - [`archive`]: `StudioArchive`, the studio's archive (`sylva studio --db`) on the
+//!   library's: plants listed and read, bred plants written back with their parents;
 //! - [`space`]: `GenomeSpace`, genomes as numpy vectors for optimisers outside Sylva;
 //! - [`errors`]: Sylva's errors as the exceptions of `sylva/errors.py`;
 //! - [`work`]: long calls off the calling thread, so Ctrl-C is heard and a Python fitness
 //!   function is served; [`mask`]: numpy masks as match targets.
 //!
 //! The module reads and makes genomes and configs with the models it was made with
-//! ([`init`]): Sylva's four, or a registry of a crate's own.
+//! ([`init`]): Sylva's four, or a registry of a crate's own, kept by the module and its
+//! classes ([`models`]); there is no registry of the process's.
 //!
 //! Calls that grow, mesh, render, write or breed release the GIL; runs stop on Ctrl-C within
 //! one member's evaluation. The pure-Python half
 //! (`python/sylva`) adds island evolution on Ray or a local process pool.
 
+mod archive;
 mod errors;
 mod evolution;
 mod genome;
+mod handle;
 mod json;
 mod mask;
+mod models;
 mod pair;
 mod plant;
 mod space;
 mod varieties;
 mod work;
 
-use std::sync::OnceLock;
-
 use pyo3::prelude::*;
 use sylva::Registry;
-
-/// The models this module knows, given when the module is made ([`init`]).
-static MODELS: OnceLock<Registry> = OnceLock::new();
-
-/// The models genome files, configs and random genomes are read and made with: the
-/// registry the module was made with, or Sylva's four.
-pub(crate) fn registry() -> &'static Registry {
-    MODELS.get_or_init(Registry::standard)
-}
 
 /// Sylva's native module, with Sylva's four models.
 #[cfg(feature = "module")]
@@ -65,31 +61,31 @@ fn _sylva(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// }
 /// ```
 ///
-/// A process holds one registry: making a second module with other models raises
+/// The module keeps `registry` (as `_models`), and so do the classes it adds: its functions
+/// and the classes' constructors read and make genomes and configs with it, and with nothing
+/// else. A class is one per process, so a second module with other models raises
 /// `ImportError`.
 pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
-    let names = |r: &Registry| r.models().iter().map(|e| e.name()).collect::<Vec<_>>();
-    let wanted = names(&registry);
-    let held = names(MODELS.get_or_init(|| registry));
-    if held != wanted {
-        return Err(pyo3::exceptions::PyImportError::new_err(format!(
-            "Sylva's native module is already loaded in this process with the models {}; \
-             it cannot also be loaded with {}",
-            held.join(", "),
-            wanted.join(", ")
-        )));
+    let py = m.py();
+    let classes = [
+        py.get_type::<handle::Genome>(),
+        py.get_type::<plant::Plant>(),
+        py.get_type::<plant::Mesh>(),
+        py.get_type::<plant::Scene>(),
+        py.get_type::<evolution::Config>(),
+        py.get_type::<evolution::Evolution>(),
+        py.get_type::<evolution::Member>(),
+        py.get_type::<varieties::Varieties>(),
+        py.get_type::<varieties::Variety>(),
+        py.get_type::<varieties::Archive>(),
+        py.get_type::<space::GenomeSpace>(),
+        py.get_type::<archive::StudioArchive>(),
+        py.get_type::<archive::ArchivedPlant>(),
+    ];
+    models::Models::install(m, &classes, registry)?;
+    for class in classes {
+        m.add(class.name()?, class)?;
     }
-    m.add_class::<genome::Genome>()?;
-    m.add_class::<plant::Plant>()?;
-    m.add_class::<plant::Mesh>()?;
-    m.add_class::<plant::Scene>()?;
-    m.add_class::<evolution::Config>()?;
-    m.add_class::<evolution::Evolution>()?;
-    m.add_class::<evolution::Member>()?;
-    m.add_class::<varieties::Varieties>()?;
-    m.add_class::<varieties::Variety>()?;
-    m.add_class::<varieties::Archive>()?;
-    m.add_class::<space::GenomeSpace>()?;
     m.add_function(wrap_pyfunction!(varieties::varieties, m)?)?;
     m.add_function(wrap_pyfunction!(genome::cross, m)?)?;
     m.add_function(wrap_pyfunction!(genome::models, m)?)?;

@@ -16,7 +16,7 @@ use sylva::mesh::wind::WindOptions;
 use sylva::render::View;
 
 use crate::errors::{IntoPy, bad_value};
-use crate::genome::Genome;
+use crate::handle::Genome;
 use crate::json::to_py;
 use crate::pair::Pair;
 

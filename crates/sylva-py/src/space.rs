@@ -7,13 +7,15 @@ use crate::work::Serving;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArray};
 use numpy::{PyArrayDescrMethods, PyUntypedArrayMethods, dtype};
 use pyo3::prelude::*;
+use pyo3::types::PyType;
 use sylva::core::par::Pool;
 use sylva::evolution::Stop;
 use sylva::evolution::{Coding, SpaceOptions};
 
 use crate::errors::{IntoPy, bad_value};
 use crate::evolution::{Config, Evolution};
-use crate::genome::Genome;
+use crate::handle::Genome;
+use crate::models::Models;
 
 /// `value` as float64 numbers and their shape; anything but numbers (an array of another
 /// kind, text, ragged lists) raises `TypeError` naming the argument `name`.
@@ -122,8 +124,10 @@ impl GenomeSpace {
 impl GenomeSpace {
     /// The space of `config`'s genomes (a `Config`, a dict or a config file's path).
     #[new]
+    #[classmethod]
     #[pyo3(signature = (config, dim = None, *, coding = None, seed = None, threads = None))]
     fn new(
+        cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         dim: Option<usize>,
@@ -131,7 +135,9 @@ impl GenomeSpace {
         seed: Option<u64>,
         threads: Option<u32>,
     ) -> PyResult<GenomeSpace> {
-        let config = Config::from_any(config)?;
+        let models = Models::of(cls)?;
+        let registry = models.get().registry();
+        let config = Config::from_any(registry, config)?;
         let coding = match coding {
             None => None,
             Some(name) => Some(Coding::from_name(name).ok_or_else(|| {
@@ -143,10 +149,7 @@ impl GenomeSpace {
         };
         let options = SpaceOptions { coding, dim, seed };
         let pool = Evolution::pool(&config.inner, threads)?;
-        let start = config
-            .inner
-            .load_start(crate::registry(), &config.base)
-            .py()?;
+        let start = config.inner.load_start(registry, &config.base).py()?;
         let inner = &config.inner;
         let space = py
             .detach(|| sylva::GenomeSpace::new(inner, start, &options))

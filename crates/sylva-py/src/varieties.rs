@@ -6,14 +6,15 @@ use std::sync::Mutex;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
 use sylva::MapStats;
 use sylva::Varieties as Map;
 use sylva::evolution::Stop;
 
 use crate::errors::IntoPy;
 use crate::evolution::{Config, Evolution, checkpoint_text};
-use crate::genome::Genome;
+use crate::handle::Genome;
+use crate::models::Models;
 use crate::work::{Serving, work};
 
 /// One filled cell of a map: where it is, and its elite.
@@ -188,19 +189,19 @@ impl Varieties {
         f(&mut map)
     }
 
+    /// Starts a map of `config`, a dict or a file read with the models of `models`.
     pub(crate) fn start(
         py: Python<'_>,
+        models: &Bound<'_, Models>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
         threads: Option<u32>,
     ) -> PyResult<Varieties> {
-        let config = Config::from_any(config)?;
+        let registry = models.get().registry();
+        let config = Config::from_any(registry, config)?;
         let start = match start {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
-            None => config
-                .inner
-                .load_start(crate::registry(), &config.base)
-                .py()?,
+            None => config.inner.load_start(registry, &config.base).py()?,
         };
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
@@ -222,28 +223,31 @@ impl Varieties {
     /// generation 0 for models that take start genomes (the config's `start` files when
     /// left out); `threads` overrides the config's (0: one per core).
     #[new]
+    #[classmethod]
     #[pyo3(signature = (config, start = None, threads = None))]
     fn new(
+        cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
         threads: Option<u32>,
     ) -> PyResult<Varieties> {
-        Varieties::start(py, config, start, threads)
+        Varieties::start(py, &Models::of(cls)?, config, start, threads)
     }
 
     /// Resumes a map from a checkpoint file (`path`) or its text (`text`), written by the
     /// same config (only generations, threads and the checkpoint interval may change).
-    #[staticmethod]
+    #[classmethod]
     #[pyo3(signature = (config, path = None, text = None, threads = None))]
     fn resume(
+        cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         path: Option<PathBuf>,
         text: Option<String>,
         threads: Option<u32>,
     ) -> PyResult<Varieties> {
-        let config = Config::from_any(config)?;
+        let config = Config::from_any(Models::of(cls)?.get().registry(), config)?;
         let (path, text) = checkpoint_text(path, text)?;
         let pool = Evolution::pool(&config.inner, threads)?;
         let inner = &config.inner;
@@ -447,12 +451,13 @@ impl Varieties {
 /// config file, with its `[map]` or the default map. The same as `Varieties(config, start,
 /// threads)`.
 #[pyfunction]
-#[pyo3(signature = (config, *, threads = None, start = None))]
+#[pyo3(pass_module, signature = (config, *, threads = None, start = None))]
 pub fn varieties(
+    module: &Bound<'_, PyModule>,
     py: Python<'_>,
     config: &Bound<'_, PyAny>,
     threads: Option<u32>,
     start: Option<Vec<Genome>>,
 ) -> PyResult<Varieties> {
-    Varieties::start(py, config, start, threads)
+    Varieties::start(py, &Models::of(module.as_any())?, config, start, threads)
 }

@@ -92,4 +92,17 @@ config_path = os.path.join(folder, "cylinder.toml")
 with open(config_path, "w") as f:
     f.write(config.to_toml())
 assert sylva.Evolution(config_path).best().genome.model == "cylinder"
+
+# The module and its classes hold the one registry it was made with.
+assert sylva.Genome._models is sylva._models and sylva.Config._models is sylva._models
+
+# A studio archive reads its genomes with the same models.
+db = os.path.join(folder, "studio.db")
+if os.path.exists(db):
+    os.remove(db)
+with sylva.StudioArchive(db, create=True) as archive:
+    ids = archive.add([{"genome": genome, "operator": "upload", "key": "tall"},
+                       {"genome": random, "operator": "mutate", "parents": ["tall"]}])
+    assert archive.genome(ids[1]) == random, archive.genome(ids[1])
+    assert archive.parents(ids[1]) == [(ids[0], 1.0)]
 "#;

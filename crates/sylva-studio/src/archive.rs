@@ -1,237 +1,22 @@
-//! The archive: every session, plant, parentage, step and run, in SQLite.
+//! The studio's part of the archive: sessions, their steps (undo and redo), runs, maps,
+//! meshes, scenes and pictures, stored on top of the library's archive
+//! ([`sylva::archive`]: the file's schema and migrations, how it is opened, the plants and
+//! their parents, which Blender and Python read and write too).
 //!
-//! One connection behind a mutex (the studio's writes are small and human-paced; SQLite
-//! serialises writers anyway), in WAL mode with `synchronous = FULL`, so that a committed
+//! One connection behind a mutex, in WAL mode with `synchronous = FULL`, so that a committed
 //! step survives a kill of the process at any moment. Every multi-row change is one
-//! transaction ([`Archive::transaction`]). The schema is built by ordered migrations, and
-//! `schema_version` records how far a file has come.
+//! transaction ([`Archive::transaction`]).
 
-use std::path::Path;
-use std::sync::Mutex;
-
-use rusqlite::{Connection, OptionalExtension, Transaction, params};
+use rusqlite::{Connection, OptionalExtension, params};
 use serde::Serialize;
 
-/// Ordered schema steps: step `i` takes a file from version `i` to `i + 1`.
-const MIGRATIONS: &[&str] = &[
-    r#"
-CREATE TABLE sessions (
-    id INTEGER PRIMARY KEY,
-    mode TEXT NOT NULL,
-    model TEXT NOT NULL,
-    title TEXT NOT NULL,
-    state TEXT NOT NULL,
-    created TEXT NOT NULL
-);
-CREATE TABLE plants (
-    id INTEGER PRIMARY KEY,
-    session INTEGER REFERENCES sessions(id),
-    model TEXT NOT NULL,
-    genome TEXT NOT NULL,
-    seed INTEGER NOT NULL,
-    operator TEXT NOT NULL,
-    settings TEXT NOT NULL,
-    created TEXT NOT NULL
-);
-CREATE INDEX plants_session ON plants(session);
-CREATE TABLE parents (
-    child INTEGER NOT NULL REFERENCES plants(id),
-    ord INTEGER NOT NULL,
-    parent INTEGER NOT NULL REFERENCES plants(id),
-    dominance REAL NOT NULL,
-    PRIMARY KEY (child, ord)
-);
-CREATE INDEX parents_parent ON parents(parent);
-CREATE TABLE meshes (
-    plant INTEGER PRIMARY KEY REFERENCES plants(id),
-    glb BLOB NOT NULL
-);
-CREATE TABLE scenes (
-    id INTEGER PRIMARY KEY,
-    glb BLOB NOT NULL
-);
-CREATE TABLE steps (
-    id INTEGER PRIMARY KEY,
-    session INTEGER NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    action TEXT NOT NULL,
-    before TEXT NOT NULL,
-    after TEXT NOT NULL,
-    undone INTEGER NOT NULL DEFAULT 0,
-    created TEXT NOT NULL,
-    UNIQUE (session, seq)
-);
-CREATE TABLE runs (
-    id INTEGER PRIMARY KEY,
-    session INTEGER NOT NULL REFERENCES sessions(id),
-    config TEXT NOT NULL,
-    checkpoint TEXT,
-    status TEXT NOT NULL,
-    generation INTEGER NOT NULL,
-    generations INTEGER NOT NULL,
-    terms TEXT NOT NULL DEFAULT '[]',
-    error TEXT
-);
-CREATE TABLE run_generations (
-    run INTEGER NOT NULL REFERENCES runs(id),
-    generation INTEGER NOT NULL,
-    best REAL NOT NULL,
-    mean REAL NOT NULL,
-    best_terms TEXT NOT NULL,
-    plant INTEGER REFERENCES plants(id),
-    PRIMARY KEY (run, generation)
-);
-CREATE TABLE run_checkpoints (
-    run INTEGER NOT NULL REFERENCES runs(id),
-    generation INTEGER NOT NULL,
-    checkpoint TEXT NOT NULL,
-    PRIMARY KEY (run, generation)
-);
-"#,
-    r#"
-CREATE TABLE map_cells (
-    run INTEGER NOT NULL REFERENCES runs(id),
-    cell INTEGER NOT NULL,
-    plant INTEGER NOT NULL REFERENCES plants(id),
-    fitness REAL NOT NULL,
-    descriptors TEXT NOT NULL,
-    PRIMARY KEY (run, cell)
-);
-"#,
-    r#"
-CREATE TABLE pictures (
-    session INTEGER NOT NULL REFERENCES sessions(id),
-    view TEXT NOT NULL,
-    bytes BLOB NOT NULL,
-    PRIMARY KEY (session, view)
-);
-"#,
-];
+pub use sylva::archive::{
+    Archive, ArchiveError, NewPlant, Operator, ParentRow, PlantRow, insert_plant, now, parents,
+    plant, plants,
+};
 
-/// Why the archive failed.
-#[derive(Debug, thiserror::Error)]
-pub enum ArchiveError {
-    /// SQLite refused.
-    #[error("archive: {0}")]
-    Sqlite(#[from] rusqlite::Error),
-    /// The file was written by a newer studio.
-    #[error("archive: schema version {found} is newer than this studio's {known}")]
-    TooNew {
-        /// The file's version.
-        found: usize,
-        /// The newest this studio knows.
-        known: usize,
-    },
-}
-
-/// The archive.
-pub struct Archive {
-    connection: Mutex<Connection>,
-}
-
-/// A plant as stored.
-#[derive(Clone, Debug, Serialize)]
-pub struct PlantRow {
-    /// Its id.
-    pub id: i64,
-    /// The session it was made in, if any.
-    pub session: Option<i64>,
-    /// Its model.
-    pub model: String,
-    /// Its genome file's text.
-    #[serde(skip)]
-    pub genome: String,
-    /// The seed it grows with.
-    pub seed: u64,
-    /// How it was made: random, example, upload, cross, mutate, edit, regrow, garden,
-    /// family, design.
-    pub operator: String,
-    /// The settings of the operator.
-    pub settings: serde_json::Value,
-    /// When (UTC, RFC 3339).
-    pub created: String,
-}
-
-/// A parent of a plant.
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
-pub struct ParentRow {
-    /// The parent.
-    pub plant: i64,
-    /// Its dominance.
-    pub dominance: f64,
-}
-
-/// How a plant was made: its `operator` in the archive and in its exports' extras.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Operator {
-    /// A random genome of its model.
-    Random,
-    /// One of Sylva's example genomes.
-    Example,
-    /// A genome file a person gave.
-    Upload,
-    /// A crossover of chosen parents.
-    Cross,
-    /// A mutant of one parent.
-    Mutate,
-    /// A genome a person edited.
-    Edit,
-    /// The same genome grown with another seed.
-    Regrow,
-    /// A garden's mother as she stands in that garden.
-    Mother,
-    /// A member of a family's run.
-    Family,
-    /// A member of a design run.
-    Design,
-    /// An elite of a variety map.
-    Map,
-    /// A generation's best of a match to a picture.
-    Match,
-    /// Empty rules, the biomorph garden's start.
-    Empty,
-    /// An archived plant, again, at the start of a new session.
-    Branch,
-}
-
-impl Operator {
-    /// Its name in the archive.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Operator::Random => "random",
-            Operator::Example => "example",
-            Operator::Upload => "upload",
-            Operator::Cross => "cross",
-            Operator::Mutate => "mutate",
-            Operator::Edit => "edit",
-            Operator::Regrow => "regrow",
-            Operator::Mother => "mother",
-            Operator::Family => "family",
-            Operator::Design => "design",
-            Operator::Map => "map",
-            Operator::Match => "match",
-            Operator::Empty => "empty",
-            Operator::Branch => "branch",
-        }
-    }
-}
-
-/// A new plant.
-pub struct NewPlant<'a> {
-    /// The session it is made in.
-    pub session: Option<i64>,
-    /// Its model.
-    pub model: &'a str,
-    /// Its genome file's text.
-    pub genome: &'a str,
-    /// Its seed.
-    pub seed: u64,
-    /// How it was made.
-    pub operator: Operator,
-    /// The operator's settings.
-    pub settings: &'a serde_json::Value,
-    /// Its parents.
-    pub parents: &'a [ParentRow],
+fn json(text: String) -> serde_json::Value {
+    serde_json::from_str(&text).unwrap_or(serde_json::Value::Null)
 }
 
 /// A session as stored.
@@ -304,139 +89,8 @@ pub struct GenerationRow {
     pub plant: Option<i64>,
 }
 
-/// The time now, RFC 3339 in UTC, to the second.
-fn now() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    let (days, rem) = (secs / 86_400, secs % 86_400);
-    let (y, m, d) = civil_from_days(days as i64);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
-        rem / 3600,
-        rem % 3600 / 60,
-        rem % 60
-    )
-}
-
-/// Days since 1970-01-01 to a civil date (Howard Hinnant's algorithm).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    (yoe + era * 400 + i64::from(m <= 2), m, d)
-}
-
-fn json(text: String) -> serde_json::Value {
-    serde_json::from_str(&text).unwrap_or(serde_json::Value::Null)
-}
-
-impl Archive {
-    /// Opens (or creates) the archive at `path` and brings its schema up to date.
-    pub fn open(path: &Path) -> Result<Archive, ArchiveError> {
-        let mut connection = Connection::open(path)?;
-        connection.pragma_update(None, "journal_mode", "WAL")?;
-        connection.pragma_update(None, "synchronous", "FULL")?;
-        connection.pragma_update(None, "foreign_keys", "ON")?;
-        connection.busy_timeout(std::time::Duration::from_secs(5))?;
-        migrate(&mut connection)?;
-        Ok(Archive {
-            connection: Mutex::new(connection),
-        })
-    }
-
-    /// Runs `f` in one transaction, committed if it returns `Ok`.
-    pub fn transaction<T, E: From<ArchiveError>>(
-        &self,
-        f: impl FnOnce(&Transaction<'_>) -> Result<T, E>,
-    ) -> Result<T, E> {
-        // A poisoned lock means a panic mid-transaction, which SQLite rolled back.
-        let mut connection = self
-            .connection
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
-        let tx = connection.transaction().map_err(ArchiveError::from)?;
-        let value = f(&tx)?;
-        tx.commit().map_err(ArchiveError::from)?;
-        Ok(value)
-    }
-
-    /// Runs a read.
-    pub fn read<T>(
-        &self,
-        f: impl FnOnce(&Connection) -> rusqlite::Result<T>,
-    ) -> Result<T, ArchiveError> {
-        let connection = self
-            .connection
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
-        Ok(f(&connection)?)
-    }
-}
-
-fn migrate(connection: &mut Connection) -> Result<(), ArchiveError> {
-    let tx = connection.transaction()?;
-    tx.execute_batch("CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL)")?;
-    let version: Option<i64> = tx
-        .query_row("SELECT version FROM schema_version", [], |r| r.get(0))
-        .optional()?;
-    let version = version.map(|v| usize::try_from(v).unwrap_or(usize::MAX));
-    let version = match version {
-        Some(v) => v,
-        None => {
-            tx.execute("INSERT INTO schema_version (version) VALUES (0)", [])?;
-            0
-        }
-    };
-    if version > MIGRATIONS.len() {
-        return Err(ArchiveError::TooNew {
-            found: version,
-            known: MIGRATIONS.len(),
-        });
-    }
-    for step in &MIGRATIONS[version..] {
-        tx.execute_batch(step)?;
-    }
-    tx.execute(
-        "UPDATE schema_version SET version = ?1",
-        [MIGRATIONS.len() as i64],
-    )?;
-    tx.commit()?;
-    Ok(())
-}
-
 // What a transaction can do. Free functions over `Connection` (a `Transaction` derefs to
 // one), so handlers compose them in one transaction.
-
-/// Inserts a plant and its parents; returns its id.
-pub fn insert_plant(c: &Connection, p: &NewPlant<'_>) -> rusqlite::Result<i64> {
-    c.execute(
-        "INSERT INTO plants (session, model, genome, seed, operator, settings, created)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-        params![
-            p.session,
-            p.model,
-            p.genome,
-            p.seed as i64,
-            p.operator.as_str(),
-            p.settings.to_string(),
-            now()
-        ],
-    )?;
-    let id = c.last_insert_rowid();
-    for (ord, parent) in p.parents.iter().enumerate() {
-        c.execute(
-            "INSERT INTO parents (child, ord, parent, dominance) VALUES (?1, ?2, ?3, ?4)",
-            params![id, ord as i64, parent.plant, parent.dominance],
-        )?;
-    }
-    Ok(id)
-}
 
 /// Stores a plant's mesh (for plants that cannot be grown alone again: garden specimens).
 pub fn insert_mesh(c: &Connection, plant: i64, glb: &[u8]) -> rusqlite::Result<()> {
@@ -465,69 +119,6 @@ pub fn mesh(c: &Connection, plant: i64) -> rusqlite::Result<Option<Vec<u8>>> {
         r.get(0)
     })
     .optional()
-}
-
-fn plant_row(r: &rusqlite::Row<'_>) -> rusqlite::Result<PlantRow> {
-    Ok(PlantRow {
-        id: r.get(0)?,
-        session: r.get(1)?,
-        model: r.get(2)?,
-        genome: r.get(3)?,
-        seed: r.get::<_, i64>(4)? as u64,
-        operator: r.get(5)?,
-        settings: json(r.get(6)?),
-        created: r.get(7)?,
-    })
-}
-
-const PLANT_COLUMNS: &str = "id, session, model, genome, seed, operator, settings, created";
-
-/// A plant by id.
-pub fn plant(c: &Connection, id: i64) -> rusqlite::Result<Option<PlantRow>> {
-    c.query_row(
-        &format!("SELECT {PLANT_COLUMNS} FROM plants WHERE id = ?1"),
-        [id],
-        plant_row,
-    )
-    .optional()
-}
-
-/// A page of plants, newest first, of one session or all; and how many there are.
-pub fn plants(
-    c: &Connection,
-    session: Option<i64>,
-    offset: u32,
-    limit: u32,
-) -> rusqlite::Result<(u64, Vec<PlantRow>)> {
-    let (filter, args): (&str, Vec<i64>) = match session {
-        Some(s) => ("WHERE session = ?1", vec![s]),
-        None => ("", vec![]),
-    };
-    let total: i64 = c.query_row(
-        &format!("SELECT COUNT(*) FROM plants {filter}"),
-        rusqlite::params_from_iter(&args),
-        |r| r.get(0),
-    )?;
-    let mut stmt = c.prepare(&format!(
-        "SELECT {PLANT_COLUMNS} FROM plants {filter} ORDER BY id DESC LIMIT {limit} OFFSET {offset}"
-    ))?;
-    let rows = stmt
-        .query_map(rusqlite::params_from_iter(&args), plant_row)?
-        .collect::<rusqlite::Result<Vec<_>>>()?;
-    Ok((total as u64, rows))
-}
-
-/// A plant's parents, in order.
-pub fn parents(c: &Connection, child: i64) -> rusqlite::Result<Vec<ParentRow>> {
-    let mut stmt =
-        c.prepare_cached("SELECT parent, dominance FROM parents WHERE child = ?1 ORDER BY ord")?;
-    stmt.query_map([child], |r| {
-        Ok(ParentRow {
-            plant: r.get(0)?,
-            dominance: r.get(1)?,
-        })
-    })?
-    .collect()
 }
 
 /// Inserts a session; returns its id.
@@ -948,43 +539,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn dates_are_civil() {
-        assert_eq!(civil_from_days(0), (1970, 1, 1));
-        assert_eq!(civil_from_days(20_417), (2025, 11, 25));
-        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
-    }
-
-    #[test]
-    fn migrations_run_once_and_newer_files_are_refused() {
-        let dir = std::env::temp_dir().join(format!("sylva-archive-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("a.db");
-        let _ = std::fs::remove_file(&path);
-        drop(Archive::open(&path).unwrap());
-        let archive = Archive::open(&path).unwrap();
-        let v: i64 = archive
-            .read(|c| c.query_row("SELECT version FROM schema_version", [], |r| r.get(0)))
-            .unwrap();
-        assert_eq!(v, MIGRATIONS.len() as i64);
-        archive
-            .read(|c| c.execute("UPDATE schema_version SET version = 99", []))
-            .unwrap();
-        drop(archive);
-        assert!(matches!(
-            Archive::open(&path),
-            Err(ArchiveError::TooNew { found: 99, .. })
-        ));
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
     fn a_step_after_an_undo_drops_the_undone_steps() {
         let dir = std::env::temp_dir().join(format!("sylva-archive-s-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let archive = Archive::open(&dir.join("s.db")).unwrap();
         let v = |n: i64| serde_json::json!({ "n": n });
         archive
-            .transaction(|c| -> Result<(), ArchiveError> {
+            .transaction(|c| -> Result<(), crate::error::ApiError> {
                 let s = insert_session(c, "breed", "plantmaker", "t", &v(0))?;
                 record_step(c, s, &v(1), &v(0), &v(1))?;
                 record_step(c, s, &v(2), &v(1), &v(2))?;

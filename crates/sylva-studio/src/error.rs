@@ -92,7 +92,7 @@ impl From<ArchiveError> for ApiError {
 
 impl From<rusqlite::Error> for ApiError {
     fn from(e: rusqlite::Error) -> ApiError {
-        ApiError::internal(ArchiveError::from(e))
+        ApiError::internal(format!("archive: {e}"))
     }
 }
 

@@ -1,6 +1,9 @@
 //! Sylva's library layer: the one API the command line, the studio and Python call to grow,
 //! mesh, export, picture, evolve and breed plants of any model.
 //!
+//! - [`archive`]: the studio's archive, the SQLite file of `sylva studio --db`: its schema
+//!   and migrations, how it is opened beside a running studio, its plants and their parents
+//!   ([`archive::Archive`]), for every front end alike.
 //! - [`registry`]: the one list of models ([`Registry::standard`]); genome files and
 //!   configs name their model and the registry hands them to it.
 //! - [`genome`]: [`Genome`], a genome of any model: read from files, grown, and varied by
@@ -47,6 +50,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod archive;
 pub mod assets;
 pub mod biomorph;
 pub mod error;

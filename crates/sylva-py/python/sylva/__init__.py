@@ -17,14 +17,17 @@ by a Python function of your own too: ``Evolution(config, fitness=f)``);
 :func:`islands` runs several populations at once, on Ray when it is installed and on a
 local process pool otherwise. :func:`varieties` fills a map of the fittest plant of every
 kind (MAP-Elites, :class:`Varieties`); :class:`GenomeSpace` hands any model's genomes to an
-optimiser outside Sylva (pyribs, CMA-ES) as numpy vectors. Errors are :class:`SylvaError`, :class:`InputError` (bad
-input, with its file, line and column) and :class:`LimitError`.
+optimiser outside Sylva (pyribs, CMA-ES) as numpy vectors. :class:`StudioArchive` reads the
+studio's archive (``sylva studio --db FILE``) and writes plants bred elsewhere into it. Errors
+are :class:`SylvaError`, :class:`InputError` (bad input, with its file, line and column),
+:class:`LimitError` and :class:`ArchiveError` (a studio archive, naming its file).
 """
 
 from __future__ import annotations
 
 from ._sylva import (
     Archive,
+    ArchivedPlant,
     Config,
     Evolution,
     Genome,
@@ -33,6 +36,7 @@ from ._sylva import (
     Mesh,
     Plant,
     Scene,
+    StudioArchive,
     Varieties,
     Variety,
     __version__,
@@ -48,11 +52,13 @@ from ._sylva import (
     picture_png,
     varieties,
 )
-from .errors import InputError, LimitError, SylvaError
+from .errors import ArchiveError, InputError, LimitError, SylvaError
 from .islands import IslandsResult, islands
 
 __all__ = [
     "Archive",
+    "ArchiveError",
+    "ArchivedPlant",
     "Config",
     "Evolution",
     "Genome",
@@ -64,6 +70,7 @@ __all__ = [
     "Mesh",
     "Plant",
     "Scene",
+    "StudioArchive",
     "SylvaError",
     "Varieties",
     "Variety",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Sequence, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -15,17 +15,17 @@ _Path = str | os.PathLike[str]
 class Genome:
     """A genome of any of Sylva's models; ``genome["field"]`` reads and sets its fields."""
 
-    @staticmethod
-    def load(path: _Path) -> Genome:
+    @classmethod
+    def load(cls, path: _Path) -> Genome:
         """Reads a genome file of any model."""
-    @staticmethod
-    def from_dict(data: dict[str, Any]) -> Genome:
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Genome:
         """A genome from a dict shaped like a genome file (with its ``model`` and ``format``)."""
-    @staticmethod
-    def from_json(text: str, source: str = "<json>") -> Genome:
+    @classmethod
+    def from_json(cls, text: str, source: str = "<json>") -> Genome:
         """A genome from a genome file's JSON text; ``source`` names it in errors."""
-    @staticmethod
-    def random(model: str, seed: int, settings: dict[str, Any] | None = None) -> Genome:
+    @classmethod
+    def random(cls, model: str, seed: int, settings: dict[str, Any] | None = None) -> Genome:
         """A random genome of ``model``, made by the model with ``settings``."""
     @property
     def model(self) -> str:
@@ -181,14 +181,16 @@ class Scene:
 class Config:
     """An evolution config of any model that evolves."""
 
-    @staticmethod
-    def load(path: _Path) -> Config: ...
-    @staticmethod
-    def from_toml(text: str, source: str = "<toml>", base: _Path | None = None) -> Config: ...
-    @staticmethod
-    def from_dict(data: dict[str, Any], base: _Path | None = None) -> Config: ...
-    @staticmethod
-    def default() -> Config: ...
+    @classmethod
+    def load(cls, path: _Path) -> Config: ...
+    @classmethod
+    def from_toml(
+        cls, text: str, source: str = "<toml>", base: _Path | None = None
+    ) -> Config: ...
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], base: _Path | None = None) -> Config: ...
+    @classmethod
+    def default(cls) -> Config: ...
     @property
     def model(self) -> str: ...
     @property
@@ -334,8 +336,9 @@ class Varieties:
         start: Sequence[Genome] | None = None,
         threads: int | None = None,
     ) -> None: ...
-    @staticmethod
+    @classmethod
     def resume(
+        cls,
         config: Config | dict[str, Any] | _Path,
         path: _Path | None = None,
         text: str | None = None,
@@ -412,6 +415,74 @@ class GenomeSpace:
         self, X: npt.ArrayLike
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """(objective (n,), descriptors (n, k)) of the rows of an (n, dim) array."""
+
+class ArchivedPlant:
+    """A plant of a studio archive, as listed: everything but its genome
+    (``StudioArchive.genome(id)`` reads it)."""
+
+    id: int
+    """Its id (row) in the archive."""
+    model: str
+    seed: int
+    """The seed it grows with."""
+    operator: str
+    """How it was made: random, example, upload, cross, mutate, edit, regrow, mother,
+    family, design, map, match, empty or branch."""
+    session: int | None
+    """The studio session it was made in; None for plants written by ``add``."""
+    created: str
+    """When it was written (UTC, ``2025-11-25T09:30:00Z``)."""
+    settings: Any
+    """The settings of its operator, as recorded."""
+
+class _NewPlant(TypedDict, total=False):
+    """A plant ``StudioArchive.add`` writes: ``genome`` and ``operator`` are needed."""
+
+    genome: Genome
+    operator: str
+    """How it was made: ``"mutate"``, ``"cross"``, ``"example"``, ``"upload"``, ``"random"``,
+    ``"design"``, ... (the studio's operators)."""
+    seed: int
+    """The seed it grows with (the genome's own by default)."""
+    parents: Sequence[int | str]
+    """Each the id of a plant in the archive, or the ``key`` of a plant given before it."""
+    dominance: Sequence[float]
+    """One weight per parent, 0 or more (1 each by default)."""
+    key: str
+    """A name later plants of the same call give as a parent."""
+    settings: dict[str, Any]
+    """JSON values recorded with it (``{}`` by default)."""
+
+class StudioArchive:
+    """A studio archive, the SQLite file of ``sylva studio --db FILE``: its plants, and plants
+    bred elsewhere written into it, which the studio shows beside its own. It may be open in
+    a running studio meanwhile. Errors are ``ArchiveError``, naming the file."""
+
+    def __init__(self, path: _Path, create: bool = False) -> None:
+        """Opens an archive that exists (``create=True``: makes one, or brings an older one
+        up to date, as the studio does)."""
+    @property
+    def path(self) -> str:
+        """The file (absolute)."""
+    @property
+    def version(self) -> int:
+        """The file's schema version."""
+    def plants(self, model: str | None = None, limit: int = 500) -> list[ArchivedPlant]:
+        """The newest ``limit`` plants, newest first, of ``model`` or of every model."""
+    def plant(self, id: int) -> ArchivedPlant:
+        """The plant of ``id``; ``ArchiveError`` if there is none."""
+    def genome(self, id: int) -> Genome:
+        """The genome of plant ``id``; ``InputError`` (naming the archive and the plant) if
+        it does not read."""
+    def parents(self, id: int) -> list[tuple[int, float]]:
+        """The parents of plant ``id``, in order: ``(id, dominance)`` each."""
+    def add(self, plants: Sequence[_NewPlant]) -> list[int]:
+        """Writes plants, each after its parents, in one transaction (all or none), in no
+        session; returns their ids."""
+    def close(self) -> None:
+        """Lets the file go."""
+    def __enter__(self) -> StudioArchive: ...
+    def __exit__(self, *exc: object) -> bool: ...
 
 def varieties(
     config: Config | dict[str, Any] | _Path,

@@ -3,7 +3,8 @@
 ``SylvaError`` is the base of every error Sylva raises. ``InputError`` (also a
 ``ValueError``) is bad input: a malformed file, dict or value; it says where, as the
 command line does. ``LimitError`` is legal input that asks for more work or memory than a
-limit or the memory budget allows.
+limit or the memory budget allows. ``ArchiveError`` is a studio archive that cannot be
+opened, read or written; it names the file.
 """
 
 from __future__ import annotations
@@ -47,4 +48,21 @@ class LimitError(InputError):
     """Legal input that asks for more than a limit or the memory budget allows."""
 
 
-__all__ = ["SylvaError", "InputError", "LimitError"]
+class ArchiveError(SylvaError):
+    """A studio archive (``sylva studio --db FILE``) that cannot be opened, read or written:
+    not found, not an archive, of a schema newer than this Sylva knows, without the plant
+    asked for, closed, or refused by SQLite (the file locked by another program past the
+    busy timeout of five seconds, a full disk).
+
+    Attributes:
+        message: the whole message, naming the file.
+        path: the archive's file.
+    """
+
+    def __init__(self, message: str, *, path: str | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.path = path
+
+
+__all__ = ["SylvaError", "InputError", "LimitError", "ArchiveError"]
