@@ -1179,10 +1179,12 @@ fn gardens_report_their_progress_while_they_grow() {
 fn design_runs_stream_valid_json_with_the_terms_named() {
     let dir = temp_dir("events");
     let server = start(&dir, "127.0.0.1");
+    // A long run, stopped once two generations are seen: one that ended before the stream
+    // opened would show only its final status (read below as the end, not waited past).
     let session = post(
         &server,
         "/api/sessions",
-        json!({"mode": "design", "design": {"population": 10, "generations": 3}}),
+        json!({"mode": "design", "design": {"population": 10, "generations": 400}}),
     );
     let id = session["id"].as_i64().unwrap();
     let mut stream = TcpStream::connect(&server.address).unwrap();
@@ -1217,9 +1219,14 @@ fn design_runs_stream_valid_json_with_the_terms_named() {
             let value: Value = serde_json::from_str(text).unwrap_or_else(|e| panic!("{text}: {e}"));
             // Each key once: serde_json keeps the last of a repeated key, so count them.
             assert_eq!(text.matches("\"generation\"").count(), 1, "{text}");
+            let ended = name == "status" && value["status"] != "running";
             events.push((name.clone(), value));
+            if ended {
+                break;
+            }
         }
     }
+    post(&server, &format!("/api/sessions/{id}/stop"), json!({}));
     let generations: Vec<&Value> = events
         .iter()
         .filter(|(n, _)| n == "generation")

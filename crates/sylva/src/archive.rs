@@ -29,7 +29,7 @@
 //! // Elsewhere (Blender, Python): a plant and its mutant, written in one transaction.
 //! let archive = Archive::open_existing(&path)?;
 //! let registry = Registry::standard();
-//! let mother = sylva::load_genome("../../examples/plantmaker/tulip.json".as_ref())?;
+//! let mother = registry.load_genome("../../examples/plantmaker/tulip.json".as_ref())?;
 //! let child = mother.mutate(sylva::Settings::Default, 3)?;
 //! let plant = |genome: &sylva::Genome, operator, parents| Addition {
 //!     genome: genome.clone(),
