@@ -40,6 +40,17 @@ pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
     } else {
         bytes
     };
+    // A key given twice would silently take its later value: refused, naming it. A body
+    // that is not JSON at all is left to the typed read below, which says where.
+    if let Err(e) = serde_json::from_slice::<Unique>(bytes)
+        && let Some(key) = e.to_string().strip_prefix(TWICE)
+    {
+        let (path, _) = key.split_once(" at line").unwrap_or((key, ""));
+        return Err(ApiError::bad(
+            path,
+            format!("`{path}` is given twice; expected each key once"),
+        ));
+    }
     let mut de = serde_json::Deserializer::from_slice(bytes);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let sent = serde_json::from_slice(bytes).unwrap_or(serde_json::Value::Null);
@@ -48,6 +59,78 @@ pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
     de.end()
         .map_err(|e| ApiError::bad("", format!("after the JSON value: {e}")))?;
     Ok(value)
+}
+
+/// The start of the error [`Unique`] gives for a key given twice, before the key's path.
+const TWICE: &str = "duplicate key ";
+
+/// Any JSON value whose objects name each key once, read for that check alone.
+struct Unique;
+
+impl<'de> serde::Deserialize<'de> for Unique {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(UniqueAt(String::new()))
+    }
+}
+
+/// The check at a JSON path (`parents[1]`).
+struct UniqueAt(String);
+
+impl<'de> serde::de::DeserializeSeed<'de> for UniqueAt {
+    type Value = Unique;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Unique, D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for UniqueAt {
+    type Value = Unique;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+    fn visit_str<E>(self, _: &str) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+    fn visit_unit<E>(self) -> Result<Unique, E> {
+        Ok(Unique)
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Unique, A::Error> {
+        let mut i = 0;
+        while seq
+            .next_element_seed(UniqueAt(format!("{}[{i}]", self.0)))?
+            .is_some()
+        {
+            i += 1;
+        }
+        Ok(Unique)
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Unique, A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            let path = join(&self.0, &key);
+            if !seen.insert(key) {
+                return Err(serde::de::Error::custom(format!("{TWICE}{path}")));
+            }
+            map.next_value_seed(UniqueAt(path))?;
+        }
+        Ok(Unique)
+    }
 }
 
 /// Reads a part of a request already parsed as JSON, naming fields under `at` (a JSON path
@@ -283,5 +366,18 @@ mod tests {
         assert!(e.error.contains("unknown field"), "{e}");
         let e = parse_json::<P>(br#"{"parents": []} []"#).unwrap_err();
         assert!(e.error.contains("after"), "{e}");
+        // A key given twice is refused, named by its path, wherever it stands.
+        let e = parse_json::<P>(br#"{"parents": [], "parents": [{"dominance": 1}]}"#).unwrap_err();
+        assert_eq!(
+            (e.field.as_str(), e.status),
+            ("parents", StatusCode::BAD_REQUEST)
+        );
+        assert!(e.error.contains("given twice"), "{e}");
+        let twice = br#"{"parents": [{"dominance": 1}, {"dominance": 2, "dominance": 3}]}"#;
+        let e = parse_json::<P>(twice).unwrap_err();
+        assert_eq!(e.field, "parents[1].dominance");
+        // Not JSON at all: the typed read says where, as before.
+        let e = parse_json::<P>(b"\x89PNG").unwrap_err();
+        assert!(!e.error.contains("twice"), "{e}");
     }
 }
