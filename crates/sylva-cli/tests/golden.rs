@@ -79,6 +79,7 @@ fn one_plant_of_each_model() {
         ("automata/helix.json", "automata"),
         ("plantmaker/flowering-bush.json", "plantmaker"),
         ("lsystem/herb.json", "lsystem"),
+        ("grown/birch.json", "grown"),
     ] {
         let glb = dir.join(format!("{name}.glb"));
         let obj = dir.join(format!("{name}.obj"));
@@ -116,6 +117,10 @@ fn one_plant_of_each_model() {
             ("lsystem.obj", 0xb7b2_1d21_c371_d211),
             ("lsystem.wrl", 0x6c1a_fb10_cf41_5531),
             ("lsystem.png", 0x6c6d_cd66_74b2_365d),
+            ("grown.glb", 0x9473_e538_f6c8_6ad9),
+            ("grown.obj", 0xd698_be96_bd75_f080),
+            ("grown.wrl", 0xe476_2fd5_b9c3_2545),
+            ("grown.png", 0x6403_fe46_cae7_7085),
         ],
     );
 }
@@ -188,6 +193,30 @@ fn a_small_automata_run() {
             ("best.glb", 0xf18d_776c_3e05_aa37),
             ("best.png", 0x25a2_b823_e666_b519),
             ("population.png", 0xcac9_870b_4f5c_0aa3),
+        ],
+    );
+}
+
+#[test]
+fn a_small_grown_run() {
+    evolve(
+        "grown",
+        "grown/evolve.toml",
+        &[
+            ("generations = 20", "generations = 2"),
+            ("population = 40", "population = 12"),
+            (
+                "start = [\"oak.json\"]",
+                &format!("start = [{:?}]", example("grown/birch.json")),
+            ),
+            ("[output]\nsheet_size = 16", SMALL_OUTPUT),
+        ],
+        &[
+            ("stats.csv", 0x7342_e5ae_abb9_5208),
+            ("best.json", 0xf8e6_f019_9f3b_0843),
+            ("best.glb", 0x2117_3e20_8b54_e564),
+            ("best.png", 0x7606_6115_880b_55f8),
+            ("population.png", 0x4a2f_2640_2eb2_a259),
         ],
     );
 }

@@ -1093,7 +1093,7 @@ fn over_long_and_malformed_requests_get_json_errors() {
         assert_refused(&format!("{bad:?}"), exchange(host, bad.as_bytes()), 400, "");
     }
     // And the studio still answers.
-    assert_eq!(get(&server, "/api/models").as_array().unwrap().len(), 4);
+    assert_eq!(get(&server, "/api/models").as_array().unwrap().len(), 5);
 }
 
 /// Reads server-sent events from `reader` until `enough` says so: (name, data) pairs.
@@ -1902,7 +1902,7 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
     assert_eq!(auto["status"], "done", "{auto}");
     let session = get(&server, &format!("/api/sessions/{a}"));
     assert!(
-        ["bintree", "automata", "plantmaker", "lsystem"]
+        ["bintree", "automata", "plantmaker", "lsystem", "grown"]
             .contains(&session["model"].as_str().unwrap())
     );
 

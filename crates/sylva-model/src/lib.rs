@@ -77,6 +77,7 @@ use std::path::PathBuf;
 
 use rand::Rng;
 use serde::{Serialize, de::DeserializeOwned};
+use sylva_core::dress::Dress;
 use sylva_core::{Plant, PlantError, PlantMeta, hash::stable_hash};
 use sylva_evolve::{Operators, Problem, Strategy, WithTerm};
 
@@ -170,6 +171,13 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     /// world); `None`, the default, for models whose plants grow in milliseconds.
     fn growth_seconds(&self, _genome: &Self::Genome) -> Option<f64> {
         None
+    }
+
+    /// How the model's plants are dressed when nobody says otherwise: the leaves or needles
+    /// and bark a genome names for itself (the self-organising model's `foliage`). The
+    /// default, [`Dress::default`], leaves a plant as it grew, as the papers' models are.
+    fn dress(&self, _genome: &Self::Genome) -> Dress {
+        Dress::default()
     }
 
     /// A short text form of `genome` a person can copy and paste, for a model that has one

@@ -121,7 +121,7 @@ pub struct GrowOptions {
     pub pruned_to: Option<Arc<[Outline]>>,
     /// Leaves or needles of a kind at their real size and a tiling bark, put on last, after
     /// the plant is scaled (`--foliage`, `--bark`; [`sylva_core::dress`]). Default: none,
-    /// the plant as its model grew it.
+    /// the plant as its model grew it, or as its genome names ([`GrowOptions::dress_for`]).
     pub dress: Dress,
 }
 
@@ -142,6 +142,20 @@ impl Default for GrowOptions {
 }
 
 impl GrowOptions {
+    /// How `genome`'s plant is dressed: as these options say, or, when they name no
+    /// foliage or bark, as the genome names for itself ([`Genome::own_dress`]).
+    pub fn dress_for(&self, genome: &Genome) -> Dress {
+        if !self.dress.is_plain() {
+            return self.dress;
+        }
+        let own = genome.own_dress();
+        Dress {
+            foliage: own.foliage,
+            bark: own.bark,
+            ..self.dress
+        }
+    }
+
     /// How GLB files of the grown asset are written.
     pub fn glb_options(&self) -> GlbOptions {
         GlbOptions {
@@ -180,7 +194,8 @@ impl Grown {
     pub fn grow(genome: Genome, options: &GrowOptions) -> Result<Grown, Error> {
         let (seed, plant, dressed) = Grown::dressed_plant(&genome, options)?;
         let (roots, taper) = (options.roots, options.taper);
-        let mut mesher = Mesher::new(mesh_options_for(genome.mesh_hint(), &options.dress))?;
+        let dress = options.dress_for(&genome);
+        let mut mesher = Mesher::new(mesh_options_for(genome.mesh_hint(), &dress))?;
         let (mesh, rig) = match &options.wind {
             None => (mesher.mesh(&plant)?, None),
             Some(wind) => {
@@ -198,7 +213,7 @@ impl Grown {
             roots,
             rig,
             height: options.height,
-            dress: (options.dress, dressed),
+            dress: (dress, dressed),
         })
     }
 
@@ -224,8 +239,9 @@ impl Grown {
             scale_to_height(&mut plant, height)?;
         }
         let mut dressed = Dressed::default();
-        if !options.dress.is_plain() {
-            (plant, dressed) = dress(&plant, &options.dress, seed)?;
+        let wear = options.dress_for(genome);
+        if !wear.is_plain() {
+            (plant, dressed) = dress(&plant, &wear, seed)?;
         }
         Ok((seed, plant, dressed))
     }

@@ -12,6 +12,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use sylva_core::Plant;
+use sylva_core::dress::Dress;
 use sylva_core::rng::ChaCha8Rng;
 use sylva_model::{
     Bred, DevelopError, GenomeError, Knobs, MeshHint, Model, Parent, VariationError,
@@ -35,6 +36,7 @@ trait Face: Send + Sync {
     fn model(&self) -> &'static str;
     fn title(&self) -> &'static str;
     fn mesh_hint(&self) -> MeshHint;
+    fn dress(&self) -> Dress;
     fn write(&self) -> String;
     fn to_value(&self) -> serde_json::Value;
     fn packed(&self) -> Option<String>;
@@ -77,6 +79,10 @@ impl<M: Model> Face for Typed<M> {
 
     fn mesh_hint(&self) -> MeshHint {
         self.model.mesh_hint()
+    }
+
+    fn dress(&self) -> Dress {
+        self.model.dress(&self.genome)
     }
 
     fn write(&self) -> String {
@@ -247,6 +253,12 @@ impl Genome {
     /// How the model's plants are best meshed.
     pub fn mesh_hint(&self) -> MeshHint {
         self.0.mesh_hint()
+    }
+
+    /// How its plant is dressed when nobody says otherwise: the foliage and bark the genome
+    /// names for itself, or nothing (the papers' models).
+    pub fn own_dress(&self) -> Dress {
+        self.0.dress()
     }
 
     /// Seconds growing it may take on one core, for models whose growth can take long

@@ -1,4 +1,4 @@
-//! The one list of models: [`Registry::standard`] holds the four, one line each. Genome
+//! The one list of models: [`Registry::standard`] holds the five, one line each. Genome
 //! files and evolution configs name their model; the registry reads the name and hands the
 //! rest to that model.
 //!
@@ -12,6 +12,7 @@ use std::sync::Arc;
 use serde::Deserialize;
 use sylva_automata::AutomataModel;
 use sylva_bintree::BinTreeModel;
+use sylva_grown::GrownModel;
 use sylva_lsystem::LSystemModel;
 use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
@@ -168,6 +169,8 @@ pub mod names {
     pub const PLANTMAKER: &str = sylva_plantmaker::PlantMakerModel::NAME;
     /// Bornhofen and Lattaud's L-system plants.
     pub const LSYSTEM: &str = sylva_lsystem::LSystemModel::NAME;
+    /// Self-organising trees.
+    pub const GROWN: &str = sylva_grown::GrownModel::NAME;
 }
 
 /// Reads the header of a genome file (`model` and `format`; every other field is the
@@ -232,6 +235,7 @@ impl Registry {
             .with(ModelEntry::of::<AutomataModel>())
             .with(ModelEntry::of::<PlantMakerModel>())
             .with(ModelEntry::of::<LSystemModel>())
+            .with(ModelEntry::of::<GrownModel>())
     }
 
     /// An empty registry.

@@ -281,7 +281,11 @@ fn auto_tries_every_model_then_runs_off_the_best_two() {
     };
     let (tried, runoff) = (reached(false), reached(true));
     let models: Vec<&str> = tried.iter().map(|t| t.0).collect();
-    assert_eq!(models, ["bintree", "automata", "plantmaker"], "{trials:?}");
+    assert_eq!(
+        models,
+        ["bintree", "automata", "plantmaker", "grown"],
+        "{trials:?}"
+    );
     assert!(trials.iter().any(|t| matches!(
         t,
         Trial::LeftOut {
