@@ -1,13 +1,117 @@
-//! The HTTP plumbing: typed JSON bodies with limits, JSON errors, and the page's files.
+//! The HTTP plumbing: routes with a 405 that says what a path takes, typed JSON bodies with
+//! limits, JSON errors, and the page's files.
 
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use axum::Router;
 use axum::body::Body as AxumBody;
-use axum::extract::{FromRequest, Request};
-use axum::http::{StatusCode, Uri, header};
+use axum::extract::{FromRequest, MatchedPath, Request};
+use axum::handler::Handler;
+use axum::http::{HeaderValue, Method, StatusCode, Uri, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
+use axum::routing::MethodRouter;
 use serde::de::DeserializeOwned;
 
+use crate::Studio;
 use crate::error::ApiError;
+
+/// An endpoint: a method, a path and its handler.
+pub struct Route {
+    pub(crate) method: Method,
+    pub(crate) path: &'static str,
+    handler: MethodRouter<Studio>,
+}
+
+impl Route {
+    /// `GET {path}` (and HEAD).
+    pub fn get<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
+        Route {
+            method: Method::GET,
+            path,
+            handler: axum::routing::get(handler),
+        }
+    }
+
+    /// `POST {path}`.
+    pub fn post<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
+        Route {
+            method: Method::POST,
+            path,
+            handler: axum::routing::post(handler),
+        }
+    }
+}
+
+/// The methods each route's path takes, by the path as routed (`/api/sessions/{id}/cross`),
+/// for the `Allow` of a 405: axum's own 405 leaves `Allow` out for routes inside a router.
+#[derive(Clone, Default)]
+pub struct Takes(Arc<HashMap<String, Vec<Method>>>);
+
+impl Takes {
+    /// What the paths of `routes` take, each path under its prefix (`/api`).
+    pub fn of(routes: &[(&str, &[Route])]) -> Takes {
+        let mut takes: HashMap<String, Vec<Method>> = HashMap::new();
+        for (prefix, routes) in routes {
+            for route in *routes {
+                let methods = takes.entry(format!("{prefix}{}", route.path)).or_default();
+                methods.push(route.method.clone());
+                if route.method == Method::GET {
+                    methods.push(Method::HEAD);
+                }
+            }
+        }
+        Takes(Arc::new(takes))
+    }
+
+    /// The 405 for `method` on a routed path (`None`: a path no route has, taking nothing).
+    fn not_allowed(&self, method: &Method, path: &str, routed: Option<&str>) -> Response {
+        let taken: Vec<&str> = routed
+            .and_then(|p| self.0.get(p))
+            .map(|methods| methods.iter().map(Method::as_str).collect())
+            .unwrap_or_default();
+        let error = if taken.is_empty() {
+            format!(
+                "`{method}` is not a method of `{path}`, a path the studio does not have; it \
+                 takes GET, HEAD and POST on the paths docs/studio.md lists"
+            )
+        } else {
+            format!(
+                "`{method}` is not a method of `{path}`; it takes {}",
+                taken.join(", ")
+            )
+        };
+        let mut response = ApiError::new(StatusCode::METHOD_NOT_ALLOWED, "", error).into_response();
+        if let Ok(allow) = HeaderValue::from_str(&taken.join(",")) {
+            response.headers_mut().insert(header::ALLOW, allow);
+        }
+        response
+    }
+}
+
+/// A router of `routes`, a path's methods merged.
+pub fn routed(routes: Vec<Route>) -> Router<Studio> {
+    routes
+        .into_iter()
+        .fold(Router::new(), |router, r| router.route(r.path, r.handler))
+}
+
+/// `router` answering a method a path does not take with a 405 and the `Allow` of `takes`.
+pub fn with_405(router: Router<Studio>, takes: Takes) -> Router<Studio> {
+    router.method_not_allowed_fallback(
+        move |method: Method, routed: Option<MatchedPath>, uri: Uri| {
+            let takes = takes.clone();
+            async move {
+                takes.not_allowed(
+                    &method,
+                    uri.path(),
+                    routed.as_ref().map(MatchedPath::as_str),
+                )
+            }
+        },
+    )
+}
 
 /// The largest request body, 1 MiB: genome files are a few kilobytes.
 pub const MAX_BODY: usize = 1 << 20;
@@ -215,10 +319,18 @@ pub fn join(path: &str, name: &str) -> String {
 }
 
 /// Makes every 4xx the API answers a JSON error, including the plain-text rejections of
-/// axum's own extractors (a path id that is not a number, a bad query string).
+/// axum's own extractors (a path id that is not a number, a bad query string). A method no
+/// route takes (`TRACE`, `DELETE`) is a 405 on a path the studio does not have too, not a 404.
 pub async fn json_errors(req: Request, next: Next) -> Response {
+    let method = req.method().clone();
+    let path = req.uri().path().to_owned();
     let response = next.run(req).await;
     let status = response.status();
+    if status == StatusCode::NOT_FOUND
+        && ![Method::GET, Method::HEAD, Method::POST].contains(&method)
+    {
+        return Takes::default().not_allowed(&method, &path, None);
+    }
     let is_json = response
         .headers()
         .get(header::CONTENT_TYPE)
