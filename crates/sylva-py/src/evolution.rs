@@ -441,9 +441,9 @@ impl Fitness {
 /// generation, `run` a batch; `stats`, `population`, `best`, `fittest` and `family` read
 /// it; `checkpoint`/`save` and `Evolution.resume` stop and go on exactly. `fitness=f` adds
 /// a Python fitness function: `f(plants)` gets a list of grown `Plant`s and returns one
-/// number per plant, a term named "python" weighted `fitness_weight`, beside the model's
-/// terms (`fitness_mode="add"`) or in their place (`"replace"`), `fitness_batch` plants per
-/// call at most. Long calls release the GIL, and Ctrl-C stops them within one member's
+/// finite number per plant (NaN and infinities are refused), a term named "python" weighted
+/// `fitness_weight`, beside the model's terms (`fitness_mode="add"`) or in their place
+/// (`"replace"`), `fitness_batch` plants per call at most. Long calls release the GIL, and Ctrl-C stops them within one member's
 /// evaluation, leaving the run as it was before the generation under way.
 #[pyclass(module = "sylva", name = "Evolution")]
 pub struct Evolution {

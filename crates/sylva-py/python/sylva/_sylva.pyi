@@ -225,7 +225,8 @@ class Member:
         """Pickled as its fields."""
 
 Fitness = Callable[[list[Plant]], Sequence[float] | npt.NDArray[np.floating[Any]]]
-"""A Python fitness function: a list of grown plants in, one number per plant out."""
+"""A Python fitness function: a list of grown plants in, one finite number per plant out
+(NaN and infinities raise ``InputError`` naming ``fitness``)."""
 
 class Evolution:
     """An evolution run of any model; ``fitness=f`` adds a Python fitness function."""
