@@ -276,7 +276,125 @@ fn body_error<E: std::fmt::Display>(
     } else {
         path.to_owned()
     };
+    let message = in_page_words(&field, &message);
     ApiError::bad(field, message)
+}
+
+/// Labels of the page's controls by the request field they fill (its last name), so that a
+/// message names the control the person typed in.
+const LABELS: &[(&str, &str)] = &[
+    ("children", "Children"),
+    ("seed", "Seed"),
+    ("depth", "Depth"),
+    ("level", "Level"),
+    ("dominance", "Dominance"),
+    ("population", "Population"),
+    ("generations", "Generations"),
+    ("steps", "Steps"),
+    ("spacing", "Spacing"),
+    ("azimuth", "Azimuth"),
+    ("elevation", "Elevation"),
+    ("model", "Model"),
+    ("count", "Count"),
+    ("genomes", "Genome files"),
+];
+
+/// How a message names `field` (a JSON path): the page's label of its control (`Children`;
+/// a parent's `Dominance (parent 2)`), or the path itself.
+fn label(field: &str) -> String {
+    let last = field.rsplit('.').next().unwrap_or(field);
+    let name = last.split('[').next().unwrap_or(last);
+    let Some((_, label)) = LABELS.iter().find(|(n, _)| *n == name) else {
+        return format!("`{field}`");
+    };
+    // `parents[1].dominance`: the parent's place, counted from 1 as the page counts.
+    let parent = field
+        .strip_prefix("parents[")
+        .and_then(|rest| rest.split(']').next())
+        .and_then(|i| i.parse::<usize>().ok());
+    match parent {
+        Some(i) if name != "parents" => format!("{label} (parent {})", i + 1),
+        _ => (*label).to_owned(),
+    }
+}
+
+/// A serde message about `field` in the page's words: the control's label, what it takes
+/// and what it got (`Children: expected a whole number from 0 to 4294967295, got 2.5`),
+/// never serde's type names (`u32`) nor its place in the JSON text (`at line 1 column 100`,
+/// which the person never saw).
+fn in_page_words(field: &str, message: &str) -> String {
+    let message = message
+        .rfind(" at line ")
+        .map_or(message, |i| &message[..i]);
+    let said = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "))
+        .and_then(|rest| rest.rsplit_once(", expected "))
+        .map(|(got, expected)| {
+            format!(
+                "expected {}, got {}",
+                expected_words(expected),
+                got_words(got)
+            )
+        })
+        .unwrap_or_else(|| match message {
+            "number out of range" => "expected a number, got one too large to read".to_owned(),
+            other => other.to_owned(),
+        });
+    if field.is_empty() {
+        said
+    } else {
+        format!("{}: {said}", label(field))
+    }
+}
+
+/// What serde says a field expects (`u32`, `a string`), in the page's words.
+fn expected_words(expected: &str) -> String {
+    let most = match expected {
+        "u8" => Some(u64::from(u8::MAX)),
+        "u16" => Some(u64::from(u16::MAX)),
+        "u32" => Some(u64::from(u32::MAX)),
+        "u64" | "usize" => Some(u64::MAX),
+        _ => None,
+    };
+    if let Some(most) = most {
+        return format!("a whole number from 0 to {most}");
+    }
+    match expected {
+        "i8" | "i16" | "i32" | "i64" | "isize" => "a whole number",
+        "f32" | "f64" => "a number",
+        "a string" => "text",
+        "a boolean" => "true or false",
+        "a sequence" => "a list",
+        "a map" => "a group of settings",
+        other => other,
+    }
+    .to_owned()
+}
+
+/// What serde says a request sent (``floating point `2.5` ``, `string "abc"`), in the
+/// page's words: the value itself (long text cut short) or what kind of thing it was.
+fn got_words(got: &str) -> String {
+    let quoted = ["floating point `", "integer `", "boolean `"]
+        .iter()
+        .find_map(|p| got.strip_prefix(p))
+        .map(|v| v.trim_end_matches('`'));
+    if let Some(value) = quoted {
+        return value.to_owned();
+    }
+    if let Some(text) = got.strip_prefix("string ") {
+        return match text.char_indices().nth(40) {
+            Some((i, _)) => format!("{}…\"", &text[..i]),
+            None => text.to_owned(),
+        };
+    }
+    match got {
+        "null" => "nothing (null)",
+        "map" => "a group of settings",
+        "sequence" => "a list",
+        other => other,
+    }
+    .to_owned()
 }
 
 /// The value at a JSON path (`a.b[1].c`) of `value`.
@@ -491,5 +609,81 @@ mod tests {
         // Not JSON at all: the typed read says where, as before.
         let e = parse_json::<P>(b"\x89PNG").unwrap_err();
         assert!(!e.error.contains("twice"), "{e}");
+    }
+
+    #[test]
+    fn messages_name_the_control_and_what_it_takes_in_the_page_s_words() {
+        #[derive(serde::Deserialize, Debug)]
+        #[serde(deny_unknown_fields)]
+        #[allow(dead_code)]
+        struct Cross {
+            parents: Vec<Parent>,
+            children: Option<u32>,
+            seed: Option<u64>,
+        }
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct Parent {
+            plant: i64,
+            dominance: f64,
+        }
+        let parents = r#""parents": [{"plant": 1, "dominance": 1}, {"plant": 2, "dominance": 1}]"#;
+        let error = |rest: &str| {
+            let body = format!("{{{parents}, {rest}}}");
+            parse_json::<Cross>(body.as_bytes()).unwrap_err()
+        };
+        let cases = [
+            (
+                r#""children": 2.5"#,
+                "children",
+                "Children: expected a whole number from 0 to 4294967295, got 2.5",
+            ),
+            (
+                r#""seed": 99999999999999999999999"#,
+                "seed",
+                "Seed: expected a whole number from 0 to 18446744073709551615, got 1e+23",
+            ),
+            (
+                r#""seed": -1"#,
+                "seed",
+                "Seed: expected a whole number from 0 to 18446744073709551615, got -1",
+            ),
+            (
+                r#""children": "two""#,
+                "children",
+                "Children: expected a whole number from 0 to 4294967295, got \"two\"",
+            ),
+        ];
+        for (rest, field, said) in cases {
+            let e = error(rest);
+            assert_eq!(
+                (e.field.as_str(), e.error.as_str()),
+                (field, said),
+                "{rest}"
+            );
+        }
+        // A parent's dominance is named by the parent's place, counted from 1.
+        let e = parse_json::<Cross>(
+            br#"{"parents": [{"plant": 1, "dominance": 1}, {"plant": 2, "dominance": "x"}]}"#,
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "parents[1].dominance");
+        assert_eq!(
+            e.error,
+            "Dominance (parent 2): expected a number, got \"x\""
+        );
+        let e =
+            parse_json::<Cross>(br#"{"parents": [{"plant": 1, "dominance": 1e400}]}"#).unwrap_err();
+        assert!(
+            e.error
+                .starts_with("Dominance (parent 1): expected a number"),
+            "{e}"
+        );
+        // No serde type names nor places in a JSON text the person never saw.
+        for word in ["u32", "u64", "f64", "invalid type", "line 1", "column"] {
+            for rest in [r#""children": 2.5"#, r#""seed": 1e30"#] {
+                assert!(!error(rest).error.contains(word), "{rest}: {}", error(rest));
+            }
+        }
     }
 }
