@@ -13,6 +13,7 @@ use crate::errors::{archive_closed, archive_error, bad_value};
 use crate::handle::Genome;
 use crate::json::{from_py, to_py};
 use crate::models::Models;
+use crate::whole::Whole;
 
 /// A studio archive, the SQLite file of `sylva studio --db FILE`: its plants (`plants`,
 /// `plant`, `genome`, `parents`) and plants bred elsewhere written into it (`add`), which
@@ -133,13 +134,14 @@ impl StudioArchive {
     }
 
     /// The newest `limit` plants, newest first, of `model` or of every model.
-    #[pyo3(signature = (model = None, limit = 500))]
+    #[pyo3(signature = (model = None, limit = Whole(500)))]
     fn plants(
         &self,
         py: Python<'_>,
         model: Option<&str>,
-        limit: u32,
+        limit: Whole,
     ) -> PyResult<Vec<ArchivedPlant>> {
+        let limit: u32 = limit.get("limit")?;
         let archive = self.open()?;
         let rows = py
             .detach(|| archive.newest_plants(model, limit))

@@ -87,28 +87,36 @@ fn in_python_words(message: &str) -> String {
 /// there, or may not be read, as Python's own `FileNotFoundError` or `PermissionError` (an
 /// `OSError` with its errno, message and file name).
 pub fn input_error(e: &sylva::InputError) -> PyErr {
-    let os_error = match e.io {
-        Some(std::io::ErrorKind::NotFound) => Some(("FileNotFoundError", "ENOENT")),
-        Some(std::io::ErrorKind::PermissionDenied) => Some(("PermissionError", "EACCES")),
-        _ => None,
-    };
-    if let (Some((class, errno)), Some(path)) = (os_error, &e.path) {
-        let made = Python::attach(|py| -> PyResult<PyErr> {
-            let errno = py.import("errno")?.getattr(errno)?;
-            let class = py.import("builtins")?.getattr(class)?;
-            let error = class.call1((errno, e.to_string(), path.display().to_string()))?;
-            Ok(PyErr::from_value(error))
-        });
-        if let Ok(error) = made {
-            return error;
-        }
+    if let (Some(kind), Some(path)) = (e.io, &e.path)
+        && let Some(error) = os_error(kind, &e.to_string(), path)
+    {
+        return error;
     }
     let class = if e.limit { "LimitError" } else { "InputError" };
     raise(class, e.to_string(), Some(e))
 }
 
+/// A file that is not there, or may not be read or written, as Python's own
+/// `FileNotFoundError` or `PermissionError` (an `OSError` with its errno, message and file
+/// name); None for other kinds.
+fn os_error(kind: std::io::ErrorKind, message: &str, path: &std::path::Path) -> Option<PyErr> {
+    let (class, errno) = match kind {
+        std::io::ErrorKind::NotFound => ("FileNotFoundError", "ENOENT"),
+        std::io::ErrorKind::PermissionDenied => ("PermissionError", "EACCES"),
+        _ => return None,
+    };
+    Python::attach(|py| -> PyResult<PyErr> {
+        let errno = py.import("errno")?.getattr(errno)?;
+        let class = py.import("builtins")?.getattr(class)?;
+        let error = class.call1((errno, message, path.display().to_string()))?;
+        Ok(PyErr::from_value(error))
+    })
+    .ok()
+}
+
 /// Any Sylva error as the Python exception of its kind, its causes in the message: bad input
-/// is an `InputError`, a refusal of work that does not fit a `LimitError`, an exception of the
+/// is an `InputError`, a file that is not there or may not be written (a missing folder to
+/// export into) `FileNotFoundError` or `PermissionError`, a refusal of work that does not fit a `LimitError`, an exception of the
 /// run's own fitness function that exception, a stop `KeyboardInterrupt`, anything else a
 /// `SylvaError`.
 pub fn error(e: sylva::Error) -> PyErr {
@@ -119,6 +127,15 @@ pub fn error(e: sylva::Error) -> PyErr {
             Ok(e) => *e,
             Err(other) => raise("SylvaError", sylva::error::chain(&*other), None),
         },
+        sylva::Error::Io {
+            ref path,
+            ref source,
+            ..
+        } => {
+            let message = sylva::error::chain(&e);
+            os_error(source.kind(), &message, path)
+                .unwrap_or_else(|| raise("SylvaError", message, None))
+        }
         sylva::Error::Stopped(_) => {
             pyo3::exceptions::PyKeyboardInterrupt::new_err("stopped before it finished")
         }

@@ -15,6 +15,7 @@ use crate::handle::Genome;
 use crate::json::{from_py, to_py};
 use crate::models::Models;
 use crate::plant::Plant;
+use crate::whole::{self, Whole};
 use crate::work::{PyFitness, Serving, work};
 
 /// An evolution config of any model that evolves: read from a TOML file (`Config.load`),
@@ -390,8 +391,9 @@ impl Fitness {
         function: Option<Bound<'_, PyAny>>,
         weight: f64,
         mode: &str,
-        batch: usize,
+        batch: Whole,
     ) -> PyResult<Option<Fitness>> {
+        let batch: usize = batch.get("fitness_batch")?;
         let Some(function) = function else {
             return Ok(None);
         };
@@ -441,9 +443,9 @@ impl Fitness {
 /// generation, `run` a batch; `stats`, `population`, `best`, `fittest` and `family` read
 /// it; `checkpoint`/`save` and `Evolution.resume` stop and go on exactly. `fitness=f` adds
 /// a Python fitness function: `f(plants)` gets a list of grown `Plant`s and returns one
-/// number per plant, a term named "python" weighted `fitness_weight`, beside the model's
-/// terms (`fitness_mode="add"`) or in their place (`"replace"`), `fitness_batch` plants per
-/// call at most. Long calls release the GIL, and Ctrl-C stops them within one member's
+/// finite number per plant (NaN and infinities are refused), a term named "python" weighted
+/// `fitness_weight`, beside the model's terms (`fitness_mode="add"`) or in their place
+/// (`"replace"`), `fitness_batch` plants per call at most. Long calls release the GIL, and Ctrl-C stops them within one member's
 /// evaluation, leaving the run as it was before the generation under way.
 #[pyclass(module = "sylva", name = "Evolution")]
 pub struct Evolution {
@@ -568,18 +570,18 @@ impl Evolution {
     #[new]
     #[classmethod]
     #[pyo3(signature = (config, start = None, threads = None, *, fitness = None,
-                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = 16))]
+                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = Whole(16)))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn new(
         cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
-        threads: Option<u32>,
+        threads: Option<Whole>,
         fitness: Option<Bound<'_, PyAny>>,
         fitness_weight: f64,
         fitness_mode: &str,
-        fitness_batch: usize,
+        fitness_batch: Whole,
     ) -> PyResult<Evolution> {
         let models = Models::of(cls)?;
         let registry = models.get().registry();
@@ -589,7 +591,7 @@ impl Evolution {
             Some(genomes) => genomes.into_iter().map(|g| g.inner).collect(),
             None => config.inner.load_start(registry, &config.base).py()?,
         };
-        let pool = Evolution::pool(&config.inner, threads)?;
+        let pool = Evolution::pool(&config.inner, whole::get(threads, "threads")?)?;
         let inner = &config.inner;
         Evolution::make(py, fitness, |hooks| {
             Run::start_with(inner, start, pool, hooks)
@@ -603,22 +605,22 @@ impl Evolution {
     /// function.
     #[staticmethod]
     #[pyo3(signature = (config, path = None, text = None, threads = None, *, fitness = None,
-                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = 16))]
+                        fitness_weight = 1.0, fitness_mode = "add", fitness_batch = Whole(16)))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
     fn resume(
         py: Python<'_>,
         config: &Config,
         path: Option<PathBuf>,
         text: Option<String>,
-        threads: Option<u32>,
+        threads: Option<Whole>,
         fitness: Option<Bound<'_, PyAny>>,
         fitness_weight: f64,
         fitness_mode: &str,
-        fitness_batch: usize,
+        fitness_batch: Whole,
     ) -> PyResult<Evolution> {
         let fitness = Fitness::of(fitness, fitness_weight, fitness_mode, fitness_batch)?;
         let (path, text) = checkpoint_text(path, text)?;
-        let pool = Evolution::pool(&config.inner, threads)?;
+        let pool = Evolution::pool(&config.inner, whole::get(threads, "threads")?)?;
         let inner = &config.inner;
         Evolution::make(py, fitness, |hooks| {
             Run::resume_with(inner, &path, &text, pool, hooks)
@@ -682,10 +684,10 @@ impl Evolution {
     fn run(
         &self,
         py: Python<'_>,
-        generations: Option<u32>,
+        generations: Option<Whole>,
         on_generation: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let todo = match generations {
+        let todo = match whole::get::<u32>(generations, "generations")? {
             Some(n) => n,
             None => self.with(py, |r| {
                 r.config().run().generations.saturating_sub(r.generation())
@@ -737,7 +739,8 @@ impl Evolution {
     }
 
     /// The `count` fittest members, fittest first.
-    fn fittest(&self, py: Python<'_>, count: usize) -> PyResult<Vec<Member>> {
+    fn fittest(&self, py: Python<'_>, count: Whole) -> PyResult<Vec<Member>> {
+        let count: usize = count.get("count")?;
         let (members, names) = self.with(py, |r| (r.fittest(count), r.term_names().to_vec()))?;
         members
             .into_iter()
@@ -746,7 +749,8 @@ impl Evolution {
     }
 
     /// A member by id, from the current population or a kept generation (None if gone).
-    fn member(&self, py: Python<'_>, id: u64) -> PyResult<Option<Member>> {
+    fn member(&self, py: Python<'_>, id: Whole) -> PyResult<Option<Member>> {
+        let id: u64 = id.get("id")?;
         let (member, names) = self.with(py, |r| {
             (r.member(IndividualId(id)), r.term_names().to_vec())
         })?;
@@ -755,7 +759,8 @@ impl Evolution {
 
     /// A member's family as far as kept generations reach: the member, its parents, theirs,
     /// each once, nearest first. Call `keep_history` before stepping to keep generations.
-    fn family(&self, py: Python<'_>, id: u64) -> PyResult<Vec<Member>> {
+    fn family(&self, py: Python<'_>, id: Whole) -> PyResult<Vec<Member>> {
+        let id: u64 = id.get("id")?;
         let (members, names) = self.with(py, |r| {
             (r.family(IndividualId(id)), r.term_names().to_vec())
         })?;
@@ -766,7 +771,12 @@ impl Evolution {
     }
 
     /// The population of `generation`, if it is the current one or still kept.
-    fn generation_members(&self, py: Python<'_>, generation: u32) -> PyResult<Option<Vec<Member>>> {
+    fn generation_members(
+        &self,
+        py: Python<'_>,
+        generation: Whole,
+    ) -> PyResult<Option<Vec<Member>>> {
+        let generation: u32 = generation.get("generation")?;
         let (members, names) = self.with(py, |r| {
             (r.generation_members(generation), r.term_names().to_vec())
         })?;
@@ -776,7 +786,8 @@ impl Evolution {
     }
 
     /// Keeps the last `generations` generations for browsing (0 keeps only the current).
-    fn keep_history(&self, py: Python<'_>, generations: usize) -> PyResult<()> {
+    fn keep_history(&self, py: Python<'_>, generations: Whole) -> PyResult<()> {
+        let generations: usize = generations.get("generations")?;
         self.with(py, |r| r.keep_history(generations))
     }
 
@@ -817,7 +828,8 @@ impl Evolution {
 
     /// The `count` fittest genomes as the engine evolves them (bytes each): what an island
     /// sends its neighbours.
-    fn emigrants<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Vec<Bound<'py, PyBytes>>> {
+    fn emigrants<'py>(&self, py: Python<'py>, count: Whole) -> PyResult<Vec<Bound<'py, PyBytes>>> {
+        let count: usize = count.get("count")?;
         Ok(self
             .with(py, |r| r.emigrants(count))?
             .iter()
@@ -864,8 +876,8 @@ impl Evolution {
 /// one member's evaluation.
 #[pyfunction(name = "match")]
 #[pyo3(pass_module, signature = (target, side = None, model = "auto", generations = None,
-                    seconds = None, population = 100, seed = 1, threshold = None, threads = 0,
-                    prune = true))]
+                    seconds = None, population = Whole(100), seed = Whole(1), threshold = None,
+                    threads = Whole(0), prune = true))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
 pub fn match_outline(
     module: &Bound<'_, PyModule>,
@@ -873,14 +885,18 @@ pub fn match_outline(
     target: &Bound<'_, PyAny>,
     side: Option<&Bound<'_, PyAny>>,
     model: &str,
-    generations: Option<u32>,
+    generations: Option<Whole>,
     seconds: Option<f64>,
-    population: u32,
-    seed: u64,
+    population: Whole,
+    seed: Whole,
     threshold: Option<&Bound<'_, PyAny>>,
-    threads: u32,
+    threads: Whole,
     prune: bool,
 ) -> PyResult<Evolution> {
+    let generations: Option<u32> = whole::get(generations, "generations")?;
+    let population: u32 = population.get("population")?;
+    let seed: u64 = seed.get("seed")?;
+    let threads: u32 = threads.get("threads")?;
     use sylva::evolution::outline::{
         Limit, breed_until, match_config, outlines, start_auto, start_within,
     };

@@ -12,6 +12,7 @@ use crate::handle::Genome;
 use crate::json::{from_py, pointer, to_py};
 use crate::models::Models;
 use crate::plant::Plant;
+use crate::whole::{self, Whole};
 
 impl Genome {
     /// A genome file's text, read with `registry`; `source` names it in errors.
@@ -61,9 +62,10 @@ impl Genome {
     fn random(
         cls: &Bound<'_, PyType>,
         model: &str,
-        seed: u64,
+        seed: Whole,
         settings: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Genome> {
+        let seed: u64 = seed.get("seed")?;
         let models = Models::of(cls)?;
         let registry = models.get().registry();
         let entry = registry.get(model).ok_or_else(|| {
@@ -177,7 +179,7 @@ impl Genome {
     fn grow(
         &self,
         py: Python<'_>,
-        seed: Option<u64>,
+        seed: Option<Whole>,
         roots: bool,
         taper: Option<f64>,
         wind: Option<f32>,
@@ -187,6 +189,7 @@ impl Genome {
         bark: Option<&str>,
         density: Option<f32>,
     ) -> PyResult<Plant> {
+        let seed = whole::get(seed, "seed")?;
         let genome = self.inner.clone();
         let taper = taper
             .map(sylva::core::taper::PipeTaper::new)
@@ -215,12 +218,13 @@ impl Genome {
         cls: &Bound<'_, PyType>,
         py: Python<'_>,
         path: std::path::PathBuf,
-        seed: Option<u64>,
+        seed: Option<Whole>,
         height: Option<f32>,
         foliage: Option<&str>,
         bark: Option<&str>,
         density: Option<f32>,
     ) -> PyResult<Plant> {
+        let seed: Option<u64> = whole::get(seed, "seed")?;
         let preset = sylva::preset::Preset::load(Models::of(cls)?.get().registry(), &path)
             .map_err(|e| crate::errors::input_error(&e))?;
         let options = sylva::GrowOptions {
@@ -238,7 +242,8 @@ impl Genome {
     /// A mutated copy, made by the model's own mutation with `settings` (a dict of the
     /// model's settings, or its defaults), drawing from the stream of `seed`.
     #[pyo3(signature = (seed, settings = None))]
-    fn mutate(&self, seed: u64, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
+    fn mutate(&self, seed: Whole, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Genome> {
+        let seed: u64 = seed.get("seed")?;
         let settings = settings.map(|s| from_py(s, "settings")).transpose()?;
         let inner = self.inner.mutate(settings.as_ref().into(), seed).py()?;
         Ok(Genome { inner })
@@ -284,10 +289,11 @@ impl Genome {
 #[pyo3(signature = (parents, seed, dominance = None, settings = None))]
 pub fn cross(
     parents: Vec<Genome>,
-    seed: u64,
+    seed: Whole,
     dominance: Option<Vec<f64>>,
     settings: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<(Genome, Vec<usize>)> {
+    let seed: u64 = seed.get("seed")?;
     let dominance = dominance.unwrap_or_else(|| vec![1.0; parents.len()]);
     if dominance.len() != parents.len() {
         return Err(bad_value(

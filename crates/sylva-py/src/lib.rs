@@ -37,6 +37,7 @@ mod pair;
 mod plant;
 mod space;
 mod varieties;
+mod whole;
 mod work;
 
 use pyo3::prelude::*;
@@ -106,8 +107,9 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
 /// the machine's memory and the process's limits). Work whose estimate is over it raises
 /// `LimitError` before it starts, as the command line's `--max-memory` does.
 #[pyfunction]
-fn set_max_memory(bytes: u64) {
-    sylva::core::budget::set_max_memory(bytes);
+fn set_max_memory(bytes: whole::Whole) -> PyResult<()> {
+    sylva::core::budget::set_max_memory(bytes.get("bytes")?);
+    Ok(())
 }
 
 /// The memory budget in force, in bytes.

@@ -19,6 +19,7 @@ use crate::errors::{IntoPy, bad_value};
 use crate::handle::Genome;
 use crate::json::to_py;
 use crate::pair::Pair;
+use crate::whole::Whole;
 
 /// A grown genome: its plant's measures, its mesh, and the files it exports to.
 #[pyclass(module = "sylva", name = "Plant", frozen)]
@@ -202,8 +203,9 @@ impl Plant {
         Mesh::view(this.as_any(), &plant.grown.mesh, triangles)
     }
 
-    /// Writes the plant as GLB, OBJ (with its MTL and textures) or VRML97, by the file's
-    /// extension; every file appears whole or not at all. Releases the GIL.
+    /// Writes the plant as GLB, OBJ (with its MTL and textures), VRML97 or STL (binary, in
+    /// millimetres), by the file's extension; every file appears whole or not at all (a
+    /// folder that is not there raises `FileNotFoundError`). Releases the GIL.
     fn export(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         py.detach(|| write_scene(&self.grown.scene(), &path)).py()
     }
@@ -241,9 +243,10 @@ impl Plant {
     fn lod_glb<'py>(
         &self,
         py: Python<'py>,
-        levels: usize,
+        levels: Whole,
         name: &str,
     ) -> PyResult<Bound<'py, PyBytes>> {
+        let levels: usize = levels.get("levels")?;
         let most = sylva::gltf::lod::MAX_LEVELS;
         if !(2..=most).contains(&levels) {
             return Err(bad_value(
@@ -276,14 +279,15 @@ impl Plant {
     }
 
     /// Renders a picture of the plant: PNG bytes, also written to `path` when given.
-    /// `view` is "front", "side", "top" or "iso"; `size` is (width, height) in pixels.
-    #[pyo3(signature = (path = None, view = "iso", size = Pair(800, 800)))]
+    /// `view` is "front", "side", "top" or "iso"; `size` is (width, height) in pixels, each
+    /// 16 to 8192.
+    #[pyo3(signature = (path = None, view = "iso", size = Pair(Whole(800), Whole(800))))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         path: Option<PathBuf>,
         view: &str,
-        size: Pair<u32>,
+        size: Pair<Whole>,
     ) -> PyResult<Bound<'py, PyBytes>> {
         render(py, &self.grown.scene(), path, view, size.into())
     }
@@ -573,7 +577,7 @@ impl Scene {
             .collect()
     }
 
-    /// Writes the scene as GLB, OBJ or VRML97, by the file's extension (one node per plant,
+    /// Writes the scene as GLB, OBJ, VRML97 or STL, by the file's extension (one node per plant,
     /// each carrying its genome and seed); every file appears whole or not at all.
     fn export(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         py.detach(|| write_scene(&self.assets.scene(), &path)).py()
@@ -586,13 +590,13 @@ impl Scene {
     }
 
     /// Renders a picture of the scene: PNG bytes, also written to `path` when given.
-    #[pyo3(signature = (path = None, view = "iso", size = Pair(1200, 800)))]
+    #[pyo3(signature = (path = None, view = "iso", size = Pair(Whole(1200), Whole(800))))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         path: Option<PathBuf>,
         view: &str,
-        size: Pair<u32>,
+        size: Pair<Whole>,
     ) -> PyResult<Bound<'py, PyBytes>> {
         render(py, &self.assets.scene(), path, view, size.into())
     }
@@ -619,9 +623,10 @@ fn render<'py>(
     scene: &sylva::mesh::Scene<'_>,
     path: Option<PathBuf>,
     view: &str,
-    size: (u32, u32),
+    size: (Whole, Whole),
 ) -> PyResult<Bound<'py, PyBytes>> {
     let view: View = view.parse().map_err(|e| bad_value("view", e))?;
+    let size = picture_size(size)?;
     if let Some(path) = &path {
         sylva::assets::check_png(path).py()?;
     }
@@ -637,11 +642,32 @@ fn render<'py>(
     Ok(PyBytes::new(py, &png))
 }
 
+/// A picture's (width, height), each side checked against the renderer's range, named `size`.
+fn picture_size((width, height): (Whole, Whole)) -> PyResult<(u32, u32)> {
+    use sylva::render::{MAX_SIZE, MIN_SIZE};
+    let side = |w: Whole| {
+        u32::try_from(w.0)
+            .ok()
+            .filter(|s| (MIN_SIZE..=MAX_SIZE).contains(s))
+    };
+    match (side(width), side(height)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(bad_value(
+            "size",
+            format!(
+                "expected (width, height), each {MIN_SIZE} to {MAX_SIZE} pixels, got ({}, {})",
+                width.0, height.0
+            ),
+        )),
+    }
+}
+
 /// The PNG of Sylva's texture `id` (what a material of `plant.mesh.materials` names in
 /// `texture`): 8-bit grey, 256 × 256, to multiply the material's colour by, the picture the
 /// GLB and OBJ exports embed. Made once per process; releases the GIL while it is made.
 #[pyfunction]
-pub fn texture_png(py: Python<'_>, id: u16) -> PyResult<Bound<'_, PyBytes>> {
+pub fn texture_png(py: Python<'_>, id: Whole) -> PyResult<Bound<'_, PyBytes>> {
+    let id: u16 = id.get("id")?;
     let png = py
         .detach(|| sylva::mesh::texture::texture_png(id))
         .map_err(|e| {
@@ -668,15 +694,17 @@ pub fn picture_png<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyBy
 /// Or give `path`, a garden file (`*.garden.json`), to grow the garden it describes.
 /// Releases the GIL.
 #[pyfunction]
-#[pyo3(signature = (genomes = Vec::new(), count = 20, area = Pair(20.0, 20.0), seed = 1, path = None))]
+#[pyo3(signature = (genomes = Vec::new(), count = Whole(20), area = Pair(20.0, 20.0), seed = Whole(1), path = None))]
 pub fn garden(
     py: Python<'_>,
     genomes: Vec<Genome>,
-    count: u32,
+    count: Whole,
     area: Pair<f64>,
-    seed: u64,
+    seed: Whole,
     path: Option<PathBuf>,
 ) -> PyResult<Scene> {
+    let count: u32 = count.get("count")?;
+    let seed: u64 = seed.get("seed")?;
     let area: (f64, f64) = area.into();
     let (garden, source) = match path {
         Some(path) => {

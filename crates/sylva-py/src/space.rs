@@ -16,6 +16,7 @@ use crate::errors::{IntoPy, bad_value};
 use crate::evolution::{Config, Evolution};
 use crate::handle::Genome;
 use crate::models::Models;
+use crate::whole::{self, Whole};
 
 /// `value` as float64 numbers and their shape; anything but numbers (an array of another
 /// kind, text, ragged lists) raises `TypeError` naming the argument `name`.
@@ -130,11 +131,14 @@ impl GenomeSpace {
         cls: &Bound<'_, PyType>,
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
-        dim: Option<usize>,
+        dim: Option<Whole>,
         coding: Option<&str>,
-        seed: Option<u64>,
-        threads: Option<u32>,
+        seed: Option<Whole>,
+        threads: Option<Whole>,
     ) -> PyResult<GenomeSpace> {
+        let dim = whole::get(dim, "dim")?;
+        let seed = whole::get(seed, "seed")?;
+        let threads = whole::get(threads, "threads")?;
         let models = Models::of(cls)?;
         let registry = models.get().registry();
         let config = Config::from_any(registry, config)?;

@@ -15,6 +15,7 @@ use crate::errors::IntoPy;
 use crate::evolution::{Config, Evolution, checkpoint_text};
 use crate::handle::Genome;
 use crate::models::Models;
+use crate::whole::{self, Whole};
 use crate::work::{Serving, work};
 
 /// One filled cell of a map: where it is, and its elite.
@@ -195,8 +196,9 @@ impl Varieties {
         models: &Bound<'_, Models>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
-        threads: Option<u32>,
+        threads: Option<Whole>,
     ) -> PyResult<Varieties> {
+        let threads = whole::get(threads, "threads")?;
         let registry = models.get().registry();
         let config = Config::from_any(registry, config)?;
         let start = match start {
@@ -230,7 +232,7 @@ impl Varieties {
         py: Python<'_>,
         config: &Bound<'_, PyAny>,
         start: Option<Vec<Genome>>,
-        threads: Option<u32>,
+        threads: Option<Whole>,
     ) -> PyResult<Varieties> {
         Varieties::start(py, &Models::of(cls)?, config, start, threads)
     }
@@ -245,11 +247,11 @@ impl Varieties {
         config: &Bound<'_, PyAny>,
         path: Option<PathBuf>,
         text: Option<String>,
-        threads: Option<u32>,
+        threads: Option<Whole>,
     ) -> PyResult<Varieties> {
         let config = Config::from_any(Models::of(cls)?.get().registry(), config)?;
         let (path, text) = checkpoint_text(path, text)?;
-        let pool = Evolution::pool(&config.inner, threads)?;
+        let pool = Evolution::pool(&config.inner, whole::get(threads, "threads")?)?;
         let inner = &config.inner;
         let (stop, serving) = (Stop::new(), Serving::default());
         let map = interruptible(py, &stop, &serving, || {
@@ -332,9 +334,10 @@ impl Varieties {
     fn run(
         &self,
         py: Python<'_>,
-        generations: Option<u32>,
+        generations: Option<Whole>,
         on_generation: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
+        let generations: Option<u32> = whole::get(generations, "generations")?;
         let todo = generations.unwrap_or_else(|| {
             self.with(|m| m.config().run().generations.saturating_sub(m.generation()))
         });
@@ -398,7 +401,8 @@ impl Varieties {
     }
 
     /// The elite of `cell`, or None if the cell is empty.
-    fn variety(&self, py: Python<'_>, cell: usize) -> PyResult<Option<Variety>> {
+    fn variety(&self, py: Python<'_>, cell: Whole) -> PyResult<Option<Variety>> {
+        let cell: usize = cell.get("cell")?;
         let (variety, names) = self.with(|m| (m.variety(cell), m.term_names().to_vec()));
         variety.map(|v| Variety::of(py, v, &names)).transpose()
     }
@@ -456,7 +460,7 @@ pub fn varieties(
     module: &Bound<'_, PyModule>,
     py: Python<'_>,
     config: &Bound<'_, PyAny>,
-    threads: Option<u32>,
+    threads: Option<Whole>,
     start: Option<Vec<Genome>>,
 ) -> PyResult<Varieties> {
     Varieties::start(py, &Models::of(module.as_any())?, config, start, threads)

@@ -191,7 +191,7 @@ def test_texture_png_is_the_picture_the_glb_embeds():
         png = sylva.texture_png(tid)
         assert png == embedded[tid]
         assert png.startswith(b"\x89PNG") and struct.unpack(">II", png[16:24]) == (256, 256)
-    with pytest.raises(OverflowError):
+    with pytest.raises(sylva.InputError, match="id"):
         sylva.texture_png(-1)
 
 
@@ -447,6 +447,77 @@ def test_messages_speak_python():
     with pytest.raises(sylva.InputError) as e:
         sylva.Genome.from_dict({"model": "bintree", "format": 1, "depth": True})
     assert "bool True" in str(e.value) and "i64" not in e.value.detail
+
+
+def test_counts_sizes_and_seeds_out_of_range_are_value_errors_naming_the_argument():
+    config = {"model": "bintree", "run": {"population": 8, "generations": 2, "seed": 1}}
+    run = sylva.Evolution(config, threads=1)
+    oak = sylva.Genome.load(GENOMES["bintree"])
+    tulip = sylva.Genome.load(GENOMES["plantmaker"])
+    varieties = sylva.varieties(config, threads=1)
+    calls = {
+        "run.run(-3)": (lambda: run.run(-3), "generations"),
+        "run.run(2**200)": (lambda: run.run(2**200), "generations"),
+        "Evolution(threads=-1)": (lambda: sylva.Evolution(config, threads=-1), "threads"),
+        "fitness_batch=-1": (lambda: sylva.Evolution(config, fitness_batch=-1), "fitness_batch"),
+        "resume(threads=-1)": (
+            lambda: sylva.Evolution.resume(sylva.Config.from_dict(config),
+                                           text=run.checkpoint(), threads=-1), "threads"),
+        "run.fittest(-1)": (lambda: run.fittest(-1), "count"),
+        "run.member(-1)": (lambda: run.member(-1), "id"),
+        "run.keep_history(-1)": (lambda: run.keep_history(-1), "generations"),
+        "run.emigrants(-1)": (lambda: run.emigrants(-1), "count"),
+        "varieties(threads=-1)": (lambda: sylva.varieties(config, threads=-1), "threads"),
+        "varieties.run(-1)": (lambda: varieties.run(-1), "generations"),
+        "varieties.variety(-1)": (lambda: varieties.variety(-1), "cell"),
+        "Genome.random(-1)": (lambda: sylva.Genome.random("bintree", -1), "seed"),
+        "grow(seed=-1)": (lambda: oak.grow(seed=-1), "seed"),
+        "mutate(-1)": (lambda: oak.mutate(-1), "seed"),
+        "cross(seed=-1)": (lambda: sylva.cross([oak, oak], -1), "seed"),
+        "garden(count=-1)": (lambda: sylva.garden([tulip], count=-1), "count"),
+        "garden(seed=-1)": (lambda: sylva.garden([tulip], count=1, seed=-1), "seed"),
+        "lod_glb(-1)": (lambda: oak.grow().lod_glb(-1), "levels"),
+        "GenomeSpace(dim=-1)": (lambda: sylva.GenomeSpace(config, dim=-1), "dim"),
+        "set_max_memory(-1)": (lambda: sylva.set_max_memory(-1), "bytes"),
+        "match(population=-1)": (
+            lambda: sylva.match(np.ones((32, 32), bool), population=-1), "population"),
+    }
+    for call, (make, name) in calls.items():
+        with pytest.raises(sylva.InputError) as refused:
+            make()
+        e = refused.value
+        assert isinstance(e, ValueError), call
+        assert e.location == name and "expected an int from 0 to" in str(e), f"{call}: {e}"
+
+
+def test_pictures_exports_and_checkpoints_refuse_bad_input_in_python_s_terms(tmp_path):
+    plant = sylva.Genome.load(GENOMES["bintree"]).grow()
+    scene = sylva.garden([sylva.Genome.load(GENOMES["plantmaker"])], count=1)
+    for size in [(0, 0), (15, 64), (64, 8193), (-1, 64)]:
+        for picture in (plant, scene):
+            with pytest.raises(sylva.InputError) as refused:
+                picture.render(size=size)
+            assert refused.value.location == "size" and "16 to 8192" in str(refused.value)
+    # A folder that is not there: Python's own error, naming the file.
+    for thing in (plant, scene):
+        with pytest.raises(FileNotFoundError) as missing:
+            thing.export(tmp_path / "missing" / "plant.glb")
+        assert "missing" in str(missing.value) and missing.value.filename
+    # STL, as the docs say.
+    plant.export(tmp_path / "plant.stl")
+    stl = (tmp_path / "plant.stl").read_bytes()
+    (triangles,) = struct.unpack_from("<I", stl, 80)
+    assert triangles > 0 and len(stl) == 84 + 50 * triangles
+    # A checkpoint that is not JSON says so, where.
+    config = sylva.Config.from_dict({"model": "bintree", "run": {"population": 8}})
+    for text, columns in [("not json", [1]), ('{"config": {"model":', range(2, 21))]:
+        with pytest.raises(sylva.InputError) as refused:
+            sylva.Evolution.resume(config, text=text)
+        e = refused.value
+        assert "not JSON" in str(e) and "ident" not in str(e) and "EOF" not in str(e), str(e)
+        assert e.line == 1 and e.column in columns, str(e)
+    with pytest.raises(sylva.InputError, match="not JSON"):
+        sylva.Varieties.resume(config, text="not json")
 
 
 def png(path: Path, pixels: np.ndarray) -> Path:

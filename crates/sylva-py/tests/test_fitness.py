@@ -111,6 +111,12 @@ def test_the_function_s_errors_are_raised_as_they_were_and_leave_the_run_whole()
         (lambda plants: 3.0, sylva.InputError, "a single number"),
         (lambda plants: [[1.0, 2.0]] * len(plants), sylva.InputError, "shape"),
         (lambda plants: [float("nan")] * len(plants), sylva.InputError, "NaN"),
+        # One infinity is refused as NaN is, not left to sink the run's ranking.
+        (lambda plants: [float("inf")] + [0.0] * (len(plants) - 1), sylva.InputError,
+         "returned inf for plant 0"),
+        (lambda plants: [0.0] * (len(plants) - 1) + [float("-inf")], sylva.InputError,
+         "returned -inf for plant"),
+        (lambda plants: np.full(len(plants), -np.inf), sylva.InputError, "returned -inf"),
         (lambda plants: "high", TypeError, "one number per plant"),
         (lambda plants: None, TypeError, "one number per plant"),
         (lambda plants: ["a"] * len(plants), TypeError, "one number per plant"),

@@ -296,15 +296,33 @@ async function main() {
     await checkPainted("breed", 0.004, "after the cross");
   });
 
-  await step("breed: a dominance below zero is refused, visibly", async () => {
+  await step("breed: a dominance empty, below zero or too large is refused at its control, nothing sent", async () => {
     await byTestId("grid-cell-0").click();
     await byTestId("grid-cell-1").click();
-    await byTestId("dominance-0").fill("-1");
-    await byTestId("cross").click();
-    await page.waitForFunction(() => document.querySelector('[data-testid="message"]').dataset.kind === "error");
-    const text = await byTestId("message").innerText();
-    check(/dominance|parent/i.test(text), `the error does not say what was wrong: ${text}`);
-    await byTestId("message-close").click();
+    let crosses = 0;
+    const counting = (r) => {
+      if (r.url().includes("/cross")) crosses += 1;
+    };
+    page.on("request", counting);
+    const h0 = await byTestId("history-item").count();
+    // 1e400 is no finite number: the browser reports the control's value as "", which the
+    // page once sent as 0 (the plant silently left out of the cross).
+    for (const bad of ["", "-1", "1e400", "2000000"]) {
+      await byTestId("dominance-0").fill(bad);
+      await byTestId("cross").click();
+      const shown = byTestId("dominance-error-0");
+      await shown.waitFor({ state: "visible", timeout: 5_000 });
+      const text = await shown.innerText();
+      check(/dominance/i.test(text) && /0 to 1000000/.test(text),
+        `dominance ${JSON.stringify(bad)}: the control's message does not say what it takes: ${text}`);
+    }
+    await sleep(300);
+    page.off("request", counting);
+    check(crosses === 0, `a cross was sent ${crosses} times with a dominance the control refused`);
+    check(await byTestId("history-item").count() === h0, "a refused cross is in the history");
+    // a good value clears the message
+    await byTestId("dominance-0").fill("1");
+    check(await byTestId("dominance-error-0").isHidden(), "the dominance message stays after a good value");
     // unpick both
     await byTestId("grid-cell-0").click();
     await byTestId("grid-cell-1").click();

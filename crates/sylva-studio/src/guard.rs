@@ -11,9 +11,11 @@
 //!    (`Sec-Fetch-Site: cross-site` or `same-site`, which includes other ports of localhost)
 //!    is refused (403), but for opening the page itself; a state-changing request whose
 //!    `Origin` is not the studio's own is refused (403).
-//! 4. **Content type**: a state-changing request must be `application/json` (415). HTML
-//!    forms and `no-cors` fetches can only send `text/plain`, form encodings or nothing, and
-//!    a JSON body cannot cross sites without a CORS preflight, which the studio never grants.
+//! 4. **Content type**: a POST (the one state-changing method the studio takes) must be
+//!    `application/json` (415). HTML forms and `no-cors` fetches can only send `text/plain`,
+//!    form encodings or nothing, and a JSON body cannot cross sites without a CORS
+//!    preflight, which the studio never grants. Other methods go on to the router, which
+//!    answers them 405 ([`crate::http::json_errors`]).
 
 use std::net::IpAddr;
 
@@ -121,7 +123,8 @@ impl Guard {
                     String::from_utf8_lossy(origin.as_bytes())
                 )));
             }
-            if !is_json(headers.get(header::CONTENT_TYPE)) {
+            // Only POST reaches a handler; other methods are the router's 405, not a 415.
+            if *method == Method::POST && !is_json(headers.get(header::CONTENT_TYPE)) {
                 return Err(ApiError::new(
                     StatusCode::UNSUPPORTED_MEDIA_TYPE,
                     "",
@@ -379,6 +382,10 @@ mod tests {
             (Method::POST, "/api/sessions", &[host, ("content-type", "multipart/form-data; boundary=x")], 415),
             (Method::POST, "/api/sessions", &[host, ("content-type", "application/jsonp")], 415),
             (Method::POST, "/api/sessions", &[host], 415),
+            // methods the studio takes nowhere go on to the router's 405
+            (Method::DELETE, "/api/sessions", &[host], 200),
+            (Method::TRACE, "/", &[host], 200),
+            (Method::DELETE, "/api/sessions", &[host, ("origin", "http://evil.example")], 403),
             (Method::POST, "/api/sessions", &[host, json, ("origin", "http://evil.example")], 403),
             (Method::POST, "/api/sessions", &[host, json, ("origin", "http://127.0.0.1:3000")], 403),
             (Method::POST, "/api/sessions", &[host, json, ("origin", "http://localhost:8417")], 403),

@@ -1,13 +1,117 @@
-//! The HTTP plumbing: typed JSON bodies with limits, JSON errors, and the page's files.
+//! The HTTP plumbing: routes with a 405 that says what a path takes, typed JSON bodies with
+//! limits, JSON errors, and the page's files.
 
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use axum::Router;
 use axum::body::Body as AxumBody;
-use axum::extract::{FromRequest, Request};
-use axum::http::{StatusCode, Uri, header};
+use axum::extract::{FromRequest, MatchedPath, Request};
+use axum::handler::Handler;
+use axum::http::{HeaderValue, Method, StatusCode, Uri, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
+use axum::routing::MethodRouter;
 use serde::de::DeserializeOwned;
 
+use crate::Studio;
 use crate::error::ApiError;
+
+/// An endpoint: a method, a path and its handler.
+pub struct Route {
+    pub(crate) method: Method,
+    pub(crate) path: &'static str,
+    handler: MethodRouter<Studio>,
+}
+
+impl Route {
+    /// `GET {path}` (and HEAD).
+    pub fn get<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
+        Route {
+            method: Method::GET,
+            path,
+            handler: axum::routing::get(handler),
+        }
+    }
+
+    /// `POST {path}`.
+    pub fn post<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
+        Route {
+            method: Method::POST,
+            path,
+            handler: axum::routing::post(handler),
+        }
+    }
+}
+
+/// The methods each route's path takes, by the path as routed (`/api/sessions/{id}/cross`),
+/// for the `Allow` of a 405: axum's own 405 leaves `Allow` out for routes inside a router.
+#[derive(Clone, Default)]
+pub struct Takes(Arc<HashMap<String, Vec<Method>>>);
+
+impl Takes {
+    /// What the paths of `routes` take, each path under its prefix (`/api`).
+    pub fn of(routes: &[(&str, &[Route])]) -> Takes {
+        let mut takes: HashMap<String, Vec<Method>> = HashMap::new();
+        for (prefix, routes) in routes {
+            for route in *routes {
+                let methods = takes.entry(format!("{prefix}{}", route.path)).or_default();
+                methods.push(route.method.clone());
+                if route.method == Method::GET {
+                    methods.push(Method::HEAD);
+                }
+            }
+        }
+        Takes(Arc::new(takes))
+    }
+
+    /// The 405 for `method` on a routed path (`None`: a path no route has, taking nothing).
+    fn not_allowed(&self, method: &Method, path: &str, routed: Option<&str>) -> Response {
+        let taken: Vec<&str> = routed
+            .and_then(|p| self.0.get(p))
+            .map(|methods| methods.iter().map(Method::as_str).collect())
+            .unwrap_or_default();
+        let error = if taken.is_empty() {
+            format!(
+                "`{method}` is not a method of `{path}`, a path the studio does not have; it \
+                 takes GET, HEAD and POST on the paths docs/studio.md lists"
+            )
+        } else {
+            format!(
+                "`{method}` is not a method of `{path}`; it takes {}",
+                taken.join(", ")
+            )
+        };
+        let mut response = ApiError::new(StatusCode::METHOD_NOT_ALLOWED, "", error).into_response();
+        if let Ok(allow) = HeaderValue::from_str(&taken.join(",")) {
+            response.headers_mut().insert(header::ALLOW, allow);
+        }
+        response
+    }
+}
+
+/// A router of `routes`, a path's methods merged.
+pub fn routed(routes: Vec<Route>) -> Router<Studio> {
+    routes
+        .into_iter()
+        .fold(Router::new(), |router, r| router.route(r.path, r.handler))
+}
+
+/// `router` answering a method a path does not take with a 405 and the `Allow` of `takes`.
+pub fn with_405(router: Router<Studio>, takes: Takes) -> Router<Studio> {
+    router.method_not_allowed_fallback(
+        move |method: Method, routed: Option<MatchedPath>, uri: Uri| {
+            let takes = takes.clone();
+            async move {
+                takes.not_allowed(
+                    &method,
+                    uri.path(),
+                    routed.as_ref().map(MatchedPath::as_str),
+                )
+            }
+        },
+    )
+}
 
 /// The largest request body, 1 MiB: genome files are a few kilobytes.
 pub const MAX_BODY: usize = 1 << 20;
@@ -172,7 +276,125 @@ fn body_error<E: std::fmt::Display>(
     } else {
         path.to_owned()
     };
+    let message = in_page_words(&field, &message);
     ApiError::bad(field, message)
+}
+
+/// Labels of the page's controls by the request field they fill (its last name), so that a
+/// message names the control the person typed in.
+const LABELS: &[(&str, &str)] = &[
+    ("children", "Children"),
+    ("seed", "Seed"),
+    ("depth", "Depth"),
+    ("level", "Level"),
+    ("dominance", "Dominance"),
+    ("population", "Population"),
+    ("generations", "Generations"),
+    ("steps", "Steps"),
+    ("spacing", "Spacing"),
+    ("azimuth", "Azimuth"),
+    ("elevation", "Elevation"),
+    ("model", "Model"),
+    ("count", "Count"),
+    ("genomes", "Genome files"),
+];
+
+/// How a message names `field` (a JSON path): the page's label of its control (`Children`;
+/// a parent's `Dominance (parent 2)`), or the path itself.
+fn label(field: &str) -> String {
+    let last = field.rsplit('.').next().unwrap_or(field);
+    let name = last.split('[').next().unwrap_or(last);
+    let Some((_, label)) = LABELS.iter().find(|(n, _)| *n == name) else {
+        return format!("`{field}`");
+    };
+    // `parents[1].dominance`: the parent's place, counted from 1 as the page counts.
+    let parent = field
+        .strip_prefix("parents[")
+        .and_then(|rest| rest.split(']').next())
+        .and_then(|i| i.parse::<usize>().ok());
+    match parent {
+        Some(i) if name != "parents" => format!("{label} (parent {})", i + 1),
+        _ => (*label).to_owned(),
+    }
+}
+
+/// A serde message about `field` in the page's words: the control's label, what it takes
+/// and what it got (`Children: expected a whole number from 0 to 4294967295, got 2.5`),
+/// never serde's type names (`u32`) nor its place in the JSON text (`at line 1 column 100`,
+/// which the person never saw).
+fn in_page_words(field: &str, message: &str) -> String {
+    let message = message
+        .rfind(" at line ")
+        .map_or(message, |i| &message[..i]);
+    let said = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "))
+        .and_then(|rest| rest.rsplit_once(", expected "))
+        .map(|(got, expected)| {
+            format!(
+                "expected {}, got {}",
+                expected_words(expected),
+                got_words(got)
+            )
+        })
+        .unwrap_or_else(|| match message {
+            "number out of range" => "expected a number, got one too large to read".to_owned(),
+            other => other.to_owned(),
+        });
+    if field.is_empty() {
+        said
+    } else {
+        format!("{}: {said}", label(field))
+    }
+}
+
+/// What serde says a field expects (`u32`, `a string`), in the page's words.
+fn expected_words(expected: &str) -> String {
+    let most = match expected {
+        "u8" => Some(u64::from(u8::MAX)),
+        "u16" => Some(u64::from(u16::MAX)),
+        "u32" => Some(u64::from(u32::MAX)),
+        "u64" | "usize" => Some(u64::MAX),
+        _ => None,
+    };
+    if let Some(most) = most {
+        return format!("a whole number from 0 to {most}");
+    }
+    match expected {
+        "i8" | "i16" | "i32" | "i64" | "isize" => "a whole number",
+        "f32" | "f64" => "a number",
+        "a string" => "text",
+        "a boolean" => "true or false",
+        "a sequence" => "a list",
+        "a map" => "a group of settings",
+        other => other,
+    }
+    .to_owned()
+}
+
+/// What serde says a request sent (``floating point `2.5` ``, `string "abc"`), in the
+/// page's words: the value itself (long text cut short) or what kind of thing it was.
+fn got_words(got: &str) -> String {
+    let quoted = ["floating point `", "integer `", "boolean `"]
+        .iter()
+        .find_map(|p| got.strip_prefix(p))
+        .map(|v| v.trim_end_matches('`'));
+    if let Some(value) = quoted {
+        return value.to_owned();
+    }
+    if let Some(text) = got.strip_prefix("string ") {
+        return match text.char_indices().nth(40) {
+            Some((i, _)) => format!("{}…\"", &text[..i]),
+            None => text.to_owned(),
+        };
+    }
+    match got {
+        "null" => "nothing (null)",
+        "map" => "a group of settings",
+        "sequence" => "a list",
+        other => other,
+    }
+    .to_owned()
 }
 
 /// The value at a JSON path (`a.b[1].c`) of `value`.
@@ -215,10 +437,18 @@ pub fn join(path: &str, name: &str) -> String {
 }
 
 /// Makes every 4xx the API answers a JSON error, including the plain-text rejections of
-/// axum's own extractors (a path id that is not a number, a bad query string).
+/// axum's own extractors (a path id that is not a number, a bad query string). A method no
+/// route takes (`TRACE`, `DELETE`) is a 405 on a path the studio does not have too, not a 404.
 pub async fn json_errors(req: Request, next: Next) -> Response {
+    let method = req.method().clone();
+    let path = req.uri().path().to_owned();
     let response = next.run(req).await;
     let status = response.status();
+    if status == StatusCode::NOT_FOUND
+        && ![Method::GET, Method::HEAD, Method::POST].contains(&method)
+    {
+        return Takes::default().not_allowed(&method, &path, None);
+    }
     let is_json = response
         .headers()
         .get(header::CONTENT_TYPE)
@@ -379,5 +609,81 @@ mod tests {
         // Not JSON at all: the typed read says where, as before.
         let e = parse_json::<P>(b"\x89PNG").unwrap_err();
         assert!(!e.error.contains("twice"), "{e}");
+    }
+
+    #[test]
+    fn messages_name_the_control_and_what_it_takes_in_the_page_s_words() {
+        #[derive(serde::Deserialize, Debug)]
+        #[serde(deny_unknown_fields)]
+        #[allow(dead_code)]
+        struct Cross {
+            parents: Vec<Parent>,
+            children: Option<u32>,
+            seed: Option<u64>,
+        }
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct Parent {
+            plant: i64,
+            dominance: f64,
+        }
+        let parents = r#""parents": [{"plant": 1, "dominance": 1}, {"plant": 2, "dominance": 1}]"#;
+        let error = |rest: &str| {
+            let body = format!("{{{parents}, {rest}}}");
+            parse_json::<Cross>(body.as_bytes()).unwrap_err()
+        };
+        let cases = [
+            (
+                r#""children": 2.5"#,
+                "children",
+                "Children: expected a whole number from 0 to 4294967295, got 2.5",
+            ),
+            (
+                r#""seed": 99999999999999999999999"#,
+                "seed",
+                "Seed: expected a whole number from 0 to 18446744073709551615, got 1e+23",
+            ),
+            (
+                r#""seed": -1"#,
+                "seed",
+                "Seed: expected a whole number from 0 to 18446744073709551615, got -1",
+            ),
+            (
+                r#""children": "two""#,
+                "children",
+                "Children: expected a whole number from 0 to 4294967295, got \"two\"",
+            ),
+        ];
+        for (rest, field, said) in cases {
+            let e = error(rest);
+            assert_eq!(
+                (e.field.as_str(), e.error.as_str()),
+                (field, said),
+                "{rest}"
+            );
+        }
+        // A parent's dominance is named by the parent's place, counted from 1.
+        let e = parse_json::<Cross>(
+            br#"{"parents": [{"plant": 1, "dominance": 1}, {"plant": 2, "dominance": "x"}]}"#,
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "parents[1].dominance");
+        assert_eq!(
+            e.error,
+            "Dominance (parent 2): expected a number, got \"x\""
+        );
+        let e =
+            parse_json::<Cross>(br#"{"parents": [{"plant": 1, "dominance": 1e400}]}"#).unwrap_err();
+        assert!(
+            e.error
+                .starts_with("Dominance (parent 1): expected a number"),
+            "{e}"
+        );
+        // No serde type names nor places in a JSON text the person never saw.
+        for word in ["u32", "u64", "f64", "invalid type", "line 1", "column"] {
+            for rest in [r#""children": 2.5"#, r#""seed": 1e30"#] {
+                assert!(!error(rest).error.contains(word), "{rest}: {}", error(rest));
+            }
+        }
     }
 }

@@ -55,7 +55,6 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use axum::Router;
-use axum::routing::{get, post};
 use rand::RngExt;
 use sylva::Registry;
 
@@ -201,37 +200,44 @@ impl Studio {
 
 /// The studio's routes.
 pub fn router(studio: Studio) -> Router {
-    let api = Router::new()
-        .route("/modes", get(modes::modes))
-        .route("/models", get(modes::models))
-        .route("/examples", get(sessions::examples))
-        .route("/sessions", get(sessions::list).post(modes::create))
-        .route("/sessions/{id}", get(sessions::get))
-        .route("/sessions/{id}/undo", post(modes::undo))
-        .route("/sessions/{id}/redo", post(modes::redo))
-        .route("/sessions/{id}/events", get(modes::events))
-        .merge(modes::routes())
-        .route("/plants", get(plants::list))
-        .route("/plants/{id}", get(plants::get))
-        .route("/plants/{id}/plant.glb", get(plants::glb))
-        .route("/plants/{id}/inspect", get(plants::inspect))
-        .route("/kinds", get(plants::kinds))
-        .route("/plants/{id}/preview.glb", get(plants::preview))
-        .route("/plants/{id}/plant.obj", get(plants::obj))
-        .route("/plants/{id}/plant.mtl", get(plants::mtl))
-        .route("/plants/{id}/plant.zip", get(plants::obj_zip))
-        .route("/plants/{id}/plant.stl", get(plants::stl))
-        .route("/plants/{id}/plant.png", get(plants::png))
-        .route("/plants/{id}/genome.json", get(plants::genome))
-        .route("/plants/{id}/{file}", get(plants::texture))
-        .route("/plants/{id}/lineage", get(plants::lineage))
-        .route("/plants/{id}/branch", post(modes::branch))
-        .fallback(|| async { ApiError::not_found("no such endpoint") });
-    Router::new()
-        .nest("/api", api)
-        .route("/vendor/three/{*path}", get(http::vendor))
-        .route("/", get(http::page))
-        .route("/app/{*path}", get(http::page))
+    use http::Route;
+    let api: Vec<Route> = [
+        Route::get("/modes", modes::modes),
+        Route::get("/models", modes::models),
+        Route::get("/examples", sessions::examples),
+        Route::get("/sessions", sessions::list),
+        Route::post("/sessions", modes::create),
+        Route::get("/sessions/{id}", sessions::get),
+        Route::post("/sessions/{id}/undo", modes::undo),
+        Route::post("/sessions/{id}/redo", modes::redo),
+        Route::get("/sessions/{id}/events", modes::events),
+        Route::get("/plants", plants::list),
+        Route::get("/plants/{id}", plants::get),
+        Route::get("/plants/{id}/plant.glb", plants::glb),
+        Route::get("/plants/{id}/inspect", plants::inspect),
+        Route::get("/kinds", plants::kinds),
+        Route::get("/plants/{id}/preview.glb", plants::preview),
+        Route::get("/plants/{id}/plant.obj", plants::obj),
+        Route::get("/plants/{id}/plant.mtl", plants::mtl),
+        Route::get("/plants/{id}/plant.zip", plants::obj_zip),
+        Route::get("/plants/{id}/plant.stl", plants::stl),
+        Route::get("/plants/{id}/plant.png", plants::png),
+        Route::get("/plants/{id}/genome.json", plants::genome),
+        Route::get("/plants/{id}/{file}", plants::texture),
+        Route::get("/plants/{id}/lineage", plants::lineage),
+        Route::post("/plants/{id}/branch", modes::branch),
+    ]
+    .into_iter()
+    .chain(modes::routes())
+    .collect();
+    let page = vec![
+        Route::get("/vendor/three/{*path}", http::vendor),
+        Route::get("/", http::page),
+        Route::get("/app/{*path}", http::page),
+    ];
+    let takes = http::Takes::of(&[("/api", &api), ("", &page)]);
+    let api = http::routed(api).fallback(|| async { ApiError::not_found("no such endpoint") });
+    http::with_405(http::routed(page).nest("/api", api), takes)
         .layer(axum::middleware::from_fn_with_state(
             studio.clone(),
             guard::check,

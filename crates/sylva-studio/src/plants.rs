@@ -821,6 +821,16 @@ pub(crate) async fn lineage(
 
 /// Reads a genome file's text, naming `field` and the line and column of any error.
 pub fn parse_genome(registry: &Registry, text: &str, field: &str) -> Result<Genome, ApiError> {
+    // A file that is not JSON at all (a picture chosen by mistake) is said to be no genome,
+    // rather than where the JSON reader gave up on it.
+    if serde_json::from_str::<serde::de::IgnoredAny>(text)
+        .is_err_and(|e| e.is_syntax() || e.is_eof())
+    {
+        return Err(ApiError::unprocessable(
+            field,
+            "the file is not a genome (a JSON genome file was expected)",
+        ));
+    }
     registry.parse_genome(text).map_err(|e| {
         ApiError::unprocessable(
             field,
@@ -832,6 +842,23 @@ pub fn parse_genome(registry: &Registry, text: &str, field: &str) -> Result<Geno
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_file_that_is_not_json_is_said_to_be_no_genome() {
+        let registry = Registry::standard();
+        let png = String::from_utf8_lossy(b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR").into_owned();
+        for text in [png.as_str(), "", "not json", "{\"model\": \"bintree\""] {
+            let e = parse_genome(&registry, text, "genomes[0]").unwrap_err();
+            assert_eq!(e.field, "genomes[0]");
+            assert_eq!(
+                e.error, "the file is not a genome (a JSON genome file was expected)",
+                "{text:?}"
+            );
+        }
+        // JSON that is not a genome still says what is wrong with it.
+        let e = parse_genome(&registry, r#"{"model": "bintree"}"#, "genome").unwrap_err();
+        assert!(!e.error.contains("not a genome (a JSON"), "{e}");
+    }
 
     #[test]
     fn preview_sizes_are_few_and_bounded() {

@@ -183,7 +183,8 @@ pub mod mesh {
 /// (`sylva-render`).
 pub mod render {
     pub use sylva_render::{
-        CAPTION_HEIGHT, SheetCell, SheetOptions, View, contact_sheet, encode_png,
+        CAPTION_HEIGHT, MAX_SIZE, MIN_SIZE, SheetCell, SheetOptions, View, contact_sheet,
+        encode_png,
     };
 
     /// Impostors' pictures.

@@ -144,7 +144,8 @@ class Plant:
     @property
     def mesh(self) -> Mesh: ...
     def export(self, path: _Path) -> None:
-        """Writes GLB, OBJ or VRML97 by the extension; all or nothing."""
+        """Writes GLB, OBJ, VRML97 or STL by the extension; all or nothing. A folder
+        that is not there raises ``FileNotFoundError``."""
     def glb(self) -> bytes:
         """The plant as GLB bytes."""
     @property
@@ -156,7 +157,8 @@ class Plant:
     def render(
         self, path: _Path | None = None, view: str = "iso", size: tuple[int, int] = (800, 800)
     ) -> bytes:
-        """PNG bytes of a picture, also written to ``path`` when given."""
+        """PNG bytes of a picture, also written to ``path`` when given; ``size`` is
+        (width, height), each 16 to 8192 pixels."""
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as its genome, seed, roots and taper; unpickled, it grows again to the
         same bytes."""
@@ -225,7 +227,8 @@ class Member:
         """Pickled as its fields."""
 
 Fitness = Callable[[list[Plant]], Sequence[float] | npt.NDArray[np.floating[Any]]]
-"""A Python fitness function: a list of grown plants in, one number per plant out."""
+"""A Python fitness function: a list of grown plants in, one finite number per plant out
+(NaN and infinities raise ``InputError`` naming ``fitness``)."""
 
 class Evolution:
     """An evolution run of any model; ``fitness=f`` adds a Python fitness function."""

@@ -648,7 +648,7 @@ fn children(n: Option<u32>, default: usize) -> Result<usize, ApiError> {
     } else {
         Err(ApiError::bad(
             "children",
-            format!("expected 1 to 9, got {n}"),
+            format!("Children: expected a whole number from 1 to {GRID}, got {n}"),
         ))
     }
 }
@@ -719,7 +719,11 @@ pub(crate) async fn cross(
         if !(p.dominance.is_finite() && (0.0..=1e6).contains(&p.dominance)) {
             return Err(ApiError::bad(
                 format!("parents[{i}].dominance"),
-                format!("expected a number from 0 to 1000000, got {}", p.dominance),
+                format!(
+                    "Dominance (parent {}): expected a number from 0 to 1000000, got {}",
+                    i + 1,
+                    p.dominance
+                ),
             ));
         }
     }

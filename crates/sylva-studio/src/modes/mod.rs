@@ -43,12 +43,9 @@ use std::convert::Infallible;
 use std::future::Future;
 use std::pin::Pin;
 
+use axum::Json;
 use axum::extract::{Path, State};
-use axum::handler::Handler;
-use axum::http::Method;
 use axum::response::sse::{Event, KeepAlive, Sse};
-use axum::routing::MethodRouter;
-use axum::{Json, Router};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use sylva::Registry;
@@ -59,6 +56,7 @@ use crate::Studio;
 use crate::archive::{self, PlantRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
+pub use crate::http::Route;
 use crate::http::{Body, from_value};
 use crate::plants::plant_row;
 use crate::sessions::{SessionView, session_row, view};
@@ -117,33 +115,6 @@ pub trait Mode: 'static {
     /// was killed), such as background runs.
     fn resume(studio: &Studio) {
         let _ = studio;
-    }
-}
-
-/// An endpoint a mode adds, under `/api`.
-pub struct Route {
-    method: Method,
-    path: &'static str,
-    handler: MethodRouter<Studio>,
-}
-
-impl Route {
-    /// `GET /api{path}`.
-    pub fn get<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
-        Route {
-            method: Method::GET,
-            path,
-            handler: axum::routing::get(handler),
-        }
-    }
-
-    /// `POST /api{path}`.
-    pub fn post<H: Handler<T, Studio>, T: 'static>(path: &'static str, handler: H) -> Route {
-        Route {
-            method: Method::POST,
-            path,
-            handler: axum::routing::post(handler),
-        }
     }
 }
 
@@ -243,14 +214,9 @@ fn branch_as<M: Mode>(studio: Studio, plant: PlantRow) -> Pending<i64> {
     Box::pin(async move { M::branch(&studio, &plant).await })
 }
 
-/// Every mode's endpoints.
-pub fn routes() -> Router<Studio> {
-    MODES
-        .iter()
-        .flat_map(|m| (m.routes)())
-        .fold(Router::new(), |router, route| {
-            router.route(route.path, route.handler)
-        })
+/// Every mode's endpoints, under `/api`.
+pub fn routes() -> Vec<Route> {
+    MODES.iter().flat_map(|m| (m.routes)()).collect()
 }
 
 /// Takes up again what every mode had going when the studio stopped.
@@ -563,6 +529,59 @@ mod tests {
                 "{page} has no default export"
             );
         }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn methods_a_path_does_not_take_are_405_with_what_it_takes() {
+        let (studio, dir) = studio("methods");
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        // No content type, as `curl -X DELETE` sends: the method is what is wrong.
+        let answer = |method: &str, path: &str| {
+            runtime.block_on(async {
+                let request = Request::builder()
+                    .method(method)
+                    .uri(path)
+                    .header("host", "127.0.0.1")
+                    .body(Bytes::empty())
+                    .unwrap();
+                let response = router(studio.clone()).oneshot(request).await.unwrap();
+                let status = response.status();
+                let allow = response
+                    .headers()
+                    .get("allow")
+                    .map(|v| v.to_str().unwrap().to_owned());
+                let body = axum::body::to_bytes(response.into_body(), usize::MAX)
+                    .await
+                    .unwrap();
+                let body: serde_json::Value = serde_json::from_slice(&body).unwrap();
+                (
+                    status,
+                    allow,
+                    body["error"].as_str().unwrap_or("").to_owned(),
+                )
+            })
+        };
+        for (method, path, allow) in [
+            ("DELETE", "/api/sessions", "GET,HEAD,POST"),
+            ("TRACE", "/", "GET,HEAD"),
+            ("PUT", "/api/plants/1", "GET,HEAD"),
+            ("FOO", "/api/sessions/1/undo", "POST"),
+            // a path the studio does not know takes nothing
+            ("TRACE", "/api/no-such-thing", ""),
+            ("FOO", "/nowhere", ""),
+        ] {
+            let (status, got, error) = answer(method, path);
+            assert_eq!(status, StatusCode::METHOD_NOT_ALLOWED, "{method} {path}");
+            assert_eq!(got.as_deref(), Some(allow), "{method} {path}");
+            assert!(error.contains(method), "{method} {path}: {error}");
+        }
+        // A method the studio takes on a path it does not know is still 404.
+        let (status, _, _) = answer("GET", "/api/no-such-thing");
+        assert_eq!(status, StatusCode::NOT_FOUND);
         std::fs::remove_dir_all(&dir).ok();
     }
 

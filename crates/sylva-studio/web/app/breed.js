@@ -9,6 +9,8 @@ import { stats } from "./stats.js";
 
 const CELLS = 9;
 const MAX_UPLOAD = 1024 * 1024;
+/** The largest dominance the studio takes (its cross refuses more). */
+const MAX_DOMINANCE = 1e6;
 
 export default function createBreedMode(ctx, root) {
   const status = h("span", { class: "hint", testid: "breed-status" });
@@ -88,6 +90,7 @@ export default function createBreedMode(ctx, root) {
       const dom = h("input", {
         type: "number",
         min: 0,
+        max: MAX_DOMINANCE,
         step: "any",
         value: "1",
         testid: `dominance-${i}`,
@@ -95,22 +98,24 @@ export default function createBreedMode(ctx, root) {
         title: "Dominance of this parent: the more dominant, the more genes it gives",
       });
       const info = h("button", { class: "cell-info", testid: `cell-info-${i}`, title: "Show this plant's genome" }, "i");
+      const domError = h("span", { class: "dom-error", testid: `dominance-error-${i}`, role: "alert", hidden: true });
       const el = h("div", { class: "cell", testid: `grid-cell-${i}`, dataset: { index: String(i) } }, label,
-        h("div", { class: "cell-tools" }, h("label", { class: "dom-label" }, "dominance ", dom), info));
-      for (const c of [dom, info]) {
+        h("div", { class: "cell-tools" }, domError, h("label", { class: "dom-label" }, "dominance ", dom), info));
+      for (const c of [dom, info, domError]) {
         c.addEventListener("pointerdown", (e) => e.stopPropagation());
         c.addEventListener("pointerup", (e) => e.stopPropagation());
         c.addEventListener("wheel", (e) => e.stopPropagation());
       }
       dom.addEventListener("input", () => {
         if (cell.plant !== null) dominance.set(cell.plant, dom.value);
+        showDominanceError(cell, "");
       });
       info.addEventListener("click", () => {
         if (cell.plant !== null) ctx.openPlant(cell.plant);
       });
       gridEl.append(el);
       const view = stage.addView(el);
-      const cell = { el, label, dom, view, plant: null };
+      const cell = { el, label, dom, domError, view, plant: null };
       cells.push(cell);
       let down = null;
       el.addEventListener("pointerdown", (e) => {
@@ -247,8 +252,41 @@ export default function createBreedMode(ctx, root) {
     return readNumber(children, "children");
   }
 
+  function showDominanceError(cell, message) {
+    cell.dom.setCustomValidity(message);
+    cell.domError.textContent = message;
+    cell.domError.hidden = !message;
+    cell.el.classList.toggle("dom-invalid", Boolean(message));
+  }
+
+  /**
+   * A picked plant's dominance, read from its cell's control: a number from 0 to
+   * MAX_DOMINANCE, or null once the control shows why not. An empty control, and one whose
+   * text is no finite number (1e400: the browser then reports "" as its value), would
+   * otherwise be sent as 0, silently leaving the plant out of the cross.
+   */
+  function readDominance(cell) {
+    const text = cell.dom.value.trim();
+    const n = Number(text);
+    const unreadable = cell.dom.validity.badInput || text === "" || !Number.isFinite(n);
+    const ok = !unreadable && n >= 0 && n <= MAX_DOMINANCE;
+    const got = unreadable ? "it is empty or not a number" : `got ${text}`;
+    showDominanceError(cell, ok ? "" : `Dominance: expected a number from 0 to ${MAX_DOMINANCE}; ${got}`);
+    return ok ? n : null;
+  }
+
   function cross() {
-    const parents = selected.map((id) => ({ plant: id, dominance: Number(dominance.get(id) ?? "1") }));
+    // Every picked plant's control is checked (each shows its own message); none is sent
+    // while one is wrong.
+    const read = selected.map((id) => {
+      const cell = cells.find((c) => c.plant === id);
+      return cell ? readDominance(cell) : Number(dominance.get(id) ?? "1");
+    });
+    if (read.some((d) => d === null)) {
+      status.textContent = `a dominance is not a number from 0 to ${MAX_DOMINANCE}: see the picked plants`;
+      return;
+    }
+    const parents = selected.map((id, i) => ({ plant: id, dominance: read[i] }));
     return step(() => {
       const body = { parents, level: level.value };
       const c = childrenCount();

@@ -44,6 +44,17 @@ impl<M: Evolve + Default> SavedRun<M> {
     }
 }
 
+/// A checkpoint whose text does not parse as JSON, said in those words at its line and
+/// column: serde's own (`expected ident`) tell a person nothing of what was wrong.
+fn not_json(path: &Path, text: &str, e: &serde_json::Error) -> InputError {
+    let message = if e.is_eof() {
+        "the checkpoint is not JSON: its text ends before its JSON does (cut short?)"
+    } else {
+        "the checkpoint is not JSON: its text stops being JSON here"
+    };
+    InputError::at(path, text, e.line(), e.column(), message.to_owned())
+}
+
 /// The own fitness term a checkpoint records, if any.
 fn own_term(path: &Path, text: &str) -> Result<Option<OwnRecord>, InputError> {
     // Most checkpoints have none: they are not read twice for it.
@@ -51,7 +62,7 @@ fn own_term(path: &Path, text: &str) -> Result<Option<OwnRecord>, InputError> {
         return Ok(None);
     }
     let value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+        serde_json::from_str(text).map_err(|e| not_json(path, text, &e))?;
     match value.get("own_term") {
         None => Ok(None),
         Some(term) => serde_json::from_value(term.clone())
@@ -68,7 +79,7 @@ pub(super) fn parse<M: Evolve + Default, C: DeserializeOwned>(
     text: &str,
 ) -> Result<(EvolveConfig<M>, C), InputError> {
     let mut value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+        serde_json::from_str(text).map_err(|e| not_json(path, text, &e))?;
     let bad = |e: serde_json::Error| InputError::file(path, e);
     if let Some(config) = value.get_mut("config").and_then(|c| c.as_object_mut()) {
         config.retain(|k, _| {
@@ -87,7 +98,7 @@ pub(super) fn parse<M: Evolve + Default, C: DeserializeOwned>(
 /// config file.
 pub fn checkpoint_model(path: &Path, text: &str) -> Result<String, InputError> {
     let value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| InputError::json(path, text, &e))?;
+        serde_json::from_str(text).map_err(|e| not_json(path, text, &e))?;
     value
         .pointer("/config/model")
         .and_then(|m| m.as_str())

@@ -26,7 +26,8 @@ use crate::genome::Genome;
 
 /// Scores of grown plants, from code outside Sylva (a Python function).
 pub trait PlantScorer: Send + Sync {
-    /// One score per plant of `plants`, in their order (higher is better; NaN is refused).
+    /// One score per plant of `plants`, in their order (higher is better; NaN and
+    /// infinities are refused: an infinite total cannot be ranked).
     /// An error stops the work that asked, the run as it was before it.
     fn score(&self, plants: Vec<Grown>) -> Result<Vec<f64>, ScorerError>;
 }
@@ -281,12 +282,15 @@ impl<M: Evolve + Default> Scored<M> {
             )
             .into());
         }
-        if let Some(i) = scores.iter().position(|s| s.is_nan()) {
+        // An infinite score makes an infinite total, which the run cannot rank (one +inf
+        // is every member's best, all -inf leave no member with a fitness): refused as NaN is.
+        if let Some(i) = scores.iter().position(|s| !s.is_finite()) {
             return Err(InputError::new(
                 "fitness",
                 format!(
-                    "the fitness function returned NaN for plant {i} of a batch of {count}; \
-                     expected a number (negative infinity for the worst)"
+                    "the fitness function returned {} for plant {i} of a batch of {count}; \
+                     expected a finite number (a very low one for the worst)",
+                    scores[i]
                 ),
             )
             .into());
