@@ -117,10 +117,10 @@ fn one_plant_of_each_model() {
             ("lsystem.obj", 0xb7b2_1d21_c371_d211),
             ("lsystem.wrl", 0x6c1a_fb10_cf41_5531),
             ("lsystem.png", 0x6c6d_cd66_74b2_365d),
-            ("grown.glb", 0x9473_e538_f6c8_6ad9),
-            ("grown.obj", 0xd698_be96_bd75_f080),
-            ("grown.wrl", 0xe476_2fd5_b9c3_2545),
-            ("grown.png", 0x6403_fe46_cae7_7085),
+            ("grown.glb", 0x8ac1_4e83_ec8f_79ad),
+            ("grown.obj", 0xc532_479e_a20c_4b38),
+            ("grown.wrl", 0xd2e8_70a5_792a_a2c1),
+            ("grown.png", 0x8a40_b90e_3c4a_7b99),
         ],
     );
 }
@@ -212,11 +212,11 @@ fn a_small_grown_run() {
             ("[output]\nsheet_size = 16", SMALL_OUTPUT),
         ],
         &[
-            ("stats.csv", 0x7342_e5ae_abb9_5208),
-            ("best.json", 0xf8e6_f019_9f3b_0843),
-            ("best.glb", 0x2117_3e20_8b54_e564),
-            ("best.png", 0x7606_6115_880b_55f8),
-            ("population.png", 0x4a2f_2640_2eb2_a259),
+            ("stats.csv", 0xe0b8_965d_b2ac_e6d1),
+            ("best.json", 0x8170_3c26_cc56_f892),
+            ("best.glb", 0x2b6f_5b76_70e0_bae3),
+            ("best.png", 0x0620_5f87_2716_a5f9),
+            ("population.png", 0x20c2_076a_7f26_b3b2),
         ],
     );
 }

@@ -343,6 +343,12 @@ impl Outline {
         &self.normalised
     }
 
+    /// The column (pixels from the normalised canvas's left edge) where the ink's foot
+    /// stands: the middle of its bottom row.
+    pub fn foot(&self) -> f32 {
+        self.foot
+    }
+
     /// Intersection over union of `plant`'s normalised silhouette with this outline, 0 to
     /// 1; 0 for a plant with nothing above the ground to see. Draws into `scratch`.
     pub fn iou(&self, plant: &Plant, scratch: &mut Scratch) -> f64 {

@@ -3,12 +3,13 @@
 //!
 //! `cargo run --release -p sylva-grown --example report -- examples/grown/oak.json
 //! [name=value ...]`, where each `name=value` sets a parameter (or `crown=cone`) first;
-//! `default` for the file grows the default genome.
+//! `default` for the file grows the default genome; `params` prints the parameter table.
 #![allow(clippy::unwrap_used)] // A tool for people tuning genomes: a bad argument panics.
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let mut genome = match args.next().as_deref() {
+        Some("params") => return print!("{}", sylva_grown::genome::params_table()),
         Some("default") | None => sylva_grown::Growth::default(),
         Some(path) => sylva_model::file::parse(&std::fs::read_to_string(path).unwrap()).unwrap(),
     };

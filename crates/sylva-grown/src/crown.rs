@@ -9,6 +9,8 @@
 
 use glam::Vec3;
 use rand::{Rng, RngExt};
+use serde::{Deserialize, Serialize};
+use sylva_model::TargetProfile;
 
 use crate::genome::{CrownShape, Growth, Param};
 
@@ -54,11 +56,149 @@ pub enum EnvelopeError {
     },
 }
 
+/// A crown's envelope drawn from pictures rather than a shape: where the crown begins and
+/// its rows to the top, all as shares of the tree's height, so the tree's `height` scales
+/// it. A genome that carries one grows into it; its crown shape, `crown_base`, `width` and
+/// `depth` then say nothing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, try_from = "RawProfile")]
+pub struct Profile {
+    /// Where the crown begins, as a share of the height, 0 to 1.
+    pub base: f32,
+    /// Rows from the crown's base to the top, each the stretch of x (front view) and of z
+    /// (side view) as shares of the height from the trunk's foot: 1 to [`MAX_PROFILE_ROWS`]
+    /// rows, each number within ±[`MAX_PROFILE_REACH`].
+    pub rows: Vec<[[f32; 2]; 2]>,
+}
+
+/// Most rows a profile holds.
+pub const MAX_PROFILE_ROWS: usize = 256;
+
+/// How far a profile's crown reaches from its foot, as a share of the height.
+pub const MAX_PROFILE_REACH: f32 = 3.0;
+
+/// Rows a profile is drawn from a target with.
+const PROFILE_ROWS: usize = 48;
+
+/// A profile as read, before its checks.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawProfile {
+    base: f32,
+    rows: Vec<[[f32; 2]; 2]>,
+}
+
+impl TryFrom<RawProfile> for Profile {
+    type Error = String;
+    fn try_from(raw: RawProfile) -> Result<Profile, String> {
+        if !(0.0..1.0).contains(&raw.base) {
+            return Err(format!(
+                "`envelope.base` must be a share of the height from 0 to 1, got {}",
+                raw.base
+            ));
+        }
+        if raw.rows.is_empty() || raw.rows.len() > MAX_PROFILE_ROWS {
+            return Err(format!(
+                "`envelope.rows` must hold 1 to {MAX_PROFILE_ROWS} rows, got {}",
+                raw.rows.len()
+            ));
+        }
+        let reach = -MAX_PROFILE_REACH..=MAX_PROFILE_REACH;
+        if let Some(i) =
+            (raw.rows.iter()).position(|r| r.as_flattened().iter().any(|v| !reach.contains(v)))
+        {
+            return Err(format!(
+                "`envelope.rows[{i}]` must hold shares of the height from -{MAX_PROFILE_REACH} \
+                 to {MAX_PROFILE_REACH}, got {:?}",
+                raw.rows[i]
+            ));
+        }
+        Ok(Profile {
+            base: raw.base,
+            rows: raw.rows,
+        })
+    }
+}
+
+impl Profile {
+    /// The crown a match's target shows ([`TargetProfile`]): the rows above the trunk (the
+    /// first row from the foot at least [`CROWN_WIDTH`] as wide as the widest, in either
+    /// view) to the top, each view's stretch of ink, drawn in [`PROFILE_ROWS`] rows. `Err`
+    /// for a target with no crown to grow into.
+    pub fn from_target(target: &TargetProfile) -> Result<Profile, EnvelopeError> {
+        let n = target.front.len().min(target.side.len());
+        let width = |r: [f32; 2]| (r[1] - r[0]).max(0.0);
+        let widest = |rows: &[[f32; 2]]| rows.iter().map(|&r| width(r)).fold(0.0, f32::max);
+        let (front, side) = (&target.front[..n], &target.side[..n]);
+        let (wf, ws) = (widest(front), widest(side));
+        let crowned =
+            |i: usize| width(front[i]) >= CROWN_WIDTH * wf || width(side[i]) >= CROWN_WIDTH * ws;
+        let top = (0..n)
+            .rev()
+            .find(|&i| width(front[i]) > 0.0 && width(side[i]) > 0.0);
+        let (Some(base), Some(top)) = ((0..n).find(|&i| crowned(i)), top) else {
+            return Err(EnvelopeError::Empty {
+                base: 0.0,
+                top: 1.0,
+            });
+        };
+        if wf <= 0.0 || ws <= 0.0 || top <= base {
+            return Err(EnvelopeError::Empty {
+                base: base as f32 / n as f32,
+                top: (top + 1) as f32 / n as f32,
+            });
+        }
+        let span = top + 1 - base;
+        let rows = (0..PROFILE_ROWS.min(span))
+            .map(|k| {
+                let (a, b) = (
+                    base + k * span / PROFILE_ROWS.min(span),
+                    base + (k + 1) * span / PROFILE_ROWS.min(span),
+                );
+                let hull = |rows: &[[f32; 2]]| {
+                    rows[a..b.max(a + 1)]
+                        .iter()
+                        .filter(|r| width(**r) > 0.0)
+                        .fold([f32::MAX, f32::MIN], |h, r| {
+                            [h[0].min(r[0]), h[1].max(r[1])]
+                        })
+                };
+                let (x, z) = (hull(front), hull(side));
+                let clean = |h: [f32; 2]| {
+                    if h[0] < h[1] {
+                        h.map(|v| v.clamp(-MAX_PROFILE_REACH, MAX_PROFILE_REACH))
+                    } else {
+                        [0.0, 0.0]
+                    }
+                };
+                [clean(x), clean(z)]
+            })
+            .collect();
+        Ok(Profile {
+            base: base as f32 / n as f32,
+            rows,
+        })
+    }
+}
+
+/// A row is the crown's when it is at least this share as wide as the crown's widest row:
+/// narrower rows below the crown are the trunk.
+pub const CROWN_WIDTH: f32 = 0.25;
+
 impl Envelope {
-    /// The envelope of a genome's crown shape and proportions.
+    /// The envelope of a genome's crown: its profile, or its shape and proportions.
     pub fn of(genome: &Growth) -> Envelope {
         let p = &genome.parameters;
         let height = p.f(Param::Height);
+        if let Some(profile) = &genome.envelope {
+            return Envelope {
+                base: profile.base * height,
+                top: height,
+                rows: (profile.rows.iter())
+                    .map(|r| r.map(|s| s.map(|v| v * height)))
+                    .collect(),
+            };
+        }
         let half_width = 0.5 * p.f(Param::Width) * height;
         let half_depth = half_width * p.f(Param::Depth);
         Envelope::of_shape(
@@ -178,6 +318,7 @@ impl Envelope {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::genome::{Growth, Param};
 
     #[test]
     fn points_fill_the_shape_and_nothing_else() {
@@ -207,6 +348,67 @@ mod tests {
             "{} {measured}",
             e.volume()
         );
+    }
+
+    /// A lollipop: a trunk a tenth as wide as the crown for 30 rows, then a round crown.
+    fn lollipop() -> TargetProfile {
+        let rows: Vec<[f32; 2]> = (0..100)
+            .map(|i| {
+                if i < 30 {
+                    [-0.02, 0.02]
+                } else {
+                    let t = (i as f32 - 65.0) / 35.0;
+                    let r = 0.35 * (1.0 - t * t).max(0.0).sqrt();
+                    [-r.max(0.02), r.max(0.02)]
+                }
+            })
+            .collect();
+        TargetProfile {
+            front: rows.clone(),
+            side: rows,
+        }
+    }
+
+    #[test]
+    fn a_target_s_crown_is_its_hull_above_the_trunk() {
+        let profile = Profile::from_target(&lollipop()).unwrap();
+        assert!((profile.base - 0.3).abs() < 0.03, "{}", profile.base);
+        let genome = Growth {
+            envelope: Some(profile),
+            ..Growth::default()
+        };
+        let e = Envelope::of(&genome);
+        let height = genome.parameters.f(Param::Height);
+        assert_eq!(e.top, height);
+        assert!(e.contains(Vec3::new(0.0, 0.65 * height, 0.0)));
+        assert!(
+            !e.contains(Vec3::new(0.0, 0.2 * height, 0.0)),
+            "the trunk is no crown"
+        );
+        assert!(!e.contains(Vec3::new(0.4 * height, 0.65 * height, 0.0)));
+        // The tree grows into it: its leaves stay about the crown's rows.
+        let (plant, report) = crate::grow(&genome, 1).unwrap();
+        assert!(report.internodes > 200, "{report:?}");
+        let low = plant
+            .organs()
+            .iter()
+            .filter(|o| o.position.y < 0.2 * height)
+            .count();
+        assert_eq!(low, 0);
+        let far = (plant.organs().iter())
+            .filter(|o| o.position.x.abs() > 0.5 * height)
+            .count();
+        assert_eq!(far, 0);
+    }
+
+    #[test]
+    fn a_target_with_no_crown_is_refused() {
+        let blank = TargetProfile {
+            front: vec![[0.0, 0.0]; 50],
+            side: vec![[0.0, 0.0]; 50],
+        };
+        let e = Profile::from_target(&blank).unwrap_err();
+        assert!(e.to_string().contains("empty or flat"), "{e}");
     }
 
     #[test]

@@ -27,6 +27,8 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::species::{BarkKind, LeafKind};
 use sylva_model::{FormatV1, model_tag};
 
+use crate::crown::Profile;
+
 /// Model name in genome files.
 pub const MODEL: &str = "grown";
 
@@ -354,6 +356,9 @@ pub struct Growth {
     /// The numbers ([`PARAMS`]); left out, a parameter takes its default.
     #[serde(default)]
     pub parameters: Params,
+    /// A crown drawn from pictures (a match's), grown into instead of the crown shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub envelope: Option<Profile>,
 }
 
 impl Default for Growth {
@@ -367,6 +372,7 @@ impl Default for Growth {
             foliage: LeafKind::Oak,
             bark: None,
             parameters: Params::default(),
+            envelope: None,
         }
     }
 }
@@ -456,6 +462,25 @@ impl Growth {
     }
 }
 
+/// The parameters as a Markdown table (name, group, range, default, meaning), as
+/// `docs/grown.md` shows them.
+pub fn params_table() -> String {
+    let mut table = String::from("| parameter | group | range | default | what it does |\n");
+    table.push_str("| --- | --- | --- | --- | --- |\n");
+    for p in &PARAMS {
+        let group = match p.group {
+            Group::Crown => "crown",
+            Group::Growth => "growth",
+            Group::Form => "form",
+        };
+        table.push_str(&format!(
+            "| `{}` | {group} | {} to {}{} | {} | {} |\n",
+            p.name, p.min, p.max, p.unit, p.default, p.meaning
+        ));
+    }
+    table
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -517,6 +542,22 @@ mod tests {
                 assert!(!spec.whole || v.fract() == 0.0);
             }
         }
+    }
+
+    #[test]
+    fn the_docs_show_every_parameter_as_the_table_says() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/grown.md");
+        let doc = std::fs::read_to_string(path).unwrap_or_default();
+        let start = "<!-- parameters: made by sylva_grown::genome::params_table -->\n";
+        let table = doc
+            .split_once(start)
+            .and_then(|(_, rest)| rest.split_once("<!-- end -->"))
+            .map(|(table, _)| table);
+        assert_eq!(
+            table,
+            Some(params_table().as_str()),
+            "docs/grown.md's table is stale"
+        );
     }
 
     #[test]

@@ -53,6 +53,10 @@ const SHADE_DEPTH: i32 = 5;
 /// distance, as internodes crowd closer when it is short.
 const SHADE: f32 = 0.1;
 
+/// Cycles a side bud may stay dormant before it is spent (and no longer perceives space):
+/// old buds deep in a crown would otherwise fill every gap the crown's shade leaves.
+const DORMANT_CYCLES: u32 = 4;
+
 /// Most leaves one internode bears.
 const MAX_LEAVES_PER_INTERNODE: u32 = 6;
 
@@ -294,8 +298,16 @@ struct Run {
     lateral: bool,
 }
 
-/// Most internodes of a twig left out of the wood.
+/// Most internodes of a twig left out of the wood (more when the wood is over its budget).
 const TWIG: u32 = 5;
+
+/// Most segments of a broadleaf's wood: about 16,000 triangles, beside 24,000 of its
+/// leaf cards (a game's budget of 40,000 for a tree in leaf).
+const BROADLEAF_SEGMENTS: usize = 1000;
+
+/// Most segments of a conifer's wood: about 13,000 triangles, beside 16,000 of its
+/// crossed needle cards (a budget of 30,000).
+const CONIFER_SEGMENTS: usize = 800;
 
 /// Most internodes joined into one segment.
 const RUN_MOST: u32 = 8;
@@ -366,7 +378,7 @@ pub fn grow_into(
     };
     tree.bole(envelope.base, envelope.top);
     let cycles = p.count(Param::Cycles).min(MAX_CYCLES);
-    let mut bud_grid = Grid::new(lo, hi, reach);
+    let mut bud_grid = Grid::new(lo, hi, 0.5 * reach);
     let mut buds = Vec::new();
     let mut stop = Stop::Cycles;
     let mut grown = 0;
@@ -375,7 +387,7 @@ pub fn grow_into(
             stop = Stop::SpaceUsed;
             break;
         }
-        tree.buds(&mut buds);
+        tree.buds(&mut buds, cycle);
         tree.perceive(&mut buds, &mut bud_grid, reach);
         tree.allocate(&mut buds);
         if !tree.shoot(&buds, cycle)? {
@@ -479,14 +491,19 @@ impl Tree<'_> {
         id
     }
 
-    /// Every bud of the living tree, in node order (main before side).
-    fn buds(&self, buds: &mut Vec<Bud>) {
+    /// Every bud of the living tree that can still grow in `cycle`, in node order (main
+    /// before side): a side bud left dormant for [`DORMANT_CYCLES`] is spent.
+    fn buds(&self, buds: &mut Vec<Bud>, cycle: u32) {
         buds.clear();
         for (i, n) in self.nodes.iter().enumerate() {
             if n.dead {
                 continue;
             }
+            let spent = n.born + DORMANT_CYCLES < cycle;
             for (slot, side) in [(n.main, false), (n.side, true)] {
+                if side && spent {
+                    continue;
+                }
                 if let Slot::Bud(heading) = slot {
                     buds.push(Bud {
                         node: i as u32,
@@ -520,7 +537,7 @@ impl Tree<'_> {
                 let d2 = to.length_squared();
                 // Within reach, in the cone (`to·h ≥ |to| cos θ`), nearest; ties to the
                 // first bud, so the order of buds decides, not the grid's.
-                if d2 < reach2 && to.dot(bud.heading) >= cone * d2.sqrt() && (d2, b) < best {
+                if d2 < reach2 && (d2, b) < best && to.dot(bud.heading) >= cone * d2.sqrt() {
                     best = (d2, b);
                 }
             });
@@ -723,29 +740,41 @@ impl Tree<'_> {
                 lateral: node.lateral,
             });
         }
-        // Twigs (runs of at most TWIG internodes with nothing growing from them) are left out
-        // of the wood and their leaves go to the stem they grow from: a leaf card pictures a
-        // twig with its leaves, and meshing thousands of twigs would blow a game's budget.
-        let mut bears_runs = vec![false; runs.len()];
-        for run in &runs {
-            if let Some(p) = run.parent {
-                bears_runs[p as usize] = true;
+        // Twigs are left out of the wood and their leaves go to the stem they grow from: a
+        // leaf card pictures a twig with its leaves, and meshing thousands of twigs would blow
+        // a game's budget. A twig is a branch of at most `most` internodes in all (from
+        // TWIG up, until the wood is within the budget of segments).
+        let mut size = runs.iter().map(|r| r.count).collect::<Vec<_>>();
+        for k in (0..runs.len()).rev() {
+            if let Some(p) = runs[k].parent {
+                size[p as usize] += size[k];
             }
         }
+        let budget = if spec.needles {
+            CONIFER_SEGMENTS
+        } else {
+            BROADLEAF_SEGMENTS
+        };
+        let mut most = TWIG;
+        let twig = loop {
+            let twig: Vec<bool> = (runs.iter().zip(&size))
+                .map(|(r, &n)| r.parent.is_some() && n <= most)
+                .collect();
+            if twig.iter().filter(|&&t| !t).count() <= budget || most > MAX_NODES as u32 {
+                break twig;
+            }
+            most = most * 3 / 2;
+        };
         let mut id_of = vec![u32::MAX; runs.len()];
-        let mut twig = vec![false; runs.len()];
         let mut kept = 0;
         for (k, run) in runs.iter().enumerate() {
-            match run.parent {
-                Some(p) if !bears_runs[k] && run.count <= TWIG => {
-                    twig[k] = true;
-                    id_of[k] = id_of[p as usize];
-                }
+            id_of[k] = match run.parent {
+                Some(p) if twig[k] => id_of[p as usize],
                 _ => {
-                    id_of[k] = kept;
                     kept += 1;
+                    kept - 1
                 }
-            }
+            };
         }
         for (k, run) in runs.iter().enumerate() {
             if twig[k] {

@@ -21,7 +21,7 @@
 //!
 //! let genome = Growth::default();
 //! let tree = GrownModel.develop(&genome, genome.seed)?;
-//! assert!(tree.segments().len() > 300);
+//! assert!(tree.segments().len() > 100 && !tree.organs().is_empty());
 //! # Ok::<(), sylva_model::DevelopError>(())
 //! ```
 
@@ -30,7 +30,7 @@ pub mod genome;
 pub mod grow;
 pub mod problem;
 
-pub use crown::{Envelope, EnvelopeError};
+pub use crown::{Envelope, EnvelopeError, Profile};
 pub use genome::{CrownShape, Growth, MODEL, PARAMS, Param, ParamSpec, Params};
 pub use grow::{MAX_NODES, Report, Stop, grow, grow_into};
 pub use problem::{GrownProblem, GrownSettings, GrownStrategy};
@@ -40,7 +40,7 @@ use sylva_core::Plant;
 use sylva_core::dress::Dress;
 use sylva_model::{
     Bred, ConfigError, CrossLevel, DevelopError, Evolve, Knobs, Model, Parent, Setup,
-    VariationError, VectorCoding, two_most_dominant,
+    TargetProfile, VariationError, VectorCoding, two_most_dominant,
 };
 
 /// Self-organising trees as a Sylva model.
@@ -127,6 +127,19 @@ impl Evolve for GrownModel {
         settings.breeding = sylva_evolve::GenerationalSettings::mostly_mutants();
     }
 
+    /// Every genome of the run grows into the crown the pictures show: the visual hull of
+    /// the front and side outlines above the trunk ([`crown::Profile::from_target`]).
+    fn fit_target(
+        &self,
+        settings: &mut GrownSettings,
+        target: &TargetProfile,
+    ) -> Result<(), ConfigError> {
+        let profile =
+            crown::Profile::from_target(target).map_err(|e| ConfigError::new("envelope", e))?;
+        settings.envelope = Some(profile);
+        Ok(())
+    }
+
     fn start_files(&self, settings: &GrownSettings) -> Vec<std::path::PathBuf> {
         settings.start.clone()
     }
@@ -161,9 +174,13 @@ impl Evolve for GrownModel {
     /// Every parameter, in its own range ([`problem::ParamCoding`]).
     fn vector_coding(
         &self,
-        _problem: &GrownProblem,
+        problem: &GrownProblem,
         seed: u64,
     ) -> Option<Box<dyn VectorCoding<Self>>> {
-        Some(Box::new(problem::ParamCoding::new(Growth::default(), seed)))
+        let template = Growth {
+            envelope: problem.settings.envelope.clone(),
+            ..Growth::default()
+        };
+        Some(Box::new(problem::ParamCoding::new(template, seed)))
     }
 }

@@ -24,6 +24,7 @@ use sylva_fitness::poncin::{NumTarget, PoncinContext, TERM_NAMES, TargetShape};
 use sylva_model::VectorCoding;
 
 use crate::GrownModel;
+use crate::crown::Profile;
 use crate::genome::{Growth, PARAMS, Params, Variation};
 
 /// The self-organising model's settings: how genomes are varied, the first generation,
@@ -50,6 +51,10 @@ pub struct GrownSettings {
     pub breeding: GenerationalSettings,
     /// The fitness (Poncin's terms over the grown tree).
     pub fitness: PoncinFitness,
+    /// The crown a match's pictures show, which every genome of the run grows into
+    /// ([`GrownModel::fit_target`](sylva_model::Evolve::fit_target)); never in a file.
+    #[serde(skip)]
+    pub envelope: Option<Profile>,
 }
 
 sylva_core::ranged!(rate: f64, "mutation_rate", 0.0, 1.0);
@@ -74,6 +79,7 @@ impl Default for GrownSettings {
             start: Vec::new(),
             breeding: GenerationalSettings::default(),
             fitness,
+            envelope: None,
         }
     }
 }
@@ -156,7 +162,9 @@ impl Problem for GrownProblem {
     }
 
     fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> Growth {
-        Growth::random(&Growth::default(), rng)
+        let mut genome = Growth::random(&Growth::default(), rng);
+        genome.envelope.clone_from(&self.settings.envelope);
+        genome
     }
 }
 
@@ -170,6 +178,12 @@ pub fn first_generation(
 ) -> Vec<Growth> {
     if chosen.is_empty() {
         return chosen;
+    }
+    let mut chosen = chosen;
+    if settings.envelope.is_some() {
+        for genome in &mut chosen {
+            genome.envelope.clone_from(&settings.envelope);
+        }
     }
     let mut rng = sylva_core::rng::stream(seed, 0, u32::MAX);
     let mut first = chosen.clone();

@@ -394,6 +394,19 @@ pub trait Evolve: Model {
     /// breeds mostly mutants here. The default changes nothing.
     fn fitting(&self, _settings: &mut Self::Settings) {}
 
+    /// The settings a match towards `target` breeds with, for a model whose plants can
+    /// grow into a target's shape (the self-organising model fills the visual hull of the
+    /// outlines): called after [`Evolve::fitting`] when a run has a target outline. `Err`
+    /// says why the target cannot be grown into (a hull with no volume). The default
+    /// changes nothing.
+    fn fit_target(
+        &self,
+        _settings: &mut Self::Settings,
+        _target: &TargetProfile,
+    ) -> Result<(), ConfigError> {
+        Ok(())
+    }
+
     /// Genome files the settings name (relative to the config file), read by the caller and
     /// given to [`Evolve::setup`] as `start`.
     fn start_files(&self, _settings: &Self::Settings) -> Vec<PathBuf> {
@@ -473,6 +486,19 @@ pub trait VectorCoding<M: Evolve>: Send + Sync {
     /// can express, or the nearest one it can; `Err` says why a genome has no vector here
     /// (another shape than the problem's genomes), naming what differs.
     fn encode(&self, genome: &M::Genome) -> Result<Vec<f64>, String>;
+}
+
+/// A match's target outlines as a model may grow into them ([`Evolve::fit_target`]): for
+/// each row of the pictures from the foot (row 0) to the top, the stretch of ink seen from
+/// the front and from the side, as shares of the outline's height measured from the foot
+/// (negative to the left, or to the back). A row without ink is `[0, 0]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetProfile {
+    /// Rows of the front view, foot to top.
+    pub front: Vec<[f32; 2]>,
+    /// Rows of the side view, foot to top (the front's again when no side view is given:
+    /// the front turned a quarter).
+    pub side: Vec<[f32; 2]>,
 }
 
 /// How long one evaluation may take ([`Evolve::evaluation_time`]).

@@ -127,6 +127,34 @@ impl Target {
             .collect()
     }
 
+    /// The pictures as a model may grow into them ([`sylva_model::TargetProfile`]): each
+    /// view's ink, row by row from its foot, at [`PROFILE_ROWS`] rows; a target without a
+    /// side view is seen from the side as from the front.
+    pub fn profile(&self) -> Result<sylva_model::TargetProfile, InputError> {
+        let outlines = self.outlines(PROFILE_ROWS)?;
+        let rows_of = |o: &Outline| {
+            let (ink, rows) = (o.normalised(), o.rows());
+            (0..rows)
+                .rev()
+                .map(|y| {
+                    let mut xs = (0..ink.width()).filter(|&x| ink.get(x, y));
+                    let Some(left) = xs.next() else {
+                        return [0.0, 0.0];
+                    };
+                    let right = xs.next_back().unwrap_or(left) + 1;
+                    let share = |x: u32| (x as f32 - o.foot()) / rows as f32;
+                    [share(left), share(right)]
+                })
+                .collect::<Vec<_>>()
+        };
+        let front = rows_of(&outlines[0]);
+        let side = match outlines.iter().find(|o| o.side() == Side::Side) {
+            Some(side) if outlines.len() > 1 => rows_of(side),
+            _ => front.clone(),
+        };
+        Ok(sylva_model::TargetProfile { front, side })
+    }
+
     /// The outlines plants grow inside (at [`SPACE_ROWS`] rows) when `config` prunes
     /// (`[match] prune`); none when it does not.
     pub fn space(&self, config: &MatchConfig) -> Result<Option<Arc<[Outline]>>, InputError> {
@@ -196,6 +224,9 @@ pub fn space(config: &MatchConfig, base: &Path) -> Result<Option<Arc<[Outline]>>
     }
     Target::read(config, base)?.space(config)
 }
+
+/// Rows of a target's profile ([`Target::profile`]).
+pub const PROFILE_ROWS: u32 = 128;
 
 /// Rows of the overlay picture's outlines.
 const OVERLAY_ROWS: u32 = 256;

@@ -301,7 +301,7 @@ impl<M: Evolve + Default> TypedRun<M> {
                 let genomes = saved.population.iter().map(|i| &i.genome);
                 scored.prepare(&problem.problem, genomes, &hooked.pool)?;
             }
-            let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, "the run")?;
+            let setup = setup(config, None, Vec::new(), 0, 0, "the run")?;
             sylva_evolve::Run::resume(problem, setup.strategy, hooked.pool.clone(), saved.clone())
                 .map_err(|e| Error::from(InputError::new("the run", e)))
         });
@@ -357,16 +357,7 @@ pub(crate) fn start<M: Evolve + Default>(
         "breed a smaller population, or smaller genomes",
     )
     .map_err(|e| InputError::new(source, e).over_limit())?;
-    let made = |start: Vec<M::Genome>| {
-        setup(
-            &config.model,
-            &config.settings,
-            start,
-            seed,
-            population,
-            source,
-        )
-    };
+    let made = |start: Vec<M::Genome>| setup(config, target, start, seed, population, source);
     // With an own term, the model is set up twice more: to make generation 0 once without its
     // fitness, and to foresee each generation's genomes (`hooks.rs`).
     let again = hooks.term.as_ref().map(|_| typed.clone());
@@ -490,7 +481,7 @@ pub(crate) fn resume<M: Evolve + Default>(
     }
     check_resumed(saved.own_term.as_ref(), hooks.term.as_ref())
         .map_err(|e| InputError::file(path, e))?;
-    let made = || setup(&config.model, &config.settings, Vec::new(), 0, 0, source);
+    let made = || setup(config, target, Vec::new(), 0, 0, source);
     let setup = made()?;
     let scout = || Ok(made()?.strategy);
     let (problem, hooked) = with_hooks(config, setup.problem, target, pool, hooks, scout)?;
@@ -551,17 +542,29 @@ pub(super) fn with_term<M: Evolve>(
     Ok(WithTerm { problem, added })
 }
 
-/// The model's problem and strategy for `settings`; a refusal names the config (`source`)
-/// and the model's section.
+/// The model's problem and strategy for the config's settings, fitted to `target` when the
+/// config matches one (`Evolve::fit_target`: a self-organising tree grows into the
+/// pictures' hull); a refusal names the config (`source`) and the model's section.
 pub(super) fn setup<M: Evolve>(
-    model: &M,
-    settings: &M::Settings,
+    config: &EvolveConfig<M>,
+    target: Option<&Target>,
     start: Vec<M::Genome>,
     seed: u64,
     population: usize,
     source: &str,
 ) -> Result<sylva_model::Setup<M>, InputError> {
+    let model = &config.model;
+    let settings = match (&config.outline, target) {
+        (Some(_), Some(target)) => {
+            let mut fitted = config.settings.clone();
+            model
+                .fit_target(&mut fitted, &target.profile()?)
+                .map_err(|e| InputError::new("match", e.message))?;
+            std::borrow::Cow::Owned(fitted)
+        }
+        _ => std::borrow::Cow::Borrowed(&config.settings),
+    };
     model
-        .setup(settings, start, seed, population)
+        .setup(&settings, start, seed, population)
         .map_err(|e| InputError::new(source, format!("[{}.{}]: {}", M::NAME, e.field, e.message)))
 }

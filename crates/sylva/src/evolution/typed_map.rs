@@ -249,8 +249,8 @@ pub(crate) fn start_map<M: Evolve + Default>(
             .map_err(|e| InputError::new(source, e).over_limit())?;
     }
     let setup = setup(
-        &config.model,
-        &config.settings,
+        &config,
+        target,
         typed,
         config.run.seed,
         settings.initial,
@@ -302,7 +302,7 @@ pub(crate) fn resume_map<M: Evolve + Default>(
     if engine.settings != settings {
         return Err(InputError::file(path, "the checkpoint's map differs from its config").into());
     }
-    let setup = setup(&config.model, &config.settings, Vec::new(), 0, 0, source)?;
+    let setup = setup(&config, target, Vec::new(), 0, 0, source)?;
     let problem = with_term(&config, setup.problem, target)?;
     let coding = emitter_coding(&config, &problem, source)?;
     let describer = Arc::new(PlantDescriber {

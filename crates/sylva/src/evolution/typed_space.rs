@@ -305,7 +305,7 @@ pub(crate) fn new_space<M: Evolve + Default>(
     let (_, descriptors) = map_settings(&config);
     let seed = options.seed.unwrap_or(config.run.seed);
     let typed = typed_start::<M>(&start)?;
-    let setup = setup(&config.model, &config.settings, typed, seed, 0, source)?;
+    let setup = setup(&config, target, typed, seed, 0, source)?;
     let problem = with_term(&config, setup.problem, target)?;
     let direct = match options.coding {
         Some(Coding::Codons) => None,
