@@ -189,16 +189,18 @@ fn height_scales_the_best_plants_assets_and_is_recorded() {
         "8",
         "--height",
         "7",
+        "--topiary",
         "--out",
         s(&out),
     ];
     ok(&sylva(&args));
     let config = fs::read_to_string(out.join("config.toml")).unwrap();
     assert!(config.contains("height = 7.0"), "{config}");
+    assert!(config.contains("topiary = true"), "{config}");
     let glb = fs::read(out.join("best.glb")).unwrap();
     assert!(String::from_utf8_lossy(&glb).contains("\"height\":7.0"));
-    // The genome is the plant as evolved; its assets are scaled, and pruned to the outline
-    // as `grow --pruned-to` prunes it.
+    // The genome is the plant as evolved; its assets are scaled, and (a topiary match's)
+    // pruned to the outline as `grow --pruned-to` prunes it.
     let grown = dir.join("grown.glb");
     let best = out.join("best.json");
     let config = out.join("config.toml");

@@ -1806,7 +1806,7 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         beside: false,
         rows: 64,
         closeness: 0.0,
-        prune: Some(true),
+        topiary: Some(true),
     };
     let space = sylva::evolution::outline::space(&target, Path::new("")).unwrap();
     let triangles = |plant: i64| {

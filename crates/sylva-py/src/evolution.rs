@@ -870,14 +870,14 @@ impl Evolution {
 /// PNG file would be); `model` a model's name or `"auto"` (each model briefly, then on with
 /// the best); for `generations` (the same bytes each time) or `seconds` of breeding (60 by
 /// default); `threshold` `"otsu"` or a luminance from 0 to 1. The best member's
-/// `terms["iou"]` is its outline term (docs/match.md); with `prune` (the default) the plants
-/// grow inside the outlines, pruned where they would show outside them (`run.grow()` grows
-/// the best so). Releases the GIL while it breeds; Ctrl-C raises `KeyboardInterrupt` within
+/// `terms["iou"]` is its outline term (docs/match.md); with `topiary=True` the plants are
+/// clipped to the outlines as a topiary is, pruned where they would show outside them
+/// (`run.grow()` grows the best so); by default they grow whole towards the outline. Releases the GIL while it breeds; Ctrl-C raises `KeyboardInterrupt` within
 /// one member's evaluation.
 #[pyfunction(name = "match")]
 #[pyo3(pass_module, signature = (target, side = None, model = "auto", generations = None,
                     seconds = None, population = Whole(100), seed = Whole(1), threshold = None,
-                    threads = Whole(0), prune = true))]
+                    threads = Whole(0), topiary = false))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments.
 pub fn match_outline(
     module: &Bound<'_, PyModule>,
@@ -891,7 +891,7 @@ pub fn match_outline(
     seed: Whole,
     threshold: Option<&Bound<'_, PyAny>>,
     threads: Whole,
-    prune: bool,
+    topiary: bool,
 ) -> PyResult<Evolution> {
     let generations: Option<u32> = whole::get(generations, "generations")?;
     let population: u32 = population.get("population")?;
@@ -919,7 +919,7 @@ pub fn match_outline(
         beside: false,
         rows: sylva::evolution::MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
-        prune: Some(prune),
+        topiary: Some(topiary),
     };
     outlines(&outline, Path::new("")).py()?;
     let limit = match (generations, seconds) {

@@ -573,16 +573,16 @@ def test_match_takes_numpy_masks_as_it_takes_pictures(tmp_path):
         sylva.match(np.zeros((64, 48), bool), **kwargs)  # no ink: no outline
 
 
-def test_a_match_grows_its_plants_inside_the_outline():
+def test_a_topiary_match_clips_its_plants_to_the_outline():
     y, x = np.mgrid[0:64, 0:48]
     cone = ((np.abs(x - 24) < (y - 4) * 0.35) & (y > 4) & (y < 60)) | ((np.abs(x - 24) < 2) & (y >= 56))
     kwargs = dict(model="plantmaker", generations=1, population=6, seed=2)
-    pruned = sylva.match(cone, **kwargs)
+    pruned = sylva.match(cone, topiary=True, **kwargs)
     best = pruned.best()
     inside, whole = pruned.grow(), best.genome.grow()
     assert inside.organs < whole.organs
     assert pruned.grow(best).glb() == inside.glb()
-    free = sylva.match(cone, prune=False, **kwargs)
+    free = sylva.match(cone, **kwargs)
     assert free.grow().glb() == free.best().genome.grow().glb()
 
 

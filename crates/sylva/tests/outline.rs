@@ -107,7 +107,7 @@ fn round_target() -> sylva::evolution::MatchConfig {
         beside: false,
         rows: sylva::evolution::MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
-        prune: None,
+        topiary: None,
     }
 }
 
@@ -350,9 +350,9 @@ fn the_tree_examples_pass_the_stem_factors() {
     }
 }
 
-/// A match that prunes (the default) grows its plants inside the outline: the term scores
-/// the pruned plant, the run's files grow it so, and the overlay shows it, each at the IoU
-/// the others see; with `prune = false` the plant grows whole.
+/// A topiary match grows its plants inside the outline: the term scores the pruned plant,
+/// the run's files grow it so, and the overlay shows it, each at the IoU the others see;
+/// without (the default) the plant grows whole.
 #[test]
 fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
     use sylva::Grown;
@@ -375,7 +375,10 @@ fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
         let (_, iou) = overlay(target, Path::new(""), &best.genome).unwrap();
         (best, options, plant, (iou, best_iou(&evolution)))
     };
-    let pruning = round_target();
+    let pruning = MatchConfig {
+        topiary: Some(true),
+        ..round_target()
+    };
     let (best, options, plant, (iou, term)) = grown(&pruning);
     let outlines = options
         .pruned_to
@@ -402,10 +405,7 @@ fn a_pruning_match_scores_writes_and_shows_the_pruned_plant() {
     // show the same outline, but for slivers at its edges.
     let shown = iou * sylva_fitness::silhouette::plausibility(&plant, &mut scratch);
     assert!((term - shown).abs() < 0.03, "{term} {shown}");
-    let free = MatchConfig {
-        prune: Some(false),
-        ..round_target()
-    };
+    let free = round_target();
     let (best, options, plant, _) = grown(&free);
     assert!(options.pruned_to.is_none());
     assert_eq!(
@@ -426,6 +426,7 @@ fn a_matchs_pictures_are_read_once_and_carried_to_its_files() {
     std::fs::copy(examples().join("match/round.png"), dir.join("round.png")).unwrap();
     let target = MatchConfig {
         front: dir.join("round.png"),
+        topiary: Some(true),
         ..round_target()
     };
     let pictures = Target::read(&target, Path::new("")).unwrap();

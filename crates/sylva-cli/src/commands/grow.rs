@@ -163,7 +163,7 @@ fn outlines_of(models: &Registry, path: &std::path::Path) -> anyhow::Result<Arc<
         InputError::file(
             path,
             "expected the config of a match that prunes its plants: it has no `[match]` \
-             section, or `prune = false`",
+             section, or no `topiary = true`",
         )
     })?;
     Ok(outlines)

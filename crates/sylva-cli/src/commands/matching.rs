@@ -59,9 +59,15 @@ pub struct MatchArgs {
     #[arg(long, default_value_t = MatchConfig::DEFAULT_ROWS,
           value_parser = clap::value_parser!(u32).range(16..=512))]
     rows: u32,
-    /// Leave the plant as its genome grows it: the outline a goal only, not the form the
-    /// plant is pruned to (`[match] prune = false`, docs/match.md).
+    /// Clip the plant to the outline as a topiary is clipped to its form: leaves cut where
+    /// they would show over sky, stems at the outline's edge (`[match] topiary = true`,
+    /// docs/match.md) [default: off: the outline is a goal, and the plant as it grew is
+    /// written]
     #[arg(long)]
+    topiary: bool,
+    /// The plant as its genome grows it, not clipped (the default now; kept so that older
+    /// scripts run).
+    #[arg(long, hide = true, conflicts_with = "topiary")]
     no_prune: bool,
     /// Worker threads; 0 means one per core. Results do not depend on it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1024))]
@@ -118,7 +124,7 @@ pub fn run(registry: &Registry, args: &MatchArgs) -> anyhow::Result<()> {
         beside: false,
         rows: args.rows,
         closeness: args.closeness,
-        prune: Some(!args.no_prune),
+        topiary: Some(args.topiary && !args.no_prune),
     };
     // The pictures are read first, once: a bad one is refused before anything is written.
     let pictures = Target::read(&target, Path::new(""))?;

@@ -513,9 +513,11 @@ def match(
     seed: int = 1,
     threshold: str | float | None = None,
     threads: int = 0,
+    topiary: bool = False,
 ) -> Evolution:
     """Evolves a plant whose outline matches a picture (a PNG or JPEG file, or a numpy
-    mask or uint8 image); returns the run."""
+    mask or uint8 image); returns the run. With `topiary=True` the plants are clipped to
+    the outline."""
 
 def set_max_memory(bytes: int) -> None:
     """Sets the memory budget in bytes (0: the default); work over it raises LimitError."""

@@ -60,9 +60,10 @@ pub struct MatchDesign {
     population: Option<u32>,
     /// The run's seed. Default 1.
     seed: Option<u64>,
-    /// Whether the plants grow inside the outlines, pruned where they would show outside
-    /// them (`[match] prune`, docs/match.md). Default true.
-    prune: Option<bool>,
+    /// Whether the plants are clipped to the outlines as a topiary is, pruned where they
+    /// would show outside them (`[match] topiary`, docs/match.md). Default false.
+    #[serde(alias = "prune")]
+    topiary: Option<bool>,
 }
 
 /// `POST /api/sessions` in match mode.
@@ -106,7 +107,7 @@ fn target(threshold: Threshold, prune: bool) -> MatchConfig {
         beside: false,
         rows: MatchConfig::DEFAULT_ROWS,
         closeness: 0.0,
-        prune: Some(prune),
+        topiary: Some(prune),
     }
 }
 
@@ -160,7 +161,7 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
     };
     let run = run_of(&design)?;
     let threshold = design.threshold.unwrap_or_default();
-    let prune = design.prune.unwrap_or(true);
+    let prune = design.topiary.unwrap_or(false);
     let model = design.model.clone().unwrap_or_else(|| AUTO.to_owned());
     let auto = model == AUTO;
     // An auto match's config is its first model's until the trials choose.
@@ -201,7 +202,12 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         let run = archive::insert_run(c, id, &config.to_toml(), generations)?;
         let state = MatchState {
             run,
-            design: json!(design),
+            // Kept explicit: a session stored before topiary was off by default says nothing
+            // and was pruned.
+            design: json!(MatchDesign {
+                topiary: Some(prune),
+                ..design
+            }),
             auto,
         };
         archive::set_state(c, id, &json!(state))?;
@@ -236,9 +242,13 @@ fn threshold_of(state: &MatchState) -> Threshold {
     serde_json::from_value(state.design["threshold"].clone()).unwrap_or_default()
 }
 
-/// Whether a match prunes its plants to the outlines (true unless asked not to).
+/// Whether a match clips its plants to the outlines (`topiary`; a session stored before
+/// topiary was off by default, which says nothing, was pruned).
 fn prune_of(state: &MatchState) -> bool {
-    state.design["prune"].as_bool().unwrap_or(true)
+    let design = &state.design;
+    (design["topiary"].as_bool())
+        .or(design["prune"].as_bool())
+        .unwrap_or(true)
 }
 
 impl Background for MatchMode {

@@ -24,7 +24,7 @@ export default function createMatchMode(ctx, root) {
   const generations = num("match-generations", 100, { min: 1, max: 10000, step: 1, width: "6em" });
   const population = num("match-population", 100, { min: 2, max: 5000, step: 1, width: "6em" });
   const seed = num("match-seed", 1, { min: 0, step: 1, width: "7em" });
-  const prune = h("input", { type: "checkbox", testid: "match-prune", checked: true });
+  const prune = h("input", { type: "checkbox", testid: "match-topiary", checked: false });
   const startBtn = h("button", { class: "primary", testid: "match-start", onclick: () => start() }, "Start");
   const stopBtn = h("button", { testid: "match-stop", onclick: () => stop() }, "Stop");
   const resumeBtn = h("button", { testid: "match-resume", title: "Go on: twice the generations asked so far", onclick: () => resume() }, "Resume");
@@ -44,7 +44,7 @@ export default function createMatchMode(ctx, root) {
       field("population", population, "2 to 5000"),
       field("seed", seed)),
     h("label", { title: "Cut what would show outside the outline, as a topiary is clipped; off: the outline is a goal only" },
-      prune, " grow inside the outline"),
+      prune, " topiary: clip to the outline"),
     h("div", { class: "buttons sticky" }, startBtn, stopBtn, resumeBtn),
   );
 
@@ -227,7 +227,7 @@ export default function createMatchMode(ctx, root) {
           generations: readNumber(generations, "match.generations"),
           population: readNumber(population, "match.population"),
           seed: seedValue(seed.value, "match.seed"),
-          prune: prune.checked,
+          topiary: prune.checked,
         },
       };
     });

@@ -226,13 +226,13 @@ pub struct MatchConfig {
         skip_serializing_if = "is_zero"
     )]
     pub closeness: f64,
-    /// Whether the plant grows inside the outlines, pruned where it would show outside
-    /// their ink as a topiary is clipped to its form ([`sylva_fitness::silhouette::prune`],
-    /// docs/match.md): in the outline's scoring and in every plant the run writes. Default
-    /// ([`MatchConfig::prunes`]): when the outline alone decides (`beside = false`); beside
-    /// the model's own terms, which score the plant as its genome grows it, not.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub prune: Option<bool>,
+    /// Whether the plant is clipped to the outlines as a topiary is to its form: pruned
+    /// where it would show outside their ink ([`sylva_fitness::silhouette::prune`],
+    /// docs/match.md), in the outline's scoring and in every plant the run writes. Default
+    /// false: the outline is a goal the plant grows towards, and a match writes trees as
+    /// they grew. (`prune`, its name before, is read too.)
+    #[serde(default, alias = "prune", skip_serializing_if = "Option::is_none")]
+    pub topiary: Option<bool>,
 }
 
 impl MatchConfig {
@@ -242,10 +242,9 @@ impl MatchConfig {
     /// the gaps of a crown and let combs of thin twigs pass for solid ink (docs/match.md).
     pub const DEFAULT_ROWS: u32 = 256;
 
-    /// Whether the plants grow inside the outlines: `prune` as set, else when the outline
-    /// alone decides.
+    /// Whether the plants are clipped to the outlines (`topiary`; false unless set).
     pub fn prunes(&self) -> bool {
-        self.prune.unwrap_or(!self.beside)
+        self.topiary.unwrap_or(false)
     }
 }
 
