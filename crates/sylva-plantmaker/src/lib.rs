@@ -496,6 +496,13 @@ impl sylva_model::Model for PlantMakerModel {
     fn default_seed(&self, genome: &PlantMaker) -> u64 {
         genome.seed
     }
+
+    fn with_seed(&self, genome: &PlantMaker, seed: u64) -> PlantMaker {
+        PlantMaker {
+            seed,
+            ..genome.clone()
+        }
+    }
 }
 
 impl sylva_model::Evolve for PlantMakerModel {
