@@ -1924,6 +1924,18 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         ["bintree", "automata", "plantmaker", "lsystem", "grown"]
             .contains(&session["model"].as_str().unwrap())
     );
+    // The model the run went on with: its plants', in the session and in the list.
+    let best = auto["rows"].as_array().unwrap().last().unwrap()["plant"].clone();
+    let model = get(&server, &format!("/api/plants/{best}"))["model"].clone();
+    assert_eq!(session["model"], model);
+    let listed = get(&server, "/api/sessions");
+    let entry = listed
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["id"] == a)
+        .unwrap();
+    assert_eq!(entry["model"], model);
 
     // Bad pictures and numbers are refused naming their fields, and keep nothing.
     let sessions = get(&server, "/api/sessions").as_array().unwrap().len();
