@@ -269,9 +269,14 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
     );
     let g3 = grid(&regrown);
     assert!(!g3.contains(&grandchild));
-    assert_eq!(
-        get(&server, &format!("/api/plants/{}", g3[1]))["operator"],
-        "regrow"
+    let again = get(&server, &format!("/api/plants/{}", g3[1]));
+    assert_eq!(again["operator"], "regrow");
+    // The panel's seed, the genome's and the packed string's are the one it grew with.
+    assert_eq!(again["seed"], 42);
+    assert_eq!(again["genome"]["seed"], 42, "{again}");
+    assert!(
+        again["packed"].as_str().unwrap().contains("\nseed 42\n"),
+        "{again}"
     );
 
     // Branch from the grandchild: a new session whose population lists it (a plant of the
@@ -293,6 +298,20 @@ fn breeding_by_hand_is_archived_step_by_step_and_survives_a_kill() {
         get(&server, &format!("/api/plants/{grandchild}"))["genome"]
     );
     assert_eq!(listed["total"], 9);
+    // In the branch, the genome's own seed edited as a field while the page sends the
+    // plant's seed as it was: the edit is the plant's seed.
+    let seed = copy["seed"].as_u64().unwrap();
+    let other = seed.wrapping_add(1);
+    let edited = post(
+        &server,
+        &format!("/api/sessions/{b}/edit"),
+        json!({"plant": first_of_branch, "fields": [{"path": "seed", "value": other}], "seed": seed}),
+    );
+    let edited = get(&server, &format!("/api/plants/{}", grid(&edited)[0]));
+    assert_eq!(
+        (edited["seed"].as_u64(), edited["genome"]["seed"].as_u64()),
+        (Some(other), Some(other))
+    );
 
     // Undo twice, redo once.
     let undone = post(&server, &format!("/api/sessions/{id}/undo"), json!({}));
@@ -1905,6 +1924,18 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         ["bintree", "automata", "plantmaker", "lsystem", "grown"]
             .contains(&session["model"].as_str().unwrap())
     );
+    // The model the run went on with: its plants', in the session and in the list.
+    let best = auto["rows"].as_array().unwrap().last().unwrap()["plant"].clone();
+    let model = get(&server, &format!("/api/plants/{best}"))["model"].clone();
+    assert_eq!(session["model"], model);
+    let listed = get(&server, "/api/sessions");
+    let entry = listed
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["id"] == a)
+        .unwrap();
+    assert_eq!(entry["model"], model);
 
     // Bad pictures and numbers are refused naming their fields, and keep nothing.
     let sessions = get(&server, "/api/sessions").as_array().unwrap().len();

@@ -161,6 +161,13 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
         0
     }
 
+    /// The genome that grows with `seed` when none is given, for models whose genomes carry
+    /// their seed (so that a plant regrown with another seed is written, packed and exported
+    /// with it); the genome as it is for the others.
+    fn with_seed(&self, genome: &Self::Genome, _seed: u64) -> Self::Genome {
+        genome.clone()
+    }
+
     /// How the model's plants are best meshed.
     fn mesh_hint(&self) -> MeshHint {
         MeshHint::default()

@@ -496,6 +496,13 @@ impl sylva_model::Model for PlantMakerModel {
     fn default_seed(&self, genome: &PlantMaker) -> u64 {
         genome.seed
     }
+
+    fn with_seed(&self, genome: &PlantMaker, seed: u64) -> PlantMaker {
+        PlantMaker {
+            seed,
+            ..genome.clone()
+        }
+    }
 }
 
 impl sylva_model::Evolve for PlantMakerModel {
@@ -526,9 +533,17 @@ impl sylva_model::Evolve for PlantMakerModel {
     ) -> Result<sylva_model::Setup<Self>, sylva_model::ConfigError> {
         let strategy = problem::strategy(settings)
             .map_err(|e| sylva_model::ConfigError::new("breeding", e))?;
+        let mut start_counts: Vec<[usize; 3]> = Vec::new();
+        for g in &start {
+            let counts = [g.branches.len(), g.fans.len(), g.inflorescences.len()];
+            if !start_counts.contains(&counts) {
+                start_counts.push(counts);
+            }
+        }
         Ok(sylva_model::Setup {
             problem: PlantMakerProblem {
                 settings: settings.clone(),
+                start_counts,
             },
             strategy,
             first: problem::first_generation(settings, start, seed, population),
@@ -539,20 +554,26 @@ impl sylva_model::Evolve for PlantMakerModel {
         genome.clone()
     }
 
-    /// The tables' codes at the settings' segment counts ([`vector::CodeCoding`]); decoded
-    /// genomes grow with `seed`.
+    /// The tables' codes ([`vector::CodeCoding`]) at the segment counts every genome of
+    /// the run has (the start genomes', else the settings'), or, where the start genomes'
+    /// differ, with the counts as entries up to the most of each; decoded genomes grow
+    /// with `seed`.
     fn vector_coding(
         &self,
         problem: &PlantMakerProblem,
         seed: u64,
     ) -> Option<Box<dyn sylva_model::VectorCoding<Self>>> {
         let s = &problem.settings;
-        Some(Box::new(vector::CodeCoding::new(
-            s.branches as usize,
-            s.fans as usize,
-            s.inflorescences as usize,
-            seed,
-        )))
+        let own = [s.branches, s.fans, s.inflorescences].map(|c| c as usize);
+        let coding = match problem.start_counts.as_slice() {
+            [] => vector::CodeCoding::new(own[0], own[1], own[2], seed),
+            [one] => vector::CodeCoding::new(one[0], one[1], one[2], seed),
+            many => {
+                let most = |i: usize| many.iter().map(|c| c[i]).max().unwrap_or(own[i]);
+                vector::CodeCoding::up_to(most(0), most(1), most(2), seed)
+            }
+        };
+        Some(Box::new(coding))
     }
 }
 

@@ -115,6 +115,10 @@ impl PlantMakerSettings {
 pub struct PlantMakerProblem {
     /// Genome sizes and operators.
     pub settings: PlantMakerSettings,
+    /// The segment counts (branches, fans, inflorescences) of the start genomes, each once:
+    /// a run's offspring take theirs from their parents, so these are every genome's (the
+    /// settings' when there are none).
+    pub start_counts: Vec<[usize; 3]>,
 }
 
 thread_local! {

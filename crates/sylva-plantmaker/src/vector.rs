@@ -8,27 +8,35 @@
 //!
 //! Each entry rounds to the nearest code, and its bounds reach half a code past the
 //! variable's range, so every code owns an equal stretch and a uniform vector draws every
-//! code alike. The segment counts are the settings' (`branches`, `fans`,
-//! `inflorescences`); the genome's own seed, which only reseeds its growth, is not an
-//! entry: decoded genomes take the coding's seed.
+//! code alike. The genome's own seed, which only reseeds its growth, is not an entry:
+//! decoded genomes take the coding's seed.
+//!
+//! Segment counts: where every genome of a run has the same (its start genomes', else the
+//! settings' `branches`, `fans` and `inflorescences`), the vector holds that many segments
+//! ([`CodeCoding::new`]). Where they differ (a map started from the five examples, whose
+//! crossovers mix their counts), the vector starts with the three counts, each from 1 to the
+//! most any start genome has, and holds that most of each segment; a genome fills the first
+//! slots and the rest are written as their lowest codes and never read
+//! ([`CodeCoding::up_to`]), so every genome of the run has a vector and decodes back to
+//! itself.
 
 use sylva_model::VectorCoding;
 
 use crate::genes::{
     BRANCH_VARIABLES, Branch, FAN_VARIABLES, Fan, FanSet, GeneKind, INFLORESCENCE_VARIABLES,
-    Inflorescence, Variable,
+    Inflorescence, Variable, mask_of,
 };
 use crate::{FormatV1, PlantMaker, PlantMakerModel, PlantMakerTag};
 
-/// Entries of a fan: its 15 codes with each of its two colours as three channels.
-const FAN_ENTRIES: usize = FAN_VARIABLES.len() + 4;
-
-/// PlantMaker's codes as a vector, for genomes of fixed segment counts.
+/// PlantMaker's codes as a vector.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CodeCoding {
+    /// Slots for branches, fans and inflorescences: a genome's counts, or the most.
     branches: usize,
     fans: usize,
     inflorescences: usize,
+    /// Whether the counts vary: the vector then starts with them.
+    counted: bool,
     seed: u64,
     bounds: Vec<[f64; 2]>,
 }
@@ -48,12 +56,33 @@ impl CodeCoding {
     /// The coding of genomes of `branches`, `fans` and `inflorescences` segments (each
     /// clamped to 1..=32, as [`PlantMaker::random`] does), decoded with growth seed `seed`.
     pub fn new(branches: usize, fans: usize, inflorescences: usize, seed: u64) -> CodeCoding {
+        CodeCoding::with(branches, fans, inflorescences, false, seed)
+    }
+
+    /// The coding of genomes of 1 to `branches`, `fans` and `inflorescences` segments (each
+    /// clamped to 1..=32): three entries for the counts, then that many slots of each.
+    pub fn up_to(branches: usize, fans: usize, inflorescences: usize, seed: u64) -> CodeCoding {
+        CodeCoding::with(branches, fans, inflorescences, true, seed)
+    }
+
+    fn with(
+        branches: usize,
+        fans: usize,
+        inflorescences: usize,
+        counted: bool,
+        seed: u64,
+    ) -> CodeCoding {
         let (n, m, k) = (
             branches.clamp(1, crate::MAX_BRANCHES),
             fans.clamp(1, crate::MAX_FANS),
             inflorescences.clamp(1, crate::MAX_INFLORESCENCES),
         );
         let mut all = Vec::new();
+        if counted {
+            all.extend([n, m, k].map(|most| bounds(1, most as u32)));
+        }
+        // A slot's ranges are those of the most segments: a genome with fewer has codes
+        // within them.
         for _ in 0..n {
             all.extend(BRANCH_VARIABLES.iter().map(|v| {
                 let (lo, hi) = v.range(n, m);
@@ -86,21 +115,24 @@ impl CodeCoding {
             branches: n,
             fans: m,
             inflorescences: k,
+            counted,
             seed,
             bounds: all,
         }
     }
 
-    /// Entries per inflorescence.
-    fn inflorescence_entries(&self) -> usize {
-        INFLORESCENCE_VARIABLES.len() - 1 + self.fans
-    }
-
-    /// Reads `N` codes of `table` from `x` (advancing it).
-    fn codes<const N: usize>(&self, table: &[Variable; N], x: &mut &[f64]) -> [u32; N] {
+    /// Reads `N` codes of `table` from a slot of `x` (advancing it), for a genome of `n`
+    /// branches and `m` fans: a branch number past `n` is read as `n`, and a fan set keeps
+    /// the first `m` fans.
+    fn codes<const N: usize>(
+        &self,
+        table: &[Variable; N],
+        x: &mut &[f64],
+        (n, m): (usize, usize),
+    ) -> [u32; N] {
         std::array::from_fn(|i| {
             let v = &table[i];
-            let (lo, hi) = v.range(self.branches, self.fans);
+            let (lo, hi) = v.range(n, m);
             match v.kind {
                 GeneKind::Color => {
                     let rgb = take(x, 3);
@@ -108,11 +140,24 @@ impl CodeCoding {
                 }
                 GeneKind::FanSet => {
                     let bits = take(x, self.fans);
-                    (bits.iter().enumerate()).fold(0, |set, (f, e)| set | (code(*e, 0, 1) << f))
+                    let set = (bits.iter().enumerate())
+                        .fold(0, |set, (f, e)| set | (code(*e, 0, 1) << f));
+                    set & mask_of(m)
                 }
                 _ => code(take(x, 1)[0], lo, hi),
             }
         })
+    }
+
+    /// The entries of a slot no segment fills: each variable's lowest code.
+    fn unused(&self, table: &[Variable], out: &mut Vec<f64>) {
+        for v in table {
+            match v.kind {
+                GeneKind::Color => out.extend([0.0; 3]),
+                GeneKind::FanSet => out.extend(std::iter::repeat_n(0.0, self.fans)),
+                _ => out.push(f64::from(v.range(self.branches, self.fans).0)),
+            }
+        }
     }
 }
 
@@ -144,22 +189,39 @@ impl VectorCoding<PlantMakerModel> for CodeCoding {
 
     fn decode(&self, x: &[f64]) -> PlantMaker {
         let mut rest = x;
+        let (n, m, k) = if self.counted {
+            let c = take(&mut rest, 3);
+            let count = |e: f64, most: usize| code(e, 1, most as u32) as usize;
+            (
+                count(c[0], self.branches),
+                count(c[1], self.fans),
+                count(c[2], self.inflorescences),
+            )
+        } else {
+            (self.branches, self.fans, self.inflorescences)
+        };
         let legal = "codes are rounded into their ranges";
-        let branches = (0..self.branches)
-            .map(|_| Branch::from_codes(&self.codes(&BRANCH_VARIABLES, &mut rest)).expect(legal))
-            .collect();
-        let fans = (0..self.fans)
+        // Every slot is read, to move past it; those beyond the genome's counts are dropped.
+        let mut branches: Vec<Branch> = (0..self.branches)
             .map(|_| {
-                let codes = self.codes(&FAN_VARIABLES, &mut rest);
-                Fan::from_codes(&codes, self.branches).expect(legal)
+                Branch::from_codes(&self.codes(&BRANCH_VARIABLES, &mut rest, (n, m))).expect(legal)
             })
             .collect();
-        let inflorescences = (0..self.inflorescences)
+        let mut fans: Vec<Fan> = (0..self.fans)
             .map(|_| {
-                let codes = self.codes(&INFLORESCENCE_VARIABLES, &mut rest);
-                Inflorescence::from_codes(&codes, self.fans).expect(legal)
+                let codes = self.codes(&FAN_VARIABLES, &mut rest, (n, m));
+                Fan::from_codes(&codes, n).expect(legal)
             })
             .collect();
+        let mut inflorescences: Vec<Inflorescence> = (0..self.inflorescences)
+            .map(|_| {
+                let codes = self.codes(&INFLORESCENCE_VARIABLES, &mut rest, (n, m));
+                Inflorescence::from_codes(&codes, m).expect(legal)
+            })
+            .collect();
+        branches.truncate(n);
+        fans.truncate(m);
+        inflorescences.truncate(k);
         PlantMaker {
             model: PlantMakerTag,
             format: FormatV1,
@@ -176,30 +238,51 @@ impl VectorCoding<PlantMakerModel> for CodeCoding {
             genome.fans.len(),
             genome.inflorescences.len(),
         );
-        if counts != (self.branches, self.fans, self.inflorescences) {
+        let most = (self.branches, self.fans, self.inflorescences);
+        let fits = if self.counted {
+            (1..=most.0).contains(&counts.0)
+                && (1..=most.1).contains(&counts.1)
+                && (1..=most.2).contains(&counts.2)
+        } else {
+            counts == most
+        };
+        if !fits {
             return Err(format!(
                 "the genome has {} branches, {} fans and {} inflorescences; this space's \
-                 genomes have {}, {} and {} (the settings' `branches`, `fans` and \
-                 `inflorescences`)",
-                counts.0, counts.1, counts.2, self.branches, self.fans, self.inflorescences
+                 genomes have {}{}, {} and {} (the start genomes', else the settings' \
+                 `branches`, `fans` and `inflorescences`)",
+                counts.0,
+                counts.1,
+                counts.2,
+                if self.counted { "1 to " } else { "" },
+                most.0,
+                most.1,
+                most.2
             ));
         }
         let mut out = Vec::with_capacity(self.bounds.len());
-        for b in &genome.branches {
-            entries(&b.codes(), &BRANCH_VARIABLES, self.fans, &mut out);
+        if self.counted {
+            out.extend([counts.0, counts.1, counts.2].map(|c| c as f64));
         }
-        for f in &genome.fans {
-            entries(&f.codes(), &FAN_VARIABLES, self.fans, &mut out);
+        for slot in 0..self.branches {
+            match genome.branches.get(slot) {
+                Some(b) => entries(&b.codes(), &BRANCH_VARIABLES, self.fans, &mut out),
+                None => self.unused(&BRANCH_VARIABLES, &mut out),
+            }
         }
-        for i in &genome.inflorescences {
-            entries(&i.codes(), &INFLORESCENCE_VARIABLES, self.fans, &mut out);
+        for slot in 0..self.fans {
+            match genome.fans.get(slot) {
+                Some(f) => entries(&f.codes(), &FAN_VARIABLES, self.fans, &mut out),
+                None => self.unused(&FAN_VARIABLES, &mut out),
+            }
         }
-        debug_assert_eq!(
-            out.len(),
-            self.branches * BRANCH_VARIABLES.len()
-                + self.fans * FAN_ENTRIES
-                + self.inflorescences * self.inflorescence_entries()
-        );
+        for slot in 0..self.inflorescences {
+            match genome.inflorescences.get(slot) {
+                Some(i) => entries(&i.codes(), &INFLORESCENCE_VARIABLES, self.fans, &mut out),
+                None => self.unused(&INFLORESCENCE_VARIABLES, &mut out),
+            }
+        }
+        debug_assert_eq!(out.len(), self.bounds.len());
         Ok(out)
     }
 }
@@ -207,6 +290,9 @@ impl VectorCoding<PlantMakerModel> for CodeCoding {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Entries of a fan: its 15 codes with each of its two colours as three channels.
+    const FAN_ENTRIES: usize = FAN_VARIABLES.len() + 4;
 
     fn lower(c: &CodeCoding) -> Vec<f64> {
         c.bounds().iter().map(|b| b[0]).collect()
@@ -261,5 +347,44 @@ mod tests {
         let coding = CodeCoding::new(4, 5, 5, 1);
         let e = coding.encode(&PlantMaker::default()).unwrap_err();
         assert!(e.contains("5 branches") && e.contains("`branches`"), "{e}");
+    }
+
+    #[test]
+    fn genomes_of_varying_counts_have_vectors_that_decode_back() {
+        // The five examples: 5 branches each, 5 or 7 fans, 5, 6 or 18 inflorescences.
+        let coding = CodeCoding::up_to(5, 7, 18, 3);
+        assert_eq!(
+            coding.bounds().len(),
+            3 + 5 * 23 + 7 * FAN_ENTRIES + 18 * (3 + 7)
+        );
+        let mut rng = sylva_core::rng::seeded(4);
+        for (n, m, k) in [(5, 5, 6), (5, 7, 18), (1, 1, 1), (3, 7, 2), (5, 2, 18)] {
+            for _ in 0..20 {
+                let g = PlantMaker::random(n, m, k, &mut rng);
+                let x = coding.encode(&g).unwrap();
+                assert_eq!(x.len(), coding.bounds().len());
+                assert!(
+                    x.iter()
+                        .zip(coding.bounds())
+                        .all(|(v, [lo, hi])| lo < v && v < hi)
+                );
+                assert_eq!(coding.decode(&x), PlantMaker { seed: 3, ..g });
+            }
+        }
+        // Any vector decodes to a legal genome, whatever its counts say.
+        for _ in 0..50 {
+            let x: Vec<f64> = coding
+                .bounds()
+                .iter()
+                .map(|[lo, hi]| rand::RngExt::random_range(&mut rng, *lo..*hi))
+                .collect();
+            let g = coding.decode(&x);
+            g.check().unwrap();
+            assert_eq!(coding.decode(&coding.encode(&g).unwrap()), g);
+        }
+        let e = coding
+            .encode(&PlantMaker::random(6, 5, 5, &mut rng))
+            .unwrap_err();
+        assert!(e.contains("6 branches") && e.contains("1 to 5"), "{e}");
     }
 }

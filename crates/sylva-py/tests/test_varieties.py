@@ -206,7 +206,9 @@ def test_a_space_has_bounds_of_its_coding(model):
     assert space.descriptors == ["height_to_width", "porosity"]
     assert space.term_names and space.seed == sylva.Config.load(CONFIGS[model]).seed
     assert sylva.GenomeSpace(CONFIGS["bintree"]).dim == 11
-    assert sylva.GenomeSpace(CONFIGS["plantmaker"]).dim == 5 * 23 + 5 * 19 + 5 * 8
+    # evolve.toml starts from the flowering bush: 5 branches, 5 fans and 6 inflorescences.
+    assert sylva.GenomeSpace(CONFIGS["plantmaker"]).dim == 5 * 23 + 5 * 19 + 6 * 8
+    assert sylva.GenomeSpace({"model": "plantmaker"}).dim == 5 * 23 + 5 * 19 + 5 * 8
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -272,6 +274,27 @@ def test_scores_are_the_native_maps_for_direct_codings():
                                              archive.descriptors, archive.genomes):
         row = genomes.index(genome)
         assert objective[row] == fitness and descriptors[row].tolist() == place.tolist()
+
+
+def test_every_elite_of_the_plantmaker_example_map_encodes():
+    # Its five start examples differ in their segment counts, which crossovers mix.
+    path = EXAMPLES / "plantmaker" / "varieties.toml"
+    data = sylva.Config.load(path).to_dict()
+    data["map"].update(initial=30, batch=20)
+    config = sylva.Config.from_dict(data, base=path.parent)
+    varieties = sylva.varieties(config, threads=2)
+    varieties.run(3)
+    genomes = varieties.archive().genomes
+    shapes = {(len(g["branches"]), len(g["fans"]), len(g["inflorescences"])) for g in genomes}
+    assert len(shapes) > 1
+    space = sylva.GenomeSpace(config, threads=2)
+    assert space.dim == 3 + 5 * 23 + 7 * 19 + 18 * (3 + 7)
+    for g in genomes:
+        x = space.encode(g)
+        assert ((space.lower <= x) & (x <= space.upper)).all()
+        back = space.decode(x).to_dict()
+        # The genome's own growth seed is no entry: decoded genomes take the space's.
+        assert back == {**g.to_dict(), "seed": space.seed}
 
 
 @pytest.mark.parametrize("model", ["automata", "lsystem"])

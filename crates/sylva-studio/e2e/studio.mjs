@@ -51,6 +51,16 @@ let server = null;
 let serverLog = "";
 
 async function startServer(port, db) {
+  const { child, address } = await spawnStudio(port, db);
+  server = child;
+  child.on("exit", (code, signal) => {
+    if (server === child) log(`the studio exited (${code ?? signal})`);
+  });
+  return address;
+}
+
+/** A `sylva studio` on `port` (0: a free one) and `db`: its process and its address. */
+async function spawnStudio(port, db) {
   check(fs.existsSync(bin), `no studio binary at ${bin}: run \`cargo build\` (or set SYLVA_BIN)`);
   for (let attempt = 0; attempt < 20; attempt++) {
     const child = spawn(bin, ["studio", "--port", String(port), "--db", db], {
@@ -76,13 +86,7 @@ async function startServer(port, db) {
         resolve(null);
       });
     });
-    if (address) {
-      server = child;
-      child.on("exit", (code, signal) => {
-        if (server === child) log(`the studio exited (${code ?? signal})`);
-      });
-      return address.replace(/\/$/, "");
-    }
+    if (address) return { child, address: address.replace(/\/$/, "") };
     child.kill("SIGKILL");
     // a port still held by the killed server: try again shortly
     if (/address already in use|AddrInUse|os error 98/i.test(serverLog)) {
@@ -95,10 +99,15 @@ async function startServer(port, db) {
 }
 
 function killServer() {
+  const s = server;
+  server = null;
+  return killChild(s);
+}
+
+/** Kills a studio as kill -9 does; resolves when it is gone. */
+function killChild(s) {
   return new Promise((resolve) => {
-    if (!server || server.exitCode !== null || server.signalCode !== null) return resolve();
-    const s = server;
-    server = null;
+    if (!s || s.exitCode !== null || s.signalCode !== null) return resolve();
     s.on("exit", () => resolve());
     s.kill("SIGKILL");
   });
@@ -177,6 +186,12 @@ async function main() {
     }
   });
 
+  const api2 = async (at, p) => {
+    const res = await fetch(at + p);
+    const text = await res.text();
+    check(res.ok, `GET ${p}: ${res.status} ${text.slice(0, 300)}`);
+    return JSON.parse(text);
+  };
   const api = async (p, init) => {
     const res = await fetch(base + p, init);
     const text = await res.text();
@@ -490,8 +505,15 @@ async function main() {
       return c.dataset.plant && Number(c.dataset.plant) !== old;
     }, [index, editedId], { timeout: 60_000 });
     await noError("regrow");
-    const r = await api(`/api/plants/${(await gridIds())[index]}`);
+    const regrownId = (await gridIds())[index];
+    const r = await api(`/api/plants/${regrownId}`);
     check(r.operator === "regrow" && Number(r.seed) === 4242, `the regrown plant is ${r.operator} with seed ${r.seed}`);
+    // the panel shows the regrown plant, its seed and its packed string's the same
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), regrownId);
+    const shownSeed = await byTestId("detail-seed").innerText();
+    const packed = await byTestId("packed").innerText();
+    check(shownSeed === "4242" && /^seed 4242$/m.test(packed),
+      `after Regrow the panel says seed ${shownSeed}, its packed string ${(packed.match(/^seed .*$/m) || ["no seed"])[0]}`);
     await waitGridLoaded();
   });
 
@@ -572,6 +594,17 @@ async function main() {
     await page.waitForFunction(() => window.sylvaStudio.stages.garden && window.sylvaStudio.stages.garden.views[0].content.children.length > 0, null, { timeout: 60_000 });
     await noError("new garden");
     await checkPainted("garden", 0.002, "garden");
+    // the whole garden exports as one GLB scene that the Khronos validator accepts
+    const gardenHref = await byTestId("garden-export-glb").getAttribute("href");
+    check(gardenHref, "the garden has no GLB export control");
+    const sceneRes = await fetch(new URL(gardenHref, base));
+    check(sceneRes.ok, `GET ${gardenHref}: ${sceneRes.status}`);
+    const sceneBytes = Buffer.from(await sceneRes.arrayBuffer());
+    check(sceneBytes.subarray(0, 4).toString() === "glTF", `${gardenHref} is not a GLB`);
+    const sceneFile = path.join(out, "garden.glb");
+    fs.writeFileSync(sceneFile, sceneBytes);
+    const sv = spawnSync(process.execPath, ["tools/gltf-validator/validate.mjs", sceneFile], { cwd: repo, encoding: "utf8" });
+    check(sv.status === 0, `the Khronos validator rejects ${sceneFile} (exit ${sv.status}):\n${sv.stdout}${sv.stderr}`);
     const cards = await page.$$eval('[data-testid^="specimen-"]', (els) => els.map((e) => ({ id: e.dataset.testid, plant: Number(e.dataset.plant), mother: e.dataset.mother === "true" })));
     const mother = cards.find((c) => c.mother);
     check(mother, "no specimen is marked as the mother");
@@ -656,6 +689,17 @@ async function main() {
     await noError("design");
     await checkPainted("design", 0.002, "design view");
     await shot("design");
+    // as in Match and Map, a finished run goes on: to twice its generations
+    check(await byTestId("design-resume").isEnabled(), "Resume is disabled after the run is done");
+    await byTestId("design-resume").click();
+    await page.waitForFunction(() => {
+      const s = document.querySelector('[data-testid="design-status"]');
+      return s.dataset.status === "done" && s.dataset.generation === "10";
+    }, null, { timeout: 90_000 });
+    const more = await api(`/api/sessions/${designId}/run`);
+    check(more.status === "done" && more.generations === 10 && more.rows.length === 11,
+      `the resumed run ended ${more.status} at ${more.generation} of ${more.generations} with ${more.rows.length} rows`);
+    await noError("design resumed");
   });
 
   let longRun = null;
@@ -718,9 +762,17 @@ async function main() {
     const glb = await fetch(`${base}${href}`);
     const bytes = Buffer.from(await glb.arrayBuffer());
     check(glb.ok && bytes.subarray(0, 4).toString() === "glTF" && bytes.includes("_LOD3") && bytes.includes('"wind"'), `the LOD export answered ${glb.status}`);
+    const mapPlant = Number(await page.evaluate(() => document.querySelector('[data-testid="plant-detail"] h2').textContent.match(/#(\d+)/)[1]));
     await byTestId("branch").click();
     await page.waitForFunction(() => window.sylvaStudio.session().mode === "breed");
     await waitGridLoaded();
+    // the panel goes on with the plant as it entered the new session, not the map's
+    const copy = (await gridIds())[0];
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), copy);
+    const copyRow = await api(`/api/plants/${copy}`);
+    check(copyRow.operator === "branch" && copyRow.parents[0].plant === mapPlant,
+      `the branched plant #${copy} is ${copyRow.operator} of ${JSON.stringify(copyRow.parents)}, not a branch of #${mapPlant}`);
+    check(await byTestId("detail-operator").innerText() === "branch", "after Branch the panel shows the old plant");
     await noError("map branch");
   });
 
@@ -754,6 +806,37 @@ async function main() {
     await byTestId("plant-detail").waitFor({ state: "visible" });
     await page.waitForFunction(() => document.querySelector('[data-testid="detail-operator"]')?.textContent === "match");
     await noError("match: the best opened");
+  });
+
+  await step("match: auto names the model its trials chose in the session list", async () => {
+    const old = await page.evaluate(() => window.sylvaStudio.session().id);
+    await byTestId("match-file").setInputFiles(path.join(repo, "examples/match/round.png"));
+    await page.waitForFunction(() => !document.querySelector('[data-testid="match-preview"]').hidden);
+    await byTestId("match-model").selectOption("auto");
+    await byTestId("match-generations").fill("10");
+    await byTestId("match-population").fill("4");
+    await byTestId("match-start").click();
+    await page.waitForFunction((o) => window.sylvaStudio.session()?.id !== o, old);
+    const id = await page.evaluate(() => window.sylvaStudio.session().id);
+    // the run as the studio has it (the page may still show the last match's status)
+    let run = await api(`/api/sessions/${id}/match/run`);
+    for (const deadline = Date.now() + 300_000; run.status === "running" && Date.now() < deadline;) {
+      await sleep(250);
+      run = await api(`/api/sessions/${id}/match/run`);
+    }
+    check(run.status === "done" && run.rows.length > 0, `the auto match ended ${run.status} with ${run.rows.length} rows`);
+    const best = await api(`/api/plants/${run.rows[run.rows.length - 1].plant}`);
+    const first = (await api("/api/models"))[0].name;
+    log(`  auto chose ${best.model} (a match starts under ${first})`);
+    check((await api(`/api/sessions/${id}`)).model === best.model, "the session does not name the model its run went on with");
+    await page.waitForFunction(([sid, model]) => {
+      const o = document.querySelector(`[data-testid="session-select"] option[value="${sid}"]`);
+      return o && o.textContent.includes(` · ${model} · `);
+    }, [id, best.model], { timeout: 10_000 }).catch(async () => {
+      const text = await page.locator(`[data-testid="session-select"] option[value="${id}"]`).innerText();
+      throw new Failure(`after an auto match of ${best.model} the session list says "${text}"`);
+    });
+    await noError("auto match");
   });
 
   // ---- restart ----
@@ -794,6 +877,54 @@ async function main() {
     await checkPainted("breed", 0.004, "breed grid after the restart");
     await noError("after the restart");
     await shot("breed-restarted");
+  });
+
+  await step("a killed studio shows as lost; the page follows again, unreloaded, when it is back", async () => {
+    // A studio of its own, so that the one above is left alone: a design run long enough
+    // to be running when it is killed.
+    const dir = fs.mkdtempSync(path.join(os.tmpdir(), "sylva-studio-e2e-lost-"));
+    const db2 = path.join(dir, "studio.db");
+    let second = await spawnStudio(0, db2);
+    const base2 = second.address;
+    try {
+      const made = await fetch(`${base2}/api/sessions`, {
+        method: "POST",
+        headers: { "Content-Type": "application/json" },
+        body: JSON.stringify({ mode: "design", design: { population: 2000, generations: 1000 } }),
+      });
+      check(made.ok, `starting a design run: ${made.status}`);
+      const id = (await made.json()).id;
+      await page.goto(`${base2}/#/design/${id}`);
+      await page.waitForFunction(() => window.sylvaStudio && window.sylvaStudio.ready === true);
+      await page.waitForFunction(() => {
+        const s = document.querySelector('[data-testid="design-status"]');
+        return s.dataset.status === "running" && Number(s.dataset.generation) >= 1;
+      }, null, { timeout: 90_000 });
+      check(await byTestId("connection").isHidden(), "the page says the connection is lost while the studio answers");
+      await page.evaluate(() => (window.sameDocument = true));
+      await killChild(second.child);
+      await byTestId("connection").waitFor({ state: "visible", timeout: 15_000 });
+      const said = await byTestId("connection").innerText();
+      check(/connection is lost/.test(said), `the banner says: ${said}`);
+      const status = await byTestId("design-status").evaluate((e) => getComputedStyle(e, "::after").content);
+      check(/connection lost/.test(status), `the run's status does not say the connection is lost (${status})`);
+      await shot("connection-lost");
+      // Back on the same port and archive: the run resumes from its checkpoint, and the
+      // page, unreloaded, follows its generations again.
+      second = await spawnStudio(Number(new URL(base2).port), db2);
+      await byTestId("connection").waitFor({ state: "hidden", timeout: 30_000 });
+      const back = (await api2(base2, `/api/sessions/${id}/run`)).generation;
+      await page.waitForFunction((g) => {
+        const s = document.querySelector('[data-testid="design-status"]');
+        return s.dataset.status === "running" && Number(s.dataset.generation) > g;
+      }, back, { timeout: 90_000 });
+      check(await page.evaluate(() => window.sameDocument === true), "the page was reloaded");
+      await noError("after reconnecting");
+      await fetch(`${base2}/api/sessions/${id}/stop`, { method: "POST", headers: { "Content-Type": "application/json" }, body: "{}" });
+    } finally {
+      await killChild(second.child);
+      fs.rmSync(dir, { recursive: true, force: true });
+    }
   });
 
   check(offsite.length === 0, `the page asked the network for ${offsite.join(", ")}`);

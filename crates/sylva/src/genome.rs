@@ -42,6 +42,7 @@ trait Face: Send + Sync {
     fn packed(&self) -> Option<String>;
     fn develop(&self, seed: u64) -> Result<Plant, DevelopError>;
     fn default_seed(&self) -> u64;
+    fn with_seed(&self, seed: u64) -> Genome;
     fn growth_seconds(&self) -> Option<f64>;
     /// Whether `other` (of any model) is the same genome.
     fn same(&self, other: &Genome) -> bool;
@@ -104,6 +105,10 @@ impl<M: Model> Face for Typed<M> {
 
     fn default_seed(&self) -> u64 {
         self.model.default_seed(&self.genome)
+    }
+
+    fn with_seed(&self, seed: u64) -> Genome {
+        self.sibling(self.model.with_seed(&self.genome, seed))
     }
 
     fn growth_seconds(&self) -> Option<f64> {
@@ -248,6 +253,12 @@ impl Genome {
     /// The seed the genome grows with when none is given.
     pub fn default_seed(&self) -> u64 {
         self.0.default_seed()
+    }
+
+    /// The genome that grows with `seed` when none is given: for a model whose genomes
+    /// carry their seed (PlantMaker), the same genome with that seed; others as they are.
+    pub fn with_seed(&self, seed: u64) -> Genome {
+        self.0.with_seed(seed)
     }
 
     /// How the model's plants are best meshed.

@@ -146,3 +146,53 @@ fn bad_vectors_and_options_are_refused_by_name() {
     let below: Vec<f64> = low.iter().map(|v| v - 100.0).collect();
     assert_eq!(space.decode(&below).unwrap(), space.decode(&low).unwrap());
 }
+
+/// The shipped PlantMaker map starts from the five examples, whose segment counts differ
+/// (5, 6 or 18 inflorescences; 5 or 7 fans) and mix in their crossovers: every elite of it
+/// still has a vector, and decodes back to itself (its own growth seed aside, which is no
+/// entry).
+#[test]
+fn every_elite_of_the_plantmaker_example_map_has_a_vector() {
+    use sylva_plantmaker::{PlantMaker, PlantMakerModel};
+    let registry = sylva::Registry::standard();
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/plantmaker/varieties.toml");
+    // A smaller first generation and batches, for a test's time.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("initial = 100\nbatch = 50", "initial = 30\nbatch = 20");
+    let config = registry.parse_config(&path, &text).unwrap();
+    let start = config
+        .load_start(&registry, path.parent().unwrap())
+        .unwrap();
+    let pool = Pool::with_threads(2).unwrap();
+    let mut map = Varieties::start(&config, start.clone(), pool).unwrap();
+    for _ in 0..3 {
+        map.step();
+    }
+    let space = GenomeSpace::new(&config, start, &SpaceOptions::default()).unwrap();
+    let elites = map.varieties();
+    let typed = |g: &sylva::Genome| -> PlantMaker { g.get::<PlantMakerModel>().unwrap().clone() };
+    let shapes: std::collections::HashSet<_> = (elites.iter())
+        .map(|v| {
+            let g = typed(&v.member.genome);
+            (g.branches.len(), g.fans.len(), g.inflorescences.len())
+        })
+        .collect();
+    assert!(
+        shapes.len() > 1,
+        "the elites all have the counts {shapes:?}"
+    );
+    for v in &elites {
+        let x = space.encode(&v.member.genome).unwrap();
+        let back = typed(&space.decode(&x).unwrap());
+        let elite = typed(&v.member.genome);
+        assert_eq!(
+            back,
+            PlantMaker {
+                seed: space.seed(),
+                ..elite
+            }
+        );
+    }
+}

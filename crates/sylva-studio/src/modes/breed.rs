@@ -950,11 +950,15 @@ pub(crate) async fn edit(
         ));
     }
     let same = genome == original;
-    let seed = request.seed.unwrap_or(if same {
-        old.seed
-    } else {
-        genome.default_seed()
-    });
+    let seed = match request.seed {
+        // Another seed than the plant's: it grows with that one.
+        Some(seed) if seed != old.seed => seed,
+        // The genome's own seed edited (a model whose genomes carry one): that one.
+        _ if genome.default_seed() != original.default_seed() => genome.default_seed(),
+        Some(seed) => seed,
+        None if same => old.seed,
+        None => genome.default_seed(),
+    };
     if same && seed == old.seed {
         return Err(ApiError::bad(
             "genome",
@@ -966,6 +970,9 @@ pub(crate) async fn edit(
     } else {
         Operator::Edit
     };
+    // A genome that carries its seed is written with the plant's, so that the panel's
+    // seed, the genome file and the packed string agree.
+    let genome = genome.with_seed(seed);
     let parents = vec![ParentRow {
         plant: old.id,
         dominance: 1.0,

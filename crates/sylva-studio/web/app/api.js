@@ -1,14 +1,18 @@
 // The studio's HTTP API (docs/studio.md), as small async functions. Every failure becomes an
 // ApiError carrying the server's `{error, field}`; nothing is swallowed here.
 
+import { probeHeaders, suspect } from "./connection.js";
+
 /** An error answered by the server (4xx/5xx) or a failed request. */
 export class ApiError extends Error {
-  constructor(message, { status = 0, field = "", path = "" } = {}) {
+  constructor(message, { status = 0, field = "", path = "", offline = false } = {}) {
     super(message);
     this.name = "ApiError";
     this.status = status;
     this.field = field;
     this.path = path;
+    /** No answer at all: the studio is gone (or the network is). */
+    this.offline = offline;
   }
 }
 
@@ -94,6 +98,7 @@ function setPending(delta) {
 export function authHeaders() {
   return token ? { Authorization: `Bearer ${token}` } : {};
 }
+probeHeaders(authHeaders());
 
 /** The raw fetch, with auth and the busy count; throws ApiError on a non-2xx answer. */
 export async function request(method, path, body, { raw = false, cache } = {}) {
@@ -109,7 +114,8 @@ export async function request(method, path, body, { raw = false, cache } = {}) {
     res = await fetch(path, init);
   } catch (e) {
     setPending(-1);
-    throw new ApiError(`${method} ${path}: the studio did not answer (${e.message})`, { path });
+    suspect();
+    throw new ApiError(`${method} ${path}: the studio did not answer (${e.message})`, { path, offline: true });
   }
   try {
     if (!res.ok) {
@@ -177,7 +183,7 @@ export const api = {
 
   design: (id, design) => post(`/api/sessions/${enc(id)}/design`, { design }),
   stop: (id) => post(`/api/sessions/${enc(id)}/stop`),
-  resume: (id) => post(`/api/sessions/${enc(id)}/resume`),
+  resume: (id, generations) => post(`/api/sessions/${enc(id)}/resume`, generations === undefined ? {} : { generations }),
   run: (id) => get(`/api/sessions/${enc(id)}/run`),
   eventsUrl: (id) => `/api/sessions/${enc(id)}/events`,
 

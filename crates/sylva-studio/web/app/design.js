@@ -9,6 +9,7 @@ import { TransformControls } from "three/addons/controls/TransformControls.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { drawChart } from "./chart.js";
 import { stats as probes } from "./stats.js";
+import { isLost, suspect } from "./connection.js";
 
 const UNIT = 0.1; // metres per paper unit
 const SHAPES = {
@@ -35,6 +36,8 @@ const WEIGHTS = [
   ["grid", 10, "F_grid: leaves in favoured cells, none in forbidden ones"],
 ];
 const RUNNING = "running";
+// The most generations a design run has (the studio's limit).
+const MAX_GENERATIONS = 1000;
 
 export default function createDesignMode(ctx, root) {
   // ---- the form ------------------------------------------------------------------------------
@@ -61,7 +64,7 @@ export default function createDesignMode(ctx, root) {
   const startBtn = h("button", { class: "primary", testid: "design-start", onclick: () => start() }, "Start");
   const updateBtn = h("button", { testid: "design-update", title: "Send this design to the open session's run", onclick: () => update() }, "Apply to this run");
   const stopBtn = h("button", { testid: "design-stop", onclick: () => stop() }, "Stop");
-  const resumeBtn = h("button", { testid: "design-resume", onclick: () => resume() }, "Resume");
+  const resumeBtn = h("button", { testid: "design-resume", title: "Go on: a stopped run to its generations, a finished one to twice as many", onclick: () => resume() }, "Resume");
   const frameBtn = h("button", { testid: "design-frame", onclick: () => view && view.frame() }, "Frame");
   // The move gizmo sits at the target's centre, where the trees grow: shown only while the
   // person moves the target (and before a run shows a tree).
@@ -464,7 +467,8 @@ export default function createDesignMode(ctx, root) {
     statusEl.className = `run-status ${status || ""}`;
     statusEl.textContent = `${status || "–"} · generation ${generation ?? "–"} of ${total ?? "–"}${error ? ` · ${error}` : ""}`;
     stopBtn.disabled = status !== RUNNING;
-    resumeBtn.disabled = !(status === "stopped" || status === "failed");
+    // as Match and Map: a finished run goes on too (to twice its generations, at most 1000)
+    resumeBtn.disabled = !(status === "stopped" || (status === "done" && (generation ?? 0) < MAX_GENERATIONS));
     updateBtn.disabled = !session;
     if (status === "failed" && error) ctx.showError(new Error(`the run failed: ${error}`));
   }
@@ -476,7 +480,8 @@ export default function createDesignMode(ctx, root) {
   }
 
   function openEvents(id) {
-    if (es && esSession === id && es.readyState !== EventSource.CLOSED) return;
+    // a stream still open goes on; one closed or reconnecting (the studio was away) starts again
+    if (es && esSession === id && es.readyState === EventSource.OPEN) return;
     closeEvents();
     esSession = id;
     // EventSource sends the cookie (set by the studio when the page was opened with a token)
@@ -522,8 +527,11 @@ export default function createDesignMode(ctx, root) {
         /* keep-alive text */
       }
     });
-    es.addEventListener("error", () => {
-      if (es && es.readyState === EventSource.CLOSED) {
+    const mine = es;
+    es.addEventListener("error", async () => {
+      // a dropped stream may be a studio that is gone: the page follows again when it is back
+      await suspect();
+      if (es === mine && mine.readyState === EventSource.CLOSED && !isLost()) {
         ctx.showError(new Error(`lost the progress stream of session #${id}; reload to follow the run again`));
       }
     });
@@ -629,7 +637,11 @@ export default function createDesignMode(ctx, root) {
 
   async function resume() {
     if (!session) return;
-    const s = await ctx.act(() => api.resume(session.id));
+    // a stopped run goes on to the generations it was asked; a finished one to twice as many
+    const more = run && run.status === "done"
+      ? Math.min(MAX_GENERATIONS, Math.max(run.generations, run.generation) * 2)
+      : undefined;
+    const s = await ctx.act(() => api.resume(session.id, more));
     if (s) await ctx.setSession(s);
   }
 

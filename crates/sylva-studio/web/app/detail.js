@@ -106,7 +106,7 @@ export function createDetail(ctx, panel) {
         h("tr", {}, h("th", {}, "model"), h("td", {}, p.model)),
         h("tr", {}, h("th", {}, "operator"), h("td", { testid: "detail-operator" }, p.operator || "–")),
         h("tr", {}, h("th", {}, "settings"), h("td", { class: "mono" }, summarize(p.settings, 400) || "–")),
-        h("tr", {}, h("th", {}, "seed"), h("td", {}, String(p.seed ?? "–"))),
+        h("tr", {}, h("th", {}, "seed"), h("td", { testid: "detail-seed" }, String(p.seed ?? "–"))),
         h("tr", {}, h("th", {}, "parents"), h("td", { testid: "detail-parents" }, parents.length ? parents.flatMap((a, i) => (i ? [", ", a] : [a])) : "none")),
         h("tr", {}, h("th", {}, "session"), h("td", {}, p.session !== null && p.session !== undefined ? `#${p.session}` : "–")),
         h("tr", {}, h("th", {}, "created"), h("td", {}, p.created || "–")),
@@ -203,7 +203,14 @@ export function createDetail(ctx, panel) {
   async function branch(mode) {
     const p = current;
     const s = await ctx.act(() => api.branch(p.id, mode));
-    if (s) await ctx.sessionCreated(s);
+    if (!s) return;
+    await ctx.sessionCreated(s);
+    // The panel goes on with the plant as it entered the new session (its copy there,
+    // whose parent it is), which the session's steps act on.
+    const list = await ctx.act(() => api.plants(s.id, 0, 1000));
+    const copy = list && (list.plants || []).find((q) => (q.parents || []).includes(p.id));
+    if (copy) await open(copy.id);
+    else close();
   }
 
   async function addToGrid() {

@@ -6,6 +6,7 @@ import { api } from "./api.js";
 import { Stage, loadGlb, THREE } from "./viewer.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { stats } from "./stats.js";
+import { suspect } from "./connection.js";
 
 export default function createGardenMode(ctx, root) {
   // the server's defaults for a new garden: neighbours meet and shade each other
@@ -17,6 +18,8 @@ export default function createGardenMode(ctx, root) {
   const azimuth = num("garden-azimuth", 0, { min: 0, max: 360, width: "4.5em" });
   const children = num("garden-children", 8, { min: 0, max: 8, step: 1, width: "3.5em" });
   const growBtn = h("button", { class: "primary", testid: "garden-grow", onclick: () => grow() }, "Grow again");
+  // the whole garden as one GLB scene, as it is shown
+  const exportGlb = h("a", { class: "button", testid: "garden-export-glb", title: "The whole garden as one GLB scene" }, "Export GLB");
   const info = h("span", { class: "hint", testid: "garden-status" });
   // how far a garden has grown, while it grows (the session's `progress` events)
   const progressBar = h("progress", { testid: "garden-progress", max: 1, value: 0, hidden: true });
@@ -29,6 +32,7 @@ export default function createGardenMode(ctx, root) {
     field("Azimuth °", azimuth, "0 to 360"),
     field("Children", children, "mutated children grown beside the mother, 0 to 8"),
     growBtn,
+    exportGlb,
     progressBar,
     info,
   );
@@ -104,6 +108,8 @@ export default function createGardenMode(ctx, root) {
     if (set.children !== undefined) children.value = set.children;
     const specimens = st.specimens || [];
     info.textContent = `mother #${st.mother ?? "–"} · ${specimens.length} plants`;
+    exportGlb.href = api.gardenGlbUrl(s.id);
+    exportGlb.download = `garden-${s.id}.glb`;
     renderCards(specimens);
     const key = JSON.stringify([s.id, st.mother, specimens.map((p) => p.plant), set]);
     if (key === gardenKey) return true;
@@ -201,10 +207,13 @@ export default function createGardenMode(ctx, root) {
   let events = null;
   let eventsSession = null;
   function follow(id) {
-    if (events && eventsSession === id && events.readyState !== EventSource.CLOSED) return;
+    // a stream still open goes on; one closed or reconnecting (the studio was away) starts again
+    if (events && eventsSession === id && events.readyState === EventSource.OPEN) return;
     unfollow();
     eventsSession = id;
     events = new EventSource(api.eventsUrl(id));
+    // a dropped stream may be a studio that is gone: the page follows again when it is back
+    events.addEventListener("error", () => suspect());
     events.addEventListener("progress", (e) => {
       let p;
       try {
@@ -304,6 +313,7 @@ export default function createGardenMode(ctx, root) {
       doneGrowing();
       session = null;
       gardenKey = "";
+      exportGlb.removeAttribute("href");
       if (view) view.setContent(null);
       clear(cards);
     },

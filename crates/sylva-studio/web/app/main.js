@@ -11,6 +11,7 @@ import { h, clear, summarize } from "./dom.js";
 import { stats } from "./stats.js";
 import { createDetail } from "./detail.js";
 import { createLineage } from "./lineage.js";
+import { onReconnect } from "./connection.js";
 
 /** The modes' names, in the order of their tabs (filled from the studio's list). */
 const MODES = [];
@@ -39,6 +40,8 @@ function showError(err, context = "") {
   const status = err && err.status ? ` [${err.status}]` : "";
   const text = `${context ? context + ": " : ""}${err && err.message ? err.message : String(err)}${field}${status}`;
   ui.message.dataset.kind = "error";
+  // a request the studio never answered: cleared when the studio is back
+  ui.message.dataset.offline = err && err.offline ? "true" : "false";
   ui.messageText.textContent = text;
   ui.message.hidden = false;
   clearTimeout(infoTimer);
@@ -94,6 +97,7 @@ const ctx = {
   setSession,
   openSession,
   sessionCreated,
+  refreshSessions,
   refreshPopulation,
   openPlant: (id) => detail.open(id),
   openLineage: (id) => lineage.open(id),
@@ -160,7 +164,11 @@ async function setSession(s) {
   if (!ctx.sessions.some((x) => x.id === s.id)) await refreshSessions();
   else {
     const entry = ctx.sessions.find((x) => x.id === s.id);
-    if (entry) entry.steps = (s.history || []).length;
+    if (entry) {
+      entry.steps = (s.history || []).length;
+      // a match's trials choose its model after it started
+      entry.model = s.model;
+    }
     fillSessionSelect();
   }
   setHash(s.mode, s.id);
@@ -452,6 +460,17 @@ async function navigate() {
   switchMode(mode);
 }
 
+// ---- a studio that was away -------------------------------------------------------------------
+
+// Back after the connection was lost: the sessions and the open one are read again, which
+// follows its runs' event streams again.
+onReconnect(async () => {
+  if (ui.message.dataset.kind === "error" && ui.message.dataset.offline === "true") clearMessage();
+  showInfo("the studio answers again");
+  await refreshSessions();
+  if (ctx.session) await openSession(ctx.session.id);
+});
+
 // ---- start ---------------------------------------------------------------------------------------
 
 async function init() {
@@ -468,5 +487,6 @@ async function init() {
   await navigate();
   stats.ready = true;
   document.body.dataset.ready = "true";
+  document.body.dataset.connection ??= "ok";
 }
 init();

@@ -208,7 +208,8 @@ export default function createMapMode(ctx, root) {
   }
 
   function openEvents(id) {
-    if (es && esSession === id && es.readyState !== EventSource.CLOSED) return;
+    // a stream still open goes on; one closed or reconnecting (the studio was away) starts again
+    if (es && esSession === id && es.readyState === EventSource.OPEN) return;
     closeEvents();
     esSession = id;
     es = follow(ctx, api.eventsUrl(id), id, {

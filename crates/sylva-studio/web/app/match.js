@@ -70,6 +70,7 @@ export default function createMatchMode(ctx, root) {
   let best = null; // the plant shown
   let es = null;
   let esSession = null;
+  let listed = false; // whether the session list has been read since the trials chose
 
   function fillModels() {
     if (model.options.length) return;
@@ -134,6 +135,7 @@ export default function createMatchMode(ctx, root) {
     if (changed) {
       rows = new Map();
       best = null;
+      listed = false;
       overlay.removeAttribute("src");
       target.src = api.matchPictureUrl(s.id);
     }
@@ -151,7 +153,16 @@ export default function createMatchMode(ctx, root) {
     if (last && last.plant !== undefined && last.plant !== null) showBest(last.plant, last);
     drawChart_();
     setStatus(r.status, r.generation, r.generations, r.error);
+    noteModel();
     if (r.status !== RUNNING) closeEvents();
+  }
+
+  // An auto match starts under the first model and names the one its trials chose when its
+  // first generation is made: the session list is read again then, to name it.
+  function noteModel() {
+    if (listed || !session || !(session.state && session.state.auto) || rows.size === 0) return;
+    listed = true;
+    ctx.refreshSessions();
   }
 
   function showBest(plant, row) {
@@ -185,7 +196,8 @@ export default function createMatchMode(ctx, root) {
   }
 
   function openEvents(id) {
-    if (es && esSession === id && es.readyState !== EventSource.CLOSED) return;
+    // a stream still open goes on; one closed or reconnecting (the studio was away) starts again
+    if (es && esSession === id && es.readyState === EventSource.OPEN) return;
     closeEvents();
     esSession = id;
     es = follow(ctx, api.eventsUrl(id), id, {
@@ -195,6 +207,7 @@ export default function createMatchMode(ctx, root) {
         if (g.plant !== undefined && g.plant !== null) showBest(g.plant, g);
         drawChart_();
         setStatus(g.status || RUNNING, g.generation, run?.generations, null);
+        noteModel();
         ctx.refreshPopulation();
       },
       status: async (st) => {
