@@ -117,10 +117,10 @@ fn one_plant_of_each_model() {
             ("lsystem.obj", 0xb7b2_1d21_c371_d211),
             ("lsystem.wrl", 0x6c1a_fb10_cf41_5531),
             ("lsystem.png", 0x6c6d_cd66_74b2_365d),
-            ("grown.glb", 0x8ac1_4e83_ec8f_79ad),
-            ("grown.obj", 0xc532_479e_a20c_4b38),
-            ("grown.wrl", 0xd2e8_70a5_792a_a2c1),
-            ("grown.png", 0x8a40_b90e_3c4a_7b99),
+            ("grown.glb", 0x14c9_8a14_27ba_dc34),
+            ("grown.obj", 0x67d3_c47c_2c87_4897),
+            ("grown.wrl", 0x602d_4100_dd9f_2a83),
+            ("grown.png", 0xebdc_0363_1cdd_8df4),
         ],
     );
 }
@@ -212,11 +212,11 @@ fn a_small_grown_run() {
             ("[output]\nsheet_size = 16", SMALL_OUTPUT),
         ],
         &[
-            ("stats.csv", 0xe0b8_965d_b2ac_e6d1),
+            ("stats.csv", 0x51e7_5265_9228_1701),
             ("best.json", 0x8170_3c26_cc56_f892),
-            ("best.glb", 0x2b6f_5b76_70e0_bae3),
-            ("best.png", 0x0620_5f87_2716_a5f9),
-            ("population.png", 0x20c2_076a_7f26_b3b2),
+            ("best.glb", 0xd9ae_4088_7575_6af5),
+            ("best.png", 0x61cc_6943_6574_0afb),
+            ("population.png", 0x5d4f_fc0d_4c7a_7005),
         ],
     );
 }

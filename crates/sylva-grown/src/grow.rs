@@ -33,6 +33,8 @@
 //! stopped it.
 
 use glam::{Mat3, Quat, Vec2, Vec3};
+use sylva_core::dress::BRANCHLET_HEIGHT;
+use sylva_core::species::Card;
 use sylva_core::{Organ, OrganKind, Plant, SegmentId};
 use sylva_model::DevelopError;
 
@@ -56,6 +58,17 @@ const SHADE: f32 = 0.1;
 /// Cycles a side bud may stay dormant before it is spent (and no longer perceives space):
 /// old buds deep in a crown would otherwise fill every gap the crown's shade leaves.
 const DORMANT_CYCLES: u32 = 4;
+
+/// The most leaf area a crown holds over its spread (leaf area index): real broadleaf and
+/// conifer crowns hold 3 to 8 (docs/realism.md).
+const MAX_LAI: f32 = 9.0;
+
+/// A blade's area over its length times its width.
+const LEAF_FILL: f32 = 0.7;
+
+/// The share of a leaf card its leaves cover, about (the atlases' own measure, in
+/// `sylva-mesh`, is 0.3 to 0.6).
+const CARD_FILL: f32 = 0.5;
 
 /// Most leaves one internode bears.
 const MAX_LEAVES_PER_INTERNODE: u32 = 6;
@@ -301,13 +314,13 @@ struct Run {
 /// Most internodes of a twig left out of the wood (more when the wood is over its budget).
 const TWIG: u32 = 5;
 
-/// Most segments of a broadleaf's wood: about 16,000 triangles, beside 24,000 of its
+/// Most segments of a broadleaf's wood: about 13,000 triangles, beside 24,000 of its
 /// leaf cards (a game's budget of 40,000 for a tree in leaf).
-const BROADLEAF_SEGMENTS: usize = 1000;
+const BROADLEAF_SEGMENTS: usize = 800;
 
-/// Most segments of a conifer's wood: about 13,000 triangles, beside 16,000 of its
+/// Most segments of a conifer's wood: about 11,000 triangles, beside 16,000 of its
 /// crossed needle cards (a budget of 30,000).
-const CONIFER_SEGMENTS: usize = 800;
+const CONIFER_SEGMENTS: usize = 700;
 
 /// Most internodes joined into one segment.
 const RUN_MOST: u32 = 8;
@@ -794,11 +807,48 @@ impl Tree<'_> {
                 Plant::BARK,
             )?;
         }
+        // Leaves on the last internodes of every shoot; where they would be more than a real
+        // crown holds (a leaf area index of MAX_LAI over the crown's spread), the most shaded
+        // go first, as a crown sheds the leaves its shade starves: its outline stays.
+        let leafy: Vec<usize> = (1..n)
+            .filter(|&i| {
+                let node = &self.nodes[i];
+                !node.dead && to_tip[i] < leaf_span && node.born > 0
+            })
+            .collect();
+        let (lo, hi) = (self.nodes.iter().filter(|n| !n.dead)).fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), n| (lo.min(n.pos), hi.max(n.pos)),
+        );
+        let spread = std::f32::consts::FRAC_PI_4 * (hi.x - lo.x) * (hi.z - lo.z);
+        // Dressed (as the genome's own foliage dresses it), each leaf is a card of the kind:
+        // the leaf area a leaf stands for is its card's when that is larger.
+        let card = if hi.y >= BRANCHLET_HEIGHT {
+            Card::Branchlet
+        } else {
+            Card::Spray
+        };
+        let card_edge = leaf_length / spec.leaf_of(card);
+        let faces = if spec.crossed { 2.0 } else { 1.0 };
+        let card_area = CARD_FILL * card_edge * card_edge * faces;
+        let blade = (LEAF_FILL * leaf_size.x * leaf_size.y).max(card_area) * per_internode as f32;
+        let most = (MAX_LAI * spread / blade).max(1.0) as usize;
+        let mut shed = vec![false; n];
+        if leafy.len() > most {
+            let mut by_light: Vec<(f32, usize)> = leafy
+                .iter()
+                .map(|&i| (self.shade.light(self.nodes[i].pos), i))
+                .collect();
+            by_light.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            for &(_, i) in &by_light[most..] {
+                shed[i] = true;
+            }
+        }
         let mut leaves = 0;
         let mut turn_count = seed as u32;
-        for i in 1..n {
+        for &i in &leafy {
             let node = &self.nodes[i];
-            if node.dead || to_tip[i] >= leaf_span || node.born == 0 {
+            if shed[i] {
                 continue;
             }
             let from = self.nodes[node.parent as usize].pos;

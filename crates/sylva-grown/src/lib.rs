@@ -107,6 +107,13 @@ impl Model for GrownModel {
         genome.seed
     }
 
+    fn with_seed(&self, genome: &Growth, seed: u64) -> Growth {
+        Growth {
+            seed,
+            ..genome.clone()
+        }
+    }
+
     /// The genome's own foliage and bark.
     fn dress(&self, genome: &Growth) -> Dress {
         Dress {

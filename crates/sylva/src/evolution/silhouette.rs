@@ -46,9 +46,18 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
     fn score(&self, problem: &M::Problem, evolved: &<M::Problem as Problem>::Genome) -> f64 {
         let genome = self.model.genome_file(problem, evolved);
         let seed = self.model.default_seed(&genome);
-        let Ok(plant) = self.model.develop(&genome, seed) else {
+        let Ok(mut plant) = self.model.develop(&genome, seed) else {
             return 0.0;
         };
+        // What is scored is what the run writes: dressed as the genome names (the
+        // self-organising model's foliage; the papers' models name none).
+        let dress = self.model.dress(&genome);
+        if !dress.is_plain() {
+            match sylva_core::dress::dress(&plant, &dress, seed) {
+                Ok((dressed, _)) => plant = dressed,
+                Err(_) => return 0.0,
+            }
+        }
         SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
             if let Some(space) = &self.space {
@@ -189,9 +198,14 @@ impl Target {
         let (side, path, ink) = &self.views[0];
         let target =
             Outline::new(ink, *side, OVERLAY_ROWS).map_err(|e| InputError::file(path, e))?;
-        let mut plant = genome.develop(genome.default_seed())?;
+        let seed = genome.default_seed();
+        let mut plant = genome.develop(seed)?;
         if let Some(space) = self.space(config)? {
             plant = prune(&space, &plant);
+        }
+        let dress = genome.own_dress();
+        if !dress.is_plain() {
+            plant = sylva_core::dress::dress(&plant, &dress, seed)?.0;
         }
         let mut scratch = Scratch::default();
         let iou = target.iou(&plant, &mut scratch);
