@@ -1773,7 +1773,7 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
     let request_of = |model: &str, generations: u32| {
         json!({"mode": "match", "match": {
             "picture": picture, "model": model, "generations": generations,
-            "population": 16, "seed": 2,
+            "population": 16, "seed": 2, "topiary": true,
         }})
     };
     // Uninterrupted.
@@ -1814,8 +1814,8 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         get(&whole, &format!("/api/plants/{plant}"))["operator"],
         "match"
     );
-    // Its plants grow inside the outline, as the library prunes them, and so does one
-    // branched into breeding; the offspring bred from it grow whole.
+    // A topiary match's plants grow inside the outline, as the library prunes them, and so
+    // does one branched into breeding; the offspring bred from it grow whole.
     let round_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/match/round.png");
     let target = sylva::evolution::MatchConfig {
         front: round_path.clone(),

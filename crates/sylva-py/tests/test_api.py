@@ -26,6 +26,7 @@ GENOMES = {
     "automata": EXAMPLES / "automata" / "helix.json",
     "plantmaker": EXAMPLES / "plantmaker" / "tulip.json",
     "lsystem": EXAMPLES / "lsystem" / "herb.json",
+    "grown": EXAMPLES / "grown" / "birch.json",
 }
 
 CONFIGS = {
@@ -33,6 +34,7 @@ CONFIGS = {
     "automata": EXAMPLES / "automata" / "sphere.toml",
     "plantmaker": EXAMPLES / "plantmaker" / "evolve.toml",
     "lsystem": EXAMPLES / "lsystem" / "evolve.toml",
+    "grown": EXAMPLES / "grown" / "evolve.toml",
 }
 
 MODELS = sorted(GENOMES)
@@ -47,7 +49,7 @@ def glb_json(data: bytes) -> dict:
     return json.loads(data[20 : 20 + chunk])
 
 
-def test_models_are_the_four():
+def test_models_are_the_five():
     assert sorted(sylva.models()) == MODELS
 
 

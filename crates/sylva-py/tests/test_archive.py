@@ -308,4 +308,4 @@ def test_the_module_and_its_classes_hold_one_registry():
     assert type(module._models).__name__ == "Models"
     for cls in (sylva.Genome, sylva.Config, sylva.StudioArchive, sylva.Evolution):
         assert cls._models is module._models
-    assert sorted(sylva.models()) == ["automata", "bintree", "lsystem", "plantmaker"]
+    assert sorted(sylva.models()) == ["automata", "bintree", "grown", "lsystem", "plantmaker"]
