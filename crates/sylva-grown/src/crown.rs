@@ -149,12 +149,10 @@ impl Profile {
             });
         }
         let span = top + 1 - base;
-        let rows = (0..PROFILE_ROWS.min(span))
+        let count = PROFILE_ROWS.min(span);
+        let rows = (0..count)
             .map(|k| {
-                let (a, b) = (
-                    base + k * span / PROFILE_ROWS.min(span),
-                    base + (k + 1) * span / PROFILE_ROWS.min(span),
-                );
+                let (a, b) = (base + k * span / count, base + (k + 1) * span / count);
                 let hull = |rows: &[[f32; 2]]| {
                     rows[a..b.max(a + 1)]
                         .iter()

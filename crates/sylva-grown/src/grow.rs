@@ -142,6 +142,9 @@ struct Grid {
     dims: [i32; 3],
     starts: Vec<u32>,
     items: Vec<u32>,
+    /// Where the next item of each cell goes while filling (kept, so a refill allocates
+    /// nothing).
+    next: Vec<u32>,
 }
 
 impl Grid {
@@ -156,6 +159,7 @@ impl Grid {
             dims: dims.to_array(),
             starts: Vec::new(),
             items: Vec::new(),
+            next: Vec::new(),
         }
     }
 
@@ -186,11 +190,11 @@ impl Grid {
         }
         self.items.clear();
         self.items.resize(self.starts[cells] as usize, 0);
-        let mut next = self.starts.clone();
+        self.next.clone_from(&self.starts);
         for (k, p) in points.enumerate() {
             let i = self.index(self.coords(p));
-            self.items[next[i] as usize] = k as u32;
-            next[i] += 1;
+            self.items[self.next[i] as usize] = k as u32;
+            self.next[i] += 1;
         }
     }
 

@@ -132,6 +132,13 @@ pub fn strategy(settings: &GrownSettings) -> Result<GrownStrategy, GenerationalE
     )
 }
 
+thread_local! {
+    /// Per-thread fitness buffers, as PlantMaker's problem keeps them; they carry nothing
+    /// between evaluations.
+    static SCRATCH: std::cell::RefCell<sylva_fitness::PoncinScratch> =
+        std::cell::RefCell::new(sylva_fitness::PoncinScratch::new());
+}
+
 /// Evolve self-organising trees towards Poncin's shared terms over the grown tree.
 #[derive(Clone, Debug)]
 pub struct GrownProblem {
@@ -152,13 +159,17 @@ impl Problem for GrownProblem {
         let Ok((plant, _)) = crate::grow::grow(genome, genome.seed) else {
             return Fitness::new(0.0, &[]);
         };
-        let mut scratch = sylva_fitness::PoncinScratch::new();
         let ctx = PoncinContext {
             seed: 0,
             negative_thickness: 0,
         };
-        let score = self.settings.fitness.score(&plant, ctx, &mut scratch);
-        Fitness::new(score.adjusted(), &score.terms())
+        SCRATCH.with(|cell| {
+            let score = self
+                .settings
+                .fitness
+                .score(&plant, ctx, &mut cell.borrow_mut());
+            Fitness::new(score.adjusted(), &score.terms())
+        })
     }
 
     fn random_genome<R: Rng + ?Sized>(&self, rng: &mut R) -> Growth {
