@@ -400,6 +400,27 @@ mod tests {
     }
 
     #[test]
+    fn a_genome_s_envelope_is_checked_as_it_is_read() {
+        let text = |envelope: &str| {
+            format!(
+                r#"{{"model":"grown","format":1,"seed":1,"crown":"cone","foliage":"oak","envelope":{envelope}}}"#
+            )
+        };
+        let read = |envelope: &str| sylva_model::file::parse::<Growth>(&text(envelope));
+        assert!(read(r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]]}"#).is_ok());
+        for (bad, says) in [
+            (r#"{"base":2,"rows":[[[-0.2,0.2],[-0.2,0.2]]]}"#, "envelope.base"),
+            (r#"{"base":0.3,"rows":[]}"#, "1 to 256 rows"),
+            (r#"{"base":0.3,"rows":[[[-1e9,0.2],[-0.2,0.2]]]}"#, "envelope.rows[0]"),
+            (r#"{"base":0.3,"rows":[[[-0.2,0.2]]]}"#, "invalid length"),
+            (r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]],"extra":1}"#, "extra"),
+        ] {
+            let e = read(bad).unwrap_err();
+            assert!(e.message.contains(says), "{bad}: {e}");
+        }
+    }
+
+    #[test]
     fn a_target_with_no_crown_is_refused() {
         let blank = TargetProfile {
             front: vec![[0.0, 0.0]; 50],
