@@ -409,11 +409,20 @@ mod tests {
         let read = |envelope: &str| sylva_model::file::parse::<Growth>(&text(envelope));
         assert!(read(r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]]}"#).is_ok());
         for (bad, says) in [
-            (r#"{"base":2,"rows":[[[-0.2,0.2],[-0.2,0.2]]]}"#, "envelope.base"),
+            (
+                r#"{"base":2,"rows":[[[-0.2,0.2],[-0.2,0.2]]]}"#,
+                "envelope.base",
+            ),
             (r#"{"base":0.3,"rows":[]}"#, "1 to 256 rows"),
-            (r#"{"base":0.3,"rows":[[[-1e9,0.2],[-0.2,0.2]]]}"#, "envelope.rows[0]"),
+            (
+                r#"{"base":0.3,"rows":[[[-1e9,0.2],[-0.2,0.2]]]}"#,
+                "envelope.rows[0]",
+            ),
             (r#"{"base":0.3,"rows":[[[-0.2,0.2]]]}"#, "invalid length"),
-            (r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]],"extra":1}"#, "extra"),
+            (
+                r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]],"extra":1}"#,
+                "extra",
+            ),
         ] {
             let e = read(bad).unwrap_err();
             assert!(e.message.contains(says), "{bad}: {e}");
