@@ -32,6 +32,8 @@
 //! an error naming the limit) and [`MAX_CYCLES`] cycles; [`Report`] says which of the ends
 //! stopped it.
 
+use std::ops::Range;
+
 use glam::{Mat3, Quat, Vec2, Vec3};
 use sylva_core::dress::BRANCHLET_HEIGHT;
 use sylva_core::species::Card;
@@ -164,7 +166,8 @@ impl Grid {
     }
 
     fn coords(&self, p: Vec3) -> [i32; 3] {
-        let c = ((p - self.lo) / self.cell).floor().as_ivec3();
+        // Cut towards zero after the clamp at zero, as `floor` would (without its call).
+        let c = ((p - self.lo) / self.cell).max(Vec3::ZERO).as_ivec3();
         [
             c.x.clamp(0, self.dims[0] - 1),
             c.y.clamp(0, self.dims[1] - 1),
@@ -200,6 +203,15 @@ impl Grid {
 
     /// Calls `f` with every item filed in a cell that meets the ball of `radius` about `p`.
     fn near(&self, p: Vec3, radius: f32, mut f: impl FnMut(u32)) {
+        self.near_slots(p, radius, |slots| {
+            self.items[slots].iter().for_each(|&i| f(i))
+        });
+    }
+
+    /// Calls `f` with the places in [`Grid::items`] of the items filed in the cells that
+    /// meet the ball of `radius` about `p`, a run of cells at a time: an array in the
+    /// order of `items` is read straight along.
+    fn near_slots(&self, p: Vec3, radius: f32, mut f: impl FnMut(Range<usize>)) {
         let a = self.coords(p - Vec3::splat(radius));
         let b = self.coords(p + Vec3::splat(radius));
         for y in a[1]..=b[1] {
@@ -209,7 +221,9 @@ impl Grid {
                     self.starts[row] as usize,
                     self.starts[row + (b[0] - a[0]) as usize + 1] as usize,
                 );
-                self.items[s..e].iter().for_each(|&i| f(i));
+                if s < e {
+                    f(s..e);
+                }
             }
         }
     }
@@ -241,7 +255,13 @@ impl Shade {
     }
 
     fn coords(&self, p: Vec3) -> [i32; 3] {
-        ((p - self.lo) / self.voxel).floor().as_ivec3().to_array()
+        let v = (p - self.lo) / self.voxel;
+        // Cutting towards zero is `floor` for the voxels inside, without its call.
+        if v.cmpge(Vec3::ZERO).all() {
+            v.as_ivec3().to_array()
+        } else {
+            v.floor().as_ivec3().to_array()
+        }
     }
 
     fn get(&self, [x, y, z]: [i32; 3]) -> f32 {
@@ -346,6 +366,13 @@ struct Tree<'g> {
 
 /// A bud this cycle: its node and place, what it perceives, and its share.
 #[derive(Clone, Copy)]
+/// A bud as perception reads it, filed in a grid's order.
+struct Filed {
+    pos: Vec3,
+    heading: Vec3,
+    bud: u32,
+}
+
 struct Bud {
     node: u32,
     side: bool,
@@ -396,6 +423,7 @@ pub fn grow_into(
     tree.bole(envelope.base, envelope.top);
     let cycles = p.count(Param::Cycles).min(MAX_CYCLES);
     let mut bud_grid = Grid::new(lo, hi, 0.5 * reach);
+    let mut filed = Vec::new();
     let mut buds = Vec::new();
     let mut stop = Stop::Cycles;
     let mut grown = 0;
@@ -405,7 +433,7 @@ pub fn grow_into(
             break;
         }
         tree.buds(&mut buds, cycle);
-        tree.perceive(&mut buds, &mut bud_grid, reach);
+        tree.perceive(&mut buds, &mut bud_grid, &mut filed, reach);
         tree.allocate(&mut buds);
         if !tree.shoot(&buds, cycle)? {
             stop = Stop::NoGrowth;
@@ -539,8 +567,18 @@ impl Tree<'_> {
 
     /// Step 1 and 2: each free point goes to the nearest bud that perceives it; a bud with
     /// points gets its light as its resource.
-    fn perceive(&self, buds: &mut [Bud], grid: &mut Grid, reach: f32) {
+    fn perceive(&self, buds: &mut [Bud], grid: &mut Grid, filed: &mut Vec<Filed>, reach: f32) {
         grid.fill(buds.iter().map(|b| b.pos));
+        // What the test needs of each bud, in the grid's order: read straight along.
+        filed.clear();
+        filed.extend(grid.items.iter().map(|&b| {
+            let bud = &buds[b as usize];
+            Filed {
+                pos: bud.pos,
+                heading: bud.heading,
+                bud: b,
+            }
+        }));
         let cone = self.param(Param::PerceptionAngle).to_radians().cos();
         let reach2 = reach * reach;
         for (i, &point) in self.points.iter().enumerate() {
@@ -548,14 +586,16 @@ impl Tree<'_> {
                 continue;
             }
             let mut best = (f32::MAX, u32::MAX);
-            grid.near(point, reach, |b| {
-                let bud = &buds[b as usize];
-                let to = point - bud.pos;
-                let d2 = to.length_squared();
-                // Within reach, in the cone (`to·h ≥ |to| cos θ`), nearest; ties to the
-                // first bud, so the order of buds decides, not the grid's.
-                if d2 < reach2 && (d2, b) < best && to.dot(bud.heading) >= cone * d2.sqrt() {
-                    best = (d2, b);
+            grid.near_slots(point, reach, |slots| {
+                for f in &filed[slots] {
+                    let to = point - f.pos;
+                    let d2 = to.length_squared();
+                    // Within reach, in the cone (`to·h ≥ |to| cos θ`), nearest; ties to the
+                    // first bud, so the order of buds decides, not the grid's.
+                    let nearer = d2 < best.0 || (d2 == best.0 && f.bud < best.1);
+                    if d2 < reach2 && nearer && to.dot(f.heading) >= cone * d2.sqrt() {
+                        best = (d2, f.bud);
+                    }
                 }
             });
             if best.1 != u32::MAX {
