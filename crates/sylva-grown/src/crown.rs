@@ -1,11 +1,13 @@
 //! The crown's envelope: the space a tree grows into, filled with attraction points.
 //!
-//! An envelope is a stack of rows from the crown's base to its top; at each height it spans
-//! a stretch of x (seen from the front) and of z (seen from the side), and holds the ellipse
-//! inscribed in that rectangle, as a trunk's crown is round in plan. A crown shape
-//! ([`CrownShape`]) makes centred rows from its radius profile; a picture's visual hull makes
-//! rows from the front and side outlines, each stretch where the outline's ink is at that
-//! height.
+//! An envelope is a stack of rows from the crown's base to its top; at each height it holds
+//! stretches of x (seen from the front) and of z (seen from the side), and the ellipse
+//! inscribed in the rectangle around them, as a tree's crown is round in plan: a point is
+//! inside where it is in that ellipse, over a stretch of x and over a stretch of z. A crown
+//! shape ([`CrownShape`]) makes centred rows of one stretch from its radius profile; a
+//! picture's visual hull makes rows from the front and side outlines, each stretch where the
+//! outline's ink is at that height, so the gaps a crown shows (beside the trunk under the
+//! crown, between its lobes) stay empty.
 
 use glam::Vec3;
 use rand::{Rng, RngExt};
@@ -17,6 +19,13 @@ use crate::genome::{CrownShape, Growth, Param};
 /// Rows a shape's envelope is drawn with.
 const SHAPE_ROWS: usize = 64;
 
+/// One view's stretches at one height, `[left, right]` each (or `[back, front]`).
+pub type Stretches = Vec<[f32; 2]>;
+
+/// A row of an envelope or a profile: the stretches of x seen from the front and of z seen
+/// from the side.
+pub type Row = [Stretches; 2];
+
 /// The space a crown fills: rows of x and z stretches from `base` to `top`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Envelope {
@@ -24,9 +33,34 @@ pub struct Envelope {
     pub base: f32,
     /// Height of the highest row, metres.
     pub top: f32,
-    /// Per row, bottom to top: the stretch of x `[left, right]` and of z `[back, front]`,
-    /// metres (an empty row has left > right).
-    pub rows: Vec<[[f32; 2]; 2]>,
+    /// Per row, bottom to top: the stretches of x and of z, metres (an empty row has none,
+    /// or stretches with left ≥ right).
+    pub rows: Vec<Row>,
+}
+
+/// The rectangle around a view's stretches, `[least, greatest]`: empty (least ≥ greatest)
+/// for none.
+fn hull(stretches: &[[f32; 2]]) -> [f32; 2] {
+    (stretches.iter())
+        .filter(|s| s[0] < s[1])
+        .fold([f32::MAX, f32::MIN], |h, s| {
+            [h[0].min(s[0]), h[1].max(s[1])]
+        })
+}
+
+/// Whether `v` is over one of the stretches.
+fn over(stretches: &[[f32; 2]], v: f32) -> bool {
+    stretches.iter().any(|s| (s[0]..=s[1]).contains(&v))
+}
+
+/// The share of a view's rectangle its stretches cover.
+fn coverage(stretches: &[[f32; 2]]) -> f32 {
+    let [lo, hi] = hull(stretches);
+    if lo >= hi {
+        return 0.0;
+    }
+    let covered: f32 = stretches.iter().map(|s| (s[1] - s[0]).max(0.0)).sum();
+    (covered / (hi - lo)).min(1.0)
 }
 
 /// Why an envelope cannot be grown into.
@@ -65,11 +99,16 @@ pub enum EnvelopeError {
 pub struct Profile {
     /// Where the crown begins, as a share of the height, 0 to 1.
     pub base: f32,
-    /// Rows from the crown's base to the top, each the stretch of x (front view) and of z
-    /// (side view) as shares of the height from the trunk's foot: 1 to [`MAX_PROFILE_ROWS`]
-    /// rows, each number within ±[`MAX_PROFILE_REACH`].
-    pub rows: Vec<[[f32; 2]; 2]>,
+    /// Rows from the crown's base to the top, each the stretches of x (front view) and of
+    /// z (side view) as shares of the height from the trunk's foot: 1 to
+    /// [`MAX_PROFILE_ROWS`] rows, at most [`MAX_STRETCHES`] stretches a view, each number
+    /// within ±[`MAX_PROFILE_REACH`]. A file may give a view one stretch as `[left, right]`
+    /// rather than `[[left, right]]` (as genomes written before stretches did).
+    pub rows: Vec<Row>,
 }
+
+/// Most stretches a profile's view holds at one height.
+pub const MAX_STRETCHES: usize = 32;
 
 /// Most rows a profile holds.
 pub const MAX_PROFILE_ROWS: usize = 256;
@@ -85,7 +124,27 @@ const PROFILE_ROWS: usize = 48;
 #[serde(deny_unknown_fields)]
 struct RawProfile {
     base: f32,
-    rows: Vec<[[f32; 2]; 2]>,
+    rows: Vec<[RawView; 2]>,
+}
+
+/// A view of a profile's row as read: one stretch, or a list of them.
+#[derive(Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a view's stretches, [[left, right], ...], or one stretch, [left, right]"
+)]
+enum RawView {
+    One([f32; 2]),
+    Many(Stretches),
+}
+
+impl From<RawView> for Stretches {
+    fn from(view: RawView) -> Stretches {
+        match view {
+            RawView::One(stretch) => vec![stretch],
+            RawView::Many(stretches) => stretches,
+        }
+    }
 }
 
 impl TryFrom<RawProfile> for Profile {
@@ -103,19 +162,31 @@ impl TryFrom<RawProfile> for Profile {
                 raw.rows.len()
             ));
         }
+        let rows: Vec<Row> = (raw.rows.into_iter())
+            .map(|[x, z]| [x.into(), z.into()])
+            .collect();
         let reach = -MAX_PROFILE_REACH..=MAX_PROFILE_REACH;
-        if let Some(i) =
-            (raw.rows.iter()).position(|r| r.as_flattened().iter().any(|v| !reach.contains(v)))
-        {
-            return Err(format!(
-                "`envelope.rows[{i}]` must hold shares of the height from -{MAX_PROFILE_REACH} \
-                 to {MAX_PROFILE_REACH}, got {:?}",
-                raw.rows[i]
-            ));
+        for (i, row) in rows.iter().enumerate() {
+            let stretches = row.iter().flatten();
+            if row.iter().any(|view| view.len() > MAX_STRETCHES) {
+                return Err(format!(
+                    "`envelope.rows[{i}]` must hold at most {MAX_STRETCHES} stretches a view"
+                ));
+            }
+            if let Some(s) = stretches
+                .into_iter()
+                .find(|s| !(reach.contains(&s[0]) && reach.contains(&s[1]) && s[0] <= s[1]))
+            {
+                return Err(format!(
+                    "`envelope.rows[{i}]` must hold stretches [left, right], left ≤ right, \
+                     of shares of the height from -{MAX_PROFILE_REACH} to \
+                     {MAX_PROFILE_REACH}, got {s:?}"
+                ));
+            }
         }
         Ok(Profile {
             base: raw.base,
-            rows: raw.rows,
+            rows,
         })
     }
 }
@@ -123,19 +194,23 @@ impl TryFrom<RawProfile> for Profile {
 impl Profile {
     /// The crown a match's target shows ([`TargetProfile`]): the rows above the trunk (the
     /// first row from the foot at least [`CROWN_WIDTH`] as wide as the widest, in either
-    /// view) to the top, each view's stretch of ink, drawn in [`PROFILE_ROWS`] rows. `Err`
-    /// for a target with no crown to grow into.
+    /// view) to the top, each view's stretches of ink, drawn in [`PROFILE_ROWS`] rows
+    /// (gaps narrower than [`GAP`] closed: a crown's leaves fill them). `Err` for a target
+    /// with no crown to grow into.
     pub fn from_target(target: &TargetProfile) -> Result<Profile, EnvelopeError> {
         let n = target.front.len().min(target.side.len());
-        let width = |r: [f32; 2]| (r[1] - r[0]).max(0.0);
-        let widest = |rows: &[[f32; 2]]| rows.iter().map(|&r| width(r)).fold(0.0, f32::max);
+        let width = |r: &[[f32; 2]]| {
+            let [lo, hi] = hull(r);
+            (hi - lo).max(0.0)
+        };
+        let widest = |rows: &[Stretches]| rows.iter().map(|r| width(r)).fold(0.0, f32::max);
         let (front, side) = (&target.front[..n], &target.side[..n]);
         let (wf, ws) = (widest(front), widest(side));
         let crowned =
-            |i: usize| width(front[i]) >= CROWN_WIDTH * wf || width(side[i]) >= CROWN_WIDTH * ws;
+            |i: usize| width(&front[i]) >= CROWN_WIDTH * wf || width(&side[i]) >= CROWN_WIDTH * ws;
         let top = (0..n)
             .rev()
-            .find(|&i| width(front[i]) > 0.0 && width(side[i]) > 0.0);
+            .find(|&i| width(&front[i]) > 0.0 && width(&side[i]) > 0.0);
         let (Some(base), Some(top)) = ((0..n).find(|&i| crowned(i)), top) else {
             return Err(EnvelopeError::Empty {
                 base: 0.0,
@@ -153,23 +228,8 @@ impl Profile {
         let rows = (0..count)
             .map(|k| {
                 let (a, b) = (base + k * span / count, base + (k + 1) * span / count);
-                let hull = |rows: &[[f32; 2]]| {
-                    rows[a..b.max(a + 1)]
-                        .iter()
-                        .filter(|r| width(**r) > 0.0)
-                        .fold([f32::MAX, f32::MIN], |h, r| {
-                            [h[0].min(r[0]), h[1].max(r[1])]
-                        })
-                };
-                let (x, z) = (hull(front), hull(side));
-                let clean = |h: [f32; 2]| {
-                    if h[0] < h[1] {
-                        h.map(|v| v.clamp(-MAX_PROFILE_REACH, MAX_PROFILE_REACH))
-                    } else {
-                        [0.0, 0.0]
-                    }
-                };
-                [clean(x), clean(z)]
+                let union = |rows: &[Stretches]| join(rows[a..b.max(a + 1)].iter().flatten());
+                [union(front), union(side)]
             })
             .collect();
         Ok(Profile {
@@ -179,13 +239,52 @@ impl Profile {
     }
 }
 
+/// Stretches of ink closer than this share of the height are one stretch in a profile.
+pub const GAP: f32 = 0.02;
+
+/// The union of `stretches` left to right, those closer than [`GAP`] joined, each clamped
+/// to ±[`MAX_PROFILE_REACH`], at most [`MAX_STRETCHES`] (the narrowest gaps closed first).
+fn join<'a>(stretches: impl Iterator<Item = &'a [f32; 2]>) -> Stretches {
+    let reach = |v: f32| v.clamp(-MAX_PROFILE_REACH, MAX_PROFILE_REACH);
+    let mut sorted: Stretches = (stretches.filter(|s| s[0] < s[1]))
+        .map(|s| s.map(reach))
+        .collect();
+    sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut joined: Stretches = Vec::with_capacity(sorted.len());
+    for s in sorted {
+        match joined.last_mut() {
+            Some(last) if s[0] - last[1] < GAP => last[1] = last[1].max(s[1]),
+            _ => joined.push(s),
+        }
+    }
+    while joined.len() > MAX_STRETCHES {
+        let narrowest = (1..joined.len())
+            .min_by(|&i, &j| {
+                let gap = |k: usize| joined[k][0] - joined[k - 1][1];
+                gap(i).total_cmp(&gap(j))
+            })
+            .expect("more than one stretch");
+        let right = joined.remove(narrowest);
+        joined[narrowest - 1][1] = right[1];
+    }
+    joined
+}
+
 /// A row is the crown's when it is at least this share as wide as the crown's widest row:
 /// narrower rows below the crown are the trunk.
 pub const CROWN_WIDTH: f32 = 0.25;
 
 impl Envelope {
-    /// The envelope of a genome's crown: its profile, or its shape and proportions.
+    /// The envelope of a genome's crown: its profile, or its shape and proportions, drawn
+    /// in by its `inset`.
     pub fn of(genome: &Growth) -> Envelope {
+        let p = &genome.parameters;
+        let inset = p.f(Param::Inset) * p.f(Param::Height);
+        Envelope::outer(genome).inset(inset)
+    }
+
+    /// The envelope of a genome's crown before its inset.
+    fn outer(genome: &Growth) -> Envelope {
         let p = &genome.parameters;
         let height = p.f(Param::Height);
         if let Some(profile) = &genome.envelope {
@@ -193,7 +292,10 @@ impl Envelope {
                 base: profile.base * height,
                 top: height,
                 rows: (profile.rows.iter())
-                    .map(|r| r.map(|s| s.map(|v| v * height)))
+                    .map(|row| {
+                        row.clone()
+                            .map(|view| view.iter().map(|s| s.map(|v| v * height)).collect())
+                    })
                     .collect(),
             };
         }
@@ -220,16 +322,37 @@ impl Envelope {
             .map(|i| {
                 let r = shape.radius((i as f32 + 0.5) / SHAPE_ROWS as f32);
                 [
-                    [-r * half_width, r * half_width],
-                    [-r * half_depth, r * half_depth],
+                    vec![[-r * half_width, r * half_width]],
+                    vec![[-r * half_depth, r * half_depth]],
                 ]
             })
             .collect();
         Envelope { base, top, rows }
     }
 
+    /// This envelope drawn in by `by` metres at each stretch's ends and (to the nearest
+    /// row) at its top; a stretch narrower than twice that is left out. Twigs stop short of the space
+    /// they grow into while their leaves reach beyond them. Nothing changes for 0.
+    pub fn inset(mut self, by: f32) -> Envelope {
+        if by <= 0.0 || self.rows.is_empty() {
+            return self;
+        }
+        for view in self.rows.iter_mut().flatten() {
+            view.retain_mut(|s| {
+                *s = [s[0] + by, s[1] - by];
+                s[0] < s[1]
+            });
+        }
+        // The top comes down by whole rows, so every row keeps its height.
+        let dy = (self.top - self.base) / self.rows.len() as f32;
+        let drop = ((by / dy) as usize).min(self.rows.len() - 1);
+        self.rows.truncate(self.rows.len() - drop);
+        self.top -= drop as f32 * dy;
+        self
+    }
+
     /// The row at height `y`, if `y` is within the envelope.
-    fn row(&self, y: f32) -> Option<&[[f32; 2]; 2]> {
+    fn row(&self, y: f32) -> Option<&Row> {
         if !(self.base..self.top).contains(&y) {
             return None;
         }
@@ -240,35 +363,43 @@ impl Envelope {
 
     /// Whether `p` lies inside.
     pub fn contains(&self, p: Vec3) -> bool {
-        let Some([[x0, x1], [z0, z1]]) = self.row(p.y) else {
+        let Some([xs, zs]) = self.row(p.y) else {
             return false;
         };
+        let ([x0, x1], [z0, z1]) = (hull(xs), hull(zs));
         if x0 >= x1 || z0 >= z1 {
             return false;
         }
         let u = (2.0 * p.x - (x0 + x1)) / (x1 - x0);
         let v = (2.0 * p.z - (z0 + z1)) / (z1 - z0);
-        u * u + v * v <= 1.0
+        u * u + v * v <= 1.0 && over(xs, p.x) && over(zs, p.z)
     }
 
     /// The box around it: least and greatest corners.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::new(f32::MAX, self.base, f32::MAX);
         let mut hi = Vec3::new(f32::MIN, self.top, f32::MIN);
-        for [[x0, x1], [z0, z1]] in &self.rows {
+        for [xs, zs] in &self.rows {
+            let ([x0, x1], [z0, z1]) = (hull(xs), hull(zs));
             if x0 < x1 && z0 < z1 {
-                lo = lo.min(Vec3::new(*x0, self.base, *z0));
-                hi = hi.max(Vec3::new(*x1, self.top, *z1));
+                lo = lo.min(Vec3::new(x0, self.base, z0));
+                hi = hi.max(Vec3::new(x1, self.top, z1));
             }
         }
         (lo, hi)
     }
 
-    /// The volume it holds, cubic metres.
+    /// The volume it holds, cubic metres: exact for rows of one stretch a view; for more,
+    /// each row's ellipse times the shares of its rectangle the stretches cover.
     pub fn volume(&self) -> f32 {
         let dy = (self.top - self.base) / self.rows.len() as f32;
-        let area = |[[x0, x1], [z0, z1]]: &[[f32; 2]; 2]| {
-            std::f32::consts::FRAC_PI_4 * (x1 - x0).max(0.0) * (z1 - z0).max(0.0)
+        let area = |[xs, zs]: &Row| {
+            let ([x0, x1], [z0, z1]) = (hull(xs), hull(zs));
+            std::f32::consts::FRAC_PI_4
+                * (x1 - x0).max(0.0)
+                * (z1 - z0).max(0.0)
+                * coverage(xs)
+                * coverage(zs)
         };
         self.rows.iter().map(area).sum::<f32>() * dy
     }
@@ -350,14 +481,14 @@ mod tests {
 
     /// A lollipop: a trunk a tenth as wide as the crown for 30 rows, then a round crown.
     fn lollipop() -> TargetProfile {
-        let rows: Vec<[f32; 2]> = (0..100)
+        let rows: Vec<Stretches> = (0..100)
             .map(|i| {
                 if i < 30 {
-                    [-0.02, 0.02]
+                    vec![[-0.02, 0.02]]
                 } else {
                     let t = (i as f32 - 65.0) / 35.0;
                     let r = 0.35 * (1.0 - t * t).max(0.0).sqrt();
-                    [-r.max(0.02), r.max(0.02)]
+                    vec![[-r.max(0.02), r.max(0.02)]]
                 }
             })
             .collect();
@@ -420,6 +551,14 @@ mod tests {
             ),
             (r#"{"base":0.3,"rows":[[[-0.2,0.2]]]}"#, "invalid length"),
             (
+                r#"{"base":0.3,"rows":[[[0.2,-0.2],[-0.2,0.2]]]}"#,
+                "left ≤ right",
+            ),
+            (
+                r#"{"base":0.3,"rows":[[[-0.2,0.2],"wide"]]}"#,
+                "a view's stretches",
+            ),
+            (
                 r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.2,0.2]]],"extra":1}"#,
                 "extra",
             ),
@@ -429,11 +568,111 @@ mod tests {
         }
     }
 
+    /// Two lobes of a crown beside a trunk, over a gap under the crown as wide as a third of
+    /// the crown, in rows 30 to 50; a round crown above.
+    fn two_lobes() -> TargetProfile {
+        let mut target = lollipop();
+        for (i, row) in target.front.iter_mut().enumerate().take(50).skip(30) {
+            let r = row[0][1];
+            *row = if i % 2 == 0 {
+                vec![[-r, -0.1], [-0.02, 0.02], [0.1, r]]
+            } else {
+                // Gaps narrower than `GAP` in a lobe are closed.
+                vec![
+                    [-r, -0.2],
+                    [-0.2 + 0.5 * GAP, -0.1],
+                    [-0.02, 0.02],
+                    [0.1, r],
+                ]
+            };
+        }
+        target
+    }
+
+    #[test]
+    fn a_target_s_gaps_stay_empty() {
+        let profile = Profile::from_target(&two_lobes()).unwrap();
+        let low = &profile.rows[2];
+        assert_eq!(low[0].len(), 3, "{low:?}");
+        assert_eq!(low[1].len(), 1, "the side view has no gap: {low:?}");
+        let genome = Growth {
+            envelope: Some(profile),
+            ..Growth::default()
+        };
+        let e = Envelope::of(&genome);
+        let height = genome.parameters.f(Param::Height);
+        let at = |x: f32, y: f32| Vec3::new(x * height, y * height, 0.0);
+        assert!(e.contains(at(-0.15, 0.4)), "over a lobe");
+        assert!(e.contains(at(0.0, 0.4)), "over the trunk");
+        assert!(!e.contains(at(0.06, 0.4)), "over the gap");
+        assert!(e.contains(at(0.06, 0.6)), "in the crown above");
+        // The volume counts the gaps out (within the sampling error).
+        let mut rng = sylva_core::rng::seeded(2);
+        let (lo, hi) = e.bounds();
+        let inside = (0..40_000)
+            .filter(|_| {
+                e.contains(Vec3::new(
+                    rng.random_range(lo.x..hi.x),
+                    rng.random_range(lo.y..hi.y),
+                    rng.random_range(lo.z..hi.z),
+                ))
+            })
+            .count();
+        let measured = (hi - lo).element_product() * inside as f32 / 40_000.0;
+        assert!(
+            (e.volume() / measured - 1.0).abs() < 0.05,
+            "{} {measured}",
+            e.volume()
+        );
+        let points = e.attraction_points(3000, &mut rng).unwrap();
+        let gap = (points.iter())
+            .filter(|p| p.y < 0.5 * height && (0.03..0.09).contains(&(p.x / height)))
+            .count();
+        assert_eq!(gap, 0);
+    }
+
+    #[test]
+    fn an_inset_draws_the_envelope_in() {
+        let e = Envelope::of_shape(CrownShape::Cylinder, 2.0, 10.0, 3.0, 3.0);
+        let inner = e.clone().inset(0.5);
+        assert_eq!(e.clone().inset(0.0), e);
+        assert!((inner.top - 9.5).abs() < 0.2, "{}", inner.top);
+        assert!(e.contains(Vec3::new(2.7, 5.0, 0.0)));
+        assert!(!inner.contains(Vec3::new(2.7, 5.0, 0.0)));
+        assert!(inner.contains(Vec3::new(2.3, 5.0, 0.0)));
+        // A stretch narrower than twice the inset goes.
+        let lobes = Envelope::of(&Growth {
+            envelope: Profile::from_target(&two_lobes()).ok(),
+            ..Growth::default()
+        });
+        let (before, after) = (&lobes.rows[2][0], &lobes.clone().inset(0.3).rows[2][0]);
+        assert_eq!((before.len(), after.len()), (3, 2), "{before:?} {after:?}");
+        // A genome's inset is its envelope's.
+        let mut genome = Growth::default();
+        genome.parameters.set_at(Param::Inset as usize, 0.05);
+        let height = genome.parameters.f(Param::Height);
+        let drawn_in = Envelope::of(&genome);
+        let whole = Envelope::of(&Growth::default());
+        assert!(drawn_in.volume() < 0.8 * whole.volume());
+        assert!((whole.top - drawn_in.top - 0.05 * height).abs() < height / 64.0);
+    }
+
+    #[test]
+    fn genomes_written_before_stretches_still_read() {
+        let text = r#"{"base":0.3,"rows":[[[-0.2,0.2],[-0.1,0.1]],[[[-0.2,-0.1],[0.1,0.2]],[]]]}"#;
+        let profile: Profile = serde_json::from_str(text).unwrap();
+        assert_eq!(profile.rows[0], [vec![[-0.2, 0.2]], vec![[-0.1, 0.1]]]);
+        assert_eq!(profile.rows[1], [vec![[-0.2, -0.1], [0.1, 0.2]], vec![]]);
+        let again: Profile =
+            serde_json::from_str(&serde_json::to_string(&profile).unwrap()).unwrap();
+        assert_eq!(again, profile);
+    }
+
     #[test]
     fn a_target_with_no_crown_is_refused() {
         let blank = TargetProfile {
-            front: vec![[0.0, 0.0]; 50],
-            side: vec![[0.0, 0.0]; 50],
+            front: vec![Vec::new(); 50],
+            side: vec![vec![[0.0, 0.0]]; 50],
         };
         let e = Profile::from_target(&blank).unwrap_err();
         assert!(e.to_string().contains("empty or flat"), "{e}");

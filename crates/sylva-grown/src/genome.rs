@@ -208,6 +208,10 @@ params! {
     /// Internodes from a tip that bear leaves.
     LeafSpan = "leaf_span", Form, 0.0, 12.0, 3.0, true, " internodes",
         "How far back from each tip a shoot keeps its leaves.";
+    /// How far inside the envelope attraction points stay, over the tree's height.
+    Inset = "inset", Crown, 0.0, 0.1, 0.0, false, "",
+        "How far inside its envelope the crown's space stays, as a share of the height: \
+         room for the leaves the outermost twigs bear.";
 }
 
 impl Param {
@@ -412,8 +416,8 @@ impl Growth {
     }
 
     /// Moves each parameter with probability `rate` by a normal step of `spread` times its
-    /// range, and picks another crown shape with the same probability. The seed stays: a
-    /// mutant grows into the same space.
+    /// range, and picks another crown shape, and another foliage (with its own bark), each
+    /// with the same probability. The seed stays: a mutant grows into the same space.
     pub fn mutate<R: Rng + ?Sized>(&mut self, v: Variation, rng: &mut R) {
         let rate = sylva_core::rng::probability(v.rate);
         for (i, spec) in PARAMS.iter().enumerate() {
@@ -430,6 +434,11 @@ impl Growth {
         }
         if rng.random_bool(rate) {
             self.crown = CrownShape::ALL[rng.random_range(0..CrownShape::ALL.len())];
+        }
+        // The species too, so that a search can find needles for a conifer's outline.
+        if rng.random_bool(rate) {
+            self.foliage = LeafKind::ALL[rng.random_range(0..LeafKind::ALL.len())];
+            self.bark = None;
         }
     }
 

@@ -496,16 +496,17 @@ pub trait VectorCoding<M: Evolve>: Send + Sync {
 }
 
 /// A match's target outlines as a model may grow into them ([`Evolve::fit_target`]): for
-/// each row of the pictures from the foot (row 0) to the top, the stretch of ink seen from
-/// the front and from the side, as shares of the outline's height measured from the foot
-/// (negative to the left, or to the back). A row without ink is `[0, 0]`.
+/// each row of the pictures from the foot (row 0) to the top, the stretches of ink seen
+/// from the front and from the side, left to right, as shares of the outline's height
+/// measured from the foot (negative to the left, or to the back). A row without ink has no
+/// stretches.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TargetProfile {
     /// Rows of the front view, foot to top.
-    pub front: Vec<[f32; 2]>,
+    pub front: Vec<Vec<[f32; 2]>>,
     /// Rows of the side view, foot to top (the front's again when no side view is given:
     /// the front turned a quarter).
-    pub side: Vec<[f32; 2]>,
+    pub side: Vec<Vec<[f32; 2]>>,
 }
 
 /// How long one evaluation may take ([`Evolve::evaluation_time`]).

@@ -137,22 +137,30 @@ impl Target {
     }
 
     /// The pictures as a model may grow into them ([`sylva_model::TargetProfile`]): each
-    /// view's ink, row by row from its foot, at [`PROFILE_ROWS`] rows; a target without a
+    /// view's stretches of ink, row by row from its foot, at [`PROFILE_ROWS`] rows; a target without a
     /// side view is seen from the side as from the front.
     pub fn profile(&self) -> Result<sylva_model::TargetProfile, InputError> {
         let outlines = self.outlines(PROFILE_ROWS)?;
         let rows_of = |o: &Outline| {
             let (ink, rows) = (o.normalised(), o.rows());
+            let share = |x: u32| (x as f32 - o.foot()) / rows as f32;
             (0..rows)
                 .rev()
                 .map(|y| {
-                    let mut xs = (0..ink.width()).filter(|&x| ink.get(x, y));
-                    let Some(left) = xs.next() else {
-                        return [0.0, 0.0];
-                    };
-                    let right = xs.next_back().unwrap_or(left) + 1;
-                    let share = |x: u32| (x as f32 - o.foot()) / rows as f32;
-                    [share(left), share(right)]
+                    let mut stretches = Vec::new();
+                    let mut x = 0;
+                    while x < ink.width() {
+                        if !ink.get(x, y) {
+                            x += 1;
+                            continue;
+                        }
+                        let left = x;
+                        while x < ink.width() && ink.get(x, y) {
+                            x += 1;
+                        }
+                        stretches.push([share(left), share(x)]);
+                    }
+                    stretches
                 })
                 .collect::<Vec<_>>()
         };
