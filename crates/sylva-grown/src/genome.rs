@@ -212,6 +212,12 @@ params! {
     Inset = "inset", Crown, 0.0, 0.1, 0.0, false, "",
         "How far inside its envelope the crown's space stays, as a share of the height: \
          room for the leaves the outermost twigs bear.";
+    /// Stems from the foot.
+    Stems = "stems", Crown, 1.0, 8.0, 1.0, true, "",
+        "Stems rising from the foot to the crown: 1 for a tree, more for a shrub.";
+    /// How far a shrub's further stems lean from upright, degrees.
+    StemSpread = "stem_spread", Crown, 0.0, 45.0, 15.0, false, "°",
+        "How far a shrub's further stems lean out from upright.";
 }
 
 impl Param {
@@ -416,8 +422,9 @@ impl Growth {
     }
 
     /// Moves each parameter with probability `rate` by a normal step of `spread` times its
-    /// range, and picks another crown shape, and another foliage (with its own bark), each
-    /// with the same probability. The seed stays: a mutant grows into the same space.
+    /// range, and picks another crown shape, and another foliage of its kind (broadleaf or
+    /// needles, with its own bark), each with the same probability. The seed stays: a
+    /// mutant grows into the same space.
     pub fn mutate<R: Rng + ?Sized>(&mut self, v: Variation, rng: &mut R) {
         let rate = sylva_core::rng::probability(v.rate);
         for (i, spec) in PARAMS.iter().enumerate() {
@@ -435,9 +442,14 @@ impl Growth {
         if rng.random_bool(rate) {
             self.crown = CrownShape::ALL[rng.random_range(0..CrownShape::ALL.len())];
         }
-        // The species too, so that a search can find needles for a conifer's outline.
+        // The species too, among its own kind: broadleaves for broadleaves, needles for
+        // needles (an outline shows no species, and an aspen's picture would otherwise be
+        // matched as well by a pine's needles).
         if rng.random_bool(rate) {
-            self.foliage = LeafKind::ALL[rng.random_range(0..LeafKind::ALL.len())];
+            let needles = self.foliage.spec().needles;
+            let like = LeafKind::ALL.iter().filter(|k| k.spec().needles == needles);
+            let pick = rng.random_range(0..like.clone().count());
+            self.foliage = like.copied().nth(pick).unwrap_or(self.foliage);
             self.bark = None;
         }
     }
@@ -550,6 +562,28 @@ mod tests {
                 assert!((spec.min..=spec.max).contains(&v), "{spec:?} {v}");
                 assert!(!spec.whole || v.fract() == 0.0);
             }
+        }
+    }
+
+    #[test]
+    fn mutation_changes_the_species_within_its_sort() {
+        let mut rng = sylva_core::rng::seeded(6);
+        let often = Variation {
+            rate: 0.9,
+            spread: 0.1,
+        };
+        for start in [LeafKind::Oak, LeafKind::Spruce] {
+            let mut g = Growth {
+                foliage: start,
+                ..Growth::default()
+            };
+            let mut seen = std::collections::BTreeSet::new();
+            for _ in 0..100 {
+                g.mutate(often, &mut rng);
+                assert_eq!(g.foliage.spec().needles, start.spec().needles, "{g:?}");
+                seen.insert(g.foliage.name());
+            }
+            assert!(seen.len() >= 3, "{seen:?}");
         }
     }
 
