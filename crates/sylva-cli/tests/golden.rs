@@ -117,7 +117,7 @@ fn one_plant_of_each_model() {
             ("lsystem.obj", 0xb7b2_1d21_c371_d211),
             ("lsystem.wrl", 0x6c1a_fb10_cf41_5531),
             ("lsystem.png", 0x6c6d_cd66_74b2_365d),
-            ("grown.glb", 0xf063_f649_4186_03f3),
+            ("grown.glb", 0x3396_8a1e_0056_0769),
             ("grown.obj", 0x67d3_c47c_2c87_4897),
             ("grown.wrl", 0x602d_4100_dd9f_2a83),
             ("grown.png", 0xebdc_0363_1cdd_8df4),
@@ -212,11 +212,11 @@ fn a_small_grown_run() {
             ("[output]\nsheet_size = 16", SMALL_OUTPUT),
         ],
         &[
-            ("stats.csv", 0xcfde_876a_11f8_c56a),
-            ("best.json", 0x0682_fe49_19ec_ac5b),
-            ("best.glb", 0x8fa8_b152_0685_bb60),
-            ("best.png", 0xd376_c1c8_1bcd_d293),
-            ("population.png", 0x8beb_8320_378c_0eb6),
+            ("stats.csv", 0xf46c_887c_c7a9_7658),
+            ("best.json", 0x22a5_4f48_dbe4_56b1),
+            ("best.glb", 0x59ba_345b_e90e_1c47),
+            ("best.png", 0x8539_7d73_9556_becb),
+            ("population.png", 0x08a1_eee5_1da0_472c),
         ],
     );
 }

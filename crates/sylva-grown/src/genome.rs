@@ -212,12 +212,6 @@ params! {
     Inset = "inset", Crown, 0.0, 0.1, 0.0, false, "",
         "How far inside its envelope the crown's space stays, as a share of the height: \
          room for the leaves the outermost twigs bear.";
-    /// Stems from the foot.
-    Stems = "stems", Crown, 1.0, 8.0, 1.0, true, "",
-        "Stems rising from the foot to the crown: 1 for a tree, more for a shrub.";
-    /// How far a shrub's further stems lean from upright, degrees.
-    StemSpread = "stem_spread", Crown, 0.0, 45.0, 15.0, false, "°",
-        "How far a shrub's further stems lean out from upright.";
 }
 
 impl Param {

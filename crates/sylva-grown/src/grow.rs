@@ -496,28 +496,6 @@ impl Tree<'_> {
             }
             self.add(self.nodes.len() as u32 - 1, false, Vec3::Y, 0);
         }
-        self.stems(base);
-    }
-
-    /// A shrub's further stems: `stems - 1` shoots from the lowest nodes of the bole, each
-    /// leaning `stem_spread` from upright and turned by the golden angle from the last,
-    /// straight up to the crown's base.
-    fn stems(&mut self, base: f32) {
-        let stems = self.genome.parameters.count(Param::Stems);
-        let lean = self.param(Param::StemSpread).to_radians();
-        let bole = self.nodes.len() as u32 - 1;
-        for k in 1..stems {
-            let azimuth = k as f32 * 137.5f32.to_radians();
-            let dir = Vec3::new(
-                lean.sin() * azimuth.cos(),
-                lean.cos(),
-                lean.sin() * azimuth.sin(),
-            );
-            let mut at = self.add(k.min(bole), true, dir, 0);
-            while self.nodes[at as usize].pos.y + self.step * dir.y < base {
-                at = self.add(at, false, dir, 0);
-            }
-        }
     }
 
     /// Adds an internode from `parent` heading `dir`, in its main or side place.
@@ -994,30 +972,6 @@ mod tests {
             let (_, report) = grow(&genome, 1).unwrap();
             assert!(report.internodes > 200, "{crown:?} {report:?}");
         }
-    }
-
-    #[test]
-    fn a_shrub_has_its_stems_from_the_foot() {
-        let mut genome = Growth::default();
-        let height = genome.parameters.f(Param::Height);
-        let low = 0.15 * height;
-        let crossing = |plant: &Plant| {
-            (plant.segments().iter())
-                .filter(|s| s.start.y <= low && s.end.y > low)
-                .count()
-        };
-        let tree = grow(&genome, 1).unwrap().0;
-        assert_eq!(crossing(&tree), 1);
-        genome.parameters.set(Param::Stems, 4.0);
-        genome.parameters.set(Param::StemSpread, 20.0);
-        let (shrub, report) = grow(&genome, 1).unwrap();
-        assert_eq!(crossing(&shrub), 4);
-        assert!(report.internodes > 200, "{report:?}");
-        // Three lean out; the bole stands upright.
-        let leaning = (shrub.segments().iter())
-            .filter(|s| s.start.y <= low && s.end.y > low && s.end.with_y(0.0).length() > 0.1)
-            .count();
-        assert_eq!(leaning, 3);
     }
 
     #[test]
