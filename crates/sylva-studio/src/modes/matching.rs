@@ -17,7 +17,7 @@ use axum::response::{IntoResponse, Response};
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::evolution::outline::{self, Limit, outlines, overlay, start_auto_at};
+use sylva::evolution::outline::{self, AutoMatch, Limit, TrialLog, outlines, overlay};
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution};
@@ -268,17 +268,18 @@ impl Background for MatchMode {
         let run = config.run().clone();
         let (threshold, prune) = (threshold_of(&state), prune_of(&state));
         let dir = picture_dir(studio, row.session)?;
-        let (evolution, _) = start_auto_at(
-            &studio.registry,
-            &target(threshold, prune),
-            &dir,
-            &run,
-            Limit::Generations(run.generations),
-            &studio.pool,
-            &sylva::core::par::Stop::new(),
-            |_| {},
-        )
-        .map_err(failed)?;
+        let auto = AutoMatch {
+            registry: &studio.registry,
+            target: &target(threshold, prune),
+            base: &dir,
+            run: &run,
+            limit: Limit::Generations(run.generations),
+            pool: &studio.pool,
+            stop: &sylva::core::par::Stop::new(),
+        };
+        let (evolution, _) = auto
+            .start(&mut TrialLog::new(), |_| Ok::<_, sylva::Error>(()))
+            .map_err(failed)?;
         let chosen = config_for(studio, evolution.config().model(), &run, threshold, prune)?;
         studio.archive.transaction(|c| -> Result<_, ApiError> {
             archive::set_run_config(c, row.id, &chosen.to_toml())?;
