@@ -535,6 +535,7 @@ fn auto_killed_during_its_trials_resumes_from_its_log_to_the_same_bytes() {
         let (mut seen, mut kept) = (0, None);
         let killed = auto.start(&mut TrialLog::new(), |event| {
             match event {
+                AutoEvent::Begun { .. } => {}
                 AutoEvent::Bred { .. } => seen += 1,
                 AutoEvent::Ended { log, .. } => kept = Some(log.to_json()?),
             }

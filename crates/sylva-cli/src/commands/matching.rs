@@ -264,21 +264,33 @@ fn trials(
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     let models: Vec<&str> = auto.registry.models().iter().map(|m| m.name()).collect();
+    let which = |model: &str, runoff: bool| {
+        if runoff {
+            format!("run-off of {model}")
+        } else {
+            let at = models.iter().position(|m| *m == model).unwrap_or(0);
+            format!("trial of {model} ({} of {})", at + 1, models.len())
+        }
+    };
+    bar.set_message("reading the target");
     let started = auto.start(log, |event| {
         match event {
+            AutoEvent::Begun { model, runoff } => {
+                let doing = if runoff {
+                    "going on"
+                } else {
+                    "making generation 0"
+                };
+                bar.set_message(format!("{}: {doing}", which(model, runoff)));
+            }
             AutoEvent::Bred {
                 model,
                 runoff,
                 evolution,
             } => {
-                let which = if runoff {
-                    format!("run-off of {model}")
-                } else {
-                    let at = models.iter().position(|m| *m == model).unwrap_or(0);
-                    format!("trial of {model} ({} of {})", at + 1, models.len())
-                };
                 bar.set_message(format!(
-                    "{which}: generation {}, best IoU {:.3}",
+                    "{}: generation {}, best IoU {:.3}",
+                    which(model, runoff),
                     evolution.generation(),
                     best_iou(evolution)
                 ));

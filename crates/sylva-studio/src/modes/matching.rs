@@ -378,19 +378,23 @@ fn trials(
         stop: &sylva::core::par::Stop::new(),
     };
     let started = auto.start(&mut log, |event| -> Result<(), TrialsEnded> {
+        // A stop (by hand, or the studio shutting down) ends the trials as the next trial
+        // or generation begins (a trial that ended is kept first); the trials kept are gone
+        // on from when the run resumes.
+        let stopped = || stop.load(Ordering::SeqCst);
         match event {
+            AutoEvent::Begun { .. } | AutoEvent::Bred { .. } if stopped() => {
+                return Err(TrialsEnded::Stopped);
+            }
+            AutoEvent::Begun { model, runoff } => {
+                let data = json!({"run": row.id, "model": model, "runoff": runoff});
+                studio.events.send(row.session, "trial-begun", data);
+            }
             AutoEvent::Bred {
                 model,
                 runoff,
                 evolution,
-            } => {
-                // A stop (by hand, or the studio shutting down) ends the trials here;
-                // those kept are gone on from when the run resumes.
-                if stop.load(Ordering::SeqCst) {
-                    return Err(TrialsEnded::Stopped);
-                }
-                trial_generation(studio, row, model, runoff, evolution)?;
-            }
+            } => trial_generation(studio, row, model, runoff, evolution)?,
             AutoEvent::Ended {
                 log,
                 resumed: false,

@@ -70,6 +70,7 @@ export default function createMatchMode(ctx, root) {
   let run = null;
   let rows = new Map();
   let trials = new Map(); // an auto match's trial generations, by "model generation", in the order bred
+  let begun = null; // the trial begun and not yet bred a generation: {model, runoff}
   let best = null; // the plant shown
   let es = null;
   let esSession = null;
@@ -138,6 +139,7 @@ export default function createMatchMode(ctx, root) {
     if (changed) {
       rows = new Map();
       trials = new Map();
+      begun = null;
       best = null;
       listed = false;
       clearPicture(overlay);
@@ -169,6 +171,7 @@ export default function createMatchMode(ctx, root) {
     const key = `${t.model} ${t.generation}`;
     trials.delete(key);
     trials.set(key, t);
+    if (begun && begun.model === t.model && begun.runoff === t.runoff) begun = null;
   }
 
   /** The trial generation bred last, while the run has none of its own yet. */
@@ -228,10 +231,13 @@ export default function createMatchMode(ctx, root) {
     const last = [...rows.values()].sort((a, b) => b.generation - a.generation)[0];
     const score = last ? ` · best ${fmtNum(last.best, 3)}` : "";
     const t = currentTrial();
-    statusEl.dataset.trial = t ? t.model : "";
-    const where = t
-      ? `${t.runoff ? "run-off" : "trial"}: ${t.model}, generation ${t.generation}, IoU ${fmtNum(t.iou, 3)}`
-      : `generation ${generation ?? "–"} of ${total ?? "–"}${score}`;
+    const b = rows.size || status !== RUNNING ? null : begun;
+    statusEl.dataset.trial = b ? b.model : t ? t.model : "";
+    const where = b
+      ? `${b.runoff ? "run-off" : "trial"}: ${b.model}, ${b.runoff ? "going on" : "making its first generation"}`
+      : t
+        ? `${t.runoff ? "run-off" : "trial"}: ${t.model}, generation ${t.generation}, IoU ${fmtNum(t.iou, 3)}`
+        : `generation ${generation ?? "–"} of ${total ?? "–"}${score}`;
     statusEl.textContent = `${status || "–"} · ${where}${error ? ` · ${error}` : ""}`;
     stopBtn.disabled = status !== RUNNING;
     resumeBtn.disabled = !(status === "stopped" || status === "done");
@@ -267,6 +273,11 @@ export default function createMatchMode(ctx, root) {
         showTrial();
         drawChart_();
         setStatus(t.status || RUNNING, 0, run?.generations, null);
+      },
+      "trial-begun": (b) => {
+        if (!session || session.id !== id) return;
+        begun = { model: b.model, runoff: b.runoff };
+        setStatus(RUNNING, 0, run?.generations, null);
       },
       status: async (st) => {
         if (!session || session.id !== id) return;
@@ -341,6 +352,7 @@ export default function createMatchMode(ctx, root) {
       run = null;
       rows = new Map();
       trials = new Map();
+      begun = null;
       best = null;
       clearPicture(target);
       clearPicture(overlay);

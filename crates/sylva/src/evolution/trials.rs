@@ -1,9 +1,10 @@
 //! The trials of an auto match ([`AutoMatch`]): a short trial of each model of the registry,
 //! a run-off of the best two, then the better goes on.
 //!
-//! The trials are a phase of the match like any other: they tell a front end each
-//! generation they breed ([`AutoEvent::Bred`]: which model, the run, so its best IoU and
-//! outline can be shown), and each trial that ends ([`AutoEvent::Ended`]) with the
+//! The trials are a phase of the match like any other: they tell a front end each trial
+//! that begins ([`AutoEvent::Begun`]), each generation it breeds ([`AutoEvent::Bred`]:
+//! which model, the run, so its best IoU and outline can be shown), and each trial that
+//! ends ([`AutoEvent::Ended`]) with the
 //! [`TrialLog`] that holds it. The log is the trials' checkpoint: every trial that ended,
 //! with how it ended, the generations it bred ([`TrialRow`]) and its run as it left it. A
 //! front end keeps it (`sylva match` as `trials.json` in its folder, the studio in its
@@ -52,7 +53,7 @@
 //!         AutoEvent::Ended { log, resumed: false, .. } => {
 //!             sylva::files::write(Path::new("trials.json"), log.to_json()?.as_bytes())?
 //!         }
-//!         AutoEvent::Ended { .. } => {}
+//!         AutoEvent::Begun { .. } | AutoEvent::Ended { .. } => {}
 //!     }
 //!     Ok::<_, sylva::Error>(())
 //! })?;
@@ -355,6 +356,14 @@ impl TrialLog {
 /// What the trials tell a front end as they go.
 #[derive(Debug)]
 pub enum AutoEvent<'a> {
+    /// A trial begins to breed (its first generation, or its run-off's, is being made):
+    /// the model on trial and whether this is its run-off.
+    Begun {
+        /// The model on trial.
+        model: &'static str,
+        /// Whether this is the run-off.
+        runoff: bool,
+    },
     /// A generation of a trial was made (generation 0 too): the model on trial, whether
     /// this is its run-off, and its run (its best plant, [`best_iou`], its statistics).
     Bred {
@@ -546,6 +555,10 @@ impl AutoMatch<'_> {
             )?;
             return Ok(None);
         }
+        on(AutoEvent::Begun {
+            model,
+            runoff: false,
+        })?;
         let hooks = RunHooks {
             stop: Some(self.stop.clone()),
             term: None,
@@ -605,6 +618,10 @@ impl AutoMatch<'_> {
                 resumed: true,
             });
         }
+        on(AutoEvent::Begun {
+            model,
+            runoff: true,
+        })?;
         let begun = Instant::now();
         let mut evolution = match entrant.run.take() {
             Some(run) => run,
