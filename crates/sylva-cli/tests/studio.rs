@@ -2000,8 +2000,18 @@ fn an_auto_matchs_trials_are_shown_recorded_and_survive_a_kill() {
         .as_i64()
         .unwrap();
     let mut events = event_stream(&whole, s);
-    let told = read_events(&mut events, |e| e.iter().any(|(n, _)| n == "trial"));
-    let (_, trial) = told.iter().find(|(n, _)| n == "trial").unwrap();
+    // A trial told as it begins, then its generations (the run's own come after).
+    let begun_then_bred = |e: &[(String, Value)]| {
+        e.iter().enumerate().any(|(i, (n, b))| {
+            n == "trial-begun"
+                && (e[i + 1..].iter()).any(|(m, t)| m == "trial" && t["model"] == b["model"])
+        })
+    };
+    let told = read_events(&mut events, |e| {
+        begun_then_bred(e) || e.iter().any(|(n, _)| n == "generation")
+    });
+    assert!(begun_then_bred(&told), "the trials told nothing: {told:?}");
+    let (_, trial) = told.iter().rev().find(|(n, _)| n == "trial").unwrap();
     for key in [
         "model",
         "runoff",
