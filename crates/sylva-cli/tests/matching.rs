@@ -1,7 +1,8 @@
 //! `sylva match` as a designer drives it: a picture in, a plant whose outline matches it
 //! out, with every file `sylva evolve` writes and `overlay.png`; the same target, seed and
-//! generations give the same bytes; a run resumes after it stops as if it never had; and
-//! a bad picture gets exit code 2 naming the file, with nothing written.
+//! generations give the same bytes; a run resumes after it stops as if it never had, and
+//! an auto match killed during its trials resumes from the trials it kept; and a bad
+//! picture gets exit code 2 naming the file, with nothing written.
 #![allow(clippy::unwrap_used)] // Tests may panic on broken setup.
 
 use std::fs;
@@ -50,8 +51,8 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .map(|name| {
             let bytes = fs::read(dir.join(&name)).unwrap();
             let bytes = match name.as_str() {
-                // The checkpoint holds each generation's wall-clock seconds.
-                "checkpoint.json" => Vec::new(),
+                // The checkpoint and the trials' log hold wall-clock seconds.
+                "checkpoint.json" | "trials.json" => Vec::new(),
                 "stats.csv" => String::from_utf8(bytes)
                     .unwrap()
                     .lines()
@@ -278,4 +279,102 @@ fn an_out_folder_that_is_a_file_is_refused_before_the_run() {
         }
     }
     assert_eq!(fs::read_to_string(&file).unwrap(), "a file\n");
+}
+
+/// An auto match of the round target, counting generations, into `out`.
+fn auto_args(out: &Path) -> Vec<String> {
+    [
+        "match",
+        s(&target()),
+        "--generations",
+        "25",
+        "--population",
+        "6",
+        "--seed",
+        "4",
+        "--out",
+        s(out),
+    ]
+    .map(str::to_owned)
+    .to_vec()
+}
+
+#[test]
+fn an_auto_match_killed_during_its_trials_resumes_from_them_to_the_same_bytes() {
+    use std::process::{Command, Stdio};
+    use std::time::Duration;
+    let dir = temp_dir("auto-killed");
+    let (whole, killed) = (dir.join("whole"), dir.join("killed"));
+    let args = auto_args(&whole);
+    let said = sylva(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&said);
+    // The trials' generations are recorded, every model's that bred.
+    let csv = fs::read_to_string(whole.join("trials.csv")).unwrap();
+    assert!(
+        csv.starts_with("model,phase,generation,best,mean,iou\n"),
+        "{csv}"
+    );
+    for model in ["bintree", "automata", "plantmaker", "grown"] {
+        let first = csv
+            .lines()
+            .filter(|l| l.starts_with(&format!("{model},trial,")))
+            .count();
+        assert_eq!(first, 3, "{model}: generations 0 to 2 of its trial\n{csv}");
+    }
+    assert_eq!(
+        csv.lines().filter(|l| l.contains(",runoff,")).count(),
+        6,
+        "{csv}"
+    );
+    // Killed (SIGKILL) as soon as the first trial is kept, while the others are bred.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(auto_args(&killed))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let log = killed.join("trials.json");
+    while child.try_wait().unwrap().is_none() && !log.exists() {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let kept: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&log).expect("the trials kept a log")).unwrap();
+    assert!(
+        kept.get("chosen").is_none(),
+        "killed after the trials: {kept}"
+    );
+    assert!(!killed.join("checkpoint.json").exists());
+    // The same command with --resume goes on from the trials kept, to the same bytes.
+    let mut again = auto_args(&killed);
+    again.push("--resume".to_owned());
+    let resumed = sylva(&again.iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&resumed);
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert!(
+        stderr.contains("auto: bintree reached") && stderr.contains("(kept in trials.json)"),
+        "{stderr}"
+    );
+    let (a, b) = (files(&whole), files(&killed));
+    assert_eq!(
+        a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        b.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    for ((name, x), (_, y)) in a.iter().zip(&b) {
+        assert!(x == y, "{name} differs after a kill during the trials");
+    }
+    // A log is resumed by its own match only.
+    let mut other = auto_args(&killed);
+    other[5] = "7".to_owned();
+    fs::write(&log, serde_json::to_string(&kept).unwrap()).unwrap();
+    other.push("--resume".to_owned());
+    let refused = sylva(&other.iter().map(String::as_str).collect::<Vec<_>>());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("trials.json") && stderr.contains("population of 6, not 7"),
+        "{stderr}"
+    );
+    fs::remove_dir_all(&dir).unwrap();
 }

@@ -1970,6 +1970,145 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
     );
 }
 
+/// The figures of an auto match's trials, as the run's view lists them (wall-clock seconds
+/// left out).
+fn trial_figures(run: &Value) -> Vec<Value> {
+    (run["trials"].as_array().unwrap().iter())
+        .map(|t| {
+            json!([
+                t["model"],
+                t["runoff"],
+                t["generation"],
+                t["best"],
+                t["mean"],
+                t["iou"]
+            ])
+        })
+        .collect()
+}
+
+#[test]
+fn an_auto_matchs_trials_are_shown_recorded_and_survive_a_kill() {
+    let (_, picture) = round_picture();
+    let asked = json!({"mode": "match", "match": {
+        "picture": picture, "model": "auto", "generations": 25, "population": 8, "seed": 4,
+    }});
+    // Uninterrupted: each trial generation is told as it is bred, and recorded.
+    let whole_dir = temp_dir("auto-whole");
+    let whole = start(&whole_dir, "127.0.0.1");
+    let s = post(&whole, "/api/sessions", asked.clone())["id"]
+        .as_i64()
+        .unwrap();
+    let mut events = event_stream(&whole, s);
+    // A trial told as it begins, then its generations (the run's own come after).
+    let begun_then_bred = |e: &[(String, Value)]| {
+        e.iter().enumerate().any(|(i, (n, b))| {
+            n == "trial-begun"
+                && (e[i + 1..].iter()).any(|(m, t)| m == "trial" && t["model"] == b["model"])
+        })
+    };
+    let told = read_events(&mut events, |e| {
+        begun_then_bred(e) || e.iter().any(|(n, _)| n == "generation")
+    });
+    assert!(begun_then_bred(&told), "the trials told nothing: {told:?}");
+    let (_, trial) = told.iter().rev().find(|(n, _)| n == "trial").unwrap();
+    for key in [
+        "model",
+        "runoff",
+        "generation",
+        "best",
+        "mean",
+        "iou",
+        "plant",
+    ] {
+        assert!(
+            !trial[key].is_null(),
+            "a trial event without {key}: {trial}"
+        );
+    }
+    let done = wait_match(&whole, s, u64::MAX);
+    assert_eq!(done["status"], "done", "{done}");
+    let rows = done["rows"].as_array().unwrap();
+    let chosen = get(&whole, &format!("/api/sessions/{s}"))["model"].clone();
+    // The chosen model's trial generations are the run's first: generations 0 to 25.
+    assert_eq!(rows.len(), 26, "{done}");
+    assert_eq!(rows[0]["generation"], 0);
+    // Every model that bred, generations 0 to 2 of its trial; the best two, 3 to 5 of
+    // the run-off; each generation's best archived as a plant of its model.
+    let ended = done["ended"].as_array().unwrap();
+    let runoffs: Vec<&Value> = ended.iter().filter(|t| t["runoff"] == true).collect();
+    assert_eq!(runoffs.len(), 2, "{done}");
+    assert!(runoffs.iter().any(|t| t["model"] == chosen));
+    let trials = done["trials"].as_array().unwrap();
+    let bred = ended.iter().filter(|t| t["outcome"]["reached"].is_object());
+    assert_eq!(trials.len(), 3 * bred.count(), "{done}");
+    for t in trials {
+        let runoff = t["runoff"] == true;
+        let generation = t["generation"].as_u64().unwrap();
+        assert_eq!(generation >= 3, runoff, "{t}");
+        let plant = get(&whole, &format!("/api/plants/{}", t["plant"]));
+        assert_eq!(plant["model"], t["model"], "{t}");
+        assert_eq!(plant["operator"], "match");
+    }
+    let (status, png) = request(
+        &whole,
+        "GET",
+        &format!(
+            "/api/sessions/{s}/match/overlay.png?plant={}",
+            trials[0]["plant"]
+        ),
+        b"",
+        true,
+    );
+    assert!(status == 200 && png.starts_with(b"\x89PNG"));
+
+    // Killed as soon as the first trial is kept, during the others; started again.
+    let dir = temp_dir("auto-killed");
+    let server = start(&dir, "127.0.0.1");
+    let k = post(&server, "/api/sessions", asked)["id"]
+        .as_i64()
+        .unwrap();
+    let path = format!("/api/sessions/{k}/match/run");
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while get(&server, &path)["ended"].as_array().unwrap().is_empty() {
+        assert!(Instant::now() < deadline, "no trial ended");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    drop(server);
+    let server = start(&dir, "127.0.0.1");
+    let after = get(&server, &path);
+    assert!(
+        after["rows"].as_array().unwrap().is_empty(),
+        "killed after the trials: {after}"
+    );
+    let kept = after["ended"][0].clone();
+    assert_eq!(kept["model"], "bintree", "{after}");
+    let resumed = wait_match(&server, k, u64::MAX);
+    assert_eq!(resumed["status"], "done", "{resumed}");
+    // The trial kept was not bred again (its wall-clock seconds are the ones kept), and the
+    // match ended as the one never killed: its trials, its generations, its best plant.
+    assert_eq!(resumed["ended"][0], kept);
+    assert_eq!(trial_figures(&resumed), trial_figures(&done));
+    let figures = |run: &Value| -> Vec<(Value, Value)> {
+        (run["rows"].as_array().unwrap().iter())
+            .map(|r| (r["best"].clone(), r["best_terms"].clone()))
+            .collect()
+    };
+    assert_eq!(figures(&resumed), figures(&done));
+    let genome = |server: &Server, run: &Value| {
+        let plant = run["rows"].as_array().unwrap().last().unwrap()["plant"].clone();
+        request(
+            server,
+            "GET",
+            &format!("/api/plants/{plant}/genome.json"),
+            b"",
+            true,
+        )
+        .1
+    };
+    assert_eq!(genome(&server, &resumed), genome(&whole, &done));
+}
+
 /// A PlantMaker plant of a match, branched into breeding, keeps the match's leaf greens and
 /// bark browns when bred by hand (`palette = "foliage"`), where the model's defaults let a
 /// fan's colours drift anywhere.

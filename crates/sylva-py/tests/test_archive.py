@@ -80,7 +80,7 @@ def test_an_archive_the_studio_wrote_is_read_while_the_studio_has_it_open(studio
         "start": {"examples": ["plantmaker/tulip", "plantmaker/fern"]}})
     grid = [cell["plant"] for cell in session["state"]["grid"]]
     with sylva.StudioArchive(tmp_path / "studio.db") as archive:
-        assert archive.version == 3
+        assert archive.version == 4
         assert archive.path == str(tmp_path / "studio.db")
         listed = archive.plants(model="plantmaker")
         ids = [p.id for p in listed]
@@ -142,7 +142,7 @@ def test_plants_written_here_are_read_grown_and_bred_by_the_running_studio(studi
 def test_an_archive_made_here_is_opened_by_the_studio(tmp_path):
     db = tmp_path / "made.db"
     with sylva.StudioArchive(db, create=True) as archive:
-        assert archive.version == 3
+        assert archive.version == 4
         mother = tulip()
         ids = archive.add([
             {"genome": mother, "operator": "example", "key": "m"},
@@ -183,9 +183,9 @@ def test_what_is_not_an_archive_is_refused_naming_the_file(tmp_path):
     sylva.StudioArchive(newer, create=True).close()
     c = sqlite3.connect(newer)
     with c:
-        c.execute("UPDATE schema_version SET version = 4")
+        c.execute("UPDATE schema_version SET version = 5")
     c.close()
-    with pytest.raises(sylva.ArchiveError, match="schema version 4 is newer than 3") as e:
+    with pytest.raises(sylva.ArchiveError, match="schema version 5 is newer than 4") as e:
         sylva.StudioArchive(newer)
     assert e.value.path == str(newer)
 

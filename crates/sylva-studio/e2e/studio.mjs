@@ -777,9 +777,16 @@ async function main() {
   });
 
   // ---- Match ----
+  // Pictures of the match view shown but not loaded: broken-image icons.
+  const brokenPictures = () =>
+    page.evaluate(() => [...document.querySelectorAll("#view-match img")]
+      .filter((img) => img.offsetParent !== null && !(img.complete && img.naturalWidth > 0))
+      .map((img) => img.dataset.testid || img.className));
   await step("match: a picture in, the best plant's outline over it live, the best opened", async () => {
     await byTestId("mode-match").click();
     await byTestId("match-form").waitFor();
+    const broken = await brokenPictures();
+    check(broken.length === 0, `before a target is chosen the page shows broken pictures: ${broken.join(", ")}`);
     await byTestId("match-file").setInputFiles(path.join(repo, "examples/match/round.png"));
     await page.waitForFunction(() => !document.querySelector('[data-testid="match-preview"]').hidden);
     await byTestId("match-model").selectOption("bintree");
@@ -837,6 +844,44 @@ async function main() {
       throw new Failure(`after an auto match of ${best.model} the session list says "${text}"`);
     });
     await noError("auto match");
+  });
+
+  await step("match: an auto match shows its trials as they go, draws them, and stops during them", async () => {
+    const old = await page.evaluate(() => window.sylvaStudio.session().id);
+    await byTestId("match-file").setInputFiles(path.join(repo, "examples/match/round.png"));
+    await page.waitForFunction(() => !document.querySelector('[data-testid="match-preview"]').hidden);
+    await byTestId("match-model").selectOption("auto");
+    await byTestId("match-generations").fill("100");
+    await byTestId("match-population").fill("30");
+    await byTestId("match-start").click();
+    await page.waitForFunction((o) => window.sylvaStudio.session()?.id !== o, old);
+    const id = await page.evaluate(() => window.sylvaStudio.session().id);
+    // which model is on trial, its generation and best IoU
+    await page.waitForFunction(() => {
+      const s = document.querySelector('[data-testid="match-status"]');
+      return s.dataset.trial && /(trial|run-off): \w+, generation \d+, IoU [\d.]+/.test(s.textContent);
+    }, null, { timeout: 120_000 });
+    // and its best outline so far, drawn over the target, with no broken picture
+    await page.waitForFunction(() => {
+      const img = document.querySelector('[data-testid="match-overlay"]');
+      return img.dataset.plant && img.complete && img.naturalWidth > 0 && !img.closest("figure").hidden;
+    }, null, { timeout: 60_000 });
+    const broken = await brokenPictures();
+    check(broken.length === 0, `during the trials the page shows broken pictures: ${broken.join(", ")}`);
+    await page.waitForFunction(() => Number(document.querySelector('[data-testid="match-chart"]').dataset.trials) >= 1);
+    log(`  ${await byTestId("match-status").innerText()}`);
+    await shot("match-trials");
+    // Stop during the trials: they end at their next generation, the trials kept.
+    await byTestId("match-stop").click();
+    await page.waitForFunction(() => document.querySelector('[data-testid="match-status"]').dataset.status === "stopped");
+    const stopped = await api(`/api/sessions/${id}/match/run`);
+    check(stopped.status === "stopped" && stopped.rows.length === 0 && stopped.trials.length > 0,
+      `stopped during the trials: ${stopped.status}, ${stopped.rows.length} rows, ${stopped.trials.length} trial generations`);
+    await sleep(3000);
+    const later = await api(`/api/sessions/${id}/match/run`);
+    check(later.trials.length <= stopped.trials.length + 1 && later.rows.length === 0,
+      `the trials went on after Stop: ${stopped.trials.length} trial generations, then ${later.trials.length}`);
+    await noError("auto match trials");
   });
 
   // ---- restart ----

@@ -505,6 +505,103 @@ pub fn generations(c: &Connection, run: i64, last: u32) -> rusqlite::Result<Vec<
     .collect()
 }
 
+/// One generation an auto match's trials bred.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrialGenerationRow {
+    /// The model on trial.
+    pub model: String,
+    /// Whether it was the run-off.
+    pub runoff: bool,
+    /// The generation of the model's run.
+    pub generation: u32,
+    /// Best total fitness (the outline score).
+    pub best: f64,
+    /// Mean total fitness.
+    pub mean: f64,
+    /// The best's outline IoU.
+    pub iou: f64,
+    /// The best, archived.
+    pub plant: Option<i64>,
+}
+
+/// Records a generation of a run's trials (again, if a trial under way at a kill is bred
+/// again: its row is replaced, and comes last).
+pub fn insert_trial_generation(
+    c: &Connection,
+    run: i64,
+    row: &TrialGenerationRow,
+) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO trial_generations
+         (run, model, runoff, generation, best, mean, iou, plant)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+        params![
+            run,
+            row.model,
+            row.runoff,
+            row.generation,
+            finite_or_zero(row.best),
+            finite_or_zero(row.mean),
+            finite_or_zero(row.iou),
+            row.plant
+        ],
+    )?;
+    Ok(())
+}
+
+/// A run's trial generations, in the order they were bred.
+pub fn trial_generations(c: &Connection, run: i64) -> rusqlite::Result<Vec<TrialGenerationRow>> {
+    let mut stmt = c.prepare_cached(
+        "SELECT model, runoff, generation, best, mean, iou, plant FROM trial_generations
+         WHERE run = ?1 ORDER BY rowid",
+    )?;
+    stmt.query_map([run], |r| {
+        Ok(TrialGenerationRow {
+            model: r.get(0)?,
+            runoff: r.get(1)?,
+            generation: r.get(2)?,
+            best: r.get(3)?,
+            mean: r.get(4)?,
+            iou: r.get(5)?,
+            plant: r.get(6)?,
+        })
+    })?
+    .collect()
+}
+
+/// Keeps a run's trials' log (the library's `TrialLog`, JSON) and how each trial that
+/// ended did (`ended`, JSON).
+pub fn set_trial_log(
+    c: &Connection,
+    run: i64,
+    log: &str,
+    ended: &serde_json::Value,
+) -> rusqlite::Result<()> {
+    c.execute(
+        "INSERT OR REPLACE INTO run_trials (run, log, ended) VALUES (?1, ?2, ?3)",
+        params![run, log, ended.to_string()],
+    )?;
+    Ok(())
+}
+
+/// A run's trials' log, once a trial has ended.
+pub fn trial_log(c: &Connection, run: i64) -> rusqlite::Result<Option<String>> {
+    c.query_row("SELECT log FROM run_trials WHERE run = ?1", [run], |r| {
+        r.get(0)
+    })
+    .optional()
+}
+
+/// How each of a run's trials that ended did, as [`set_trial_log`] kept it (empty before).
+pub fn trials_ended(c: &Connection, run: i64) -> rusqlite::Result<serde_json::Value> {
+    let text: Option<String> = c
+        .query_row("SELECT ended FROM run_trials WHERE run = ?1", [run], |r| {
+            r.get(0)
+        })
+        .optional()?;
+    Ok(text.map_or_else(|| serde_json::json!([]), json))
+}
+
 /// Keeps a run's checkpoint at a generation (for undo).
 pub fn insert_checkpoint(
     c: &Connection,

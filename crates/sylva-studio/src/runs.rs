@@ -60,37 +60,37 @@ pub fn archive_member(
         }
     }
     studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let found: Option<i64> = c
-            .query_row(
+        // A member is known by its run, id and model: the trials of an auto match breed
+        // runs of several models under one run, each counting ids from 0.
+        let model = member.genome.model();
+        let archived = |id: sylva::IndividualId| -> Option<i64> {
+            c.query_row(
                 "SELECT id FROM plants WHERE session = ?1 AND json_extract(settings, '$.run') = ?2
-                 AND json_extract(settings, '$.member') = ?3",
-                rusqlite::params![session, run, member.id.0 as i64],
+                 AND json_extract(settings, '$.member') = ?3 AND model = ?4",
+                rusqlite::params![session, run, id.0 as i64, model],
                 |r| r.get(0),
             )
-            .ok();
-        if let Some(id) = found {
+            .ok()
+        };
+        if let Some(id) = archived(member.id) {
             return Ok(id);
         }
         // Its parents, where they are archived too.
         let mut parents = Vec::new();
         for p in &member.origin.parents {
-            let found: Option<i64> = c
-                .query_row(
-                    "SELECT id FROM plants WHERE session = ?1 AND json_extract(settings, '$.run') = ?2
-                     AND json_extract(settings, '$.member') = ?3",
-                    rusqlite::params![session, run, p.0 as i64],
-                    |r| r.get(0),
-                )
-                .ok();
+            let found = archived(*p);
             if let Some(plant) = found {
-                parents.push(archive::ParentRow { plant, dominance: 1.0 });
+                parents.push(archive::ParentRow {
+                    plant,
+                    dominance: 1.0,
+                });
             }
         }
         Ok(archive::insert_plant(
             c,
             &NewPlant {
                 session: Some(session),
-                model: member.genome.model(),
+                model,
                 genome: &text,
                 seed,
                 operator,
@@ -246,10 +246,18 @@ pub trait Background: 'static {
     /// The run's config, from its row (and whatever else it needs: a match run's pictures).
     fn config(studio: &Studio, row: &RunRow) -> Result<Config, ApiError>;
 
-    /// A new run of `config`, generation 0 made.
-    fn start(studio: &Studio, row: &RunRow, config: &Config) -> Result<Evolution, ApiError> {
-        let _ = row;
-        Evolution::start(config, Vec::new(), studio.pool.clone()).map_err(library)
+    /// A new run of `config`, generation 0 made; `None` if `stop` was set before it was
+    /// (a run with work before its generation 0, as an auto match's trials, watches it).
+    fn start(
+        studio: &Studio,
+        row: &RunRow,
+        config: &Config,
+        stop: &AtomicBool,
+    ) -> Result<Option<Evolution>, ApiError> {
+        let _ = (row, stop);
+        Evolution::start(config, Vec::new(), studio.pool.clone())
+            .map(Some)
+            .map_err(library)
     }
 }
 
@@ -297,7 +305,9 @@ fn drive<B: Background>(studio: &Studio, run: i64, stop: &AtomicBool) -> Result<
             Evolution::resume(&config, path, text, studio.pool.clone()).map_err(library)?
         }
         None => {
-            let evolution = B::start(studio, &row, &config)?;
+            let Some(evolution) = B::start(studio, &row, &config, stop)? else {
+                return Ok(());
+            };
             studio.archive.transaction(|c| -> Result<_, ApiError> {
                 Ok(archive::set_run_terms(c, run, evolution.term_names())?)
             })?;

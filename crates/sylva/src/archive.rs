@@ -156,6 +156,27 @@ CREATE TABLE pictures (
     PRIMARY KEY (session, view)
 );
 "#,
+    // An auto match's trials: their log (the library's `TrialLog`, JSON), to resume from,
+    // with how each trial that ended did (JSON, small, to show), and each generation they
+    // bred, in the order bred (rowid), with its best plant.
+    r#"
+CREATE TABLE run_trials (
+    run INTEGER PRIMARY KEY REFERENCES runs(id),
+    log TEXT NOT NULL,
+    ended TEXT NOT NULL
+);
+CREATE TABLE trial_generations (
+    run INTEGER NOT NULL REFERENCES runs(id),
+    model TEXT NOT NULL,
+    runoff INTEGER NOT NULL,
+    generation INTEGER NOT NULL,
+    best REAL NOT NULL,
+    mean REAL NOT NULL,
+    iou REAL NOT NULL,
+    plant INTEGER REFERENCES plants(id),
+    PRIMARY KEY (run, model, generation)
+);
+"#,
 ];
 
 /// The newest schema version this Sylva reads and writes.

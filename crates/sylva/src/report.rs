@@ -1,5 +1,5 @@
-//! Reports people read: the statistics table (CSV), the fitness plot (SVG), and the outcome
-//! of an L-system experiment (text).
+//! Reports people read: the statistics table (CSV), the generations of an auto match's
+//! trials (CSV), the fitness plot (SVG), and the outcome of an L-system experiment (text).
 
 use std::fmt::Write as _;
 
@@ -31,6 +31,25 @@ pub fn stats_csv(term_names: &[String], stats: &[GenerationStats]) -> String {
             }
         }
         let _ = writeln!(out, ",{:.0}", s.evals_per_second());
+    }
+    out
+}
+
+/// `trials.csv` of an auto match: `model,phase,generation,best,mean,iou`, one row per
+/// generation each model bred in its trials (`phase` is `trial` or `runoff`), in the order
+/// they were bred; a model left out has no rows. No wall-clock figure: equal matches give
+/// equal bytes.
+pub fn trials_csv(log: &crate::evolution::outline::TrialLog) -> String {
+    let mut out = String::from("model,phase,generation,best,mean,iou\n");
+    for trial in log.trials() {
+        let phase = if trial.runoff { "runoff" } else { "trial" };
+        for r in &trial.rows {
+            let _ = writeln!(
+                out,
+                "{},{phase},{},{},{},{}",
+                trial.model, r.generation, r.best, r.mean, r.iou
+            );
+        }
     }
     out
 }

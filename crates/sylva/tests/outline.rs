@@ -463,3 +463,134 @@ fn a_matchs_pictures_are_read_once_and_carried_to_its_files() {
     };
     assert!(!pictures.is_of(&other) && pictures.is_of(&target));
 }
+
+/// A run's checkpoint without its wall-clock seconds: equal runs give equal text.
+fn without_seconds(checkpoint: &str) -> serde_json::Value {
+    let mut value: serde_json::Value = serde_json::from_str(checkpoint).unwrap();
+    for row in value["checkpoint"]["stats"].as_array_mut().unwrap() {
+        row["seconds"] = serde_json::Value::Null;
+    }
+    value
+}
+
+/// An auto match killed during its trials resumes from the trials its log kept: those are
+/// not bred again (a model goes on to its run-off from its kept run), and a match counting
+/// generations ends with the same bytes as one never killed, its trials' generations too.
+#[test]
+fn auto_killed_during_its_trials_resumes_from_its_log_to_the_same_bytes() {
+    use std::time::Instant;
+    use sylva::core::par::Stop;
+    use sylva::evolution::RunConfig;
+    use sylva::evolution::outline::{AutoEvent, AutoMatch, Limit, TrialLog, breed_until};
+    use sylva::report::trials_csv;
+    let (target, registry, stop) = (round_target(), Registry::standard(), Stop::new());
+    let run = RunConfig {
+        population: 6,
+        seed: 4,
+        ..RunConfig::default()
+    };
+    let limit = Limit::Generations(25);
+    let auto = AutoMatch {
+        registry: &registry,
+        target: &target,
+        base: Path::new(""),
+        run: &run,
+        limit,
+        pool: &Pool::Serial,
+        stop: &stop,
+    };
+    let finish = |mut evolution: Evolution| {
+        breed_until(&mut evolution, limit, Instant::now(), &stop, |_| {
+            Ok::<_, sylva::Error>(())
+        })
+        .unwrap();
+        (
+            without_seconds(&evolution.checkpoint().unwrap()),
+            evolution.best().genome.to_json(),
+        )
+    };
+    // Never killed: every generation of the trials, in order.
+    let mut whole_log = TrialLog::new();
+    let mut bred = Vec::new();
+    let (whole, _) = auto
+        .start(&mut whole_log, |event| {
+            if let AutoEvent::Bred {
+                model,
+                runoff,
+                evolution,
+            } = event
+            {
+                bred.push((model, runoff, evolution.generation()));
+            }
+            Ok::<_, sylva::Error>(())
+        })
+        .unwrap();
+    assert_eq!(whole_log.chosen().unwrap().0, whole.config().model());
+    let whole = finish(whole);
+    let whole_csv = trials_csv(&whole_log);
+    assert_eq!(whole_csv.lines().count(), 1 + bred.len(), "{whole_csv}");
+    // Killed at a generation of the first trials, of the first run-off and of the second:
+    // the log as the last trial to end left it, written and read as a front end keeps it.
+    for kill in [4, 13, bred.len() - 2] {
+        let (mut seen, mut kept) = (0, None);
+        let killed = auto.start(&mut TrialLog::new(), |event| {
+            match event {
+                AutoEvent::Begun { .. } => {}
+                AutoEvent::Bred { .. } => seen += 1,
+                AutoEvent::Ended { log, .. } => kept = Some(log.to_json()?),
+            }
+            if seen == kill {
+                return Err(sylva::Error::Stopped(sylva::evolution::Stopped));
+            }
+            Ok(())
+        });
+        assert!(killed.is_err());
+        let text = kept.unwrap();
+        let mut log = TrialLog::parse(Path::new("trials.json"), &text).unwrap();
+        let ended: Vec<(String, bool)> = (log.trials().iter())
+            .map(|t| (t.model.clone(), t.runoff))
+            .collect();
+        assert!(!ended.is_empty(), "kill {kill}: no trial had ended");
+        let mut again = Vec::new();
+        let (resumed, _) = auto
+            .start(&mut log, |event| {
+                if let AutoEvent::Bred {
+                    model,
+                    runoff,
+                    evolution,
+                } = event
+                {
+                    again.push((model, runoff, evolution.generation()));
+                }
+                Ok::<_, sylva::Error>(())
+            })
+            .unwrap();
+        // Only what had not ended is bred, and just as the match never killed bred it.
+        for (model, runoff, _) in &again {
+            assert!(
+                !ended.contains(&(model.to_string(), *runoff)),
+                "kill {kill}: {model} (run-off {runoff}) was bred again"
+            );
+        }
+        assert_eq!(again, bred[bred.len() - again.len()..], "kill {kill}");
+        assert_eq!(trials_csv(&log), whole_csv, "kill {kill}");
+        assert!(
+            finish(resumed) == whole,
+            "kill {kill}: the match ended otherwise"
+        );
+    }
+    // A log is resumed by its own match only.
+    let other = RunConfig {
+        population: 7,
+        ..run.clone()
+    };
+    let e = AutoMatch {
+        run: &other,
+        ..auto
+    }
+    .start(&mut whole_log.clone(), |_| Ok::<_, sylva::Error>(()))
+    .unwrap_err();
+    assert!(e.to_string().contains("population of 6, not 7"), "{e}");
+    let e = TrialLog::parse(Path::new("trials.json"), "{\"format\": 1, \"trials\": [").unwrap_err();
+    assert!(e.to_string().contains("trials.json"), "{e}");
+}

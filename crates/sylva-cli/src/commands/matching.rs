@@ -1,22 +1,36 @@
 //! `sylva match`: evolve a plant whose outline matches a picture, in any model (or the
 //! model that matches it best), for a number of generations or seconds; writes what
 //! `sylva evolve` writes and `overlay.png`.
+//!
+//! `--model auto` first runs the trials of every model: a line says which model is on
+//! trial, its generation and best IoU; `trials.json` in the run's folder keeps every trial
+//! that ended (the library's `TrialLog`), so `--resume` after a kill during the trials goes
+//! on from them, and `trials.csv` records the generations they bred.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sylva::core::budget::Seconds;
 use sylva::core::par::Stop;
 use sylva::evolution::outline::{
-    Limit, Target, Trial, best_iou, breed_until, match_config, start_auto, start_within,
+    AutoEvent, AutoMatch, Limit, Target, Trial, TrialLog, best_iou, breed_until, match_config,
+    start_within,
 };
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
+use sylva::report::trials_csv;
 use sylva::{Config, Evolution, InputError, Registry};
 
 use super::evolve::write_results;
 use super::run_files::{CHECKPOINT, FILES};
+
+/// The log of an auto match's trials, in its folder: what `--resume` goes on from while
+/// the trials are under way.
+const TRIALS: &str = "trials.json";
+
+/// The generations the trials of an auto match bred, one row each.
+const TRIALS_CSV: &str = "trials.csv";
 
 /// Arguments of `sylva match`.
 #[derive(clap::Args)]
@@ -160,55 +174,57 @@ pub fn run(registry: &Registry, args: &MatchArgs) -> anyhow::Result<()> {
             .map(|config| config.with_target(Some(pictures.clone())))
             .map_err(|e| InputError::new("--model", format!("{}: {}", e.field, e.message)))
     };
-    let (mut evolution, config, elsewhere) = if args.resume {
-        let text = sylva::files::read_text(&checkpoint)?;
-        let model = sylva::evolution::checkpoint_model(&checkpoint, &text)?;
-        let config = config_of(&model)?;
-        let evolution = Evolution::resume(&config, &checkpoint, &text, pool.clone())?;
-        (evolution, config, 0.0)
-    } else if args.model == "auto" {
-        let (evolution, elsewhere) = start_auto(
-            registry,
-            &target,
-            &run,
-            limit,
-            &pool,
-            &stop,
-            |t| match t {
-                Trial::Reached {
-                    model,
-                    iou,
-                    generations,
-                    runoff,
-                } => eprintln!(
-                    "auto: {model} reached an outline score of {iou:.3} in {generations} generations{}",
-                    if *runoff { " (run-off)" } else { "" }
-                ),
-                Trial::OutOfTime { model, seconds } => eprintln!(
-                    "auto: {model} left out: its first generation was not scored within the {}",
-                    Seconds(*seconds)
-                ),
-                Trial::LeftOut {
-                    model,
-                    seconds,
-                    allowance,
-                } => eprintln!(
-                    "auto: {model} left out: a generation may take {} (more than {} of a trial)",
-                    Seconds(*seconds),
-                    Seconds(*allowance)
-                ),
-            },
-        )?;
-        let config = evolution.config();
-        (evolution, config, elsewhere)
-    } else {
-        let config = config_of(&args.model)?;
-        let evolution = start_within(&config, limit, &pool, &stop)?;
-        (evolution, config, 0.0)
+    // An auto match's log: resumed, the one its folder keeps; a new auto match starts one.
+    let trials_path = out.join(TRIALS);
+    let mut log = match (args.resume, trials_path.exists()) {
+        (true, true) => Some(TrialLog::parse(
+            &trials_path,
+            &sylva::files::read_text(&trials_path)?,
+        )?),
+        _ => (!args.resume && args.model == "auto").then(TrialLog::new),
+    };
+    let (mut evolution, config, elsewhere) = match &mut log {
+        // Trials under way: they go on from the log, whatever `--model` says.
+        Some(log) if log.chosen().is_none() => {
+            let auto = AutoMatch {
+                registry,
+                target: &target,
+                base: Path::new(""),
+                run: &run,
+                limit,
+                pool: &pool,
+                stop: &stop,
+            };
+            let (evolution, elsewhere) = trials(&auto, log, &out)?;
+            // The chosen run is kept before the log that says it was chosen: killed between
+            // the two, `--resume` finds the choice again in the trials kept.
+            sylva::files::write(&checkpoint, evolution.checkpoint()?.as_bytes())?;
+            sylva::files::write(&trials_path, log.to_json()?.as_bytes())?;
+            let config = evolution.config();
+            (evolution, config, elsewhere)
+        }
+        _ if args.resume => {
+            let text = sylva::files::read_text(&checkpoint)?;
+            let model = sylva::evolution::checkpoint_model(&checkpoint, &text)?;
+            let config = config_of(&model)?;
+            let evolution = Evolution::resume(&config, &checkpoint, &text, pool.clone())?;
+            // An auto match's trials are counted against its seconds again.
+            let elsewhere = log.as_ref().and_then(|l| l.chosen()).map_or(0.0, |c| c.1);
+            (evolution, config, elsewhere)
+        }
+        _ => {
+            let config = config_of(&args.model)?;
+            let evolution = start_within(&config, limit, &pool, &stop)?;
+            // A match of one model leaves no trials of an earlier match to resume.
+            for name in [TRIALS, TRIALS_CSV] {
+                let _ = std::fs::remove_file(out.join(name));
+            }
+            (evolution, config, 0.0)
+        }
     };
     sylva::files::create_dir(&out)?;
     let mut files = FILES.to_vec();
-    files.push("overlay.png");
+    files.extend(["overlay.png", TRIALS, TRIALS_CSV]);
     sylva::files::remove_leftovers(&out, &files);
     breed(
         &mut evolution,
@@ -225,15 +241,110 @@ pub fn run(registry: &Registry, args: &MatchArgs) -> anyhow::Result<()> {
     args.dress.apply(config.output_mut());
     let best = evolution.best();
     let (picture, iou) = pictures.overlay(&target, &best.genome)?;
-    write_results(
-        &evolution,
-        &config,
-        &out,
-        &pool,
-        vec![("overlay.png", picture)],
-    )?;
+    let mut extra = vec![("overlay.png", picture)];
+    if let Some(log) = &log {
+        extra.push((TRIALS_CSV, trials_csv(log).into_bytes()));
+    }
+    write_results(&evolution, &config, &out, &pool, extra)?;
     println!("outline IoU {iou:.3} ({}, front view)", evolution.title());
     Ok(())
+}
+
+/// The trials of `auto`, going on from `log`: a line shows the model on trial, its
+/// generation and best IoU; each trial's end is said, and the log kept in `out` (made
+/// then: a match refused before any model bred writes nothing).
+fn trials(
+    auto: &AutoMatch<'_>,
+    log: &mut TrialLog,
+    out: &Path,
+) -> anyhow::Result<(Evolution, f64)> {
+    let bar = ProgressBar::new_spinner().with_style(
+        ProgressStyle::with_template("{spinner} auto: {msg} ({elapsed})")
+            .expect("the template is valid"),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    let models: Vec<&str> = auto.registry.models().iter().map(|m| m.name()).collect();
+    let which = |model: &str, runoff: bool| {
+        if runoff {
+            format!("run-off of {model}")
+        } else {
+            let at = models.iter().position(|m| *m == model).unwrap_or(0);
+            format!("trial of {model} ({} of {})", at + 1, models.len())
+        }
+    };
+    bar.set_message("reading the target");
+    let started = auto.start(log, |event| {
+        match event {
+            AutoEvent::Begun { model, runoff } => {
+                let doing = if runoff {
+                    "going on"
+                } else {
+                    "making generation 0"
+                };
+                bar.set_message(format!("{}: {doing}", which(model, runoff)));
+            }
+            AutoEvent::Bred {
+                model,
+                runoff,
+                evolution,
+            } => {
+                bar.set_message(format!(
+                    "{}: generation {}, best IoU {:.3}",
+                    which(model, runoff),
+                    evolution.generation(),
+                    best_iou(evolution)
+                ));
+            }
+            AutoEvent::Ended {
+                trial,
+                log,
+                resumed,
+            } => {
+                let kept = if resumed {
+                    " (kept in trials.json)"
+                } else {
+                    ""
+                };
+                bar.suspend(|| eprintln!("auto: {}{kept}", said(trial)));
+                // Kept once a model has bred: a match refused before that writes nothing.
+                if !resumed && matches!(trial, Trial::Reached { .. }) {
+                    sylva::files::create_dir(out)?;
+                    sylva::files::write(&out.join(TRIALS), log.to_json()?.as_bytes())?;
+                }
+            }
+        }
+        Ok::<_, anyhow::Error>(())
+    });
+    bar.finish_and_clear();
+    started
+}
+
+/// How a trial ended, in words.
+fn said(trial: &Trial) -> String {
+    match trial {
+        Trial::Reached {
+            model,
+            iou,
+            generations,
+            runoff,
+        } => format!(
+            "{model} reached an outline score of {iou:.3} in {generations} generations{}",
+            if *runoff { " (run-off)" } else { "" }
+        ),
+        Trial::OutOfTime { model, seconds } => format!(
+            "{model} left out: its first generation was not scored within the {}",
+            Seconds(*seconds)
+        ),
+        Trial::LeftOut {
+            model,
+            seconds,
+            allowance,
+        } => format!(
+            "{model} left out: a generation may take {} (more than {} of a trial)",
+            Seconds(*seconds),
+            Seconds(*allowance)
+        ),
+    }
 }
 
 /// Breeds until `limit`, showing the best IoU and checkpointing as it goes; `elsewhere`

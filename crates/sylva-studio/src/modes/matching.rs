@@ -7,8 +7,16 @@
 //! on as [`runs`](crate::runs) keeps background runs: checkpointed every generation,
 //! resumed after a kill to the bytes of a run never stopped. Each generation's best is
 //! archived as a plant, to open, branch into breeding and export.
+//!
+//! An auto match's trials come first, in the run's thread: each generation they breed is a
+//! row of `trial_generations` with its best plant, told to the pages as a `trial` event (the
+//! page shows which model is on trial and its best outline so far), and the trials' log
+//! (`run_trials`) is kept as each trial ends, so a server killed during the trials goes on
+//! from the trials kept. A stop asked for during the trials ends them at their next
+//! generation; resumed, they go on from their log.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use axum::Json;
 use axum::extract::{Path, Query, State};
@@ -17,13 +25,15 @@ use axum::response::{IntoResponse, Response};
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::evolution::outline::{self, Limit, outlines, overlay, start_auto_at};
+use sylva::evolution::outline::{
+    self, AutoEvent, AutoMatch, Limit, TrialLog, best_iou, outlines, overlay,
+};
 use sylva::evolution::{MatchConfig, RunConfig};
 use sylva::picture::Threshold;
 use sylva::{Config, Evolution};
 
 use crate::Studio;
-use crate::archive::{self, Operator, RunRow};
+use crate::archive::{self, GenerationRow, Operator, RunRow, TrialGenerationRow};
 use crate::error::ApiError;
 use crate::events::SessionEvent;
 use crate::http::Body;
@@ -258,35 +268,202 @@ impl Background for MatchMode {
         pruning::match_config(studio, row)
     }
 
-    /// Auto: each model briefly, then on with the best, whose config the run keeps.
-    fn start(studio: &Studio, row: &RunRow, config: &Config) -> Result<Evolution, ApiError> {
+    /// Auto: the trials of every model (see the module's overview), then on with the best,
+    /// whose config the run keeps.
+    fn start(
+        studio: &Studio,
+        row: &RunRow,
+        config: &Config,
+        stop: &AtomicBool,
+    ) -> Result<Option<Evolution>, ApiError> {
         let state = match_state(studio, row.session)?;
-        let failed = |e: sylva::Error| ApiError::internal(sylva::error::chain(&e));
         if !state.auto {
-            return Evolution::start(config, Vec::new(), studio.pool.clone()).map_err(failed);
+            return Evolution::start(config, Vec::new(), studio.pool.clone())
+                .map(Some)
+                .map_err(failed);
         }
-        let run = config.run().clone();
+        let Some(evolution) = trials(studio, row, config, &state, stop)? else {
+            return Ok(None);
+        };
         let (threshold, prune) = (threshold_of(&state), prune_of(&state));
-        let dir = picture_dir(studio, row.session)?;
-        let (evolution, _) = start_auto_at(
-            &studio.registry,
-            &target(threshold, prune),
-            &dir,
-            &run,
-            Limit::Generations(run.generations),
-            &studio.pool,
-            &sylva::core::par::Stop::new(),
-            |_| {},
-        )
-        .map_err(failed)?;
-        let chosen = config_for(studio, evolution.config().model(), &run, threshold, prune)?;
+        let chosen = config_for(
+            studio,
+            evolution.config().model(),
+            config.run(),
+            threshold,
+            prune,
+        )?;
         studio.archive.transaction(|c| -> Result<_, ApiError> {
             archive::set_run_config(c, row.id, &chosen.to_toml())?;
             archive::set_session_model(c, row.session, chosen.model())?;
+            // The chosen model's trial generations are the run's first: its run went on
+            // from them.
+            for t in archive::trial_generations(c, row.id)? {
+                if t.model == chosen.model() {
+                    let first = GenerationRow {
+                        generation: t.generation,
+                        best: t.best,
+                        mean: t.mean,
+                        best_terms: vec![t.iou],
+                        plant: t.plant,
+                    };
+                    archive::insert_generation(c, row.id, &first)?;
+                }
+            }
             Ok(())
         })?;
-        Ok(evolution)
+        Ok(Some(evolution))
     }
+}
+
+/// A library error in a run: the studio's fault or the run's settings, told as they are.
+fn failed(e: sylva::Error) -> ApiError {
+    ApiError::internal(sylva::error::chain(&e))
+}
+
+/// Why an auto match's trials ended early.
+enum TrialsEnded {
+    /// A stop was asked for.
+    Stopped,
+    /// The library failed.
+    Library(sylva::Error),
+    /// The studio failed to keep them.
+    Studio(ApiError),
+}
+
+impl From<sylva::Error> for TrialsEnded {
+    fn from(e: sylva::Error) -> Self {
+        TrialsEnded::Library(e)
+    }
+}
+
+impl From<ApiError> for TrialsEnded {
+    fn from(e: ApiError) -> Self {
+        TrialsEnded::Studio(e)
+    }
+}
+
+/// The trials of auto match `row`, going on from the log the archive keeps: the run of the
+/// model chosen, or `None` when `stop` ended them.
+fn trials(
+    studio: &Studio,
+    row: &RunRow,
+    config: &Config,
+    state: &MatchState,
+    stop: &AtomicBool,
+) -> Result<Option<Evolution>, ApiError> {
+    // The trials are of the match as asked: resumed to more generations, a match stopped
+    // during its trials goes on from them unchanged.
+    let asked = (state.design["generations"].as_u64())
+        .and_then(|g| u32::try_from(g).ok())
+        .unwrap_or(config.run().generations);
+    let run = RunConfig {
+        generations: asked,
+        ..config.run().clone()
+    };
+    let target = target(threshold_of(state), prune_of(state));
+    let dir = picture_dir(studio, row.session)?;
+    let mut log = match studio.archive.read(|c| archive::trial_log(c, row.id))? {
+        Some(text) => TrialLog::parse(std::path::Path::new("the run's trials"), &text)
+            .map_err(|e| ApiError::internal(e.to_string()))?,
+        None => TrialLog::new(),
+    };
+    let auto = AutoMatch {
+        registry: &studio.registry,
+        target: &target,
+        base: &dir,
+        run: &run,
+        limit: Limit::Generations(asked),
+        pool: &studio.pool,
+        stop: &sylva::core::par::Stop::new(),
+    };
+    let started = auto.start(&mut log, |event| -> Result<(), TrialsEnded> {
+        // A stop (by hand, or the studio shutting down) ends the trials as the next trial
+        // or generation begins (a trial that ended is kept first); the trials kept are gone
+        // on from when the run resumes.
+        let stopped = || stop.load(Ordering::SeqCst);
+        match event {
+            AutoEvent::Begun { .. } | AutoEvent::Bred { .. } if stopped() => {
+                return Err(TrialsEnded::Stopped);
+            }
+            AutoEvent::Begun { model, runoff } => {
+                let data = json!({"run": row.id, "model": model, "runoff": runoff});
+                studio.events.send(row.session, "trial-begun", data);
+            }
+            AutoEvent::Bred {
+                model,
+                runoff,
+                evolution,
+            } => trial_generation(studio, row, model, runoff, evolution)?,
+            AutoEvent::Ended {
+                log,
+                resumed: false,
+                ..
+            } => keep_log(studio, row.id, log)?,
+            AutoEvent::Ended { .. } => {}
+        }
+        Ok(())
+    });
+    match started {
+        Ok((evolution, _)) => {
+            keep_log(studio, row.id, &log)?;
+            Ok(Some(evolution))
+        }
+        Err(TrialsEnded::Stopped) => Ok(None),
+        Err(TrialsEnded::Library(e)) => Err(failed(e)),
+        Err(TrialsEnded::Studio(e)) => Err(e),
+    }
+}
+
+/// Keeps the trials' log of run `run`, with how each trial that ended did.
+fn keep_log(studio: &Studio, run: i64, log: &TrialLog) -> Result<(), ApiError> {
+    let text = log.to_json().map_err(failed)?;
+    let ended: Vec<serde_json::Value> = (log.trials().iter())
+        .map(|t| json!({"model": t.model, "runoff": t.runoff, "outcome": t.outcome, "seconds": t.seconds}))
+        .collect();
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        Ok(archive::set_trial_log(c, run, &text, &json!(ended))?)
+    })
+}
+
+/// A generation of a trial: its best archived as a plant, its figures recorded, and the
+/// pages watching told (a `trial` event).
+fn trial_generation(
+    studio: &Studio,
+    row: &RunRow,
+    model: &str,
+    runoff: bool,
+    evolution: &Evolution,
+) -> Result<(), ApiError> {
+    let generation = evolution.generation();
+    let phase = if runoff { "runoff" } else { "trial" };
+    let plant = runs::archive_member(
+        studio,
+        row.session,
+        row.id,
+        generation,
+        &evolution.best(),
+        Operator::Match,
+        Some(json!({ "trial": phase })),
+    )?;
+    let last = evolution.stats().last();
+    let figures = TrialGenerationRow {
+        model: model.to_owned(),
+        runoff,
+        generation,
+        best: last.map_or(0.0, |s| runs::finite(s.best)),
+        mean: last.map_or(0.0, |s| runs::finite(s.mean)),
+        iou: runs::finite(best_iou(evolution)),
+        plant: Some(plant),
+    };
+    studio.archive.transaction(|c| -> Result<_, ApiError> {
+        Ok(archive::insert_trial_generation(c, row.id, &figures)?)
+    })?;
+    let mut data = json!(figures);
+    data["run"] = json!(row.id);
+    data["status"] = json!("running");
+    studio.events.send(row.session, "trial", data);
+    Ok(())
 }
 
 /// `POST /api/sessions/{id}/match/stop`.
@@ -318,14 +495,35 @@ pub(crate) async fn resume(
     Ok(Json(view(&studio, id)?))
 }
 
+/// A match's run as the page shows it: a design run's view, and an auto match's trials.
+#[derive(Serialize)]
+pub(crate) struct MatchRunView {
+    #[serde(flatten)]
+    run: runs::RunView,
+    /// Every generation the trials bred, in the order bred (empty unless `auto`).
+    trials: Vec<TrialGenerationRow>,
+    /// How each trial that ended did: `{model, runoff, outcome, seconds}`, in order.
+    ended: serde_json::Value,
+}
+
 /// `GET /api/sessions/{id}/match/run`: the run and its figures (`best` is the outline score,
-/// `best_terms` the IoU).
+/// `best_terms` the IoU), and the trials of an auto match.
 pub(crate) async fn run(
     State(studio): State<Studio>,
     Path(id): Path<i64>,
-) -> Result<Json<runs::RunView>, ApiError> {
+) -> Result<Json<MatchRunView>, ApiError> {
     let state = match_state(&studio, id)?;
-    Ok(Json(runs::run_view(&studio, state.run)?))
+    let (trials, ended) = studio.archive.read(|c| {
+        Ok((
+            archive::trial_generations(c, state.run)?,
+            archive::trials_ended(c, state.run)?,
+        ))
+    })?;
+    Ok(Json(MatchRunView {
+        run: runs::run_view(&studio, state.run)?,
+        trials,
+        ended,
+    }))
 }
 
 #[derive(Deserialize)]

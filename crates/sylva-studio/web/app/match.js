@@ -3,7 +3,9 @@
 // try each, start, and watch the best plant's outline come over the target generation by
 // generation. Each generation's best is archived: open it to branch it into a breeding
 // session or export it with wind and levels of detail. Runs go on in the server; the page
-// follows them through server-sent events.
+// follows them through server-sent events. An auto match tries each model first: while it
+// does, the status says which model is on trial, its generation and best IoU, the overlay
+// shows that model's best outline so far, and the chart draws each model's trial.
 
 import { api, seedValue } from "./api.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
@@ -52,13 +54,13 @@ export default function createMatchMode(ctx, root) {
   const statusEl = h("div", { class: "run-status", testid: "match-status" }, "no match");
   const target = h("img", { class: "match-target", testid: "match-target", alt: "the target" });
   const overlay = h("img", { class: "match-overlay", testid: "match-overlay", alt: "the best plant's outline over the target" });
+  const targetFigure = shownWhenLoaded(target, "target");
+  const overlayFigure = shownWhenLoaded(overlay, "blue: target · orange: the best plant · green: both");
   const openBest = h("button", { testid: "match-open-best", title: "Open the best plant: branch it, export it", onclick: () => best !== null && ctx.openPlant(best) }, "Open the best plant");
   const chart = h("canvas", { class: "chart", testid: "match-chart" });
   const right = h("div", { class: "design-right match-right" },
     h("div", { class: "toolbar" }, statusEl, openBest),
-    h("div", { class: "match-pictures" },
-      h("figure", {}, target, h("figcaption", {}, "target")),
-      h("figure", {}, overlay, h("figcaption", {}, "blue: target · orange: the best plant · green: both"))),
+    h("div", { class: "match-pictures" }, targetFigure, overlayFigure),
     h("div", { class: "charts" }, chart));
   const workspace = h("div", { class: "workspace design match" }, form, right);
   const formHolder = h("div", { class: "form-holder" });
@@ -67,6 +69,8 @@ export default function createMatchMode(ctx, root) {
   let session = null;
   let run = null;
   let rows = new Map();
+  let trials = new Map(); // an auto match's trial generations, by "model generation", in the order bred
+  let begun = null; // the trial begun and not yet bred a generation: {model, runoff}
   let best = null; // the plant shown
   let es = null;
   let esSession = null;
@@ -134,9 +138,11 @@ export default function createMatchMode(ctx, root) {
     session = s;
     if (changed) {
       rows = new Map();
+      trials = new Map();
+      begun = null;
       best = null;
       listed = false;
-      overlay.removeAttribute("src");
+      clearPicture(overlay);
       target.src = api.matchPictureUrl(s.id);
     }
     openEvents(s.id);
@@ -149,12 +155,35 @@ export default function createMatchMode(ctx, root) {
   function applyRun(r) {
     run = r;
     for (const row of r.rows || []) rows.set(row.generation, row);
+    for (const t of r.trials || []) noteTrial(t);
     const last = [...rows.values()].sort((a, b) => b.generation - a.generation)[0];
     if (last && last.plant !== undefined && last.plant !== null) showBest(last.plant, last);
+    else showTrial();
     drawChart_();
     setStatus(r.status, r.generation, r.generations, r.error);
     noteModel();
     if (r.status !== RUNNING) closeEvents();
+  }
+
+  // A trial generation (from the run's view or a `trial` event), kept in the order bred: a
+  // generation bred again (the studio restarted during its trial) moves to the end.
+  function noteTrial(t) {
+    const key = `${t.model} ${t.generation}`;
+    trials.delete(key);
+    trials.set(key, t);
+    if (begun && begun.model === t.model && begun.runoff === t.runoff) begun = null;
+  }
+
+  /** The trial generation bred last, while the run has none of its own yet. */
+  function currentTrial() {
+    if (rows.size || !trials.size) return null;
+    return [...trials.values()][trials.size - 1];
+  }
+
+  // While the trials go on, the overlay shows the best outline of the model on trial.
+  function showTrial() {
+    const t = currentTrial();
+    if (t && t.plant !== undefined && t.plant !== null) showBest(t.plant, { best_terms: [t.iou] });
   }
 
   // An auto match starts under the first model and names the one its trials chose when its
@@ -176,10 +205,23 @@ export default function createMatchMode(ctx, root) {
 
   function drawChart_() {
     const sorted = [...rows.values()].sort((a, b) => a.generation - b.generation);
+    // each model's trials (first trial and run-off), a line of its own under the run's
+    const byModel = new Map();
+    for (const t of trials.values()) {
+      if (!byModel.has(t.model)) byModel.set(t.model, []);
+      byModel.get(t.model).push([t.generation, t.iou]);
+    }
+    const tried = [...byModel.entries()].map(([m, points], i) => ({
+      name: `trial: ${m}`,
+      points: points.sort((a, b) => a[0] - b[0]),
+      color: TRIAL_COLOURS[i % TRIAL_COLOURS.length],
+    }));
     drawChart(chart, [
       { name: "best IoU × stem factor", points: sorted.map((r) => [r.generation, (r.best_terms || [])[0] ?? r.best]), color: "#7fd18b", width: 2 },
       { name: "mean score", points: sorted.map((r) => [r.generation, r.mean]), color: "#e0b85c" },
-    ], { title: "the outline: best and mean" });
+      ...tried,
+    ], { title: tried.length ? "the outline: best and mean, and each model's trial" : "the outline: best and mean" });
+    chart.dataset.trials = String(byModel.size);
   }
 
   function setStatus(status, generation, total, error) {
@@ -188,7 +230,15 @@ export default function createMatchMode(ctx, root) {
     statusEl.className = `run-status ${status || ""}`;
     const last = [...rows.values()].sort((a, b) => b.generation - a.generation)[0];
     const score = last ? ` · best ${fmtNum(last.best, 3)}` : "";
-    statusEl.textContent = `${status || "–"} · generation ${generation ?? "–"} of ${total ?? "–"}${score}${error ? ` · ${error}` : ""}`;
+    const t = currentTrial();
+    const b = rows.size || status !== RUNNING ? null : begun;
+    statusEl.dataset.trial = b ? b.model : t ? t.model : "";
+    const where = b
+      ? `${b.runoff ? "run-off" : "trial"}: ${b.model}, ${b.runoff ? "going on" : "making its first generation"}`
+      : t
+        ? `${t.runoff ? "run-off" : "trial"}: ${t.model}, generation ${t.generation}, IoU ${fmtNum(t.iou, 3)}`
+        : `generation ${generation ?? "–"} of ${total ?? "–"}${score}`;
+    statusEl.textContent = `${status || "–"} · ${where}${error ? ` · ${error}` : ""}`;
     stopBtn.disabled = status !== RUNNING;
     resumeBtn.disabled = !(status === "stopped" || status === "done");
     openBest.disabled = best === null;
@@ -201,14 +251,33 @@ export default function createMatchMode(ctx, root) {
     closeEvents();
     esSession = id;
     es = follow(ctx, api.eventsUrl(id), id, {
-      generation: (g) => {
+      generation: async (g) => {
         if (!session || session.id !== id) return;
+        // the first generation after the trials: the chosen model's trial generations
+        // became the run's first, read again with the run
+        const chosen = rows.size === 0 && trials.size > 0;
         rows.set(g.generation, g);
         if (g.plant !== undefined && g.plant !== null) showBest(g.plant, g);
         drawChart_();
         setStatus(g.status || RUNNING, g.generation, run?.generations, null);
         noteModel();
         ctx.refreshPopulation();
+        if (chosen) {
+          const r = await ctx.act(() => api.matchRun(id));
+          if (r && session && session.id === id) applyRun(r);
+        }
+      },
+      trial: (t) => {
+        if (!session || session.id !== id) return;
+        noteTrial(t);
+        showTrial();
+        drawChart_();
+        setStatus(t.status || RUNNING, 0, run?.generations, null);
+      },
+      "trial-begun": (b) => {
+        if (!session || session.id !== id) return;
+        begun = { model: b.model, runoff: b.runoff };
+        setStatus(RUNNING, 0, run?.generations, null);
       },
       status: async (st) => {
         if (!session || session.id !== id) return;
@@ -282,9 +351,11 @@ export default function createMatchMode(ctx, root) {
       session = null;
       run = null;
       rows = new Map();
+      trials = new Map();
+      begun = null;
       best = null;
-      target.removeAttribute("src");
-      overlay.removeAttribute("src");
+      clearPicture(target);
+      clearPicture(overlay);
       drawChart_();
       setStatus(null, null, null, null);
     },
@@ -292,4 +363,24 @@ export default function createMatchMode(ctx, root) {
       return false;
     },
   };
+}
+
+// Colours of the models' trial lines on the chart: muted, under the run's own.
+const TRIAL_COLOURS = ["#6fb3e8", "#e07a6f", "#b994e6", "#5fd0c8", "#d98fc0", "#8aa0b8"];
+
+/**
+ * A figure of `img` with `caption`, hidden until the picture loads and again when it fails
+ * or is taken away: no broken-image icon before a target is chosen or a plant is there.
+ */
+function shownWhenLoaded(img, caption) {
+  const figure = h("figure", { hidden: true }, img, h("figcaption", {}, caption));
+  img.addEventListener("load", () => (figure.hidden = false));
+  img.addEventListener("error", () => (figure.hidden = true));
+  return figure;
+}
+
+/** Takes a picture away, hiding its figure. */
+function clearPicture(img) {
+  img.removeAttribute("src");
+  if (img.parentElement) img.parentElement.hidden = true;
 }

@@ -44,7 +44,8 @@
 //! - `hooks.rs`: what a front end adds to a run ([`RunHooks`]): a [`Stop`] that cuts a long
 //!   generation short, and a fitness term of its own scored a batch of plants at a time.
 //! - `silhouette.rs`: the `[match]` term, a plant's silhouette against target pictures.
-//! - `outline.rs`: matches, runs towards target pictures, and `auto` across the models.
+//! - `outline.rs`: matches, runs towards target pictures; `trials.rs`: `auto`, the trials
+//!   across the models and their log, from which trials killed part way resume.
 //! - `typed_map.rs` and `varieties.rs`: a MAP-Elites run of one model, typed, and
 //!   [`Varieties`], a MAP-Elites run of any model (`[run] strategy =
 //!   "map-elites"` and `[map]`): a map of the fittest plant of every kind.
@@ -60,6 +61,7 @@ mod run;
 mod schema;
 mod silhouette;
 mod space;
+mod trials;
 mod typed;
 mod typed_map;
 mod typed_space;

@@ -1,11 +1,12 @@
 //! Matches: runs of any model towards target pictures. The config of a match
 //! ([`match_config`]), how long it breeds ([`Limit`], [`breed_until`]), and `auto`, which
-//! tries every model and keeps the best ([`start_auto`]). The term itself, a plant's
-//! silhouette against the pictures, is `silhouette.rs`, re-exported here.
+//! tries every model and keeps the best ([`start_auto`], [`AutoMatch`]; its trials and
+//! their [`TrialLog`] are `trials.rs`, re-exported here). The term itself, a plant's
+//! silhouette against the pictures, is `silhouette.rs`, re-exported here too.
 
-use std::path::Path;
 use std::time::{Duration, Instant};
 
+use serde::{Deserialize, Serialize};
 use sylva_core::budget::Seconds;
 use sylva_core::par::{Pool, Stop};
 
@@ -13,6 +14,10 @@ use crate::error::{Error, FieldError, InputError};
 use crate::registry::Registry;
 
 pub use super::silhouette::{Outline, TERM, Target, outlines, overlay, prune, score_pruned, space};
+pub use super::trials::{
+    AutoEvent, AutoMatch, Outcome, RUNOFF_SHARE, TRIAL_SHARE, Trial, TrialLog, TrialRecord,
+    TrialRow, start_auto,
+};
 
 use super::config::Config;
 use super::hooks::RunHooks;
@@ -35,8 +40,10 @@ pub fn match_config(
     registry.match_config(model, run, &outline)
 }
 
-/// How long a match breeds.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How long a match breeds (kept in a [`TrialLog`] as `{"generations": n}` or
+/// `{"seconds": s}`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Limit {
     /// Until this generation: the same target, seed and generations give the same bytes.
     Generations(u32),
@@ -106,14 +113,14 @@ pub fn breed_until<E: From<Error>>(
     bred
 }
 
-/// The share of a match each model's first trial gets in [`start_auto`].
-pub const TRIAL_SHARE: f64 = 0.08;
-
-/// The further share of a match the best two models of the first trials get in
-/// [`start_auto`], before the better goes on: a slow model's few first generations
-/// undersell it (a PlantMaker trial of 6 s lost a round outline to binary trees, which
-/// PlantMaker matched better by 20 s).
-pub const RUNOFF_SHARE: f64 = 0.12;
+impl std::fmt::Display for Limit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Limit::Generations(n) => write!(f, "{n} generations"),
+            Limit::Seconds(s) => write!(f, "{}", Seconds(*s)),
+        }
+    }
+}
 
 /// The outline IoU of the run's best member (0 for a run without the term).
 pub fn best_iou(evolution: &Evolution) -> f64 {
@@ -124,208 +131,16 @@ pub fn best_iou(evolution: &Evolution) -> f64 {
     }
 }
 
-/// Breeds `evolution` `more` (generations, or seconds from now) and gives its best IoU. The
-/// last generation is bred whole: cut short, the run that goes on would score it again.
-/// Only the match's own deadline (`stop`'s, [`start_auto_at`]) cuts one short, and the trial
-/// ends at the last whole generation.
-fn trial(evolution: &mut Evolution, more: Limit, stop: &Stop) -> Result<f64, Error> {
-    let (begun, bred) = (Instant::now(), evolution.generation());
-    let done = |evolution: &Evolution| match more {
-        Limit::Generations(n) => evolution.generation() >= bred.saturating_add(n),
-        Limit::Seconds(_) => more.reached(evolution, begun),
-    };
-    while !done(evolution) {
-        match evolution.step() {
-            Ok(_) => {}
-            Err(Error::Stopped(_)) if out_of_time(stop) => break,
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(best_iou(evolution))
-}
-
 /// Whether `stop` ended work because its deadline passed, not by hand.
-fn out_of_time(stop: &Stop) -> bool {
+pub(super) fn out_of_time(stop: &Stop) -> bool {
     stop.timed_out() && !stop.is_set()
 }
 
-/// How one model did in the trials of [`start_auto`].
-#[derive(Clone, Debug, PartialEq)]
-pub enum Trial {
-    /// It had bred `generations` generations and reached `iou`, at the end of its first
-    /// trial or (`runoff`) of the run-off between the best two.
-    Reached {
-        /// The model.
-        model: &'static str,
-        /// Its best plant's outline IoU.
-        iou: f64,
-        /// Generations bred.
-        generations: u32,
-        /// Whether this was the run-off.
-        runoff: bool,
-    },
-    /// It was left out: its first generation was not scored within the match's time.
-    OutOfTime {
-        /// The model.
-        model: &'static str,
-        /// The match's seconds.
-        seconds: f64,
-    },
-    /// It was left out: a generation may take `seconds`, more than a trial allows.
-    LeftOut {
-        /// The model.
-        model: &'static str,
-        /// Seconds a generation may take.
-        seconds: f64,
-        /// Seconds a trial allows a generation.
-        allowance: f64,
-    },
-}
-
-/// A match by the model that matches the outline best: a short trial of each model of the
-/// registry ([`TRIAL_SHARE`] of `limit`; a model whose generation may take longer than
-/// that, or counting generations longer than that share of a minute, is left out), a
-/// run-off of the best two ([`RUNOFF_SHARE`] more each), then the run of the better (the
-/// first on a tie), with the seconds spent on the others. `on_trial` hears how each model
-/// did. The target's pictures are found as their paths say (relative ones from the
-/// current folder; [`start_auto_at`] finds them elsewhere).
-///
-/// The trials watch `stop`: set by hand, they end with [`Error::Stopped`]. A limit in
-/// seconds is also a deadline on them, however large the population: a trial cut short by
-/// it ends at its last whole generation, a model whose first generation it cuts is left
-/// out ([`Trial::OutOfTime`]), and when it leaves no model the match is refused, naming
-/// the population.
-pub fn start_auto(
-    registry: &Registry,
-    target: &MatchConfig,
-    run: &RunConfig,
-    limit: Limit,
-    pool: &Pool,
-    stop: &Stop,
-    on_trial: impl FnMut(&Trial),
-) -> Result<(Evolution, f64), Error> {
-    start_auto_at(
-        registry,
-        target,
-        Path::new(""),
-        run,
-        limit,
-        pool,
-        stop,
-        on_trial,
-    )
-}
-
-/// [`start_auto`], the target's relative paths found in `base` (the studio keeps its
-/// pictures in a folder of its own).
-#[allow(clippy::too_many_arguments)]
-pub fn start_auto_at(
-    registry: &Registry,
-    target: &MatchConfig,
-    base: &Path,
-    run: &RunConfig,
-    limit: Limit,
-    pool: &Pool,
-    stop: &Stop,
-    mut on_trial: impl FnMut(&Trial),
-) -> Result<(Evolution, f64), Error> {
-    let started = Instant::now();
-    let _deadline = Deadline::set(stop, deadline(limit, started));
-    let share = |share: f64| match limit {
-        Limit::Generations(n) => Limit::Generations(((f64::from(n) * share) as u32).max(1)),
-        Limit::Seconds(s) => Limit::Seconds(s * share),
-    };
-    let allowance = match limit {
-        Limit::Generations(_) => 60.0 * TRIAL_SHARE,
-        Limit::Seconds(s) => s * TRIAL_SHARE,
-    };
-    // The pictures are read once, for every model's trial.
-    let pictures = Target::read(target, base)?;
-    let mut entrants: Vec<(f64, &'static str, Evolution)> = Vec::new();
-    for entry in registry.models() {
-        let mut config = match_config(registry, entry.name(), run, target)
-            .map_err(|e| InputError::new(e.field, e.message))?
-            .with_target(Some(pictures.clone()));
-        config.set_base(base);
-        if let Some(t) = config.generation_time(&[], pool.threads())
-            && t.seconds > allowance
-        {
-            on_trial(&Trial::LeftOut {
-                model: entry.name(),
-                seconds: t.seconds,
-                allowance,
-            });
-            continue;
-        }
-        let hooks = RunHooks {
-            stop: Some(stop.clone()),
-            term: None,
-        };
-        let mut evolution = match Evolution::start_with(&config, Vec::new(), pool.clone(), hooks) {
-            Ok(evolution) => evolution,
-            Err(Error::Stopped(_)) if out_of_time(stop) => {
-                on_trial(&Trial::OutOfTime {
-                    model: entry.name(),
-                    seconds: match limit {
-                        Limit::Seconds(s) => s,
-                        Limit::Generations(_) => 0.0,
-                    },
-                });
-                continue;
-            }
-            Err(e) => return Err(e),
-        };
-        let iou = trial(&mut evolution, share(TRIAL_SHARE), stop)?;
-        on_trial(&Trial::Reached {
-            model: entry.name(),
-            iou,
-            generations: evolution.generation(),
-            runoff: false,
-        });
-        entrants.push((iou, entry.name(), evolution));
-    }
-    // The best two, the first on a tie, go on to the run-off.
-    entrants.sort_by(|a, b| b.0.total_cmp(&a.0));
-    entrants.truncate(2);
-    if entrants.len() > 1 {
-        for (iou, model, evolution) in &mut entrants {
-            *iou = trial(evolution, share(RUNOFF_SHARE), stop)?;
-            on_trial(&Trial::Reached {
-                model,
-                iou: *iou,
-                generations: evolution.generation(),
-                runoff: true,
-            });
-        }
-    }
-    let best = entrants
-        .into_iter()
-        .reduce(|a, b| if b.0 > a.0 { b } else { a });
-    let (_, _, mut evolution) = best.ok_or_else(|| match limit {
-        Limit::Seconds(s) if out_of_time(stop) => InputError::new(
-            "population",
-            format!(
-                "no model scored its first generation of {} plants within the {} given; \
-                 breed a smaller population or give more seconds",
-                run.population,
-                Seconds(s)
-            ),
-        ),
-        _ => InputError::new(
-            "model",
-            "no model's generation fits a trial of the time given",
-        ),
-    })?;
-    let own: f64 = evolution.stats().iter().map(|g| g.seconds).sum();
-    evolution.set_stop(None);
-    Ok((evolution, (started.elapsed().as_secs_f64() - own).max(0.0)))
-}
-
 /// A deadline on a [`Stop`] while it lives: cleared when dropped, however the work ends.
-struct Deadline<'a>(&'a Stop);
+pub(super) struct Deadline<'a>(&'a Stop);
 
 impl<'a> Deadline<'a> {
-    fn set(stop: &'a Stop, at: Option<Instant>) -> Deadline<'a> {
+    pub(super) fn set(stop: &'a Stop, at: Option<Instant>) -> Deadline<'a> {
         stop.stop_at(at);
         Deadline(stop)
     }
