@@ -255,15 +255,21 @@ pub trait Background: 'static {
         stop: &AtomicBool,
     ) -> Result<Option<Evolution>, ApiError> {
         let _ = (row, stop);
-        Evolution::start(config, Vec::new(), studio.pool.clone())
-            .map(Some)
-            .map_err(library)
+        start_fresh(studio, config)
     }
 }
 
 /// A library error in a run: the studio's fault or the run's settings, told as they are.
-fn library(e: sylva::Error) -> ApiError {
+pub(crate) fn library(e: sylva::Error) -> ApiError {
     ApiError::internal(sylva::error::chain(&e))
+}
+
+/// A new run of `config` with nothing before its generation 0 ([`Background::start`]'s
+/// default, and a mode's when it has no other work first).
+pub(crate) fn start_fresh(studio: &Studio, config: &Config) -> Result<Option<Evolution>, ApiError> {
+    Evolution::start(config, Vec::new(), studio.pool.clone())
+        .map(Some)
+        .map_err(library)
 }
 
 /// Starts (or resumes) a background run's thread, unless it is going already.

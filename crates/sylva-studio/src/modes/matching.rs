@@ -278,9 +278,7 @@ impl Background for MatchMode {
     ) -> Result<Option<Evolution>, ApiError> {
         let state = match_state(studio, row.session)?;
         if !state.auto {
-            return Evolution::start(config, Vec::new(), studio.pool.clone())
-                .map(Some)
-                .map_err(failed);
+            return runs::start_fresh(studio, config);
         }
         let Some(evolution) = trials(studio, row, config, &state, stop)? else {
             return Ok(None);
@@ -317,10 +315,6 @@ impl Background for MatchMode {
 }
 
 /// A library error in a run: the studio's fault or the run's settings, told as they are.
-fn failed(e: sylva::Error) -> ApiError {
-    ApiError::internal(sylva::error::chain(&e))
-}
-
 /// Why an auto match's trials ended early.
 enum TrialsEnded {
     /// A stop was asked for.
@@ -410,14 +404,14 @@ fn trials(
             Ok(Some(evolution))
         }
         Err(TrialsEnded::Stopped) => Ok(None),
-        Err(TrialsEnded::Library(e)) => Err(failed(e)),
+        Err(TrialsEnded::Library(e)) => Err(runs::library(e)),
         Err(TrialsEnded::Studio(e)) => Err(e),
     }
 }
 
 /// Keeps the trials' log of run `run`, with how each trial that ended did.
 fn keep_log(studio: &Studio, run: i64, log: &TrialLog) -> Result<(), ApiError> {
-    let text = log.to_json().map_err(failed)?;
+    let text = log.to_json().map_err(runs::library)?;
     let ended: Vec<serde_json::Value> = (log.trials().iter())
         .map(|t| json!({"model": t.model, "runoff": t.runoff, "outcome": t.outcome, "seconds": t.seconds}))
         .collect();
