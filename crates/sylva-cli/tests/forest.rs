@@ -140,7 +140,7 @@ fn variants_are_instanced_one_node_per_variant() {
 
 /// Every vertex of a GLB as Sylva's reader places it in the world.
 fn world_vertices(glb: &[u8]) -> Vec<[f32; 3]> {
-    let scene = sylva::gltf::import::read_glb(glb).unwrap();
+    let scene = sylva::import::read_glb(glb).unwrap();
     scene
         .meshes
         .iter()

@@ -1832,7 +1832,7 @@ fn a_match_to_a_picture_runs_live_survives_a_kill_and_shows_its_outline() {
         let path = format!("/api/plants/{plant}/plant.glb");
         let (status, glb) = request(&whole, "GET", &path, b"", true);
         assert_eq!(status, 200);
-        let scene = sylva::gltf::import::read_glb(&glb).unwrap();
+        let scene = sylva::import::read_glb(&glb).unwrap();
         scene
             .meshes
             .iter()

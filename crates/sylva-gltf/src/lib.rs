@@ -10,7 +10,8 @@
 //!
 //! How it fits: it reads what `sylva-mesh` makes (meshes, scenes, the textures it embeds and
 //! the wind rigs it writes) and knows nothing of pictures: the renderer, `sylva-render`,
-//! draws scenes without it. The `sylva` library re-exports it as `sylva::gltf`.
+//! draws scenes without it. Front ends write scenes through the `sylva` library's `export` verbs and read GLBs
+//! through `sylva::import`.
 //!
 //! Every writer is deterministic: the same scene gives the same bytes.
 

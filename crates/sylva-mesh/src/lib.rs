@@ -18,7 +18,8 @@
 //! (GLB, OBJ, VRML97, STL, the GLB reader and levels of detail) are `sylva-gltf`; pictures
 //! (the software renderer and contact sheets) are `sylva-render`. Both read the meshes,
 //! scenes and textures made here, and neither depends on the other; the `sylva` library
-//! re-exports all three (`sylva::mesh`, `sylva::gltf`, `sylva::render`).
+//! hands front ends what they need of all three (`sylva::mesh`, `sylva::export`,
+//! `sylva::import`, `sylva::render`).
 //!
 //! A mesh never knows which model made the plant.
 

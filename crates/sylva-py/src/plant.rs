@@ -247,7 +247,7 @@ impl Plant {
         name: &str,
     ) -> PyResult<Bound<'py, PyBytes>> {
         let levels: usize = levels.get("levels")?;
-        let most = sylva::gltf::lod::MAX_LEVELS;
+        let most = sylva::lod::MAX_LEVELS;
         if !(2..=most).contains(&levels) {
             return Err(bad_value(
                 "levels",
@@ -607,15 +607,14 @@ impl Scene {
 }
 
 fn write_scene(scene: &sylva::mesh::Scene<'_>, path: &Path) -> Result<(), sylva::Error> {
-    sylva::assets::asset_format(path)?;
+    sylva::export::format(path)?;
     let mut out = Outputs::new();
     out.add_scene(path, scene)?;
     out.commit()
 }
 
 fn glb_bytes(scene: &sylva::mesh::Scene<'_>) -> Result<Vec<u8>, sylva::Error> {
-    sylva::gltf::export::check_scene(scene)?;
-    Ok(sylva::gltf::export::to_glb(scene)?)
+    sylva::export::glb(scene)
 }
 
 fn render<'py>(

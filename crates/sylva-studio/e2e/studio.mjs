@@ -763,7 +763,7 @@ async function main() {
     const bytes = Buffer.from(await glb.arrayBuffer());
     check(glb.ok && bytes.subarray(0, 4).toString() === "glTF" && bytes.includes("_LOD3") && bytes.includes('"wind"'), `the LOD export answered ${glb.status}`);
     const mapPlant = Number(await page.evaluate(() => document.querySelector('[data-testid="plant-detail"] h2').textContent.match(/#(\d+)/)[1]));
-    await byTestId("branch").click();
+    await byTestId("branch-breed").click();
     await page.waitForFunction(() => window.sylvaStudio.session().mode === "breed");
     await waitGridLoaded();
     // the panel goes on with the plant as it entered the new session, not the map's

@@ -123,7 +123,7 @@ pub fn grow_glb(
     let mut node = SceneNode::new(genome.model(), &grown.mesh);
     node.extras = Some(extras(genome, seed, parents, operator));
     let scene = sylva::mesh::Scene::single(node);
-    sylva::gltf::export::to_glb(&scene).map_err(|e| ApiError::library("genome", e.into()))
+    sylva::export::glb(&scene).map_err(|e| ApiError::library("genome", e))
 }
 
 /// A preview GLB of `size` of `plant` (grown from `genome` with `seed`, roots left out), for
@@ -289,14 +289,11 @@ pub(crate) async fn glb(
     Query(q): Query<GlbQuery>,
 ) -> Result<Response, ApiError> {
     if let Some(n) = q.lod
-        && !(2..=sylva::gltf::lod::MAX_LEVELS).contains(&n)
+        && !(2..=sylva::lod::MAX_LEVELS).contains(&n)
     {
         return Err(ApiError::bad(
             "lod",
-            format!(
-                "expected 2 to {} levels, got {n}",
-                sylva::gltf::lod::MAX_LEVELS
-            ),
+            format!("expected 2 to {} levels, got {n}", sylva::lod::MAX_LEVELS),
         ));
     }
     q.dress().options()?;
@@ -331,11 +328,11 @@ fn asset_glb(studio: &Studio, id: i64, q: &GlbQuery) -> Result<Vec<u8>, ApiError
     let grown = Grown::grow(genome, &options).map_err(failed)?;
     let glb = if options.lod.is_some() {
         let chain = LodAssets::new(grown, &options).map_err(failed)?;
-        sylva::gltf::export::to_glb(&chain.group_scene(&row.model))
+        sylva::export::glb(&chain.group_scene(&row.model))
     } else {
-        sylva::gltf::export::to_glb(&grown.scene())
+        sylva::export::glb(&grown.scene())
     };
-    glb.map_err(|e| ApiError::library("genome", e.into()))
+    glb.map_err(failed)
 }
 
 /// `GET /api/plants/{id}/inspect[?foliage=KIND][&bark=KIND][&height=M]`: how the plant
@@ -400,9 +397,8 @@ pub(crate) async fn preview(
     Ok(glb_response(&glb))
 }
 
-fn imported(glb: &[u8]) -> Result<sylva::gltf::import::ImportedScene, ApiError> {
-    sylva::gltf::import::read_glb(glb)
-        .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))
+fn imported(glb: &[u8]) -> Result<sylva::import::ImportedScene, ApiError> {
+    sylva::import::read_glb(glb).map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))
 }
 
 /// `GET /api/plants/{id}/plant.obj`.
@@ -426,7 +422,7 @@ pub(crate) async fn mtl(
 fn obj_files(studio: &Studio, id: i64) -> Result<(String, String), ApiError> {
     let glb = plant_glb(studio, id, false)?;
     let scene = imported(&glb)?;
-    Ok(sylva::gltf::export::to_obj(&scene.scene(), "plant.mtl"))
+    sylva::export::obj(&scene.scene(), "plant.mtl").map_err(ApiError::internal)
 }
 
 /// `GET /api/plants/{id}/plant.zip`: the OBJ export in one download: `plant-ID.obj`, the
@@ -440,7 +436,7 @@ pub(crate) async fn obj_zip(
         let glb = plant_glb(&studio, id, false)?;
         let scene = imported(&glb)?;
         let obj = format!("plant-{id}.obj");
-        let files = sylva::gltf::export::scene_files(std::path::Path::new(&obj), &scene.scene())
+        let files = sylva::export::files(&scene.scene(), std::path::Path::new(&obj))
             .map_err(|e| ApiError::internal(format!("exporting OBJ: {e}")))?;
         zip_files(&files).map_err(|e| ApiError::internal(format!("writing the zip: {e}")))
     })
@@ -476,7 +472,7 @@ pub(crate) async fn stl(
 ) -> Result<Response, ApiError> {
     let stl = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
         let glb = plant_glb(&studio, id, false)?;
-        Ok(sylva::gltf::export::to_stl(&imported(&glb)?.scene()))
+        sylva::export::stl(&imported(&glb)?.scene()).map_err(ApiError::internal)
     })
     .await??;
     Ok(download(stl, "model/stl", &format!("plant-{id}.stl")))
@@ -566,7 +562,7 @@ pub(crate) async fn texture(
         .ok_or_else(not_found)?;
     let named = tokio::task::spawn_blocking(move || -> Result<bool, ApiError> {
         let glb = plant_glb(&studio, id, false)?;
-        let ids = sylva::gltf::import::texture_ids(&glb)
+        let ids = sylva::import::texture_ids(&glb)
             .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))?;
         Ok(ids.contains(&texture))
     })

@@ -7,8 +7,9 @@
 //! kept in the archive and written into a folder of the studio's own whenever one is
 //! missing (after a restart), which the config is then read against.
 
+use std::collections::VecDeque;
 use std::path::{Path as FilePath, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use sylva::Config;
 use sylva::Genome;
@@ -58,6 +59,9 @@ pub fn match_config(studio: &Studio, row: &RunRow) -> Result<Config, ApiError> {
     Ok(config)
 }
 
+/// The outlines a plant is pruned to, if any.
+pub type Shears = Option<Arc<[Outline]>>;
+
 /// The match run whose outlines `row`'s plant may grow inside: its own run for a
 /// generation's best, the run its settings name as [`PRUNED_TO`] for one taken elsewhere.
 pub fn pruned_run(row: &PlantRow) -> Option<i64> {
@@ -71,18 +75,53 @@ pub fn pruned_run(row: &PlantRow) -> Option<i64> {
 
 /// The outlines a plant grows inside: those of the match run it comes from
 /// ([`pruned_run`]), when that match prunes; none for any other plant.
-pub fn pruned_to(studio: &Studio, row: &PlantRow) -> Result<Option<Arc<[Outline]>>, ApiError> {
+pub fn pruned_to(studio: &Studio, row: &PlantRow) -> Result<Shears, ApiError> {
     let Some(run) = pruned_run(row) else {
         return Ok(None);
     };
+    let kept = studio.kept::<RunOutlines>();
+    if let Some(outlines) = kept.get(run) {
+        return Ok(outlines);
+    }
     let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
         return Ok(None);
     };
     let config = match_config(studio, &run)?;
-    match config.outline() {
+    let outlines = match config.outline() {
         Some(outline) => space(outline, &config.base())
-            .map_err(|e| ApiError::internal(format!("match run {}'s pictures: {e}", run.id))),
-        None => Ok(None),
+            .map_err(|e| ApiError::internal(format!("match run {}'s pictures: {e}", run.id)))?,
+        None => None,
+    };
+    kept.put(run.id, outlines.clone());
+    Ok(outlines)
+}
+
+/// Match runs whose outlines are kept in memory at most; the oldest read goes first.
+const KEPT_RUNS: usize = 32;
+
+/// Match runs' outlines (none for a run that does not prune), read from the run's config and
+/// pictures once rather than at every plant shown: a run's pictures never change and runs
+/// are never deleted, so its id names them for the studio's life.
+#[derive(Default)]
+struct RunOutlines(Mutex<VecDeque<(i64, Shears)>>);
+
+impl RunOutlines {
+    fn get(&self, run: i64) -> Option<Shears> {
+        let kept = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        kept.iter()
+            .find(|(id, _)| *id == run)
+            .map(|(_, o)| o.clone())
+    }
+
+    fn put(&self, run: i64, outlines: Shears) {
+        let mut kept = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if kept.iter().any(|(id, _)| *id == run) {
+            return;
+        }
+        if kept.len() == KEPT_RUNS {
+            kept.pop_front();
+        }
+        kept.push_back((run, outlines));
     }
 }
 

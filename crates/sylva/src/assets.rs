@@ -18,7 +18,7 @@ use sylva_core::taper::PipeTaper;
 use sylva_core::{MaterialKind, Plant};
 use sylva_evolve::IndividualId;
 use sylva_fitness::silhouette::{Outline, prune};
-use sylva_gltf::export::{self, Format, GlbOptions};
+use sylva_gltf::export::{self, GlbOptions};
 use sylva_mesh::mesher::{MeshOptions, Mesher};
 use sylva_mesh::wind::{Rig, WindOptions};
 use sylva_mesh::{Mesh, Scene, SceneNode};
@@ -580,16 +580,6 @@ pub fn guide_mesh(plant: &Plant) -> Result<Mesh, Error> {
         ..Default::default()
     };
     Ok(Mesher::new(options)?.mesh(plant)?)
-}
-
-/// Writes a scene as GLB, OBJ (with its MTL and textures) or VRML97, by the extension.
-pub fn export(scene: &Scene<'_>, path: &Path) -> Result<(), Error> {
-    Ok(export::write_scene(path, scene)?)
-}
-
-/// Checks an output path's extension before any work is done.
-pub fn asset_format(path: &Path) -> Result<Format, InputError> {
-    Format::from_path(path).map_err(|e| InputError::file_error(path, &e))
 }
 
 /// Checks that a picture path ends in `.png`.

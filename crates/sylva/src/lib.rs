@@ -9,7 +9,9 @@
 //! - [`genome`]: [`Genome`], a genome of any model: read from files, grown, and varied by
 //!   hand with the model's own operators ([`Genome::mutate`], [`Genome::cross`]).
 //! - [`assets`]: grown plants as meshes carrying their origin, scenes of many plants,
-//!   exports (GLB, OBJ, VRML97) and pictures.
+//!   and pictures.
+//! - [`export`]: the one verb scenes are written with: GLB, OBJ, VRML97 or STL, as bytes
+//!   or files.
 //! - [`lod`]: a grown plant's levels of detail as assets ([`LodAssets`]): one mesh per
 //!   level at about half the triangles of the one before, as files or one scene.
 //! - [`skeleton`]: a grown plant as data ([`Skeleton`]): segments, organs, materials and
@@ -56,6 +58,7 @@ pub mod biomorph;
 pub mod error;
 pub mod evolution;
 pub mod experiment;
+pub mod export;
 pub mod files;
 pub mod garden;
 pub mod genome;
@@ -145,20 +148,10 @@ pub mod core {
     }
 }
 
-/// Files: GLB, OBJ and STL writers, the GLB reader, levels of detail (`sylva-gltf`).
-pub mod gltf {
-    /// Writers.
-    pub mod export {
-        pub use sylva_gltf::export::{Format, check_scene, scene_files, to_glb, to_obj, to_stl};
-    }
-    /// The GLB reader.
-    pub mod import {
-        pub use sylva_gltf::import::{ImportedScene, first_extras, read_glb, texture_ids};
-    }
-    /// Levels of detail.
-    pub mod lod {
-        pub use sylva_gltf::lod::MAX_LEVELS;
-    }
+/// GLBs read back (`sylva-gltf`): a file's scene, its first node's extras, its textures.
+/// Scenes are written through [`export`].
+pub mod import {
+    pub use sylva_gltf::import::{ImportedScene, first_extras, read_glb, texture_ids};
 }
 
 /// Meshes, scenes, textures and wind rigs (`sylva-mesh`).

@@ -20,6 +20,8 @@ use crate::error::{Error, InputError};
 use crate::genome::Genome;
 use sylva_core::Plant;
 
+pub use sylva_gltf::lod::MAX_LEVELS;
+
 /// The screen coverage (plant height over screen height) below which the impostor stands
 /// for the plant: 108 pixels of a 1080-pixel screen, a fifth of the picture's cells.
 pub const IMPOSTOR_COVERAGE: f32 = 0.1;
@@ -64,10 +66,7 @@ impl LodAssets {
             LodError::Mesh(e) => Error::Mesh(e),
             LodError::Levels(n) => Error::Input(InputError::new(
                 "--lod",
-                format!(
-                    "{n} levels asked for, expected 2 to {}",
-                    sylva_gltf::lod::MAX_LEVELS
-                ),
+                format!("{n} levels asked for, expected 2 to {}", MAX_LEVELS),
             )),
             other => Error::Input(InputError::new("--lod", other.to_string())),
         })?;
@@ -260,6 +259,6 @@ impl Preview {
 
     /// The preview as a GLB file's bytes: what a front end's 3D view loads.
     pub fn glb(&self) -> Result<Vec<u8>, Error> {
-        Ok(sylva_gltf::export::to_glb(&self.scene())?)
+        crate::export::glb(&self.scene())
     }
 }

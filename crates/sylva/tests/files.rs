@@ -199,7 +199,7 @@ fn skeleton_paths_by_their_ending() {
     assert!(!is_skeleton_path(Path::new("skeleton.json.glb")));
     assert_eq!(
         GrowOutput::of(Path::new("a.glb")).unwrap(),
-        GrowOutput::Asset(sylva::gltf::export::Format::Glb)
+        GrowOutput::Asset(sylva::export::Format::Glb)
     );
     assert_eq!(
         GrowOutput::of(Path::new("a.skeleton.json")).unwrap(),

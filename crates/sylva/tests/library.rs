@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use sylva::assets::export;
+use sylva::export;
 use sylva::{
     Config, Evolution, Genome, GrowOptions, Grown, InputError, ModelEntry, Registry, Settings,
 };
@@ -395,7 +395,7 @@ fn a_fifth_model_grows_meshes_and_exports_through_the_trait_alone() {
     let dir = std::env::temp_dir().join(format!("sylva-cylinder-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let glb = dir.join("cylinder.glb");
-    export(&grown.scene(), &glb).unwrap();
+    export::write(&grown.scene(), &glb).unwrap();
     sylva_testkit::validate(std::slice::from_ref(&glb));
     let imported = sylva_gltf::import::read_glb(&std::fs::read(&glb).unwrap()).unwrap();
     assert_eq!(imported.scene().nodes.len(), 1);

@@ -3,13 +3,13 @@
 
 use std::path::PathBuf;
 
-use sylva::assets::{SceneAssets, asset_format, check_png, picture};
+use sylva::assets::{SceneAssets, check_png, picture};
+use sylva::export::Format;
 use sylva::files::{Outputs, read_text};
 use sylva::garden::{
     GardenLayout, GardenNodes, PlanError, check_garden, garden_glb, garden_glb_options,
     garden_placed, garden_placements, grow_garden,
 };
-use sylva::gltf::export::Format;
 use sylva::render::View;
 use sylva::{Genome, InputError, Registry};
 
@@ -54,7 +54,7 @@ pub struct GardenArgs {
 /// scene (one node per plant, or per variant when instanced, each carrying its genome and
 /// seed) and the garden file.
 pub fn run(models: &Registry, args: &GardenArgs) -> anyhow::Result<()> {
-    let format = asset_format(&args.output)?;
+    let format = sylva::export::format(&args.output)?;
     let wind = args.wind.options(&args.output)?;
     let quantize = args.quantize.check(&args.output, wind.is_some())?;
     if let Some(png) = &args.png {

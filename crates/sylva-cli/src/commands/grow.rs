@@ -80,7 +80,7 @@ pub fn run(models: &Registry, args: &GrowArgs) -> anyhow::Result<()> {
         ..flags.over(base)
     };
     let glb = options.glb_options();
-    if args.lod.is_some() && output != GrowOutput::Asset(sylva::gltf::export::Format::Glb) {
+    if args.lod.is_some() && output != GrowOutput::Asset(sylva::export::Format::Glb) {
         return Err(InputError::new(
             "--lod",
             "levels of detail are written as GLB files: give an output ending in .glb",

@@ -112,7 +112,7 @@ pub fn run(models: &Registry, args: &InspectArgs) -> anyhow::Result<()> {
         }
         Input::Glb => {
             let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
-            let extras = sylva::gltf::import::first_extras(&bytes)
+            let extras = sylva::import::first_extras(&bytes)
                 .map_err(|e| InputError::file_error(&args.file, &e))?;
             let (genome, options) = sylva::assets::regrow(models, &extras, &args.file)?;
             let grown = Grown::grow(genome, &options).in_file(&args.file)?;

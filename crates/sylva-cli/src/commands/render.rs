@@ -128,8 +128,8 @@ pub fn run(models: &Registry, args: &RenderArgs) -> anyhow::Result<()> {
             }
         }
         let bytes = sylva::files::read_bytes(&args.file, MAX_GLB)?;
-        let imported = sylva::gltf::import::read_glb(&bytes)
-            .map_err(|e| InputError::file_error(&args.file, &e))?;
+        let imported =
+            sylva::import::read_glb(&bytes).map_err(|e| InputError::file_error(&args.file, &e))?;
         write_picture(&imported.scene(), &args.output, args.view, args.size)?;
     } else {
         let (genome, base) = super::load_input(models, &args.file)?;

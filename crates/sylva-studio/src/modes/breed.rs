@@ -21,7 +21,7 @@ use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
-use crate::modes::{Mode, Route};
+use crate::modes::{Branch, Mode, Route};
 use crate::plants::{Form, PreviewSize, genome_of, parse_genome, plant_bytes, preview_glb};
 use crate::pruning::{PRUNED_TO, grow_shown, match_settings, pruned_run, pruned_to};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
@@ -1010,6 +1010,10 @@ pub struct BreedMode;
 impl Mode for BreedMode {
     const NAME: &'static str = "breed";
     type Start = Start;
+    const BRANCH: Option<Branch> = Some(Branch {
+        label: "Branch from here",
+        hint: "A new breeding session that starts from this plant",
+    });
 
     fn models(registry: &Registry) -> Vec<&'static str> {
         registry.models().iter().map(|m| m.name()).collect()

@@ -19,7 +19,7 @@ use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::ApiError;
 use crate::http::Body;
-use crate::modes::{Mode, Route};
+use crate::modes::{Branch, Mode, Route};
 use crate::plants::{extras, genome_of, parse_genome, plant_row};
 use crate::sessions::{SessionView, example, session_of, step_seed, view};
 
@@ -369,14 +369,14 @@ async fn grow_garden(
         let assets = garden
             .assets(|i, _| format!("specimen-{i}"), |_, s| node_extras(s))
             .map_err(|e| ApiError::library("settings", e))?;
-        let scene = sylva::gltf::export::to_glb(&assets.scene())
-            .map_err(|e| ApiError::library("settings", e.into()))?;
+        let scene =
+            sylva::export::glb(&assets.scene()).map_err(|e| ApiError::library("settings", e))?;
         let mut specimens = Vec::with_capacity(garden.specimens.len());
         for (s, mesh) in garden.specimens.iter().zip(assets.meshes()) {
             let mut node = SceneNode::new(LSYSTEM, mesh);
             node.extras = Some(node_extras(s));
-            let glb = sylva::gltf::export::to_glb(&Scene::single(node))
-                .map_err(|e| ApiError::library("settings", e.into()))?;
+            let glb = sylva::export::glb(&Scene::single(node))
+                .map_err(|e| ApiError::library("settings", e))?;
             let view = SpecimenView {
                 plant: 0,
                 is_mother: s.is_mother,
@@ -550,6 +550,10 @@ pub struct GardenMode;
 impl Mode for GardenMode {
     const NAME: &'static str = "garden";
     type Start = Start;
+    const BRANCH: Option<Branch> = Some(Branch {
+        label: "Branch to a garden",
+        hint: "A new garden with this plant as the mother",
+    });
 
     fn models(_: &sylva::Registry) -> Vec<&'static str> {
         vec![biomorph::MODEL]

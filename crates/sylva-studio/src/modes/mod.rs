@@ -79,19 +79,30 @@ pub trait Mode: 'static {
         start: Self::Start,
     ) -> impl Future<Output = Result<i64, ApiError>> + Send;
 
-    /// A new session whose first plants are `plant` (`POST /api/plants/{id}/branch`).
+    /// The plant panel's button that starts a session of this mode from a plant
+    /// ([`Mode::branch`]); none for a mode whose sessions start from their own settings.
+    const BRANCH: Option<Branch> = None;
+
+    /// A new session whose first plants are `plant` (`POST /api/plants/{id}/branch`), for a
+    /// mode with a [`Mode::BRANCH`] button.
     fn branch(
         studio: &Studio,
         plant: &PlantRow,
     ) -> impl Future<Output = Result<i64, ApiError>> + Send {
         let _ = (studio, plant);
         async {
+            let branching: Vec<&str> = MODES
+                .iter()
+                .filter(|m| m.branch_button.is_some())
+                .map(|m| m.name)
+                .collect();
             Err(ApiError::bad(
                 "mode",
                 format!(
-                    "a {} session starts from its own settings, not from a plant; branch to a \
-                     breed or garden session",
-                    Self::NAME
+                    "a {} session starts from its own settings, not from a plant; branch to \
+                     a session of {}",
+                    Self::NAME,
+                    branching.join(" or ")
                 ),
             ))
         }
@@ -118,6 +129,15 @@ pub trait Mode: 'static {
     }
 }
 
+/// A button of the plant panel that starts a session of a mode from the plant shown.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Branch {
+    /// What the button says.
+    pub label: &'static str,
+    /// What it says when pointed at.
+    pub hint: &'static str,
+}
+
 /// A step of a mode that answers later, boxed so that every mode's fits one entry.
 type Pending<T> = Pin<Box<dyn Future<Output = Result<T, ApiError>> + Send>>;
 
@@ -131,6 +151,8 @@ pub struct ModeEntry {
     pub hint: &'static str,
     /// Its page module: `web/app/{page}`, served as `/app/{page}`.
     pub page: &'static str,
+    /// The plant panel's button that branches to it ([`Mode::BRANCH`]).
+    pub branch_button: Option<Branch>,
     models: fn(&Registry) -> Vec<&'static str>,
     routes: fn() -> Vec<Route>,
     create: fn(Studio, serde_json::Value) -> Pending<i64>,
@@ -149,6 +171,7 @@ impl ModeEntry {
             label,
             hint,
             page,
+            branch_button: M::BRANCH,
             models: M::models,
             routes: M::routes,
             create: create_as::<M>,
@@ -367,6 +390,8 @@ pub(crate) struct ModeInfo {
     page: String,
     routes: Vec<RouteInfo>,
     models: Vec<&'static str>,
+    /// The plant panel's button that starts a session of it from a plant of its models.
+    branch: Option<Branch>,
 }
 
 /// `GET /api/modes`: every mode, in the order of their tabs.
@@ -387,6 +412,7 @@ pub(crate) async fn modes(State(studio): State<Studio>) -> Json<Vec<ModeInfo>> {
                     })
                     .collect(),
                 models: (m.models)(&studio.registry),
+                branch: m.branch_button,
             })
             .collect(),
     )
@@ -521,6 +547,11 @@ mod tests {
             // Its tab's view comes from its page module, served as a module whose default
             // export makes the view.
             let page = mode["page"].as_str().unwrap();
+            // The plant panel's button, for a mode that starts from a plant.
+            match entry.branch_button {
+                Some(button) => assert_eq!(mode["branch"]["label"], button.label),
+                None => assert!(mode["branch"].is_null(), "{mode}"),
+            }
             let (status, kind, body) = send(&studio, "GET", page);
             assert_eq!(status, StatusCode::OK, "{page}");
             assert!(kind.starts_with("text/javascript"), "{page}: {kind}");
@@ -592,9 +623,11 @@ mod tests {
         let (studio, dir) = studio("page");
         let (_, _, shell) = send(&studio, "GET", "/");
         let (_, _, main) = send(&studio, "GET", "/app/main.js");
-        let (shell, main) = (
+        let (_, _, panel) = send(&studio, "GET", "/app/detail.js");
+        let (shell, main, panel) = (
             String::from_utf8_lossy(&shell),
             String::from_utf8_lossy(&main),
+            String::from_utf8_lossy(&panel),
         );
         assert!(shell.contains(r#"id="modes""#) && shell.contains(r#"id="main""#));
         for entry in MODES {
@@ -612,6 +645,12 @@ mod tests {
                 !main.contains(&format!("./{}", entry.page)),
                 "{}",
                 entry.page
+            );
+            // The plant panel's branch buttons come from the list too.
+            assert!(
+                !panel.contains(&format!("\"{}\"", entry.name)),
+                "detail.js names {}",
+                entry.name
             );
         }
         std::fs::remove_dir_all(&dir).ok();

@@ -51,7 +51,8 @@ export function createDetail(ctx, panel) {
     genomeText.value = p.genome_text ?? JSON.stringify(p.genome, null, 2);
     const seed = h("input", { type: "text", inputmode: "numeric", testid: "regrow-seed", value: String(p.seed ?? 1), style: { width: "13em" } });
 
-    const inGardens = ((ctx.models || []).find((m) => m.name === p.model)?.modes || []).includes("garden");
+    // A button for each mode that starts a session from a plant of this one's model.
+    const branches = ctx.modeList.filter((m) => m.branch && (m.models || []).includes(p.model));
     // Leaves and bark: a foliage kind and a height, for the GLB exports and the report.
     const foliage = h("select", { testid: "look-foliage", title: "Leaves or needles at their real size" },
       h("option", { value: "" }, "as grown"));
@@ -113,8 +114,7 @@ export function createDetail(ctx, panel) {
       )),
       h("div", { class: "buttons" },
         h("button", { testid: "lineage-open", onclick: () => ctx.openLineage(p.id) }, "Lineage"),
-        h("button", { testid: "branch", title: "A new breeding session that starts from this plant", onclick: () => branch("breed") }, "Branch from here"),
-        inGardens ? h("button", { testid: "branch-garden", title: "A new garden with this plant as the mother", onclick: () => branch("garden") }, "Branch to a garden") : null,
+        ...branches.map((m) => h("button", { testid: `branch-${m.name}`, title: m.branch.hint, onclick: () => branch(m.name) }, m.branch.label)),
         h("button", { testid: "add-to-grid", title: "Put this plant back in the current breeding grid", onclick: addToGrid }, "Add to grid"),
       ),
       h("h3", {}, "Leaves and bark"),
@@ -149,20 +149,24 @@ export function createDetail(ctx, panel) {
     );
   }
 
-  function breedSession() {
+  /** The open session, if its mode takes the step `POST /api/sessions/{id}/${step}` (as the
+   * studio's list of modes says); otherwise an error naming a mode that does. */
+  function sessionTaking(step, doing) {
+    const path = `/api/sessions/{id}/${step}`;
+    const takes = (m) => (m.routes || []).some((r) => r.method === "POST" && r.path === path);
     const s = ctx.session;
-    if (!s || s.mode !== "breed") {
-      const e = new Error("editing needs an open breeding session (Branch from here makes one from this plant)");
-      e.field = "session";
-      throw e;
-    }
-    return s;
+    if (s && ctx.modeList.some((m) => m.name === s.mode && takes(m))) return s;
+    const mode = ctx.modeList.find(takes);
+    const how = mode && mode.branch ? ` (${mode.branch.label} makes one from this plant)` : "";
+    const e = new Error(`${doing} needs an open ${mode ? mode.label : ""} session${how}`);
+    e.field = "session";
+    throw e;
   }
 
   async function regrow(text, seedInput) {
     const p = current;
     const s = await ctx.act(() => {
-      const session = breedSession();
+      const session = sessionTaking("edit", "editing");
       const body = { plant: p.id, genome: text };
       if (seedInput.value.trim() !== "") body.seed = seedValue(seedInput.value);
       return api.edit(session.id, body);
@@ -173,7 +177,7 @@ export function createDetail(ctx, panel) {
   async function applyFields(table, seedInput) {
     const p = current;
     const s = await ctx.act(() => {
-      const session = breedSession();
+      const session = sessionTaking("edit", "editing");
       // the studio sets the fields on the stored genome itself, so no digit is lost
       const fields = [];
       for (const input of table.querySelectorAll("input[data-path]")) {
@@ -215,7 +219,7 @@ export function createDetail(ctx, panel) {
 
   async function addToGrid() {
     const p = current;
-    const s = await ctx.act(() => api.add(breedSession().id, { plants: [p.id] }));
+    const s = await ctx.act(() => api.add(sessionTaking("add", "adding to the grid").id, { plants: [p.id] }));
     if (s) await ctx.setSession(s);
   }
 

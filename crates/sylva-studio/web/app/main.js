@@ -79,6 +79,8 @@ onBusy((n) => (ui.busy.hidden = n === 0));
 
 const ctx = {
   models: [],
+  /** The studio's modes as `GET /api/modes` lists them. */
+  modeList: [],
   examples: [],
   sessions: [],
   session: null,
@@ -481,6 +483,7 @@ async function init() {
     refreshSessions(),
   ]);
   ctx.models = models || [];
+  ctx.modeList = list || [];
   ctx.examples = examples || [];
   if (list) await ctx.act(() => loadModes(list));
   if (MODES.length === 0) return;
