@@ -529,6 +529,9 @@ fn hostile_requests_get_a_4xx_that_names_the_field_as_sent() {
         case("POST", &edit, &plant(r#", "fields": [{"path": "nope", "value": 1}]"#), 400, "fields[0].path"),
         case("POST", &edit, &plant(r#", "fields": [{"path": 5, "value": 1}]"#), 400, "fields[0].path"),
         case("POST", &edit, &plant(r#", "fields": [{"value": 1}]"#), 400, "fields[0].path"),
+        // A value the genome refuses is the edit's, not the whole list's.
+        case("POST", &edit, &plant(r#", "fields": [{"path": "depth", "value": "abc"}]"#), 422, "fields[0].value"),
+        case("POST", &edit, &plant(r#", "fields": [{"path": "depth", "value": 4}, {"path": "length", "value": "abc"}]"#), 422, "fields[1].value"),
         case("POST", &edit, &plant(r#", "seed": "x""#), 400, "seed"),
         case("POST", format!("/api/sessions/{id}/grow"), "{}", 409, ""),
         case("POST", format!("/api/sessions/{id}/redo"), "", 409, ""),

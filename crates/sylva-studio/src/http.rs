@@ -322,7 +322,7 @@ fn label(field: &str) -> String {
 /// and what it got (`Children: expected a whole number from 0 to 4294967295, got 2.5`),
 /// never serde's type names (`u32`) nor its place in the JSON text (`at line 1 column 100`,
 /// which the person never saw).
-fn in_page_words(field: &str, message: &str) -> String {
+pub fn in_page_words(field: &str, message: &str) -> String {
     let message = message
         .rfind(" at line ")
         .map_or(message, |i| &message[..i]);
@@ -336,6 +336,17 @@ fn in_page_words(field: &str, message: &str) -> String {
                 expected_words(expected),
                 got_words(got)
             )
+        })
+        // A choice: `unknown variant `abc`, expected one of `a`, `b``.
+        .or_else(|| {
+            let (got, expected) = message
+                .strip_prefix("unknown variant ")?
+                .split_once(", expected ")?;
+            Some(format!(
+                "expected {}, got {}",
+                expected.replace('`', ""),
+                got.trim_matches('`')
+            ))
         })
         .unwrap_or_else(|| match message {
             "number out of range" => "expected a number, got one too large to read".to_owned(),
@@ -662,6 +673,15 @@ mod tests {
                 "{rest}"
             );
         }
+        // A genome's field by its path, and a choice's options without serde's quotes.
+        assert_eq!(
+            in_page_words(
+                "branches[0].segment_pattern",
+                "unknown variant `abc`, expected one of `straight`, `triangular` at line 1 \
+                 column 40"
+            ),
+            "`branches[0].segment_pattern`: expected one of straight, triangular, got abc"
+        );
         // A parent's dominance is named by the parent's place, counted from 1.
         let e = parse_json::<Cross>(
             br#"{"parents": [{"plant": 1, "dominance": 1}, {"plant": 2, "dominance": "x"}]}"#,

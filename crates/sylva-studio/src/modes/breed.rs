@@ -20,7 +20,7 @@ use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
 use crate::error::{ApiError, input_message};
-use crate::http::Body;
+use crate::http::{Body, in_page_words};
 use crate::modes::{Branch, Mode, Route};
 use crate::plants::{Form, PreviewSize, genome_of, parse_genome, plant_bytes, preview_glb};
 use crate::pruning::{PRUNED_TO, grow_shown, match_settings, pruned_run, pruned_to};
@@ -879,6 +879,29 @@ pub struct FieldEdit {
     value: serde_json::Value,
 }
 
+/// `plant`'s genome with `fields` set. A value the genome refuses is named as the edit's
+/// (`fields[1].value`) with the field's path and what it takes, found by setting the edits
+/// one at a time: the genome's own message points into JSON text the person never saw.
+fn edited(registry: &Registry, plant: &PlantRow, fields: &[FieldEdit]) -> Result<Genome, ApiError> {
+    let mut value: serde_json::Value = serde_json::from_str(&plant.genome)
+        .map_err(|e| ApiError::internal(format!("plant {}'s stored genome: {e}", plant.id)))?;
+    for (i, edit) in fields.iter().enumerate() {
+        set_field(&mut value, &edit.path, edit.value.clone()).ok_or_else(|| {
+            ApiError::bad(
+                format!("fields[{i}].path"),
+                format!("the genome has no field {:?}", edit.path),
+            )
+        })?;
+        if let Err(e) = registry.parse_genome(&value.to_string()) {
+            return Err(ApiError::unprocessable(
+                format!("fields[{i}].value"),
+                in_page_words(&edit.path, &e.message),
+            ));
+        }
+    }
+    parse_genome(registry, &value.to_string(), "fields")
+}
+
 /// Sets the value at `path` (`a.b[2].c`) in a genome's JSON; the path must exist.
 fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Option<()> {
     let mut at = genome;
@@ -914,20 +937,7 @@ pub(crate) async fn edit(
     let original = genome_of(&studio.registry, &old)?;
     let genome = match (&request.genome, request.fields.is_empty()) {
         (None, true) => original.clone(),
-        (None, false) => {
-            let mut value: serde_json::Value = serde_json::from_str(&old.genome).map_err(|e| {
-                ApiError::internal(format!("plant {}'s stored genome: {e}", old.id))
-            })?;
-            for (i, edit) in request.fields.iter().enumerate() {
-                set_field(&mut value, &edit.path, edit.value.clone()).ok_or_else(|| {
-                    ApiError::bad(
-                        format!("fields[{i}].path"),
-                        format!("the genome has no field {:?}", edit.path),
-                    )
-                })?;
-            }
-            parse_genome(&studio.registry, &value.to_string(), "fields")?
-        }
+        (None, false) => edited(&studio.registry, &old, &request.fields)?,
         (Some(serde_json::Value::String(text)), true) => {
             parse_genome(&studio.registry, text, "genome")?
         }
