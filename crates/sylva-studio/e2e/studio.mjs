@@ -437,6 +437,21 @@ async function main() {
       check(r.ok, `${link}: GET ${u}: ${r.status}`);
       fs.writeFileSync(path.join(out, `plant-${child}${path.extname(new URL(u, base).pathname)}`), Buffer.from(await r.arrayBuffer()));
     }
+    // Clicked, an export says it is being prepared while the studio makes the file (held
+    // here until checked), then the browser saves it under its name.
+    let release;
+    const held = new Promise((resolve) => { release = resolve; });
+    await page.route("**/plant.zip", async (route) => { await held; await route.continue(); });
+    const saved = page.waitForEvent("download");
+    await byTestId("export-obj").click();
+    await page.waitForFunction(() => /preparing \d+ s/.test(document.querySelector('[data-testid="export-obj"]').textContent));
+    release();
+    const download = await saved;
+    check(download.suggestedFilename() === `plant-${child}.zip`, `the OBJ export was saved as ${download.suggestedFilename()}`);
+    const zip = fs.readFileSync(await download.path());
+    check(zip.subarray(0, 2).toString() === "PK", "the saved OBJ export is not a zip");
+    await page.unroute("**/plant.zip");
+    await page.waitForFunction(() => document.querySelector('[data-testid="export-obj"]').textContent === "OBJ (zip)");
   });
 
   await step("breed: dress the child in oak leaves, inspect it, export it and validate it", async () => {

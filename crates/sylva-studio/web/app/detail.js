@@ -1,7 +1,7 @@
 // The plant panel: an archived plant's origin, genome fields and packed string, an editable
 // genome with Regrow, exports, Branch from here and its lineage.
 
-import { api, seedValue, BigInteger } from "./api.js";
+import { api, getBytes, seedValue, BigInteger } from "./api.js";
 import { h, add, clear, fmtNum, summarize } from "./dom.js";
 
 export function createDetail(ctx, panel) {
@@ -27,7 +27,6 @@ export function createDetail(ctx, panel) {
 
   function render(p) {
     clear(panel);
-    const enc = encodeURIComponent(p.id);
     const parents = (p.parents || []).map((q) =>
       h("a", { href: "#", class: "plant-link", testid: "detail-parent", onclick: (e) => { e.preventDefault(); open(q.plant); } },
         `#${q.plant}`, q.dominance !== undefined && q.dominance !== null ? ` (dominance ${fmtNum(q.dominance)})` : ""),
@@ -66,6 +65,10 @@ export function createDetail(ctx, panel) {
     const glbLinks = [];
     const exportLink = (file, label, testid, download) => {
       const a = h("a", { href: api.plantUrl(p.id, file), download, testid, class: "button" }, label);
+      a.addEventListener("click", (e) => {
+        e.preventDefault();
+        save(a);
+      });
       if (file.startsWith("plant.glb")) glbLinks.push([a, file]);
       return a;
     };
@@ -131,7 +134,7 @@ export function createDetail(ctx, panel) {
         exportLink("plant.glb?wind=true&lod=4", "GLB + wind + LOD", "export-glb-lod", `plant-${p.id}-lod.glb`),
         exportLink("plant.zip", "OBJ (zip)", "export-obj", `plant-${p.id}.zip`),
         exportLink("plant.stl", "STL", "export-stl", `plant-${p.id}.stl`),
-        h("a", { href: `/api/plants/${enc}/plant.png?view=iso&size=1024x1024`, download: `plant-${p.id}.png`, testid: "export-png", class: "button" }, "PNG"),
+        exportLink("plant.png?view=iso&size=1024x1024", "PNG", "export-png", `plant-${p.id}.png`),
         exportLink("genome.json", "genome.json", "export-genome", `plant-${p.id}.genome.json`),
       ),
       p.packed ? h("div", {}, h("h3", {}, "Packed string"), h("pre", { class: "packed", testid: "packed" }, p.packed)) : null,
@@ -194,6 +197,34 @@ export function createDetail(ctx, panel) {
       return api.edit(session.id, body);
     });
     if (s) await afterEdit(s, p.id);
+  }
+
+  /** Saves an export link's file. A heavy plant's file takes the studio seconds to make, so
+   * the link says it is being prepared, and for how long, until the browser saves it. */
+  async function save(link) {
+    if (link.dataset.busy) return;
+    link.dataset.busy = "true";
+    const label = link.textContent;
+    const started = performance.now();
+    const tick = () => {
+      link.textContent = `${label} · preparing ${Math.floor((performance.now() - started) / 1000)} s`;
+    };
+    tick();
+    const timer = setInterval(tick, 1000);
+    try {
+      const bytes = await ctx.act(() => getBytes(link.href));
+      if (!bytes) return;
+      const url = URL.createObjectURL(new Blob([bytes]));
+      const saving = h("a", { href: url, download: link.download, hidden: true });
+      document.body.append(saving);
+      saving.click();
+      saving.remove();
+      setTimeout(() => URL.revokeObjectURL(url), 60_000);
+    } finally {
+      clearInterval(timer);
+      link.textContent = label;
+      delete link.dataset.busy;
+    }
   }
 
   async function afterEdit(session, oldId) {
