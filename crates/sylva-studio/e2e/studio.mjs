@@ -900,6 +900,14 @@ async function main() {
   });
 
   // ---- restart ----
+  await step("the studio's memory after the whole session is bounded", async () => {
+    // Linux's own figures for the server: resident now, and its peak over the session.
+    const status = fs.readFileSync(`/proc/${server.pid}/status`, "utf8");
+    const kib = (key) => Number(status.match(new RegExp(`^${key}:\\s+(\\d+) kB`, "m"))[1]);
+    results.memory = { rssMB: kib("VmRSS") / 1024, peakMB: kib("VmHWM") / 1024 };
+    check(results.memory.rssMB < 512, `the studio holds ${results.memory.rssMB.toFixed(0)} MB after the session (at most 512)`);
+  });
+
   await step("the archive survives a killed server (and the running design run resumes)", async () => {
     const before = await api(`/api/sessions/${breedId}`);
     const plantsBefore = await api(`/api/plants?session=${breedId}&limit=1000`);
@@ -1004,6 +1012,7 @@ async function main() {
   }
   fs.writeFileSync(path.join(out, "timings.json"), JSON.stringify(results, null, 2));
   console.log(`screenshots in ${path.relative(repo, out)}/`);
+  if (results.memory) console.log(`studio memory:          ${results.memory.rssMB.toFixed(0)} MB resident after the session, at most ${results.memory.peakMB.toFixed(0)} MB during it`);
   console.log(`studio e2e: all passed in ${((Date.now() - T0) / 1000).toFixed(1)} s`);
 }
 

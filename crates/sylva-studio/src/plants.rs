@@ -27,22 +27,23 @@ use crate::cache::Bounded;
 use crate::error::ApiError;
 use crate::pruning::{grow_shown, pruned_to};
 
-/// GLBs kept in memory, by plant and form: at most 256, and 512 MB (a random PlantMaker
-/// plant's GLB in full can be 40 MB).
+/// GLBs kept in memory, by plant and form: at most 256, and 128 MB (a view's preview is a
+/// few hundred kB; a random PlantMaker plant's GLB in full, for an export, can be 40 MB).
 pub type MeshCache = Bounded<(i64, Form), Vec<u8>>;
 
 /// A mesh cache of the studio's size.
 pub fn mesh_cache() -> MeshCache {
-    Bounded::new(256, 512 << 20)
+    Bounded::new(256, 128 << 20)
 }
 
 /// Grown plants kept in memory, by plant (roots left out), so that a preview of any size is
-/// simplified and meshed without growing the plant again: at most 256, and 256 MB.
+/// simplified and meshed without growing the plant again: at most 256, and 64 MB. The two
+/// caches together stay well under the studio's memory figure (docs/studio.md, "Memory").
 pub type PlantCache = Bounded<i64, Plant>;
 
 /// A plant cache of the studio's size.
 pub fn plant_cache() -> PlantCache {
-    Bounded::new(256, 256 << 20)
+    Bounded::new(256, 64 << 20)
 }
 
 /// Roughly the bytes a plant holds.
