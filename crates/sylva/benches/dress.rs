@@ -2,7 +2,8 @@
 //! oak leaves at real size, furrowed bark) grown and meshed in leaf, against the same plant
 //! at the same height grown and meshed bare, and the dress alone. The bar: in leaf
 //! within twice the bare plant. And the impostor of the oak in leaf (the last level of its
-//! chain of detail): its two pictures drawn and its cards made.
+//! chain of detail): its two pictures drawn and its cards made. And the plausibility report
+//! of the oak in leaf, which a match's term takes of every plant it scores.
 //!
 //! Run with `cargo bench -p sylva --bench dress`.
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
@@ -51,6 +52,13 @@ fn dress(c: &mut Criterion) {
     group.bench_function("the dress alone", |b| {
         b.iter(|| black_box(sylva::core::dress::dress(&undressed, &dressed.dress, 0).unwrap()))
     });
+    group.bench_function(
+        format!(
+            "the plausibility report of the oak in leaf ({} organs)",
+            grown.plant.organs().len()
+        ),
+        |b| b.iter(|| black_box(sylva::inspect::Report::of(&grown.plant, None))),
+    );
     let scene = grown.scene();
     group.bench_function("the impostor of the oak in leaf", |b| {
         b.iter(|| black_box(sylva::render::impostor::impostor(&scene).unwrap()))

@@ -442,7 +442,10 @@ impl Measures {
             .map(|p| f64::from(p.y - ground))
             .fold(0.0, f64::max);
         let flat: Vec<Vec2> = points.iter().map(|p| Vec2::new(p.x, p.z)).collect();
-        let crown_width = spread(&flat);
+        // Widths and the projection are the hull's: a few dozen corners of tens of thousands
+        // of points (a match scores every plant it grows by this report).
+        let hull = hull(&flat);
+        let crown_width = spread(&hull);
 
         // Trunk diameters.
         let (base_diameter, dbh) = match foot {
@@ -466,7 +469,7 @@ impl Measures {
             .collect();
         let leaf_length = median(leaves.iter().map(|l| l.0).collect());
         let area: f64 = leaves.iter().map(|l| l.1).sum();
-        let projection = hull_area(&flat);
+        let projection = polygon_area(&hull);
         let leaf_area_index = (!leaves.is_empty() && projection > 0.0).then(|| area / projection);
         let strahler = strahler(plant);
         let placed: Vec<usize> = leaves.iter().filter_map(|l| l.2).collect();
@@ -494,8 +497,8 @@ fn median(mut values: Vec<f64>) -> Option<f64> {
     if values.is_empty() {
         return None;
     }
-    values.sort_by(f64::total_cmp);
-    Some(values[values.len() / 2])
+    let middle = values.len() / 2;
+    Some(*values.select_nth_unstable_by(middle, f64::total_cmp).1)
 }
 
 /// The crown's spread as foresters take it: the widest extent over the ground, and the extent
@@ -519,16 +522,20 @@ fn spread(points: &[Vec2]) -> f64 {
     0.5 * (widest + extent(f64::from(at + 90)))
 }
 
-/// The area of the convex hull of `points` (monotone chain), square metres.
-fn hull_area(points: &[Vec2]) -> f64 {
+/// The corners of the convex hull of `points` (monotone chain), counter-clockwise.
+fn hull(points: &[Vec2]) -> Vec<Vec2> {
     let mut p: Vec<(f64, f64)> = points
         .iter()
         .map(|v| (f64::from(v.x), f64::from(v.y)))
         .collect();
-    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    // Unstable is the same order: equal points are the same point, and are merged next.
+    p.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     p.dedup();
     if p.len() < 3 {
-        return 0.0;
+        return p
+            .iter()
+            .map(|&(x, y)| Vec2::new(x as f32, y as f32))
+            .collect();
     }
     let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
         (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
@@ -551,10 +558,22 @@ fn hull_area(points: &[Vec2]) -> f64 {
         }
         hull.pop();
     }
-    let n = hull.len();
+    // Exact: the corners are points given as f32.
+    hull.iter()
+        .map(|&(x, y)| Vec2::new(x as f32, y as f32))
+        .collect()
+}
+
+/// The area of a convex polygon given by its corners (`hull`), square metres.
+fn polygon_area(corners: &[Vec2]) -> f64 {
+    let n = corners.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let xy = |v: Vec2| (f64::from(v.x), f64::from(v.y));
     0.5 * (0..n)
         .map(|i| {
-            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            let (a, b) = (xy(corners[i]), xy(corners[(i + 1) % n]));
             a.0 * b.1 - b.0 * a.1
         })
         .sum::<f64>()
