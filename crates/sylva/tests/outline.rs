@@ -138,10 +138,11 @@ fn a_match_breeds_for_fitting() {
 }
 
 /// A match's PlantMaker leaves are leaf green (`palette = "foliage"`): the outline cannot
-/// see colour, and the colours do not change the forms bred, which are those of a match
-/// whose fans take any colour.
+/// see colour, but the plausibility report can: a green blade is a leaf, judged for its
+/// size against the plant's height, where a fan of any colour may be a flower, which it
+/// does not judge. So the colours do change the scores, through the report alone.
 #[test]
-fn a_match_grows_green_leaves_and_the_forms_any_colours_would() {
+fn a_match_grows_green_leaves_judged_as_leaves() {
     use sylva::core::MaterialKind;
     use sylva::evolution::RunConfig;
     use sylva::evolution::outline::match_config;
@@ -169,9 +170,12 @@ fn a_match_grows_green_leaves_and_the_forms_any_colours_would() {
         let best = evolution.best().genome.clone();
         (ious, best.develop(best.default_seed()).unwrap())
     };
-    let ((green_ious, green), (any_ious, plant)) = (bred(&foliage), bred(&any));
-    assert_eq!(green_ious, any_ious);
-    assert_eq!(green.segments().len(), plant.segments().len());
+    let ((green_scores, green), (any_scores, plant)) = (bred(&foliage), bred(&any));
+    assert_ne!(green_scores, any_scores);
+    // The green plant's blades are measured as leaves.
+    let report = sylva::inspect::Report::of(&green, None);
+    let leaf = report.figures.iter().find(|f| f.name == "leaf_length");
+    assert!(leaf.and_then(|f| f.value).is_some(), "{}", report.table());
     assert!(!green.organs().is_empty());
     for o in green.organs() {
         let kind = green.materials()[o.material.index()].kind;
@@ -593,4 +597,36 @@ fn auto_killed_during_its_trials_resumes_from_its_log_to_the_same_bytes() {
     assert!(e.to_string().contains("population of 6, not 7"), "{e}");
     let e = TrialLog::parse(Path::new("trials.json"), "{\"format\": 1, \"trials\": [").unwrap_err();
     assert!(e.to_string().contains("trials.json"), "{e}");
+}
+
+/// A plant the plausibility report fails scores half its outline per figure failed: a
+/// binary tree whose trunk is a log (4 m wide, the tree about 13 m tall) against the same
+/// tree slender.
+#[test]
+fn a_log_scores_half_per_figure_it_fails() {
+    use sylva::evolution::outline::{IMPLAUSIBLE, realism};
+    let tree = |radius: f64| {
+        let text = format!(
+            r#"{{"model": "bintree", "format": 1, "depth": 5, "lower_radius": {radius},
+              "upper_radius": {radius}, "length": 4.0, "length_ratio": 0.8,
+              "rotation1": {{"angle": 30, "axis": [1, 0, 0]}},
+              "rotation2": {{"angle": -30, "axis": [0, 0, 1]}}, "min_radius": 0.02}}"#
+        );
+        let genome = Registry::standard().parse_genome(&text).unwrap();
+        genome.develop(0).unwrap()
+    };
+    let (log, pole) = (tree(2.0), tree(0.1));
+    let failed = sylva::inspect::Report::of(&log, None).failures().len();
+    assert!(
+        failed >= 1,
+        "{}",
+        sylva::inspect::Report::of(&log, None).table()
+    );
+    assert_eq!(realism(&log), IMPLAUSIBLE.powi(failed as i32));
+    assert_eq!(
+        realism(&pole),
+        1.0,
+        "{}",
+        sylva::inspect::Report::of(&pole, None).table()
+    );
 }

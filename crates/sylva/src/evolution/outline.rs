@@ -13,7 +13,9 @@ use sylva_core::par::{Pool, Stop};
 use crate::error::{Error, FieldError, InputError};
 use crate::registry::Registry;
 
-pub use super::silhouette::{Outline, TERM, Target, outlines, overlay, prune, score_pruned, space};
+pub use super::silhouette::{
+    IMPLAUSIBLE, Outline, TERM, Target, outlines, overlay, prune, realism, score_pruned, space,
+};
 pub use super::trials::{
     AutoEvent, AutoMatch, Outcome, RUNOFF_SHARE, TRIAL_SHARE, Trial, TrialLog, TrialRecord,
     TrialRow, start_auto,

@@ -26,8 +26,22 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
+/// What each figure of the plausibility report ([`crate::inspect::Report`]) that a plant
+/// fails does to its score: halves it. A trunk no tree has (a log, slenderness under 5; a
+/// post, over 180; a foot flared past three times its breast-height width), a crown or
+/// leaves of a size no tree of its height has, stems thicker than their parents: such a
+/// plant cannot win against one that passes and matches more than half as well.
+pub const IMPLAUSIBLE: f64 = 0.5;
+
+/// [`IMPLAUSIBLE`] to the power of the figures `plant` fails.
+pub fn realism(plant: &sylva_core::Plant) -> f64 {
+    let failed = crate::inspect::Report::of(plant, None).failures().len();
+    IMPLAUSIBLE.powi(failed as i32)
+}
+
 /// Model `M`'s plants against target outlines: the mean over the views of the IoU times
-/// the plant's stem plausibility ([`Outline::score`]).
+/// the plant's stem plausibility ([`Outline::score`]), halved for each figure of the
+/// plausibility report the plant fails ([`realism`]).
 struct OutlineTerm<M> {
     model: M,
     outlines: Vec<Outline>,
@@ -58,7 +72,7 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
                 Err(_) => return 0.0,
             }
         }
-        SCRATCH.with(|scratch| {
+        let outline = SCRATCH.with(|scratch| {
             let scratch = &mut scratch.borrow_mut();
             if let Some(space) = &self.space {
                 return score_pruned(space, &self.outlines, &plant, self.closeness, scratch);
@@ -67,7 +81,13 @@ impl<M: Evolve> Term<M::Problem> for OutlineTerm<M> {
                 .map(|o| o.score_with_closeness(&plant, self.closeness, scratch))
                 .sum();
             sum / self.outlines.len() as f64
-        })
+        });
+        // The report is the plant's, whether pruned to the outlines or not.
+        if outline > 0.0 {
+            outline * realism(&plant)
+        } else {
+            outline
+        }
     }
 }
 
