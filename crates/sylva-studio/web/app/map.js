@@ -118,8 +118,8 @@ export default function createMapMode(ctx, root) {
     if (!view) return;
     const [x, y] = view.axes;
     const columns = x.cells, rowsN = y ? y.cells : 1;
-    grid.style.gridTemplateColumns = `repeat(${columns}, ${THUMB}px)`;
-    grid.style.gridTemplateRows = `repeat(${rowsN}, ${THUMB}px)`;
+    // cells of THUMB pixels, narrower (square still) when the map's box is: no side scrolling
+    grid.style.gridTemplateColumns = `repeat(${columns}, minmax(0, ${THUMB}px))`;
     // the top row is the highest cells of the second axis
     for (let r = rowsN - 1; r >= 0; r--) {
       for (let c = 0; c < columns; c++) {
