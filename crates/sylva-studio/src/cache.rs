@@ -1,7 +1,8 @@
 //! What the studio keeps in memory: values by key, the least recently used going first when
 //! there are more than a count or their bytes pass a total. Keys are always real plants' (a
 //! plant is read from the archive before anything of it is made), each with a handful of
-//! forms, so nothing a request makes up can enter or fill a cache.
+//! forms (pictures: any view and size, but bounded like the rest), so nothing a request makes
+//! up can enter a cache.
 
 use std::collections::{HashMap, VecDeque};
 use std::hash::Hash;

@@ -137,6 +137,8 @@ pub struct Inner {
     pub meshes: plants::MeshCache,
     /// Recently grown plants.
     pub plants: plants::PlantCache,
+    /// Recently drawn pictures (thumbnails).
+    pub pictures: plants::PictureCache,
     /// Threads for growing many plants at once.
     pub pool: sylva::core::par::Pool,
     /// One lock per session, so that two tabs' steps on one session queue up.
@@ -171,6 +173,7 @@ impl Studio {
             guard,
             meshes: plants::mesh_cache(),
             plants: plants::plant_cache(),
+            pictures: plants::picture_cache(),
             pool: sylva::core::par::Pool::with_threads(0).unwrap_or_default(),
             locks: Mutex::default(),
             kept: Mutex::default(),

@@ -36,6 +36,15 @@ pub fn mesh_cache() -> MeshCache {
     Bounded::new(256, 128 << 20)
 }
 
+/// Pictures kept in memory, by plant, view and size: at most 4096, and 64 MB (a thumbnail is
+/// a few kilobytes), so that a thumbnail asked for again is answered at once.
+pub type PictureCache = Bounded<(i64, View, (u32, u32)), Vec<u8>>;
+
+/// A picture cache of the studio's size.
+pub fn picture_cache() -> PictureCache {
+    Bounded::new(4096, 64 << 20)
+}
+
 /// Grown plants kept in memory, by plant (roots left out), so that a preview of any size is
 /// simplified and meshed without growing the plant again: at most 256, and 64 MB. The two
 /// caches together stay well under the studio's memory figure (docs/studio.md, "Memory").
@@ -69,7 +78,7 @@ pub enum Form {
 /// rounded up to a power of two from 128 to 2048. A class allows `side² / 8` triangles (at
 /// most 400,000): one triangle for every eight pixels of a square view is more than the eye
 /// can tell from the plant in full.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct PreviewSize(u16);
 
 impl PreviewSize {
@@ -80,6 +89,11 @@ impl PreviewSize {
     /// The class of a view `pixels` wide at most.
     pub fn of(pixels: u32) -> PreviewSize {
         PreviewSize(pixels.clamp(128, 2048).next_power_of_two() as u16)
+    }
+
+    /// Every class, the smallest first.
+    fn all() -> impl Iterator<Item = PreviewSize> {
+        (7..=11).map(|power| PreviewSize(1 << power))
     }
 
     /// The triangles a preview of this class may have.
@@ -521,13 +535,38 @@ pub(crate) async fn png(
         None => (512, 512),
         Some(s) => parse_size(s)?,
     };
-    let png = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, ApiError> {
-        let glb = plant_glb(&studio, id, false)?;
-        let scene = imported(&glb)?;
-        sylva::assets::picture(&scene.scene(), view, size).map_err(ApiError::internal)
-    })
-    .await??;
-    Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
+    let key = (id, view, size);
+    let png = match studio.pictures.get(key) {
+        Some(png) => png,
+        None => {
+            tokio::task::spawn_blocking(move || -> Result<Arc<Vec<u8>>, ApiError> {
+                let glb = picture_glb(&studio, id, size)?;
+                let scene = imported(&glb)?;
+                let png = sylva::assets::picture(&scene.scene(), view, size)
+                    .map_err(ApiError::internal)?;
+                let png = Arc::new(png);
+                studio.pictures.put(key, png.clone(), png.len());
+                Ok(png)
+            })
+            .await??
+        }
+    };
+    Ok(([(header::CONTENT_TYPE, "image/png")], png.to_vec()).into_response())
+}
+
+/// The cheapest GLB a picture of `size` is drawn from: the smallest preview in memory that
+/// has the detail the picture needs (a step's grid previews are), else a preview of just
+/// that detail. A preview has all the eye can tell at its size, and a thumbnail drawn from
+/// one takes a fraction of the plant in full.
+fn picture_glb(studio: &Studio, id: i64, size: (u32, u32)) -> Result<Arc<Vec<u8>>, ApiError> {
+    let needed = PreviewSize::of(size.0.max(size.1));
+    let kept = PreviewSize::all()
+        .filter(|class| *class >= needed)
+        .find_map(|class| studio.meshes.get((id, Form::Preview(class))));
+    match kept {
+        Some(glb) => Ok(glb),
+        None => plant_form(studio, id, Form::Preview(needed)),
+    }
 }
 
 /// `WxH`, each 16 to [`MAX_PICTURE`].

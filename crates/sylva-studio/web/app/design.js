@@ -105,7 +105,8 @@ export default function createDesignMode(ctx, root) {
   const wrap = h("div", { class: "view-wrap design-view" }, canvas, viewEl);
   const statusEl = h("div", { class: "run-status", testid: "design-status" }, "no run");
   const table = h("table", { class: "progress", testid: "design-table" });
-  const tableBox = h("div", { class: "table-box" }, table);
+  // a table of many figures a generation: it scrolls sideways where the view is narrow
+  const tableBox = h("div", { class: "table-box", dataset: { scroll: "x" } }, table);
   const chart = h("canvas", { class: "chart", testid: "design-chart" });
   const termsChart = h("canvas", { class: "chart", testid: "design-terms-chart" });
   const right = h("div", { class: "design-right" },

@@ -7,6 +7,7 @@ import { Stage, loadGlb, THREE } from "./viewer.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { stats } from "./stats.js";
 import { suspect } from "./connection.js";
+import { thumb } from "./thumbs.js";
 
 export default function createGardenMode(ctx, root) {
   // the server's defaults for a new garden: neighbours meet and shade each other
@@ -164,7 +165,7 @@ export default function createGardenMode(ctx, root) {
           title: s.is_mother ? "the mother" : "make this plant the next mother",
           onclick: () => pick(s.plant),
         },
-        h("img", { src: api.pngUrl(s.plant, "96x96"), width: 96, height: 96, alt: `plant ${s.plant}`, loading: "lazy" }),
+        thumb(api.pngUrl(s.plant, "96x96"), { width: 96, height: 96, alt: `plant ${s.plant}` }),
         h("span", { class: "card-title" }, `#${s.plant}`, s.is_mother ? h("span", { class: "badge" }, "mother") : null),
         h("span", { class: "card-line" }, `biomass ${fmtNum(s.biomass, 3)}`),
         h("span", { class: "card-line" }, `light ${fmtNum(s.light, 3)}`),

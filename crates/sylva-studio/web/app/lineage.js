@@ -3,6 +3,7 @@
 
 import { api } from "./api.js";
 import { h, clear, fmtNum, summarize } from "./dom.js";
+import { thumb } from "./thumbs.js";
 
 const NODE_W = 150;
 const NODE_H = 196;
@@ -123,7 +124,7 @@ export function createLineage(ctx, overlay) {
           title: `#${n.id} ${n.operator || ""} ${settings}\nseed ${n.seed}\nclick to show this plant`,
           onclick: () => ctx.openPlant(n.id),
         },
-        h("img", { src: api.pngUrl(n.id, "128x128"), width: 128, height: 128, alt: `plant ${n.id}`, loading: "lazy" }),
+        thumb(api.pngUrl(n.id, "128x128"), { width: 128, height: 128, alt: `plant ${n.id}` }),
         h("span", { class: "lcap" }, h("b", {}, `#${n.id}`), " ", n.operator || "–"),
         settings ? h("span", { class: "lset" }, settings) : null,
       );

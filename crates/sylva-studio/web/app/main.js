@@ -12,6 +12,7 @@ import { stats } from "./stats.js";
 import { createDetail } from "./detail.js";
 import { createLineage } from "./lineage.js";
 import { onReconnect } from "./connection.js";
+import { thumb } from "./thumbs.js";
 
 /** The modes' names, in the order of their tabs (filled from the studio's list). */
 const MODES = [];
@@ -286,7 +287,7 @@ async function loadPopulation() {
           title: shown ? "on screen now" : "",
           onclick: () => detail.open(p.id),
         },
-        h("img", { src: api.pngUrl(p.id, "48x48"), width: 48, height: 48, alt: "", loading: "lazy" }),
+        thumb(api.pngUrl(p.id, "48x48"), { width: 48, height: 48, alt: "" }),
         h("span", { class: "pop-text" },
           h("b", {}, `#${p.id}`), " ", p.operator || "",
           h("span", { class: "dim" }, (p.parents && p.parents.length ? ` ← ${p.parents.map((x) => "#" + x).join(" ")}` : "") + ` · seed ${p.seed}`))),

@@ -8,6 +8,7 @@ import { api, seedValue } from "./api.js";
 import { h, clear, field, num, readNumber, fmtNum } from "./dom.js";
 import { drawChart } from "./chart.js";
 import { follow } from "./follow.js";
+import { thumb } from "./thumbs.js";
 
 const RUNNING = "running";
 const THUMB = 72;
@@ -117,8 +118,8 @@ export default function createMapMode(ctx, root) {
     if (!view) return;
     const [x, y] = view.axes;
     const columns = x.cells, rowsN = y ? y.cells : 1;
-    grid.style.gridTemplateColumns = `repeat(${columns}, ${THUMB}px)`;
-    grid.style.gridTemplateRows = `repeat(${rowsN}, ${THUMB}px)`;
+    // cells of THUMB pixels, narrower (square still) when the map's box is: no side scrolling
+    grid.style.gridTemplateColumns = `repeat(${columns}, minmax(0, ${THUMB}px))`;
     // the top row is the highest cells of the second axis
     for (let r = rowsN - 1; r >= 0; r--) {
       for (let c = 0; c < columns; c++) {
@@ -136,7 +137,7 @@ export default function createMapMode(ctx, root) {
             disabled: !filled,
             onclick: () => filled && ctx.openPlant(filled.plant),
           },
-          filled ? h("img", { src: api.pngUrl(filled.plant, `${THUMB * 2}x${THUMB * 2}`, "front"), width: THUMB, height: THUMB, alt: `plant ${filled.plant}`, loading: "lazy" }) : null),
+          filled ? thumb(api.pngUrl(filled.plant, `${THUMB * 2}x${THUMB * 2}`, "front"), { width: THUMB, height: THUMB, alt: `plant ${filled.plant}` }) : null),
         );
       }
     }
@@ -154,7 +155,7 @@ export default function createMapMode(ctx, root) {
     el.dataset.plant = String(c.plant);
     el.onclick = () => ctx.openPlant(c.plant);
     clear(el);
-    el.append(h("img", { src: api.pngUrl(c.plant, `${THUMB * 2}x${THUMB * 2}`, "front"), width: THUMB, height: THUMB, alt: `plant ${c.plant}` }));
+    el.append(thumb(api.pngUrl(c.plant, `${THUMB * 2}x${THUMB * 2}`, "front"), { width: THUMB, height: THUMB, alt: `plant ${c.plant}` }));
   }
 
   function drawChart_() {

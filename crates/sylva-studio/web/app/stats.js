@@ -6,6 +6,7 @@
 // Create to its grid drawn.
 // lastSelectMs: from a click on a grid cell to its highlight being applied.
 // gardenProgress: the steps of every garden progress event the page received.
+// thumbs: the thumbnail queue's counts (thumbs.js).
 // probe(name): draws stage `name` ("breed", "garden", "family", "design") and counts the
 // pixels that differ from the background (gl.readPixels, same task as the draw).
 
@@ -20,6 +21,8 @@ export const stats = {
   lastSelectMs: null,
   history: [],
   gardenProgress: [],
+  // thumbs.js: thumbnails in flight now and at most, waiting on screen, fetched and aborted
+  thumbs: { inFlight: 0, maxInFlight: 0, waiting: 0, fetched: 0, aborted: 0 },
   stages: {},
   ready: false,
   probe(name) {
