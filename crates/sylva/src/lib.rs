@@ -81,7 +81,7 @@ pub use skeleton::Skeleton;
 pub use sylva_core::dress::{Dress, Dressed};
 pub use sylva_core::species::{BarkKind, LeafKind};
 pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
-pub use sylva_lsystem::work::Work;
+pub use sylva_model::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 
 /// Model settings a front end builds in code (the studio's design and family forms), item
