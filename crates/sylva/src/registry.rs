@@ -292,8 +292,9 @@ impl Default for Registry {
 }
 
 impl Registry {
-    /// The four models of Sylva: the binary tree (first: the default run's), automata,
-    /// PlantMaker and L-systems. There is no global registry: whoever starts (the command
+    /// The five models of Sylva: the binary tree (first: the default run's), automata,
+    /// PlantMaker (which grows gardens), L-systems (biomorph gardens and experiments) and
+    /// self-organising trees. There is no global registry: whoever starts (the command
     /// line's `main`, the studio's server, the Python module's init, a test) builds this once
     /// and passes it to what reads genomes and configs.
     pub fn standard() -> Registry {
