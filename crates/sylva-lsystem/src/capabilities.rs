@@ -55,6 +55,8 @@ impl From<&SpecimenStats> for biomorphs::SpecimenStats {
 
 /// The L-system's plants grow in biomorph gardens (section 4.1).
 impl Biomorphs for LSystemModel {
+    const SMALLER: &'static str = "lower `max_modules` in the mother's `physiology`";
+
     /// Empty rules: the paper's start, from which breeding builds a plant.
     fn first_mother(&self) -> LSystemGenome {
         LSystemGenome::empty()
@@ -100,6 +102,7 @@ impl Biomorphs for LSystemModel {
 /// empty rules.
 impl Experiments for LSystemModel {
     type Experiment = Simulation;
+    const SMALLER: &'static str = "lower `max_modules` in the genomes' `physiology`";
 
     fn genome_files(experiment: &Simulation) -> Vec<&Path> {
         experiment.genome_files()

@@ -100,6 +100,10 @@ pub struct Specimen<G> {
 /// (`ModelEntry::of::<M>().with_biomorphs()`), and the library's biomorph loop finds it
 /// there.
 pub trait Biomorphs: Model {
+    /// What a person changes to grow smaller plants, when a garden's scene is too large
+    /// to write (said in the error, after "grow smaller plants").
+    const SMALLER: &'static str;
+
     /// The genome a garden starts from when a person brings none (the L-system's paper
     /// starts from empty rules, from which breeding builds a plant).
     fn first_mother(&self) -> Self::Genome;

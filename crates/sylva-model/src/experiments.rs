@@ -63,6 +63,10 @@ pub trait Experiments: Model {
     /// An experiment config, as its TOML file reads.
     type Experiment: DeserializeOwned + Send + Sync + 'static;
 
+    /// What a person changes to grow smaller plants, when an experiment's scene is too
+    /// large to write (said in the error, after "grow smaller plants").
+    const SMALLER: &'static str;
+
     /// The genome files `experiment` names, relative to its config, in the order
     /// [`Experiments::run_experiment`] takes their genomes.
     fn genome_files(experiment: &Self::Experiment) -> Vec<&Path>;

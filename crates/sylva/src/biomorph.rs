@@ -167,6 +167,8 @@ impl<M: biomorphs::Biomorphs> BiomorphFace for M {
 /// Genomes sown, of one model.
 pub(crate) trait Sown: Send {
     fn len(&self) -> usize;
+    /// What to change for smaller plants ([`biomorphs::Biomorphs::SMALLER`]).
+    fn smaller(&self) -> &'static str;
     fn steps(&self) -> u32;
     fn work(&self) -> Work;
     fn grow(
@@ -185,6 +187,10 @@ struct SownOf<M: Model> {
 impl<M: biomorphs::Biomorphs> Sown for SownOf<M> {
     fn len(&self) -> usize {
         self.genomes.len()
+    }
+
+    fn smaller(&self) -> &'static str {
+        M::SMALLER
     }
 
     fn steps(&self) -> u32 {
@@ -274,6 +280,7 @@ impl Biomorphs {
         pool: &Pool,
         on_step: &mut dyn FnMut(u32),
     ) -> Result<BiomorphGarden, InputError> {
+        let smaller = self.sown.smaller();
         let mut specimens = self
             .sown
             .grow(pool, on_step)
@@ -286,6 +293,7 @@ impl Biomorphs {
         Ok(BiomorphGarden {
             specimens,
             source: self.source,
+            smaller,
         })
     }
 }
@@ -317,6 +325,7 @@ pub struct BiomorphGarden {
     /// The specimens, the mother first.
     pub specimens: Vec<Specimen>,
     source: PathBuf,
+    smaller: &'static str,
 }
 
 impl BiomorphGarden {
@@ -341,7 +350,7 @@ impl BiomorphGarden {
             &placed,
             false,
             &self.source,
-            "grow smaller plants (lower `max_modules` in the mother's `physiology`)",
+            &format!("grow smaller plants ({})", self.smaller),
         )?;
         SceneAssets::mesh(&placed, None).map_err(|e| e.in_file(&self.source))
     }

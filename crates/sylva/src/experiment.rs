@@ -99,6 +99,8 @@ impl<M: Experiments> ExperimentFace for M {
 pub(crate) trait Loaded: Send + Sync {
     /// How the model's plants are meshed.
     fn mesh_hint(&self) -> MeshHint;
+    /// What to change for smaller plants ([`Experiments::SMALLER`]).
+    fn smaller(&self) -> &'static str;
     fn work(&self) -> Result<Work, Box<dyn StdError + Send + Sync>>;
     fn run(
         &self,
@@ -116,6 +118,10 @@ struct LoadedOf<M: Experiments> {
 impl<M: Experiments> Loaded for LoadedOf<M> {
     fn mesh_hint(&self) -> MeshHint {
         self.model.mesh_hint()
+    }
+
+    fn smaller(&self) -> &'static str {
+        M::SMALLER
     }
 
     fn work(&self) -> Result<Work, Box<dyn StdError + Send + Sync>> {
@@ -221,7 +227,7 @@ impl Experiment {
             &placed,
             false,
             path,
-            "grow smaller plants (lower `max_modules` in the genomes' `physiology`)",
+            &format!("grow smaller plants ({})", self.loaded.smaller()),
         )?;
         let scene = SceneAssets::mesh(&placed, None).map_err(|e| e.in_file(path))?;
         let hint = self.loaded.mesh_hint();
