@@ -20,6 +20,7 @@
 //! an experiment before it starts, and it is refused when that is over the time budget
 //! ([`crate::work`]).
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
@@ -793,6 +794,85 @@ impl SimulationOutcome {
             SimulationOutcome::LateralLight(o) => &o.records,
             SimulationOutcome::EmptyRules(o) => &o.run.last.records,
         }
+    }
+}
+
+impl SimulationOutcome {
+    /// `report.txt`: the measured outcome, one figure a line.
+    pub fn report(&self) -> String {
+        let mut out = String::new();
+        match self {
+            SimulationOutcome::HerbsUnderTree(o) => {
+                let _ = writeln!(out, "tree crown radius: {:.2} m", o.crown.radius);
+                let _ = writeln!(out, "shaded herbs, mean biomass: {:.3} g", o.shaded_biomass);
+                let _ = writeln!(out, "open herbs, mean biomass: {:.3} g", o.open_biomass);
+                let _ = writeln!(out, "biomass ratio shaded/open: {:.3}", o.biomass_ratio);
+                let _ = writeln!(out, "light ratio shaded/open: {:.3}", o.light_ratio);
+            }
+            SimulationOutcome::LateralLight(o) => {
+                for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
+                    for (i, s) in shapes.iter().enumerate() {
+                        let _ = writeln!(
+                            out,
+                            "{name} light, tree {}: height {:.2} m, crown radius {:.2} m, \
+                             leaves offset towards the light {:.2} m, asymmetry {:.3}",
+                            i + 1,
+                            s.height,
+                            s.radius,
+                            s.offset,
+                            s.asymmetry
+                        );
+                    }
+                }
+                let _ = writeln!(
+                    out,
+                    "mean asymmetry: lateral {:.3}, vertical {:.3}",
+                    o.lateral_asymmetry(),
+                    o.vertical_asymmetry()
+                );
+                for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
+                    for (i, s) in shapes.iter().enumerate() {
+                        let _ = writeln!(
+                            out,
+                            "{name} light, tree {}: {} shoot tips, {} branches, {} leaves, \
+                             crown hull {:.2} m³, bushiness {:.1} tips/m³",
+                            i + 1,
+                            s.tips,
+                            s.branches,
+                            s.leaves,
+                            s.volume,
+                            s.bushiness
+                        );
+                    }
+                }
+                let _ = writeln!(
+                    out,
+                    "mean bushiness (shoot tips per m³ of crown hull): lateral {:.1}, vertical {:.1}",
+                    o.lateral_bushiness(),
+                    o.vertical_bushiness()
+                );
+            }
+            SimulationOutcome::EmptyRules(o) => {
+                for g in &o.run.generations {
+                    let _ = writeln!(
+                        out,
+                        "generation {}: chose {} (biomass {:.3} g, {} leaves, {} fine roots), \
+                         {} of the garden germinated",
+                        g.generation,
+                        g.chosen,
+                        g.stats.biomass,
+                        g.stats.leaves(),
+                        g.stats.fine_roots(),
+                        g.germinated
+                    );
+                }
+                let _ = match o.leaves_and_roots_at {
+                    Some(g) => writeln!(out, "leaves and fine roots from generation {g}"),
+                    None => writeln!(out, "no plant with leaves and fine roots yet"),
+                };
+            }
+        }
+        out
     }
 }
 

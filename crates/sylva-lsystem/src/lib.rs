@@ -35,6 +35,7 @@
 //! ```
 
 pub mod breed;
+pub mod capabilities;
 mod develop;
 pub mod experiments;
 pub mod garden;

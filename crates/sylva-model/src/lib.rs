@@ -16,6 +16,18 @@
 //!   outside Sylva ([`Evolve::vector_coding`]; the library decodes any model's vectors
 //!   otherwise).
 //!
+//! Some models offer a workflow of their own besides growing and evolving. Each is one
+//! trait here, with model-neutral options and outcomes; a model implements it and says so
+//! in its registry line, and the library runs the workflow for whichever model offers it:
+//!
+//! - [`Biomorphs`](biomorphs::Biomorphs): a mother and her children grown together in one
+//!   world, for a person to breed by eye (the L-system's).
+//! - [`Gardens`](gardens::Gardens): many plants of a few genomes on one plot, kept in a
+//!   garden file (PlantMaker's).
+//! - [`Experiments`](experiments::Experiments): experiments run from a config into a
+//!   report, records and plants (the L-system's).
+//! - [`Work`]: what growing plants together costs, estimated before it starts.
+//!
 //! ```
 //! use rand::{Rng, RngExt};
 //! use sylva_core::{Plant, glam::Vec3};
@@ -70,7 +82,11 @@
 //! # Ok::<(), DevelopError>(())
 //! ```
 
+pub mod biomorphs;
+pub mod experiments;
 pub mod file;
+pub mod gardens;
+mod work;
 
 use std::fmt::Debug;
 use std::path::PathBuf;
@@ -82,6 +98,7 @@ use sylva_core::{Plant, PlantError, PlantMeta, hash::stable_hash};
 use sylva_evolve::{Operators, Problem, Strategy, WithTerm};
 
 pub use file::{FormatV1, GenomeError};
+pub use work::Work;
 
 /// A plant model: a genome type, how it grows, and its own variation operators.
 ///

@@ -30,10 +30,11 @@ use std::f32::consts::TAU;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 use sylva_core::Plant;
-use sylva_core::glam::{Quat, Vec2, Vec3};
+use sylva_core::glam::{Vec2, Vec3};
 
-use crate::PlantMaker;
-use sylva_model::{DevelopError, GenomeError};
+use crate::{PlantMaker, PlantMakerModel};
+use sylva_model::GenomeError;
+use sylva_model::gardens::{GardenPlan, Gardens};
 use sylva_model::{FormatV1, model_tag};
 
 /// Model name of garden files.
@@ -111,97 +112,9 @@ pub struct GardenPlants {
     pub seeds: Vec<u64>,
 }
 
-/// Where one plant stands.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placement {
-    /// Index of its genome in [`Garden::plants`].
-    pub group: usize,
-    /// Index of its seed in that genome's seeds.
-    pub index: usize,
-    /// The seed it grows from.
-    pub seed: u64,
-    /// Its plant in [`GrownGarden::plants`] (shared by the plants of one variant).
-    pub plant: usize,
-    /// Where its base stands (y = 0), metres.
-    pub translation: Vec3,
-    /// Its turn about +Y, radians.
-    pub yaw: f32,
-    /// Radius of its footprint about its base, metres.
-    pub radius: f32,
-}
-
-impl Placement {
-    /// The turn as a quaternion, for a scene node.
-    pub fn rotation(&self) -> Quat {
-        Quat::from_rotation_y(self.yaw)
-    }
-}
-
-/// A grown garden: plants and their placements, in file order (genome by genome, seed by
-/// seed). Without variants there is one plant per placement, in the same order; with
-/// variants, one per variant, which the placements share.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GrownGarden {
-    /// Where each plant stands.
-    pub placements: Vec<Placement>,
-    /// The plants, in their own coordinates (base at the origin), like `placements`.
-    pub plants: Vec<Plant>,
-}
-
-/// Why a garden could not be grown.
-#[derive(Debug, thiserror::Error)]
-pub enum GardenError {
-    /// The garden has no plants.
-    #[error("the garden has no plants")]
-    Empty,
-    /// More plants than [`MAX_PLANTS`].
-    #[error("the garden has {0} plants; at most {MAX_PLANTS}")]
-    TooManyPlants(usize),
-    /// The plants would not fit in the memory budget.
-    #[error("the garden does not fit in memory")]
-    OverBudget(#[from] sylva_core::budget::OverBudget),
-    /// A plant could not be grown.
-    #[error("plant {index} of genome {group} could not be grown")]
-    Develop {
-        /// Its genome.
-        group: usize,
-        /// Its seed's index.
-        index: usize,
-        /// Why.
-        source: DevelopError,
-    },
-    /// A plant's footprint is wider than the plot.
-    #[error(
-        "plant {index} of genome {group} needs a circle {diameter:.2} m across, wider than the {width} x {depth} m plot"
-    )]
-    TooWide {
-        /// Its genome.
-        group: usize,
-        /// Its seed's index.
-        index: usize,
-        /// Its footprint's diameter, metres.
-        diameter: f32,
-        /// Plot width, metres.
-        width: f64,
-        /// Plot depth, metres.
-        depth: f64,
-    },
-    /// The plot is too crowded: a plant found no free spot.
-    #[error(
-        "only {placed} of {count} plants fit on the plot ({tries} tries each); enlarge the area or plant fewer"
-    )]
-    DoesNotFit {
-        /// Plants placed before one found no spot (largest first).
-        placed: usize,
-        /// Plants in the garden.
-        count: usize,
-        /// Darts per plant.
-        tries: u32,
-    },
-}
-
-/// Most plants in a garden.
-pub const MAX_PLANTS: usize = 100_000;
+// Where plants stand, grown gardens, their errors and limit are any model's
+// (`sylva_model::gardens`); PlantMaker's gardens plan, place and grow them.
+pub use sylva_model::gardens::{GardenError, GrownGarden, MAX_PLANTS, Placement};
 
 /// Bytes a grown plant holds.
 fn plant_bytes(plant: &Plant) -> u64 {
@@ -467,6 +380,80 @@ impl Garden {
             )
             .collect();
         Ok(GrownGarden { placements, plants })
+    }
+}
+
+/// PlantMaker's gardens, as the library's garden module reaches them.
+impl GardenPlan for Garden {
+    type Genome = PlantMaker;
+
+    fn add(&mut self, genome: PlantMaker, count: usize) {
+        Garden::add(self, genome, count);
+    }
+
+    fn count(&self) -> usize {
+        Garden::count(self)
+    }
+
+    fn groups(&self) -> Vec<(&PlantMaker, &[u64])> {
+        self.plants
+            .iter()
+            .map(|g| (&g.genome, g.seeds.as_slice()))
+            .collect()
+    }
+
+    fn variants(&self) -> Option<u32> {
+        self.variants
+    }
+
+    fn set_variants(&mut self, variants: Option<u32>) {
+        self.variants = variants;
+    }
+
+    fn instancing(&self) -> Option<bool> {
+        self.instancing
+    }
+
+    fn set_instancing(&mut self, instancing: Option<bool>) {
+        self.instancing = instancing;
+    }
+
+    fn quantize(&self) -> bool {
+        self.quantize
+    }
+
+    fn set_quantize(&mut self, quantize: bool) {
+        self.quantize = quantize;
+    }
+
+    fn to_json(&self) -> String {
+        Garden::to_json(self)
+    }
+
+    fn grow(&self) -> Result<GrownGarden, GardenError> {
+        Garden::grow(self)
+    }
+
+    fn placements(&self) -> Result<Vec<Placement>, GardenError> {
+        Garden::placements(self)
+    }
+
+    fn develop(&self, placement: &Placement) -> Result<Plant, GardenError> {
+        Garden::develop(self, placement)
+    }
+}
+
+/// PlantMaker offers gardens and forests (its registry line says so).
+impl Gardens for PlantMakerModel {
+    type Garden = Garden;
+    const GARDEN_FILE: &'static str = GARDEN_MODEL;
+
+    fn read_garden(text: &str) -> Result<Garden, GenomeError> {
+        Garden::from_json(text)
+    }
+
+    fn new_garden(genome: PlantMaker, count: usize, area: [f64; 2], seed: u64) -> Garden {
+        Garden::new(genome, count, area, seed)
     }
 }
 

@@ -18,6 +18,7 @@ use sylva::render::View;
 use crate::errors::{IntoPy, bad_value};
 use crate::handle::Genome;
 use crate::json::to_py;
+use crate::models::Models;
 use crate::pair::Pair;
 use crate::whole::Whole;
 
@@ -693,15 +694,18 @@ pub fn picture_png<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyBy
 /// Or give `path`, a garden file (`*.garden.json`), to grow the garden it describes.
 /// Releases the GIL.
 #[pyfunction]
-#[pyo3(signature = (genomes = Vec::new(), count = Whole(20), area = Pair(20.0, 20.0), seed = Whole(1), path = None))]
+#[pyo3(pass_module, signature = (genomes = Vec::new(), count = Whole(20), area = Pair(20.0, 20.0), seed = Whole(1), path = None))]
 pub fn garden(
-    py: Python<'_>,
+    module: &Bound<'_, PyModule>,
     genomes: Vec<Genome>,
     count: Whole,
     area: Pair<f64>,
     seed: Whole,
     path: Option<PathBuf>,
 ) -> PyResult<Scene> {
+    let py = module.py();
+    let models = Models::of(module.as_any())?;
+    let registry = models.get().registry();
     let count: u32 = count.get("count")?;
     let seed: u64 = seed.get("seed")?;
     let area: (f64, f64) = area.into();
@@ -714,7 +718,7 @@ pub fn garden(
                 ));
             }
             let text = sylva::files::read_text(&path).py()?;
-            let garden = sylva::garden::read(&path, &text).py()?;
+            let garden = sylva::garden::read(registry, &path, &text).py()?;
             (garden, path)
         }
         None => {
@@ -735,13 +739,14 @@ pub fn garden(
                 ));
             }
             let genomes: Vec<sylva::Genome> = genomes.iter().map(|g| g.inner.clone()).collect();
-            let garden = sylva::garden::plant(&genomes, count as usize, [area.0, area.1], seed)
-                .map_err(|e| match e {
-                    sylva::garden::PlanError::WrongModel { index, .. } => {
-                        bad_value(format!("genomes[{index}]"), e)
-                    }
-                    sylva::garden::PlanError::NoGenomes => bad_value("genomes", e),
-                })?;
+            let garden =
+                sylva::garden::plant(registry, &genomes, count as usize, [area.0, area.1], seed)
+                    .map_err(|e| match e {
+                        sylva::garden::PlanError::WrongModel { index, .. } => {
+                            bad_value(format!("genomes[{index}]"), e)
+                        }
+                        sylva::garden::PlanError::NoGenomes => bad_value("genomes", e),
+                    })?;
             (garden, PathBuf::from("<garden>"))
         }
     };

@@ -1,14 +1,18 @@
-//! Bornhofen and Lattaud's design loop (section 4.1) as one workflow: the mother and her
-//! mutated children are sown on a 3×3 grid of one voxel world and grow together, shading
-//! each other; a person picks the next mother from what grew. The command line's
-//! `sylva breed` and the studio's garden mode both run it.
+//! The biomorph loop (Bornhofen and Lattaud's design loop, section 4.1) for any model that
+//! offers it ([`sylva_model::biomorphs::Biomorphs`], said in its registry line): the mother
+//! and her mutated children are sown on a 3×3 grid of one world and grow together, shading
+//! each other; a person picks the next mother from what grew. The model sows and grows
+//! them; this module finds the model in the registry, keeps the genomes typed between
+//! sowing and growing, and meshes what grew. The command line's `sylva breed` and the
+//! studio's garden mode both run it.
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use sylva::biomorph::{BiomorphOptions, Biomorphs};
+//! let models = sylva::Registry::standard();
 //! let path = std::path::Path::new("examples/lsystem/herb.json");
-//! let mother = sylva::Registry::standard().load_genome(path)?;
-//! let sown = Biomorphs::sow(&mother, path, &BiomorphOptions::default(), 1)?;
+//! let mother = models.load_genome(path)?;
+//! let sown = Biomorphs::sow(&models, &mother, path, &BiomorphOptions::default(), 1)?;
 //! let pool = sylva::core::par::Pool::with_threads(0)?;
 //! let garden = sown.grow(&pool, &mut |_step| {})?;
 //! let scene = garden.assets(|i, _| format!("specimen-{i}"), |_, s| s.origin(1).extras())?;
@@ -16,31 +20,57 @@
 //! # }
 //! ```
 
+use std::error::Error as StdError;
 use std::path::{Path, PathBuf};
 
 use sylva_core::glam::Vec3;
 use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant};
-use sylva_lsystem::breed::{BreedSettings, breeding_genomes, breeding_work, grow_together_with};
-use sylva_lsystem::{LSystemGenome, LSystemModel};
-use sylva_model::Model;
+use sylva_model::biomorphs::{self, BiomorphSettings};
+use sylva_model::{Model, Work};
 
-pub use sylva_lsystem::breed::SpecimenStats;
+pub use sylva_model::biomorphs::{BoundsHit, SpecimenStats};
 
-use crate::Work;
 use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
+use crate::registry::Registry;
 
-/// The model whose plants grow in biomorph gardens.
-pub const MODEL: &str = LSystemModel::NAME;
+/// The models of `registry` whose plants grow in biomorph gardens, in order (the first is
+/// the one [`first_mother`] starts with).
+pub fn models(registry: &Registry) -> Vec<&'static str> {
+    offering(registry).map(|(name, _)| name).collect()
+}
 
-/// A genome of another model than [`MODEL`], given to a biomorph garden.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("`{MODEL}` genomes; this is a `{model}` genome")]
+/// The models of `registry` that grow biomorphs, with their faces, in order.
+fn offering(registry: &Registry) -> impl Iterator<Item = (&'static str, &dyn BiomorphFace)> {
+    registry
+        .models()
+        .iter()
+        .filter_map(|m| Some((m.name(), m.biomorphs.as_deref()?)))
+}
+
+/// A genome of a model that does not grow biomorphs, given to a biomorph garden.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{expected} genomes; this is a `{model}` genome")]
 pub struct WrongModel {
     /// The genome's model.
     pub model: &'static str,
+    /// The models that do, as a person reads them (`` `lsystem` ``).
+    pub expected: String,
+}
+
+impl WrongModel {
+    fn of(registry: &Registry, genome: &Genome) -> WrongModel {
+        let names: Vec<String> = offering(registry).map(|(n, _)| format!("`{n}`")).collect();
+        WrongModel {
+            model: genome.model(),
+            expected: match names.is_empty() {
+                true => "no model's (none here grows biomorphs)".to_owned(),
+                false => names.join(" or "),
+            },
+        }
+    }
 }
 
 /// How a biomorph garden is laid out and grown. The defaults are the paper's.
@@ -65,13 +95,13 @@ pub struct BiomorphOptions {
 
 impl Default for BiomorphOptions {
     fn default() -> Self {
-        let paper = BreedSettings::default();
+        let paper = BiomorphSettings::default();
         BiomorphOptions {
-            children: paper.children as u32,
-            steps: paper.grow.steps,
+            children: paper.children,
+            steps: paper.steps,
             spacing: paper.spacing,
-            elevation: paper.grow.world.light.elevation,
-            azimuth: paper.grow.world.light.azimuth,
+            elevation: paper.elevation,
+            azimuth: paper.azimuth,
             visible_children: paper.visible_children,
             roots: true,
         }
@@ -79,59 +109,145 @@ impl Default for BiomorphOptions {
 }
 
 impl BiomorphOptions {
-    fn settings(&self) -> BreedSettings {
-        let mut b = BreedSettings {
-            children: self.children as usize,
+    fn settings(&self) -> BiomorphSettings {
+        BiomorphSettings {
+            children: self.children,
+            steps: self.steps,
             spacing: self.spacing,
+            elevation: self.elevation,
+            azimuth: self.azimuth,
             visible_children: self.visible_children,
-            ..BreedSettings::default()
-        };
-        b.grow.steps = self.steps;
-        b.grow.world.light.elevation = self.elevation;
-        b.grow.world.light.azimuth = self.azimuth;
-        b
+        }
     }
 }
 
-/// Checks that `genome` can grow in a biomorph garden.
-pub fn grows(genome: &Genome) -> Result<(), WrongModel> {
-    mother_of(genome).map(|_| ())
+/// Checks that `genome` can grow in a biomorph garden: its model offers them in `registry`.
+pub fn grows(registry: &Registry, genome: &Genome) -> Result<(), WrongModel> {
+    match face_of(registry, genome) {
+        Some(_) => Ok(()),
+        None => Err(WrongModel::of(registry, genome)),
+    }
 }
 
-fn mother_of(genome: &Genome) -> Result<&LSystemGenome, WrongModel> {
-    genome.get::<LSystemModel>().ok_or(WrongModel {
-        model: genome.model(),
-    })
+fn face_of<'r>(registry: &'r Registry, genome: &Genome) -> Option<&'r dyn BiomorphFace> {
+    registry.get(genome.model())?.biomorphs.as_deref()
 }
 
-/// Empty rules: the paper's start, from which breeding builds a plant.
-pub fn empty_rules() -> Genome {
-    Genome::new(LSystemModel, LSystemGenome::empty())
+/// The mother a garden of `registry`'s first biomorph model starts from when a person
+/// brings none (the L-system's empty rules, from which breeding builds a plant).
+pub fn first_mother(registry: &Registry) -> Option<Genome> {
+    offering(registry)
+        .next()
+        .map(|(_, face)| face.first_mother())
+}
+
+/// What the registry holds of a model that grows biomorphs: its typed trait, erased.
+pub(crate) trait BiomorphFace: Send + Sync {
+    fn first_mother(&self) -> Genome;
+    /// The mother and her children, typed until they grow; `None` when `mother` is not
+    /// this model's.
+    fn sow(&self, mother: &Genome, settings: BiomorphSettings, seed: u64) -> Option<Box<dyn Sown>>;
+}
+
+impl<M: biomorphs::Biomorphs> BiomorphFace for M {
+    fn first_mother(&self) -> Genome {
+        Genome::new(self.clone(), biomorphs::Biomorphs::first_mother(self))
+    }
+
+    fn sow(&self, mother: &Genome, settings: BiomorphSettings, seed: u64) -> Option<Box<dyn Sown>> {
+        let genomes = biomorphs::Biomorphs::sow(self, mother.get::<M>()?, &settings, seed);
+        Some(Box::new(SownOf {
+            model: self.clone(),
+            genomes,
+            settings,
+        }))
+    }
+}
+
+/// Genomes sown, of one model.
+pub(crate) trait Sown: Send {
+    fn len(&self) -> usize;
+    /// What to change for smaller plants ([`biomorphs::Biomorphs::SMALLER`]).
+    fn smaller(&self) -> &'static str;
+    fn steps(&self) -> u32;
+    fn work(&self) -> Work;
+    fn grow(
+        self: Box<Self>,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u32),
+    ) -> Result<Vec<Specimen>, Box<dyn StdError + Send + Sync>>;
+}
+
+struct SownOf<M: Model> {
+    model: M,
+    genomes: Vec<M::Genome>,
+    settings: BiomorphSettings,
+}
+
+impl<M: biomorphs::Biomorphs> Sown for SownOf<M> {
+    fn len(&self) -> usize {
+        self.genomes.len()
+    }
+
+    fn smaller(&self) -> &'static str {
+        M::SMALLER
+    }
+
+    fn steps(&self) -> u32 {
+        self.settings.steps
+    }
+
+    fn work(&self) -> Work {
+        self.model.biomorph_work(&self.genomes, &self.settings)
+    }
+
+    fn grow(
+        self: Box<Self>,
+        pool: &Pool,
+        on_step: &mut dyn FnMut(u32),
+    ) -> Result<Vec<Specimen>, Box<dyn StdError + Send + Sync>> {
+        let SownOf {
+            model,
+            genomes,
+            settings,
+        } = *self;
+        let grown = model.grow_together(genomes, &settings, pool, on_step)?;
+        Ok(grown
+            .into_iter()
+            .map(|s| Specimen {
+                genome: Genome::new(model.clone(), s.genome),
+                is_mother: s.is_mother,
+                position: s.position,
+                plant: s.plant,
+                stats: s.stats,
+            })
+            .collect())
+    }
 }
 
 /// A mother and her children, sown and not yet grown.
 pub struct Biomorphs {
-    genomes: Vec<LSystemGenome>,
-    settings: BreedSettings,
+    sown: Box<dyn Sown>,
     roots: bool,
     source: PathBuf,
 }
 
 impl Biomorphs {
-    /// Sows `mother` and her children, mutated with `seed`; `source` (the mother's file, or
-    /// what the front end calls her) is named in errors.
+    /// Sows `mother` and her children, mutated with `seed`, by her model in `registry`;
+    /// `source` (the mother's file, or what the front end calls her) is named in errors.
+    /// A mother of a model that does not grow biomorphs is refused.
     pub fn sow(
+        registry: &Registry,
         mother: &Genome,
         source: &Path,
         options: &BiomorphOptions,
         seed: u64,
     ) -> Result<Biomorphs, WrongModel> {
-        let settings = options.settings();
-        let mut rng = sylva_core::rng::seeded(seed);
-        let genomes = breeding_genomes(mother_of(mother)?, &settings, &mut rng);
+        let sown = face_of(registry, mother)
+            .and_then(|face| face.sow(mother, options.settings(), seed))
+            .ok_or_else(|| WrongModel::of(registry, mother))?;
         Ok(Biomorphs {
-            genomes,
-            settings,
+            sown,
             roots: options.roots,
             source: source.to_owned(),
         })
@@ -139,22 +255,22 @@ impl Biomorphs {
 
     /// Plants sown, the mother's first.
     pub fn len(&self) -> usize {
-        self.genomes.len()
+        self.sown.len()
     }
 
     /// True when nothing is sown (never: the mother is).
     pub fn is_empty(&self) -> bool {
-        self.genomes.is_empty()
+        self.sown.len() == 0
     }
 
     /// Steps they will grow.
     pub fn steps(&self) -> u32 {
-        self.settings.grow.steps
+        self.sown.steps()
     }
 
     /// Their work at the genomes' bounds.
     pub fn work(&self) -> Work {
-        breeding_work(&self.genomes, &self.settings)
+        self.sown.work()
     }
 
     /// Grows them together on `pool`, calling `on_step` with the steps done. Refused before
@@ -164,25 +280,20 @@ impl Biomorphs {
         pool: &Pool,
         on_step: &mut dyn FnMut(u32),
     ) -> Result<BiomorphGarden, InputError> {
-        let garden = grow_together_with(self.genomes, &self.settings, pool, on_step)
-            .map_err(|e| InputError::file_error(&self.source, &e))?;
-        let specimens = garden
-            .specimens
-            .into_iter()
-            .map(|s| Specimen {
-                plant: match self.roots {
-                    true => s.plant,
-                    false => s.plant.without(MaterialKind::Root),
-                },
-                genome: Genome::new(LSystemModel, s.genome),
-                is_mother: s.is_mother,
-                position: Vec3::new(s.position.x, 0.0, s.position.y),
-                stats: s.stats,
-            })
-            .collect();
+        let smaller = self.sown.smaller();
+        let mut specimens = self
+            .sown
+            .grow(pool, on_step)
+            .map_err(|e| InputError::file_error(&self.source, &*e))?;
+        if !self.roots {
+            for s in &mut specimens {
+                s.plant = s.plant.without(MaterialKind::Root);
+            }
+        }
         Ok(BiomorphGarden {
             specimens,
             source: self.source,
+            smaller,
         })
     }
 }
@@ -214,6 +325,7 @@ pub struct BiomorphGarden {
     /// The specimens, the mother first.
     pub specimens: Vec<Specimen>,
     source: PathBuf,
+    smaller: &'static str,
 }
 
 impl BiomorphGarden {
@@ -224,7 +336,6 @@ impl BiomorphGarden {
         name: impl Fn(usize, &Specimen) -> String,
         extras: impl Fn(usize, &Specimen) -> serde_json::Value,
     ) -> Result<SceneAssets, Error> {
-        let hint = LSystemModel.mesh_hint();
         let placed: Vec<Placed> = self
             .specimens
             .iter()
@@ -232,14 +343,14 @@ impl BiomorphGarden {
             .map(|(i, s)| Placed {
                 translation: s.position,
                 extras: Some(extras(i, s)),
-                ..Placed::new(name(i, s), &s.plant, hint)
+                ..Placed::new(name(i, s), &s.plant, s.genome.mesh_hint())
             })
             .collect();
         check_scene_glb(
             &placed,
             false,
             &self.source,
-            "grow smaller plants (lower `max_modules` in the mother's `physiology`)",
+            &format!("grow smaller plants ({})", self.smaller),
         )?;
         SceneAssets::mesh(&placed, None).map_err(|e| e.in_file(&self.source))
     }

@@ -292,7 +292,7 @@ impl Error {
                 || matches!(e.downcast_ref(), Some(ExportError::TooLarge { .. }))
                 || matches!(
                     e.downcast_ref(),
-                    Some(sylva_plantmaker::GardenError::TooManyPlants(_))
+                    Some(sylva_model::gardens::GardenError::TooManyPlants(_))
                 );
             if limit {
                 return true;

@@ -1,8 +1,11 @@
-//! PlantMaker gardens and forests (Gal, Mahal and Sipper): many plants of a few genomes on
-//! one plot, in one scene. A garden is planned ([`plant`], or read from a garden file with
-//! [`read`]), estimated before it grows ([`check_garden`]), then either held as assets
-//! ([`garden_assets`]) or streamed as a GLB, growing and meshing one plant at a time
-//! ([`garden_glb`]). The command line's `sylva garden` and Python's `sylva.garden` run it.
+//! Gardens and forests for any model that grows them ([`sylva_model::gardens::Gardens`],
+//! said in its registry line; PlantMaker's, after Gal, Mahal and Sipper): many plants of a
+//! few genomes on one plot, in one scene. The model plans, places and grows the plants;
+//! this module finds it in the registry and does the rest: a garden is planned ([`plant`],
+//! or read from a garden file with [`read`]), estimated before it grows ([`check_garden`]),
+//! then either held as assets ([`garden_assets`]) or streamed as a GLB, growing and meshing
+//! one plant at a time ([`garden_glb`]). The command line's `sylva garden` and Python's
+//! `sylva.garden` run it.
 
 use std::path::Path;
 
@@ -13,76 +16,318 @@ use sylva_gltf::export::{self, Glb, GlbNode, GlbOptions, MeshSource};
 use sylva_mesh::Mesh;
 use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::WindOptions;
-use sylva_model::Model;
-use sylva_plantmaker::garden::GARDEN_MODEL;
-use sylva_plantmaker::{GrownGarden, Placement, PlantMakerModel};
+use sylva_model::gardens::{GardenError, GardenPlan, Gardens, MAX_PLANTS};
+use sylva_model::{GenomeError, MeshHint};
 
-pub use sylva_plantmaker::Garden;
+pub use sylva_model::gardens::{GrownGarden, Placement};
 
 use crate::assets::{Origin, Placed, SceneAssets, mesh_options};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
+use crate::registry::Registry;
 
-/// The model whose plants gardens grow.
-pub const MODEL: &str = PlantMakerModel::NAME;
+/// A garden of any model that grows them, as its garden file holds it: genomes, each with
+/// one seed per plant, the plot, and how its scene is laid out.
+pub struct Garden {
+    plan: Box<dyn Plan>,
+}
 
-/// True when `text` is a garden file (`"model": "garden"`) rather than a genome file.
-pub fn is_garden_file(text: &str) -> bool {
+impl Clone for Garden {
+    fn clone(&self) -> Garden {
+        Garden {
+            plan: self.plan.clone_plan(),
+        }
+    }
+}
+
+impl Garden {
+    /// A garden of model `M`, made by the model (a test's, or a front end's own).
+    pub fn of<M: Gardens + Default>(plan: M::Garden) -> Garden {
+        Garden {
+            plan: Box::new(PlanOf {
+                model: M::default(),
+                plan,
+            }),
+        }
+    }
+
+    /// Number of plants.
+    pub fn count(&self) -> usize {
+        self.plan.count()
+    }
+
+    /// How many seeds of each genome grow, every plant being one of them (a forest of
+    /// variants), or `None`: every plant its own seed.
+    pub fn variants(&self) -> Option<u32> {
+        self.plan.variants()
+    }
+
+    /// Makes the garden a forest of `variants` (or not, with `None`); recorded in its file.
+    pub fn set_variants(&mut self, variants: Option<u32>) {
+        self.plan.set_variants(variants);
+    }
+
+    /// Whether a forest of variants is written as GPU instances (`None`: the default, yes).
+    pub fn instancing(&self) -> Option<bool> {
+        self.plan.instancing()
+    }
+
+    /// Sets [`Garden::instancing`]; recorded in its file.
+    pub fn set_instancing(&mut self, instancing: Option<bool>) {
+        self.plan.set_instancing(instancing);
+    }
+
+    /// Whether its GLB quantises positions and normals.
+    pub fn quantize(&self) -> bool {
+        self.plan.quantize()
+    }
+
+    /// Sets [`Garden::quantize`]; recorded in its file.
+    pub fn set_quantize(&mut self, quantize: bool) {
+        self.plan.set_quantize(quantize);
+    }
+
+    /// The garden file, pretty-printed with a final newline.
+    pub fn to_json(&self) -> String {
+        self.plan.to_json()
+    }
+}
+
+/// What the registry holds of a model that grows gardens: its typed trait, erased.
+pub(crate) trait GardenFace: Send + Sync {
+    /// The `model` its garden files name.
+    fn garden_file(&self) -> &'static str;
+    fn read(&self, text: &str) -> Result<Garden, GenomeError>;
+    /// A new garden of `genome`; `None` when it is not this model's.
+    fn plant(&self, genome: &Genome, count: usize, area: [f64; 2], seed: u64) -> Option<Garden>;
+}
+
+impl<M: Gardens> GardenFace for M {
+    fn garden_file(&self) -> &'static str {
+        M::GARDEN_FILE
+    }
+
+    fn read(&self, text: &str) -> Result<Garden, GenomeError> {
+        let plan = M::read_garden(text)?;
+        Ok(Garden {
+            plan: Box::new(PlanOf {
+                model: self.clone(),
+                plan,
+            }),
+        })
+    }
+
+    fn plant(&self, genome: &Genome, count: usize, area: [f64; 2], seed: u64) -> Option<Garden> {
+        let plan = M::new_garden(genome.get::<M>()?.clone(), count, area, seed);
+        Some(Garden {
+            plan: Box::new(PlanOf {
+                model: self.clone(),
+                plan,
+            }),
+        })
+    }
+}
+
+/// A garden plan of one model, erased: what this module asks of it.
+trait Plan: Send + Sync {
+    fn clone_plan(&self) -> Box<dyn Plan>;
+    fn mesh_hint(&self) -> MeshHint;
+    /// Adds `count` plants of `genome`; false when it is not this garden's model's.
+    fn add(&mut self, genome: &Genome, count: usize) -> bool;
+    fn count(&self) -> usize;
+    /// Per genome, its seeds.
+    fn seeds(&self) -> Vec<&[u64]>;
+    /// The genome of group `group`, erased.
+    fn genome(&self, group: usize) -> Option<Genome>;
+    fn variants(&self) -> Option<u32>;
+    fn set_variants(&mut self, variants: Option<u32>);
+    fn instancing(&self) -> Option<bool>;
+    fn set_instancing(&mut self, instancing: Option<bool>);
+    fn quantize(&self) -> bool;
+    fn set_quantize(&mut self, quantize: bool);
+    fn to_json(&self) -> String;
+    fn grow(&self) -> Result<GrownGarden, GardenError>;
+    fn placements(&self) -> Result<Vec<Placement>, GardenError>;
+    fn develop(&self, placement: &Placement) -> Result<Plant, GardenError>;
+}
+
+struct PlanOf<M: Gardens> {
+    model: M,
+    plan: M::Garden,
+}
+
+impl<M: Gardens> Plan for PlanOf<M> {
+    fn clone_plan(&self) -> Box<dyn Plan> {
+        Box::new(PlanOf {
+            model: self.model.clone(),
+            plan: self.plan.clone(),
+        })
+    }
+
+    fn mesh_hint(&self) -> MeshHint {
+        self.model.mesh_hint()
+    }
+
+    fn add(&mut self, genome: &Genome, count: usize) -> bool {
+        match genome.get::<M>() {
+            Some(g) => {
+                self.plan.add(g.clone(), count);
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn count(&self) -> usize {
+        self.plan.count()
+    }
+
+    fn seeds(&self) -> Vec<&[u64]> {
+        self.plan.groups().into_iter().map(|(_, s)| s).collect()
+    }
+
+    fn genome(&self, group: usize) -> Option<Genome> {
+        let (genome, _) = self.plan.groups().into_iter().nth(group)?;
+        Some(Genome::new(self.model.clone(), genome.clone()))
+    }
+
+    fn variants(&self) -> Option<u32> {
+        self.plan.variants()
+    }
+
+    fn set_variants(&mut self, variants: Option<u32>) {
+        self.plan.set_variants(variants);
+    }
+
+    fn instancing(&self) -> Option<bool> {
+        self.plan.instancing()
+    }
+
+    fn set_instancing(&mut self, instancing: Option<bool>) {
+        self.plan.set_instancing(instancing);
+    }
+
+    fn quantize(&self) -> bool {
+        self.plan.quantize()
+    }
+
+    fn set_quantize(&mut self, quantize: bool) {
+        self.plan.set_quantize(quantize);
+    }
+
+    fn to_json(&self) -> String {
+        self.plan.to_json()
+    }
+
+    fn grow(&self) -> Result<GrownGarden, GardenError> {
+        self.plan.grow()
+    }
+
+    fn placements(&self) -> Result<Vec<Placement>, GardenError> {
+        self.plan.placements()
+    }
+
+    fn develop(&self, placement: &Placement) -> Result<Plant, GardenError> {
+        self.plan.develop(placement)
+    }
+}
+
+/// The models of `registry` that grow gardens, in order.
+fn offering(registry: &Registry) -> impl Iterator<Item = (&'static str, &dyn GardenFace)> {
+    registry
+        .models()
+        .iter()
+        .filter_map(|m| Some((m.name(), m.gardens.as_deref()?)))
+}
+
+/// The `model` a file's text names, if it is an object that names one.
+fn named_model(text: &str) -> Option<String> {
     #[derive(serde::Deserialize)]
     struct Header {
         model: String,
     }
-    serde_json::from_str::<Header>(text).is_ok_and(|h| h.model == GARDEN_MODEL)
+    serde_json::from_str::<Header>(text).ok().map(|h| h.model)
 }
 
-/// Reads a garden file already read from `path`.
-pub fn read(path: &Path, text: &str) -> Result<Garden, InputError> {
-    Garden::from_json(text).map_err(|e| InputError::genome(path, text, e))
+/// True when `text` is a garden file of a model of `registry` (`"model":
+/// "plantmaker-garden"`) rather than a genome file.
+pub fn is_garden_file(registry: &Registry, text: &str) -> bool {
+    named_model(text).is_some_and(|name| offering(registry).any(|(_, f)| f.garden_file() == name))
+}
+
+/// Reads a garden file already read from `path`, by the model of `registry` whose garden
+/// file it names (or, naming none of them, the first model that grows gardens, whose
+/// error says what it expected).
+pub fn read(registry: &Registry, path: &Path, text: &str) -> Result<Garden, InputError> {
+    let named = named_model(text);
+    let face = offering(registry)
+        .map(|(_, f)| f)
+        .find(|f| named.as_deref() == Some(f.garden_file()))
+        .or_else(|| offering(registry).map(|(_, f)| f).next())
+        .ok_or_else(|| {
+            InputError::file(
+                path,
+                "no model here grows gardens; expected a registry with one",
+            )
+        })?;
+    face.read(text)
+        .map_err(|e| InputError::genome(path, text, e))
 }
 
 /// Why genomes cannot be planted as a garden.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum PlanError {
     /// No genome was given.
     #[error("a garden needs at least one genome")]
     NoGenomes,
-    /// A genome of another model than [`MODEL`]: its index among those given, and its model.
-    #[error("gardens grow `{MODEL}` genomes; this is a `{model}` genome")]
+    /// A genome of a model that grows no gardens, or of another model than the first
+    /// genome's: its index among those given, and its model.
+    #[error("gardens grow {expected} genomes; this is a `{model}` genome")]
     WrongModel {
         /// Which genome, from 0.
         index: usize,
         /// Its model.
         model: &'static str,
+        /// The models it could be, as a person reads them (`` `plantmaker` ``).
+        expected: String,
     },
 }
 
 /// Plans a new garden: `count` plants of each genome on a plot `area` = (width, depth)
-/// metres centred on the origin, their seeds, places and turns drawn from `seed`.
+/// metres centred on the origin, their seeds, places and turns drawn from `seed`. The
+/// first genome's model grows it (one that offers gardens in `registry`), and the others
+/// must be of that model.
 pub fn plant(
+    registry: &Registry,
     genomes: &[Genome],
     count: usize,
     area: [f64; 2],
     seed: u64,
 ) -> Result<Garden, PlanError> {
-    let mut typed = genomes.iter().enumerate().map(|(index, genome)| {
-        genome
-            .get::<PlantMakerModel>()
-            .cloned()
-            .ok_or(PlanError::WrongModel {
-                index,
-                model: genome.model(),
-            })
-    });
-    let first = typed.next().ok_or(PlanError::NoGenomes)??;
-    let mut garden = Garden::new(first, count, area, seed);
-    for genome in typed {
-        garden.add(genome?, count);
+    let first = genomes.first().ok_or(PlanError::NoGenomes)?;
+    let wrong = |index: usize, expected: String| PlanError::WrongModel {
+        index,
+        model: genomes[index].model(),
+        expected,
+    };
+    let mut garden = registry
+        .get(first.model())
+        .and_then(|m| m.gardens.as_deref())
+        .and_then(|face| face.plant(first, count, area, seed))
+        .ok_or_else(|| {
+            let names: Vec<String> = offering(registry).map(|(n, _)| format!("`{n}`")).collect();
+            wrong(0, names.join(" or "))
+        })?;
+    for (index, genome) in genomes.iter().enumerate().skip(1) {
+        if !garden.plan.add(genome, count) {
+            return Err(wrong(index, format!("`{}`", first.model())));
+        }
     }
     Ok(garden)
 }
 
-/// Grows a PlantMaker garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...),
-/// each standing at its placement and carrying its genome and seed, with a wind skin when
+/// Grows a garden and meshes it: one node per plant (`plant-0`, `plant-1`, ...), each
+/// standing at its placement and carrying its genome and seed, with a wind skin when
 /// `wind` is given. Errors name `source`, the garden's file (or whatever a front end calls
 /// it).
 pub fn garden_assets(
@@ -94,17 +339,18 @@ pub fn garden_assets(
     SceneAssets::mesh(&garden_placed(garden, &grown), wind).map_err(|e| e.in_file(source))
 }
 
-/// Grows every plant of a PlantMaker garden and places it, unmeshed. Errors name `source`.
+/// Grows every plant of a garden and places it, unmeshed. Errors name `source`.
 pub fn grow_garden(garden: &Garden, source: &Path) -> Result<GrownGarden, Error> {
     Ok(garden
+        .plan
         .grow()
         .map_err(|e| InputError::file_error(source, &e))?)
 }
 
-/// Where every plant of a PlantMaker garden stands, without keeping the plants
-/// ([`Garden::placements`]). Errors name `source`.
+/// Where every plant of a garden stands, without keeping the plants. Errors name `source`.
 pub fn garden_placements(garden: &Garden, source: &Path) -> Result<Vec<Placement>, Error> {
     Ok(garden
+        .plan
         .placements()
         .map_err(|e| InputError::file_error(source, &e))?)
 }
@@ -112,7 +358,7 @@ pub fn garden_placements(garden: &Garden, source: &Path) -> Result<Vec<Placement
 /// The plants of a grown garden as placed in its scene: one per placement (`plant-0`,
 /// `plant-1`, ...), each carrying its genome and seed; the plants of one variant share it.
 pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<'g>> {
-    let hint = PlantMakerModel.mesh_hint();
+    let hint = garden.plan.mesh_hint();
     grown
         .placements
         .iter()
@@ -128,12 +374,11 @@ pub fn garden_placed<'g>(garden: &Garden, grown: &'g GrownGarden) -> Vec<Placed<
 
 /// The origin a garden plant's node carries: its genome and seed.
 fn placement_extras(garden: &Garden, placement: &Placement) -> serde_json::Value {
-    let genome = &garden.plants[placement.group].genome;
-    Origin::of(
-        &Genome::new(PlantMakerModel, genome.clone()),
-        placement.seed,
-    )
-    .extras()
+    match garden.plan.genome(placement.group) {
+        Some(genome) => Origin::of(&genome, placement.seed).extras(),
+        // A placement is the garden's own, so its genome is there.
+        None => serde_json::Value::Null,
+    }
 }
 
 /// The names and origin extras of a garden's nodes, one per placement (`plant-0`, …), which
@@ -158,7 +403,7 @@ impl GardenNodes {
     }
 }
 
-/// The GLB of a garden from its placements alone ([`Garden::placements`]), laid out and ready
+/// The GLB of a garden from its placements alone ([`garden_placements`]), laid out and ready
 /// to stream: each distinct plant is grown and meshed when the writer asks for it (twice:
 /// once to lay the file out, once to write its bytes) and dropped after, so memory holds the
 /// JSON, one plant and one mesh, however large the garden. The bytes are those of the grown
@@ -195,7 +440,7 @@ pub fn garden_glb<'a>(
     let source = GardenMeshes {
         garden,
         plants,
-        mesher: Mesher::new(mesh_options(PlantMakerModel.mesh_hint()))?,
+        mesher: Mesher::new(mesh_options(garden.plan.mesh_hint()))?,
         mesh: Mesh::default(),
     };
     Ok(Glb::new(glb_nodes, Box::new(source), options)?)
@@ -216,7 +461,7 @@ impl MeshSource for GardenMeshes<'_> {
             .plants
             .get(index)
             .ok_or(sylva_gltf::export::ExportError::NoSuchMesh { index })?;
-        let plant = self.garden.develop(placement).map_err(|e| {
+        let plant = self.garden.plan.develop(placement).map_err(|e| {
             sylva_gltf::export::ExportError::Source {
                 index,
                 source: Box::new(e),
@@ -262,11 +507,12 @@ pub fn estimate_garden(
     options: &GlbOptions,
 ) -> Result<GardenEstimate, Error> {
     let count = garden.count();
-    if count > MAX_GARDEN_PLANTS {
-        let e = sylva_plantmaker::GardenError::TooManyPlants(count);
+    if count > MAX_PLANTS {
+        let e = GardenError::TooManyPlants(count);
         return Err(InputError::file_error(source, &e).into());
     }
-    let hint = PlantMakerModel.mesh_hint();
+    let hint = garden.plan.mesh_hint();
+    let variants = garden.variants();
     let mut mesher = Mesher::new(mesh_options(hint))?;
     let mut estimate = GardenEstimate {
         plants: 0,
@@ -276,20 +522,26 @@ pub fn estimate_garden(
     };
     let mut largest_plant = 0u64;
     let mut textures = 0u64;
-    for (group, g) in garden.plants.iter().enumerate() {
-        let Some(&seed) = g.seeds.first() else {
+    for (group, seeds) in garden.plan.seeds().into_iter().enumerate() {
+        let Some(&seed) = seeds.first() else {
             continue;
         };
-        let count = g.seeds.len();
-        let distinct = garden.variants.map_or(count, |v| count.min(v as usize));
-        let plant = g.genome.develop(seed).map_err(|source_error| {
-            let e = sylva_plantmaker::GardenError::Develop {
-                group,
-                index: 0,
-                source: source_error,
-            };
-            InputError::file_error(source, &e)
-        })?;
+        let count = seeds.len();
+        let distinct = variants.map_or(count, |v| count.min(v as usize));
+        // The group's first plant, as the garden grows it (its errors name the plant).
+        let first = Placement {
+            group,
+            index: 0,
+            seed,
+            plant: 0,
+            translation: Vec3::ZERO,
+            yaw: 0.0,
+            radius: 0.0,
+        };
+        let plant = garden
+            .plan
+            .develop(&first)
+            .map_err(|e| InputError::file_error(source, &e))?;
         let mesh = mesher
             .mesh(&plant)
             .map_err(|e| Error::from(e).in_file(source))?;
@@ -306,8 +558,8 @@ pub fn estimate_garden(
         };
         let extras = placement_extras(garden, &placement);
         let node = json!({
-            "name": format!("plant-{}", MAX_GARDEN_PLANTS),
-            "mesh": MAX_GARDEN_PLANTS,
+            "name": format!("plant-{}", MAX_PLANTS),
+            "mesh": MAX_PLANTS,
             "translation": [-12345.678, 0.0, 12345.678],
             "rotation": [0.0, -0.70710677, 0.0, 0.70710677],
             "extras": extras,
@@ -321,7 +573,7 @@ pub fn estimate_garden(
         // variant are instanced (their extras are equal). A held scene copies the extras
         // three more times on the way (the placed plants, the assets' nodes, the scene) and
         // keeps every plant and mesh.
-        let instanced = garden.variants.is_some() && options.instancing;
+        let instanced = variants.is_some() && options.instancing;
         let copies = match layout {
             GardenLayout::Streamed => 1,
             GardenLayout::Held => 4,
@@ -375,7 +627,7 @@ pub fn check_garden(
 ) -> Result<GardenEstimate, Error> {
     let estimate = estimate_garden(garden, source, layout, options)?;
     let plants = estimate.plants;
-    let variants = if garden.variants.is_some() {
+    let variants = if garden.variants().is_some() {
         ""
     } else {
         ", or grow a forest of variants (`--variants K`)"
@@ -404,9 +656,6 @@ pub fn check_garden(
     .map_err(|e| Error::from(e).in_file(source))?;
     Ok(estimate)
 }
-
-/// Most plants of a garden, for the widest node a garden can write.
-const MAX_GARDEN_PLANTS: usize = sylva_plantmaker::garden::MAX_PLANTS;
 
 /// A `serde_json::Value` itself, where a vector or map holds it.
 const VALUE: u64 = std::mem::size_of::<serde_json::Value>() as u64;
@@ -478,7 +727,7 @@ fn plant_bytes(plant: &Plant) -> u64 {
 /// unless `"instancing": false`; positions are quantised with `"quantize": true`.
 pub fn garden_glb_options(garden: &Garden) -> GlbOptions {
     GlbOptions {
-        instancing: garden.variants.is_some() && garden.instancing != Some(false),
-        quantize: garden.quantize,
+        instancing: garden.variants().is_some() && garden.instancing() != Some(false),
+        quantize: garden.quantize(),
     }
 }

@@ -5,7 +5,8 @@
 //!   and migrations, how it is opened beside a running studio, its plants and their parents
 //!   ([`archive::Archive`]), for every front end alike.
 //! - [`registry`]: the one list of models ([`Registry::standard`]); genome files and
-//!   configs name their model and the registry hands them to it.
+//!   configs name their model and the registry hands them to it, and each model's line says
+//!   which workflows of its own it offers.
 //! - [`genome`]: [`Genome`], a genome of any model: read from files, grown, and varied by
 //!   hand with the model's own operators ([`Genome::mutate`], [`Genome::cross`]).
 //! - [`assets`]: grown plants as meshes carrying their origin, scenes of many plants,
@@ -20,12 +21,13 @@
 //!   tree of a species (height, foliage, bark), in one small file.
 //! - [`inspect`]: a plausibility report ([`inspect::Report`]): a plant's figures against
 //!   the ranges real trees give.
-//! - [`biomorph`]: Bornhofen and Lattaud's design loop, a mother and her children grown
-//!   together in one voxel world ([`biomorph::Biomorphs`]).
-//! - [`experiment`]: their experiments, run from a config into a report, records and
-//!   assets ([`Experiment`]).
-//! - [`garden`]: PlantMaker gardens and forests, planned, estimated, grown and meshed or
-//!   streamed as a GLB.
+//! - [`biomorph`]: the biomorph loop (Bornhofen and Lattaud's design loop), a mother and
+//!   her children grown together in one world ([`biomorph::Biomorphs`]), for any model
+//!   whose registry line offers it.
+//! - [`experiment`]: experiments run from a config into a report, records and assets
+//!   ([`Experiment`]), for any model whose registry line offers them.
+//! - [`garden`]: gardens and forests, planned, estimated, grown and meshed or streamed as a
+//!   GLB, for any model whose registry line offers them.
 //! - [`evolution`]: configs ([`Config`]) and runs ([`Evolution`]) of any model that evolves:
 //!   step, browse, checkpoint, resume; maps of varieties ([`Varieties`]) and genomes as
 //!   vectors for optimisers outside Sylva ([`GenomeSpace`]).
@@ -84,7 +86,7 @@ pub use skeleton::Skeleton;
 pub use sylva_core::dress::{Dress, Dressed};
 pub use sylva_core::species::{BarkKind, LeafKind};
 pub use sylva_evolve::{GenerationStats, IndividualId, MapStats};
-pub use sylva_lsystem::work::Work;
+pub use sylva_model::Work;
 pub use sylva_model::{CrossLevel, Depth, Knobs};
 
 /// Model settings a front end builds in code (the studio's design and family forms), item

@@ -5,7 +5,14 @@
 //! Adding a model is its crate (a type that implements [`Model`](sylva_model::Model) and
 //! [`Evolve`]) and one line in [`Registry::standard`]. A front end can also build a registry
 //! of its own ([`Registry::with`]), as the test that adds a toy model does.
+//!
+//! A model's line also says which workflows of its own it offers besides growing and
+//! evolving, each a trait of `sylva_model` the model implements ([`EntryOf::with_biomorphs`],
+//! [`EntryOf::with_gardens`], [`EntryOf::with_experiments`]); the library's module for that
+//! workflow ([`crate::biomorph`], [`crate::garden`], [`crate::experiment`]) finds the models
+//! offering it here, never by name.
 
+use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -14,18 +21,71 @@ use sylva_automata::AutomataModel;
 use sylva_bintree::BinTreeModel;
 use sylva_grown::GrownModel;
 use sylva_lsystem::LSystemModel;
+use sylva_model::biomorphs::Biomorphs;
+use sylva_model::experiments::Experiments;
+use sylva_model::gardens::Gardens;
 use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
 
+use crate::biomorph::BiomorphFace;
 use crate::error::{FieldError, InputError};
 use crate::evolution::{Config, EvolveConfig, MatchConfig, RunConfig};
+use crate::experiment::ExperimentFace;
+use crate::garden::GardenFace;
 use crate::genome::{Genome, Settings, expect_model, settings_of};
 
 /// A model the library knows: its name and title, how to read its genome files, configs
-/// and checkpoints, make random genomes and run its evolution.
+/// and checkpoints, make random genomes and run its evolution; and the workflows of its own
+/// it offers, each found by the module that runs it.
 #[derive(Clone)]
 pub struct ModelEntry {
     model: Arc<dyn ModelFace>,
+    pub(crate) biomorphs: Option<Arc<dyn BiomorphFace>>,
+    pub(crate) gardens: Option<Arc<dyn GardenFace>>,
+    pub(crate) experiments: Option<Arc<dyn ExperimentFace>>,
+}
+
+/// A model's registry line as it is written: [`ModelEntry::of`] the model, then what it
+/// offers besides growing and evolving (each `with_` needs the model to implement that
+/// workflow's trait). A [`Registry`] takes it as a [`ModelEntry`].
+pub struct EntryOf<M> {
+    entry: ModelEntry,
+    model: PhantomData<M>,
+}
+
+impl<M: Evolve + Default> EntryOf<M> {
+    /// Its plants grow in biomorph gardens ([`crate::biomorph`]).
+    pub fn with_biomorphs(mut self) -> Self
+    where
+        M: Biomorphs,
+    {
+        self.entry.biomorphs = Some(Arc::new(M::default()));
+        self
+    }
+
+    /// Its plants grow in gardens and forests ([`crate::garden`]).
+    pub fn with_gardens(mut self) -> Self
+    where
+        M: Gardens,
+    {
+        self.entry.gardens = Some(Arc::new(M::default()));
+        self
+    }
+
+    /// It runs experiments from config files ([`crate::experiment`]).
+    pub fn with_experiments(mut self) -> Self
+    where
+        M: Experiments,
+    {
+        self.entry.experiments = Some(Arc::new(M::default()));
+        self
+    }
+}
+
+impl<M> From<EntryOf<M>> for ModelEntry {
+    fn from(line: EntryOf<M>) -> ModelEntry {
+        line.entry
+    }
 }
 
 /// How many genomes [`ModelEntry::random`] draws, at most, to find one that grows.
@@ -111,10 +171,17 @@ impl<M: Evolve + Default> ModelFace for M {
 }
 
 impl ModelEntry {
-    /// Model `M`, with its default settings.
-    pub fn of<M: Evolve + Default>() -> ModelEntry {
-        ModelEntry {
-            model: Arc::new(M::default()),
+    /// Model `M`, with its default settings: a registry line, to which the workflows it
+    /// offers are added ([`EntryOf`]).
+    pub fn of<M: Evolve + Default>() -> EntryOf<M> {
+        EntryOf {
+            entry: ModelEntry {
+                model: Arc::new(M::default()),
+                biomorphs: None,
+                gardens: None,
+                experiments: None,
+            },
+            model: PhantomData,
         }
     }
 
@@ -225,16 +292,21 @@ impl Default for Registry {
 }
 
 impl Registry {
-    /// The four models of Sylva: the binary tree (first: the default run's), automata,
-    /// PlantMaker and L-systems. There is no global registry: whoever starts (the command
+    /// The five models of Sylva: the binary tree (first: the default run's), automata,
+    /// PlantMaker (which grows gardens), L-systems (biomorph gardens and experiments) and
+    /// self-organising trees. There is no global registry: whoever starts (the command
     /// line's `main`, the studio's server, the Python module's init, a test) builds this once
     /// and passes it to what reads genomes and configs.
     pub fn standard() -> Registry {
         Registry::new()
             .with(ModelEntry::of::<BinTreeModel>())
             .with(ModelEntry::of::<AutomataModel>())
-            .with(ModelEntry::of::<PlantMakerModel>())
-            .with(ModelEntry::of::<LSystemModel>())
+            .with(ModelEntry::of::<PlantMakerModel>().with_gardens())
+            .with(
+                ModelEntry::of::<LSystemModel>()
+                    .with_biomorphs()
+                    .with_experiments(),
+            )
             .with(ModelEntry::of::<GrownModel>())
     }
 
@@ -244,7 +316,8 @@ impl Registry {
     }
 
     /// This registry and one more model (a model of the same name is replaced).
-    pub fn with(mut self, entry: ModelEntry) -> Registry {
+    pub fn with(mut self, entry: impl Into<ModelEntry>) -> Registry {
+        let entry = entry.into();
         self.models.retain(|m| m.name() != entry.name());
         self.models.push(entry);
         self

@@ -1,12 +1,11 @@
 //! Reports people read: the statistics table (CSV), the generations of an auto match's
-//! trials (CSV), the fitness plot (SVG), and the outcome of an L-system experiment (text).
+//! trials (CSV) and the fitness plot (SVG). An experiment's report is its model's own.
 
 use std::fmt::Write as _;
 
 use plotters::prelude::*;
 use sylva_evolve::GenerationStats;
 use sylva_evolve::map::MapStats;
-use sylva_lsystem::experiments::SimulationOutcome;
 
 /// `stats.csv`: `generation,best,mean,<term...>,evals_per_s`, one row per generation.
 /// Numbers are written in Rust's shortest round-trip form, so equal runs give equal bytes
@@ -148,82 +147,4 @@ pub fn fitness_svg(stats: &[GenerationStats], title: &str) -> Result<String, Plo
         root.present().map_err(|e| err(&e))?;
     }
     Ok(svg)
-}
-
-/// `report.txt` of `sylva simulate`: the measured outcome of an experiment, one figure a
-/// line.
-pub fn simulation_report(outcome: &SimulationOutcome) -> String {
-    let mut out = String::new();
-    match outcome {
-        SimulationOutcome::HerbsUnderTree(o) => {
-            let _ = writeln!(out, "tree crown radius: {:.2} m", o.crown.radius);
-            let _ = writeln!(out, "shaded herbs, mean biomass: {:.3} g", o.shaded_biomass);
-            let _ = writeln!(out, "open herbs, mean biomass: {:.3} g", o.open_biomass);
-            let _ = writeln!(out, "biomass ratio shaded/open: {:.3}", o.biomass_ratio);
-            let _ = writeln!(out, "light ratio shaded/open: {:.3}", o.light_ratio);
-        }
-        SimulationOutcome::LateralLight(o) => {
-            for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
-                for (i, s) in shapes.iter().enumerate() {
-                    let _ = writeln!(
-                        out,
-                        "{name} light, tree {}: height {:.2} m, crown radius {:.2} m, \
-                         leaves offset towards the light {:.2} m, asymmetry {:.3}",
-                        i + 1,
-                        s.height,
-                        s.radius,
-                        s.offset,
-                        s.asymmetry
-                    );
-                }
-            }
-            let _ = writeln!(
-                out,
-                "mean asymmetry: lateral {:.3}, vertical {:.3}",
-                o.lateral_asymmetry(),
-                o.vertical_asymmetry()
-            );
-            for (name, shapes) in [("lateral", &o.lateral), ("vertical", &o.vertical)] {
-                for (i, s) in shapes.iter().enumerate() {
-                    let _ = writeln!(
-                        out,
-                        "{name} light, tree {}: {} shoot tips, {} branches, {} leaves, \
-                         crown hull {:.2} m³, bushiness {:.1} tips/m³",
-                        i + 1,
-                        s.tips,
-                        s.branches,
-                        s.leaves,
-                        s.volume,
-                        s.bushiness
-                    );
-                }
-            }
-            let _ = writeln!(
-                out,
-                "mean bushiness (shoot tips per m³ of crown hull): lateral {:.1}, vertical {:.1}",
-                o.lateral_bushiness(),
-                o.vertical_bushiness()
-            );
-        }
-        SimulationOutcome::EmptyRules(o) => {
-            for g in &o.run.generations {
-                let _ = writeln!(
-                    out,
-                    "generation {}: chose {} (biomass {:.3} g, {} leaves, {} fine roots), \
-                     {} of the garden germinated",
-                    g.generation,
-                    g.chosen,
-                    g.stats.biomass,
-                    g.stats.leaves(),
-                    g.stats.fine_roots(),
-                    g.germinated
-                );
-            }
-            let _ = match o.leaves_and_roots_at {
-                Some(g) => writeln!(out, "leaves and fine roots from generation {g}"),
-                None => writeln!(out, "no plant with leaves and fine roots yet"),
-            };
-        }
-    }
-    out
 }

@@ -37,21 +37,23 @@ fn written_and_estimated(garden: &Garden) -> (u64, GardenEstimate) {
 #[test]
 fn a_garden_is_estimated_from_its_first_plant() {
     // Every plant its own mesh: the estimate is within 3% of the file (seeds differ).
-    let garden = Garden::new(conifer(), 12, [60.0, 60.0], 3);
+    let planted = |count, area| sylva_plantmaker::Garden::new(conifer(), count, area, 3);
+    let garden = Garden::of::<PlantMakerModel>(planted(12, [60.0, 60.0]));
     let (bytes, estimate) = written_and_estimated(&garden);
     assert_eq!((estimate.plants, estimate.meshes), (12, 12));
     let ratio = estimate.glb as f64 / bytes as f64;
     assert!((0.97..1.03).contains(&ratio), "{} / {bytes}", estimate.glb);
     // A forest of 3 variants: 3 meshes, each placement an instance.
-    let mut forest = Garden::new(conifer(), 40, [80.0, 80.0], 3);
-    forest.variants = Some(3);
+    let mut typed = planted(40, [80.0, 80.0]);
+    typed.variants = Some(3);
+    let forest = Garden::of::<PlantMakerModel>(typed.clone());
     let (bytes, instanced) = written_and_estimated(&forest);
     assert_eq!((instanced.plants, instanced.meshes), (40, 3));
     let ratio = instanced.glb as f64 / bytes as f64;
     assert!((0.97..1.03).contains(&ratio), "{} / {bytes}", instanced.glb);
     // Memory grows with the plants however few the meshes: each node carries a genome.
-    let mut larger = forest.clone();
-    larger.plants[0].seeds.extend(1000..1040);
+    typed.plants[0].seeds.extend(1000..1040);
+    let larger = Garden::of::<PlantMakerModel>(typed);
     let estimate = |g: &Garden, layout| {
         estimate_garden(g, Path::new("c.json"), layout, &garden_glb_options(g)).unwrap()
     };

@@ -46,7 +46,7 @@ pub fn run(models: &Registry, args: &BreedArgs) -> anyhow::Result<()> {
         ..BiomorphOptions::default()
     };
     let pool = super::pool(args.threads)?;
-    let sown = Biomorphs::sow(&mother, &args.mother, &options, args.seed)
+    let sown = Biomorphs::sow(models, &mother, &args.mother, &options, args.seed)
         .map_err(|e| InputError::file(&args.mother, format!("breeding grows {e}")))?;
     super::announce(
         sown.work().seconds(pool.threads()),
@@ -84,9 +84,9 @@ pub fn run(models: &Registry, args: &BreedArgs) -> anyhow::Result<()> {
             s.biomass,
             s.light,
             s.uptake,
-            s.leaves(),
-            s.fine_roots(),
-            s.germinated(),
+            s.leaves,
+            s.fine_roots,
+            s.germinated,
             s.bounds.symbols + s.bounds.modules
         );
     }

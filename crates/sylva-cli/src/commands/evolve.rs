@@ -51,7 +51,7 @@ pub struct EvolveArgs {
 pub fn run(models: &Registry, args: &EvolveArgs) -> anyhow::Result<()> {
     let mut config = match &args.config {
         Some(path) => models.load_config(path)?,
-        None => Config::builtin_run(),
+        None => Config::builtin_run(models)?,
     };
     let run = config.run_mut();
     run.generations = args.generations.unwrap_or(run.generations);

@@ -62,7 +62,7 @@ pub fn run(models: &Registry, args: &GardenArgs) -> anyhow::Result<()> {
     }
     let first = &args.inputs[0];
     let text = read_text(first)?;
-    let is_garden = sylva::garden::is_garden_file(&text);
+    let is_garden = sylva::garden::is_garden_file(models, &text);
     let mut garden = if is_garden {
         if args.inputs.len() > 1 {
             return Err(InputError::file(
@@ -78,7 +78,7 @@ pub fn run(models: &Registry, args: &GardenArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        sylva::garden::read(first, &text)?
+        sylva::garden::read(models, first, &text)?
     } else {
         // The first file is already read.
         let mut genomes: Vec<Genome> = vec![models.parse_genome_at(first, &text)?];
@@ -86,27 +86,29 @@ pub fn run(models: &Registry, args: &GardenArgs) -> anyhow::Result<()> {
             genomes.push(models.load_genome(path)?);
         }
         let area = [args.area.0, args.area.1];
-        let mut garden = sylva::garden::plant(&genomes, args.count as usize, area, args.seed)
-            .map_err(|e| match e {
-                PlanError::WrongModel { index, .. } => InputError::file(&args.inputs[index], e),
-                PlanError::NoGenomes => InputError::new("inputs", e),
-            })?;
-        garden.variants = args.variants;
+        let mut garden =
+            sylva::garden::plant(models, &genomes, args.count as usize, area, args.seed).map_err(
+                |e| match e {
+                    PlanError::WrongModel { index, .. } => InputError::file(&args.inputs[index], e),
+                    PlanError::NoGenomes => InputError::new("inputs", e),
+                },
+            )?;
+        garden.set_variants(args.variants);
         garden
     };
     // The layout flags are recorded in a new garden file, and add to what a garden file says.
     if args.no_instancing {
-        if garden.variants.is_none() {
+        if garden.variants().is_none() {
             return Err(InputError::new(
                 "--no-instancing",
                 "only forests of variants are instanced; add --variants K, or leave the flag out",
             )
             .into());
         }
-        garden.instancing = Some(false);
+        garden.set_instancing(Some(false));
     }
-    garden.quantize |= quantize;
-    if garden.quantize && wind.is_some() {
+    garden.set_quantize(garden.quantize() || quantize);
+    if garden.quantize() && wind.is_some() {
         return Err(InputError::new(
             "--wind",
             format!(

@@ -11,9 +11,9 @@ use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::Genome;
 use sylva::biomorph::{self, BiomorphOptions, Biomorphs};
 use sylva::mesh::{Scene, SceneNode};
+use sylva::{Genome, Registry};
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
@@ -194,11 +194,9 @@ pub struct Start {
     seed: Option<u64>,
 }
 
-const LSYSTEM: &str = biomorph::MODEL;
-
-/// `genome`, when it can grow in a garden.
-fn lsystem_genome(genome: Genome, field: &str) -> Result<Genome, ApiError> {
-    match biomorph::grows(&genome) {
+/// `genome`, when it can grow in a garden (its model grows biomorphs in `registry`).
+fn biomorph_genome(registry: &Registry, genome: Genome, field: &str) -> Result<Genome, ApiError> {
+    match biomorph::grows(registry, &genome) {
         Ok(()) => Ok(genome),
         Err(e) => Err(ApiError::unprocessable(
             field,
@@ -225,14 +223,14 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
             let genome = example(&studio.registry, &name)
                 .ok_or_else(|| ApiError::bad("start.example", format!("no example {name:?}")))?;
             (
-                lsystem_genome(genome, "start.example")?,
+                biomorph_genome(&studio.registry, genome, "start.example")?,
                 Came::Made(Operator::Example, json!({"example": name})),
             )
         }
         Mother::Genome(text) => {
             let genome = parse_genome(&studio.registry, &text, "start.genome")?;
             (
-                lsystem_genome(genome, "start.genome")?,
+                biomorph_genome(&studio.registry, genome, "start.genome")?,
                 Came::Made(Operator::Upload, json!({})),
             )
         }
@@ -243,10 +241,18 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
                 e
             })?;
             let genome = genome_of(&studio.registry, &row)?;
-            (lsystem_genome(genome, "start.plant")?, Came::Archived(id))
+            (
+                biomorph_genome(&studio.registry, genome, "start.plant")?,
+                Came::Archived(id),
+            )
         }
         Mother::Empty(true) => (
-            biomorph::empty_rules(),
+            biomorph::first_mother(&studio.registry).ok_or_else(|| {
+                ApiError::bad(
+                    "start.empty",
+                    "no model here grows biomorphs from empty rules",
+                )
+            })?,
             Came::Made(Operator::Empty, json!({})),
         ),
         Mother::Empty(false) => {
@@ -257,13 +263,14 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
         }
     };
     let id = studio.archive.transaction(|c| -> Result<_, ApiError> {
-        let id = archive::insert_session(c, GardenMode::NAME, LSYSTEM, "Garden", &json!({}))?;
+        let model = mother.model();
+        let id = archive::insert_session(c, GardenMode::NAME, model, "Garden", &json!({}))?;
         let mother_id = match &made {
             Came::Made(operator, settings) => archive::insert_plant(
                 c,
                 &NewPlant {
                     session: Some(id),
-                    model: LSYSTEM,
+                    model,
                     genome: &mother.to_json(),
                     seed: 0,
                     operator: *operator,
@@ -295,7 +302,10 @@ async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {
 
 /// A new garden session whose mother is an archived plant.
 async fn branch(studio: &Studio, row: &PlantRow) -> Result<i64, ApiError> {
-    if row.model != LSYSTEM {
+    if !biomorph::models(&studio.registry)
+        .iter()
+        .any(|m| *m == row.model)
+    {
         return Err(ApiError::bad(
             "mode",
             format!(
@@ -344,6 +354,7 @@ async fn grow_garden(
     let mother_id = state.mother;
     tokio::task::spawn_blocking(move || -> Result<Grown, ApiError> {
         let sown = Biomorphs::sow(
+            &studio.registry,
             &mother,
             std::path::Path::new("garden"),
             &settings.options(),
@@ -373,7 +384,7 @@ async fn grow_garden(
             sylva::export::glb(&assets.scene()).map_err(|e| ApiError::library("settings", e))?;
         let mut specimens = Vec::with_capacity(garden.specimens.len());
         for (s, mesh) in garden.specimens.iter().zip(assets.meshes()) {
-            let mut node = SceneNode::new(LSYSTEM, mesh);
+            let mut node = SceneNode::new(s.genome.model(), mesh);
             node.extras = Some(node_extras(s));
             let glb = sylva::export::glb(&Scene::single(node))
                 .map_err(|e| ApiError::library("settings", e))?;
@@ -384,8 +395,8 @@ async fn grow_garden(
                 z: s.position.z,
                 biomass: s.stats.biomass,
                 light: s.stats.light,
-                leaves: s.stats.leaves(),
-                fine_roots: s.stats.fine_roots(),
+                leaves: s.stats.leaves,
+                fine_roots: s.stats.fine_roots,
             };
             specimens.push((s.genome.clone(), s.is_mother, view, glb));
         }
@@ -412,7 +423,7 @@ fn store_garden(
             c,
             &NewPlant {
                 session: Some(session),
-                model: LSYSTEM,
+                model: genome.model(),
                 genome: &genome.to_json(),
                 seed: 0,
                 operator,
@@ -468,7 +479,11 @@ async fn step(
 ) -> Result<SessionView, ApiError> {
     let (_, before) = garden_state(studio, id)?;
     let row = plant_row(studio, mother)?;
-    let genome = lsystem_genome(genome_of(&studio.registry, &row)?, "plant")?;
+    let genome = biomorph_genome(
+        &studio.registry,
+        genome_of(&studio.registry, &row)?,
+        "plant",
+    )?;
     let state = GardenState {
         mother,
         settings: before.settings.with(settings)?,
@@ -555,8 +570,8 @@ impl Mode for GardenMode {
         hint: "A new garden with this plant as the mother",
     });
 
-    fn models(_: &sylva::Registry) -> Vec<&'static str> {
-        vec![biomorph::MODEL]
+    fn models(registry: &Registry) -> Vec<&'static str> {
+        biomorph::models(registry)
     }
 
     async fn create(studio: &Studio, start: Start) -> Result<i64, ApiError> {

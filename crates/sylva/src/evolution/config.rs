@@ -47,25 +47,20 @@ impl Clone for Config {
 
 impl Config {
     /// The run `sylva evolve` makes without a config (written out in
-    /// `examples/bintree/default.toml`): [`Config::default`], its best plant and contact
-    /// sheet dressed in oak leaves at 1.5 times the kind's density and the oak's furrowed
-    /// bark, as a tree in a scene would be. The evolution itself is the default's (it scores
-    /// the plants as grown); `examples/bintree/paper.toml` keeps the paper's bare figures.
-    pub fn builtin_run() -> Self {
-        let mut config = Config::default();
+    /// `examples/bintree/default.toml`): the default config of `registry`'s first model
+    /// ([`Registry::default_config`]: what an empty config reads as), its best plant and
+    /// contact sheet dressed in oak leaves at 1.5 times the kind's density and the oak's
+    /// furrowed bark, as a tree in a scene would be. The evolution itself is the default's
+    /// (it scores the plants as grown); `examples/bintree/paper.toml` keeps the paper's bare
+    /// figures. An empty registry has none.
+    pub fn builtin_run(registry: &Registry) -> Result<Self, InputError> {
+        let mut config = registry
+            .default_config()
+            .ok_or_else(|| InputError::new("model", "this registry has no models"))?;
         let output = config.output_mut();
         output.foliage = Some(sylva_core::species::LeafKind::Oak);
         output.density = 1.5;
-        config
-    }
-}
-
-impl Default for Config {
-    /// The first model of the standard registry (binary trees), every setting at its
-    /// default: what an empty config reads as. (`sylva evolve` without a config runs
-    /// [`Config::builtin_run`].)
-    fn default() -> Self {
-        Config::new(EvolveConfig::<sylva_bintree::BinTreeModel>::default())
+        Ok(config)
     }
 }
 
