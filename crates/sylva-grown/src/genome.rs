@@ -27,7 +27,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::species::{BarkKind, LeafKind};
 use sylva_model::{FormatV1, model_tag};
 
-use crate::crown::Profile;
+use crate::profile::Profile;
 
 /// Model name in genome files.
 pub const MODEL: &str = "grown";

@@ -29,11 +29,13 @@ pub mod crown;
 pub mod genome;
 pub mod grow;
 pub mod problem;
+pub mod profile;
 
-pub use crown::{Envelope, EnvelopeError, Profile};
+pub use crown::Envelope;
 pub use genome::{CrownShape, Growth, MODEL, PARAMS, Param, ParamSpec, Params};
 pub use grow::{MAX_NODES, Report, Stop, grow, grow_into};
 pub use problem::{GrownProblem, GrownSettings, GrownStrategy};
+pub use profile::{EnvelopeError, Profile};
 
 use rand::{Rng, RngExt};
 use sylva_core::Plant;
@@ -135,14 +137,14 @@ impl Evolve for GrownModel {
     }
 
     /// Every genome of the run grows into the crown the pictures show: the visual hull of
-    /// the front and side outlines above the trunk ([`crown::Profile::from_target`]).
+    /// the front and side outlines above the trunk ([`profile::Profile::from_target`]).
     fn fit_target(
         &self,
         settings: &mut GrownSettings,
         target: &TargetProfile,
     ) -> Result<(), ConfigError> {
         let profile =
-            crown::Profile::from_target(target).map_err(|e| ConfigError::new("envelope", e))?;
+            profile::Profile::from_target(target).map_err(|e| ConfigError::new("envelope", e))?;
         settings.envelope = Some(profile);
         Ok(())
     }

@@ -24,7 +24,7 @@ use sylva_fitness::poncin::{NumTarget, PoncinContext, TERM_NAMES, TargetShape};
 use sylva_model::VectorCoding;
 
 use crate::GrownModel;
-use crate::crown::Profile;
+use crate::profile::Profile;
 use crate::genome::{Growth, PARAMS, Params, Variation};
 
 /// The self-organising model's settings: how genomes are varied, the first generation,

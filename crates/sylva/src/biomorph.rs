@@ -22,19 +22,20 @@
 
 use std::error::Error as StdError;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use sylva_core::glam::Vec3;
 use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant};
 use sylva_model::biomorphs::{self, BiomorphSettings};
-use sylva_model::{Model, Work};
+use sylva_model::{Evolve, Model, Work};
 
 pub use sylva_model::biomorphs::{BoundsHit, SpecimenStats};
 
 use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
-use crate::registry::Registry;
+use crate::registry::{EntryOf, Registry};
 
 /// The models of `registry` whose plants grow in biomorph gardens, in order (the first is
 /// the one [`first_mother`] starts with).
@@ -47,7 +48,7 @@ fn offering(registry: &Registry) -> impl Iterator<Item = (&'static str, &dyn Bio
     registry
         .models()
         .iter()
-        .filter_map(|m| Some((m.name(), m.biomorphs.as_deref()?)))
+        .filter_map(|m| Some((m.name(), m.offer::<Arc<dyn BiomorphFace>>()?.as_ref())))
 }
 
 /// A genome of a model that does not grow biomorphs, given to a biomorph garden.
@@ -130,7 +131,8 @@ pub fn grows(registry: &Registry, genome: &Genome) -> Result<(), WrongModel> {
 }
 
 fn face_of<'r>(registry: &'r Registry, genome: &Genome) -> Option<&'r dyn BiomorphFace> {
-    registry.get(genome.model())?.biomorphs.as_deref()
+    let face = registry.get(genome.model())?.offer::<Arc<dyn BiomorphFace>>()?;
+    Some(face.as_ref())
 }
 
 /// The mother a garden of `registry`'s first biomorph model starts from when a person
@@ -139,6 +141,13 @@ pub fn first_mother(registry: &Registry) -> Option<Genome> {
     offering(registry)
         .next()
         .map(|(_, face)| face.first_mother())
+}
+
+impl<M: biomorphs::Biomorphs + Evolve + Default> EntryOf<M> {
+    /// Its plants grow in biomorph gardens (this module).
+    pub fn with_biomorphs(self) -> Self {
+        self.offering::<Arc<dyn BiomorphFace>>(Arc::new(M::default()))
+    }
 }
 
 /// What the registry holds of a model that grows biomorphs: its typed trait, erased.

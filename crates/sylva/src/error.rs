@@ -246,7 +246,7 @@ pub enum Error {
     Budget(#[from] sylva_core::budget::OverBudget),
     /// A plot could not be drawn.
     #[error(transparent)]
-    Plot(#[from] crate::report::PlotError),
+    Plot(#[from] PlotError),
     /// The worker threads could not start.
     #[error("starting the worker threads")]
     Threads(#[from] sylva_core::par::ThreadPoolBuildError),
@@ -360,3 +360,8 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
     (line, column)
 }
+
+/// Why a plot could not be drawn ([`crate::report::fitness_svg`]).
+#[derive(Debug, thiserror::Error)]
+#[error("could not draw the fitness plot: {0}")]
+pub struct PlotError(pub(crate) String);

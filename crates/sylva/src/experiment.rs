@@ -17,16 +17,17 @@
 
 use std::error::Error as StdError;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use sylva_core::par::Pool;
 use sylva_model::experiments::{ExperimentOutcome, Experiments};
-use sylva_model::{MeshHint, Work};
+use sylva_model::{Evolve, MeshHint, Work};
 
 use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
 use crate::files::read_text;
 use crate::genome::Genome;
-use crate::registry::Registry;
+use crate::registry::{EntryOf, Registry};
 
 /// An experiment config with the genomes it names, ready to run.
 pub struct Experiment {
@@ -46,6 +47,13 @@ pub struct ExperimentResult {
     /// experiment: tree 1 under lateral light beside tree 1 under vertical light, roots left
     /// out, turned so the light comes from +X, for a front view).
     pub side: Option<SceneAssets>,
+}
+
+impl<M: Experiments + Evolve + Default> EntryOf<M> {
+    /// It runs experiments from config files (this module).
+    pub fn with_experiments(self) -> Self {
+        self.offering::<Arc<dyn ExperimentFace>>(Arc::new(M::default()))
+    }
 }
 
 /// What the registry holds of a model that runs experiments: its typed trait, erased.
@@ -167,7 +175,7 @@ impl Experiment {
         for face in registry
             .models()
             .iter()
-            .filter_map(|m| m.experiments.as_deref())
+            .filter_map(|m| m.offer::<Arc<dyn ExperimentFace>>())
         {
             match face.load(registry, path, &text) {
                 Ok(loaded) => {

@@ -8,6 +8,7 @@
 //! `sylva.garden` run it.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde_json::json;
 use sylva_core::Plant;
@@ -17,14 +18,14 @@ use sylva_mesh::Mesh;
 use sylva_mesh::mesher::Mesher;
 use sylva_mesh::wind::WindOptions;
 use sylva_model::gardens::{GardenError, GardenPlan, Gardens, MAX_PLANTS};
-use sylva_model::{GenomeError, MeshHint};
+use sylva_model::{Evolve, GenomeError, MeshHint};
 
 pub use sylva_model::gardens::{GrownGarden, Placement};
 
 use crate::assets::{Origin, Placed, SceneAssets, mesh_options};
 use crate::error::{Error, InputError};
 use crate::genome::Genome;
-use crate::registry::Registry;
+use crate::registry::{EntryOf, Registry};
 
 /// A garden of any model that grows them, as its garden file holds it: genomes, each with
 /// one seed per plant, the plot, and how its scene is laid out.
@@ -90,6 +91,13 @@ impl Garden {
     /// The garden file, pretty-printed with a final newline.
     pub fn to_json(&self) -> String {
         self.plan.to_json()
+    }
+}
+
+impl<M: Gardens + Evolve + Default> EntryOf<M> {
+    /// Its plants grow in gardens and forests (this module).
+    pub fn with_gardens(self) -> Self {
+        self.offering::<Arc<dyn GardenFace>>(Arc::new(M::default()))
     }
 }
 
@@ -237,7 +245,7 @@ fn offering(registry: &Registry) -> impl Iterator<Item = (&'static str, &dyn Gar
     registry
         .models()
         .iter()
-        .filter_map(|m| Some((m.name(), m.gardens.as_deref()?)))
+        .filter_map(|m| Some((m.name(), m.offer::<Arc<dyn GardenFace>>()?.as_ref())))
 }
 
 /// The `model` a file's text names, if it is an object that names one.
@@ -312,7 +320,7 @@ pub fn plant(
     };
     let mut garden = registry
         .get(first.model())
-        .and_then(|m| m.gardens.as_deref())
+        .and_then(|m| m.offer::<Arc<dyn GardenFace>>())
         .and_then(|face| face.plant(first, count, area, seed))
         .ok_or_else(|| {
             let names: Vec<String> = offering(registry).map(|(n, _)| format!("`{n}`")).collect();

@@ -12,6 +12,7 @@
 //! workflow ([`crate::biomorph`], [`crate::garden`], [`crate::experiment`]) finds the models
 //! offering it here, never by name.
 
+use std::any::Any;
 use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::Arc;
@@ -21,17 +22,11 @@ use sylva_automata::AutomataModel;
 use sylva_bintree::BinTreeModel;
 use sylva_grown::GrownModel;
 use sylva_lsystem::LSystemModel;
-use sylva_model::biomorphs::Biomorphs;
-use sylva_model::experiments::Experiments;
-use sylva_model::gardens::Gardens;
 use sylva_model::{Evolve, GenomeError, Model};
 use sylva_plantmaker::PlantMakerModel;
 
-use crate::biomorph::BiomorphFace;
 use crate::error::{FieldError, InputError};
 use crate::evolution::{Config, EvolveConfig, MatchConfig, RunConfig};
-use crate::experiment::ExperimentFace;
-use crate::garden::GardenFace;
 use crate::genome::{Genome, Settings, expect_model, settings_of};
 
 /// A model the library knows: its name and title, how to read its genome files, configs
@@ -40,9 +35,8 @@ use crate::genome::{Genome, Settings, expect_model, settings_of};
 #[derive(Clone)]
 pub struct ModelEntry {
     model: Arc<dyn ModelFace>,
-    pub(crate) biomorphs: Option<Arc<dyn BiomorphFace>>,
-    pub(crate) gardens: Option<Arc<dyn GardenFace>>,
-    pub(crate) experiments: Option<Arc<dyn ExperimentFace>>,
+    /// The workflows it offers, each as its module's face, one of each type.
+    offers: Vec<Arc<dyn Any + Send + Sync>>,
 }
 
 /// A model's registry line as it is written: [`ModelEntry::of`] the model, then what it
@@ -53,31 +47,12 @@ pub struct EntryOf<M> {
     model: PhantomData<M>,
 }
 
-impl<M: Evolve + Default> EntryOf<M> {
-    /// Its plants grow in biomorph gardens ([`crate::biomorph`]).
-    pub fn with_biomorphs(mut self) -> Self
-    where
-        M: Biomorphs,
-    {
-        self.entry.biomorphs = Some(Arc::new(M::default()));
-        self
-    }
-
-    /// Its plants grow in gardens and forests ([`crate::garden`]).
-    pub fn with_gardens(mut self) -> Self
-    where
-        M: Gardens,
-    {
-        self.entry.gardens = Some(Arc::new(M::default()));
-        self
-    }
-
-    /// It runs experiments from config files ([`crate::experiment`]).
-    pub fn with_experiments(mut self) -> Self
-    where
-        M: Experiments,
-    {
-        self.entry.experiments = Some(Arc::new(M::default()));
+impl<M> EntryOf<M> {
+    /// Adds what the model offers of one workflow: `face`, the workflow module's erased
+    /// trait over the model, found again by its type ([`ModelEntry::offer`]). Each workflow
+    /// module adds its own `with_` method to `EntryOf`, so the registry names none.
+    pub(crate) fn offering<F: Any + Send + Sync>(mut self, face: F) -> Self {
+        self.entry.offers.push(Arc::new(face));
         self
     }
 }
@@ -177,12 +152,16 @@ impl ModelEntry {
         EntryOf {
             entry: ModelEntry {
                 model: Arc::new(M::default()),
-                biomorphs: None,
-                gardens: None,
-                experiments: None,
+                offers: Vec::new(),
             },
             model: PhantomData,
         }
+    }
+
+    /// What the model offers of a workflow, by the type of that workflow's face
+    /// ([`EntryOf::offering`]); none when it does not offer it.
+    pub(crate) fn offer<F: Any>(&self) -> Option<&F> {
+        self.offers.iter().find_map(|face| face.downcast_ref::<F>())
     }
 
     /// The model's name in files.

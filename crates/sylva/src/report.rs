@@ -75,10 +75,7 @@ pub fn map_stats_csv(stats: &[MapStats]) -> String {
     out
 }
 
-/// Why a plot could not be drawn.
-#[derive(Debug, thiserror::Error)]
-#[error("could not draw the fitness plot: {0}")]
-pub struct PlotError(String);
+pub use crate::error::PlotError;
 
 /// `fitness.svg`: best and mean fitness per generation.
 pub fn fitness_svg(stats: &[GenerationStats], title: &str) -> Result<String, PlotError> {

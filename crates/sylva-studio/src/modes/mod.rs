@@ -21,8 +21,9 @@
 //!
 //! 1. a module here implementing [`Mode`]: its `NAME` (a session's `mode` in requests and
 //!    the archive, kept once sessions of it are archived), its `Start` (the fields of
-//!    `POST /api/sessions` besides `mode`), `create`, and its [`Route`]s; `branch`,
-//!    `first_event`, `moved` and `resume` if it needs them; what it keeps in memory through
+//!    `POST /api/sessions` besides `mode`), `create`, and its [`Route`]s; `branch` with its
+//!    `BRANCH` button on the plant panel, `first_event`, `moved` and `resume` if it needs
+//!    them; what it keeps in memory through
 //!    [`Studio::kept`](crate::Studio::kept);
 //! 2. one [`ModeEntry::of`] line in [`MODES`]: its tab's label and hint, and its page
 //!    module;
