@@ -9,10 +9,10 @@
 //! outline's ink is at that height, so the gaps a crown shows (beside the trunk under the
 //! crown, between its lobes) stay empty.
 
+use crate::genome::{CrownShape, Growth, Param};
+use crate::profile::{EnvelopeError, Row, hull};
 use glam::Vec3;
 use rand::{Rng, RngExt};
-use crate::genome::{CrownShape, Growth, Param};
-use crate::profile::{EnvelopeError, Row, Stretches, hull};
 
 /// Rows a shape's envelope is drawn with.
 const SHAPE_ROWS: usize = 64;
@@ -218,7 +218,7 @@ impl Envelope {
 mod tests {
     use super::*;
     use crate::genome::{Growth, Param};
-    use crate::profile::{GAP, Profile};
+    use crate::profile::{GAP, Profile, Stretches};
     use sylva_model::TargetProfile;
 
     #[test]

@@ -24,8 +24,8 @@ use sylva_fitness::poncin::{NumTarget, PoncinContext, TERM_NAMES, TargetShape};
 use sylva_model::VectorCoding;
 
 use crate::GrownModel;
-use crate::profile::Profile;
 use crate::genome::{Growth, PARAMS, Params, Variation};
+use crate::profile::Profile;
 
 /// The self-organising model's settings: how genomes are varied, the first generation,
 /// breeding and the fitness (by default: twig tips on a sphere of 4.5 m centred 8 m up,

@@ -233,4 +233,3 @@ fn join<'a>(stretches: impl Iterator<Item = &'a [f32; 2]>) -> Stretches {
 /// A row is the crown's when it is at least this share as wide as the crown's widest row:
 /// narrower rows below the crown are the trunk.
 pub const CROWN_WIDTH: f32 = 0.25;
-

@@ -131,7 +131,9 @@ pub fn grows(registry: &Registry, genome: &Genome) -> Result<(), WrongModel> {
 }
 
 fn face_of<'r>(registry: &'r Registry, genome: &Genome) -> Option<&'r dyn BiomorphFace> {
-    let face = registry.get(genome.model())?.offer::<Arc<dyn BiomorphFace>>()?;
+    let face = registry
+        .get(genome.model())?
+        .offer::<Arc<dyn BiomorphFace>>()?;
     Some(face.as_ref())
 }
 
