@@ -44,11 +44,7 @@ impl From<&SpecimenStats> for biomorphs::SpecimenStats {
             leaves: s.leaves(),
             fine_roots: s.fine_roots(),
             germinated: s.germinated(),
-            bounds: biomorphs::BoundsHit {
-                symbols: s.bounds.symbols,
-                modules: s.bounds.modules,
-                first_step: s.bounds.first_step,
-            },
+            bounds: s.bounds,
         }
     }
 }

@@ -54,23 +54,11 @@ pub fn surface(s: &ModuleShape) -> f64 {
     2.0 * PI * s.radius * s.length + 4.0 * PI * s.radius * s.radius
 }
 
-/// Rewrites refused because they would pass a bound.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub struct BoundsHit {
-    /// Rewrites refused by [`max_symbols`](crate::physiology::Physiology::max_symbols).
-    pub symbols: u32,
-    /// Rewrites refused by [`max_modules`](crate::physiology::Physiology::max_modules).
-    pub modules: u32,
-    /// The first step (1-based) a bound was hit, if ever.
-    pub first_step: Option<u32>,
-}
-
-impl BoundsHit {
-    /// True when some rewrite was refused.
-    pub fn any(&self) -> bool {
-        self.symbols > 0 || self.modules > 0
-    }
-}
+/// Rewrites refused because they would pass a bound: by
+/// [`max_symbols`](crate::physiology::Physiology::max_symbols) and
+/// [`max_modules`](crate::physiology::Physiology::max_modules) (the biomorph workflow's own
+/// type, which the front ends report).
+pub use sylva_model::biomorphs::BoundsHit;
 
 /// Where a plant is in its life.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -64,7 +64,7 @@ pub struct SpecimenStats {
 
 /// Growth a model's bounds refused while a specimen grew (an L-system's rewrites refused by
 /// its symbol and module limits).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct BoundsHit {
     /// Refused by the limit on the genome's size (an L-system's symbols).
     pub symbols: u32,

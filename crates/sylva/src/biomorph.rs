@@ -27,10 +27,10 @@ use std::sync::Arc;
 use sylva_core::glam::Vec3;
 use sylva_core::par::Pool;
 use sylva_core::{MaterialKind, Plant};
-use sylva_model::biomorphs::{self, BiomorphSettings};
+use sylva_model::biomorphs;
 use sylva_model::{Evolve, Model, Work};
 
-pub use sylva_model::biomorphs::{BoundsHit, SpecimenStats};
+pub use sylva_model::biomorphs::{BiomorphSettings, BoundsHit, SpecimenStats};
 
 use crate::assets::{Origin, Placed, SceneAssets, check_scene_glb};
 use crate::error::{Error, InputError};
@@ -74,50 +74,21 @@ impl WrongModel {
     }
 }
 
-/// How a biomorph garden is laid out and grown. The defaults are the paper's.
+/// How a biomorph garden is laid out and grown (the paper's defaults), and whether the
+/// plants handed back keep their roots.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BiomorphOptions {
-    /// Children sown with the mother, 0 to 8. Default 8.
-    pub children: u32,
-    /// Steps to grow. Default 150.
-    pub steps: u32,
-    /// Metres between neighbouring seeds. Default 2.5.
-    pub spacing: f32,
-    /// The light's height above the horizon, degrees. Default 90 (straight down).
-    pub elevation: f64,
-    /// The compass direction the light comes from, degrees. Default 0.
-    pub azimuth: f64,
-    /// Mutate children of a mother whose shoot draws nothing until theirs draws something,
-    /// so a person breeding by eye has something to see. Default false (the paper's loop).
-    pub visible_children: bool,
+    /// The garden: children, steps, spacing, light, visible children.
+    pub settings: BiomorphSettings,
     /// Keep the roots in the plants handed back (and so in their meshes). Default true.
     pub roots: bool,
 }
 
 impl Default for BiomorphOptions {
     fn default() -> Self {
-        let paper = BiomorphSettings::default();
         BiomorphOptions {
-            children: paper.children,
-            steps: paper.steps,
-            spacing: paper.spacing,
-            elevation: paper.elevation,
-            azimuth: paper.azimuth,
-            visible_children: paper.visible_children,
+            settings: BiomorphSettings::default(),
             roots: true,
-        }
-    }
-}
-
-impl BiomorphOptions {
-    fn settings(&self) -> BiomorphSettings {
-        BiomorphSettings {
-            children: self.children,
-            steps: self.steps,
-            spacing: self.spacing,
-            elevation: self.elevation,
-            azimuth: self.azimuth,
-            visible_children: self.visible_children,
         }
     }
 }
@@ -255,7 +226,7 @@ impl Biomorphs {
         seed: u64,
     ) -> Result<Biomorphs, WrongModel> {
         let sown = face_of(registry, mother)
-            .and_then(|face| face.sow(mother, options.settings(), seed))
+            .and_then(|face| face.sow(mother, options.settings, seed))
             .ok_or_else(|| WrongModel::of(registry, mother))?;
         Ok(Biomorphs {
             sown,

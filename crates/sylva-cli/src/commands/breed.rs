@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use sylva::InputError;
 use sylva::Registry;
 use sylva::assets::picture;
-use sylva::biomorph::{BiomorphOptions, Biomorphs};
+use sylva::biomorph::{BiomorphOptions, BiomorphSettings, Biomorphs};
 use sylva::files::Outputs;
 use sylva::mesh::{Scene, SceneNode};
 use sylva::render::{self, SheetCell, SheetOptions, View};
@@ -41,9 +41,11 @@ pub struct BreedArgs {
 pub fn run(models: &Registry, args: &BreedArgs) -> anyhow::Result<()> {
     let mother = models.load_genome(&args.mother)?;
     let options = BiomorphOptions {
-        children: args.children,
+        settings: BiomorphSettings {
+            children: args.children,
+            ..BiomorphSettings::default()
+        },
         roots: !args.hide_roots,
-        ..BiomorphOptions::default()
     };
     let pool = super::pool(args.threads)?;
     let sown = Biomorphs::sow(models, &mother, &args.mother, &options, args.seed)

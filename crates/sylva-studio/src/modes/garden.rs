@@ -11,7 +11,7 @@ use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use sylva::biomorph::{self, BiomorphOptions, Biomorphs};
+use sylva::biomorph::{self, BiomorphOptions, BiomorphSettings, Biomorphs};
 use sylva::mesh::{Scene, SceneNode};
 use sylva::{Genome, Registry};
 
@@ -122,13 +122,15 @@ impl GardenSettings {
 
     fn options(&self) -> BiomorphOptions {
         BiomorphOptions {
-            children: self.children,
-            steps: self.steps,
-            spacing: self.spacing as f32,
-            elevation: self.elevation,
-            azimuth: self.azimuth,
-            // a person breeding by eye needs something to see, from empty rules too
-            visible_children: true,
+            settings: BiomorphSettings {
+                children: self.children,
+                steps: self.steps,
+                spacing: self.spacing as f32,
+                elevation: self.elevation,
+                azimuth: self.azimuth,
+                // a person breeding by eye needs something to see, from empty rules too
+                visible_children: true,
+            },
             roots: false,
         }
     }
