@@ -221,6 +221,21 @@ mod tests {
     use crate::profile::{GAP, Profile, Stretches};
     use sylva_model::TargetProfile;
 
+    /// `e`'s volume as the share of `samples` random points of its bounding box inside it.
+    fn sampled_volume(e: &Envelope, samples: u32, rng: &mut impl Rng) -> f32 {
+        let (lo, hi) = e.bounds();
+        let inside = (0..samples)
+            .filter(|_| {
+                e.contains(Vec3::new(
+                    rng.random_range(lo.x..hi.x),
+                    rng.random_range(lo.y..hi.y),
+                    rng.random_range(lo.z..hi.z),
+                ))
+            })
+            .count();
+        (hi - lo).element_product() * inside as f32 / samples as f32
+    }
+
     #[test]
     fn points_fill_the_shape_and_nothing_else() {
         let e = Envelope::of_shape(CrownShape::Cone, 2.0, 10.0, 3.0, 3.0);
@@ -232,18 +247,7 @@ mod tests {
         let low = points.iter().filter(|p| p.y < 6.0).count();
         assert!(low > 1400, "{low}");
         // The volume is what a box's share of random points says it is.
-        let (lo, hi) = e.bounds();
-        let inside = (0..20_000)
-            .filter(|_| {
-                let p = Vec3::new(
-                    rng.random_range(lo.x..hi.x),
-                    rng.random_range(lo.y..hi.y),
-                    rng.random_range(lo.z..hi.z),
-                );
-                e.contains(p)
-            })
-            .count();
-        let measured = (hi - lo).element_product() * inside as f32 / 20_000.0;
+        let measured = sampled_volume(&e, 20_000, &mut rng);
         assert!(
             (e.volume() / measured - 1.0).abs() < 0.05,
             "{} {measured}",
@@ -380,17 +384,7 @@ mod tests {
         assert!(e.contains(at(0.06, 0.6)), "in the crown above");
         // The volume counts the gaps out (within the sampling error).
         let mut rng = sylva_core::rng::seeded(2);
-        let (lo, hi) = e.bounds();
-        let inside = (0..40_000)
-            .filter(|_| {
-                e.contains(Vec3::new(
-                    rng.random_range(lo.x..hi.x),
-                    rng.random_range(lo.y..hi.y),
-                    rng.random_range(lo.z..hi.z),
-                ))
-            })
-            .count();
-        let measured = (hi - lo).element_product() * inside as f32 / 40_000.0;
+        let measured = sampled_volume(&e, 40_000, &mut rng);
         assert!(
             (e.volume() / measured - 1.0).abs() < 0.05,
             "{} {measured}",
