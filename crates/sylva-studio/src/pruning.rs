@@ -7,9 +7,8 @@
 //! kept in the archive and written into a folder of the studio's own whenever one is
 //! missing (after a restart), which the config is then read against.
 
-use std::collections::VecDeque;
 use std::path::{Path as FilePath, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use sylva::Config;
 use sylva::Genome;
@@ -19,6 +18,7 @@ use sylva::{GrowOptions, Grown};
 
 use crate::Studio;
 use crate::archive::{self, Operator, PlantRow, RunRow};
+use crate::cache::Bounded;
 use crate::error::ApiError;
 
 /// The key of a plant's settings naming the match run whose outlines it grows inside, for
@@ -80,8 +80,8 @@ pub fn pruned_to(studio: &Studio, row: &PlantRow) -> Result<Shears, ApiError> {
         return Ok(None);
     };
     let kept = studio.kept::<RunOutlines>();
-    if let Some(outlines) = kept.get(run) {
-        return Ok(outlines);
+    if let Some(outlines) = kept.0.get(run) {
+        return Ok(Shears::clone(&outlines));
     }
     let Some(run) = studio.archive.read(|c| archive::run(c, run))? else {
         return Ok(None);
@@ -92,36 +92,22 @@ pub fn pruned_to(studio: &Studio, row: &PlantRow) -> Result<Shears, ApiError> {
             .map_err(|e| ApiError::internal(format!("match run {}'s pictures: {e}", run.id)))?,
         None => None,
     };
-    kept.put(run.id, outlines.clone());
+    kept.0.put(run.id, Arc::new(outlines.clone()), 0);
     Ok(outlines)
 }
 
-/// Match runs whose outlines are kept in memory at most; the oldest read goes first.
+/// Match runs whose outlines are kept in memory at most; the least recently used goes first.
 const KEPT_RUNS: usize = 32;
 
 /// Match runs' outlines (none for a run that does not prune), read from the run's config and
 /// pictures once rather than at every plant shown: a run's pictures never change and runs
-/// are never deleted, so its id names them for the studio's life.
-#[derive(Default)]
-struct RunOutlines(Mutex<VecDeque<(i64, Shears)>>);
+/// are never deleted, so its id names them for the studio's life. Bounded by count: a run's
+/// outlines are a few hundred rows of stretches.
+struct RunOutlines(Bounded<i64, Shears>);
 
-impl RunOutlines {
-    fn get(&self, run: i64) -> Option<Shears> {
-        let kept = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        kept.iter()
-            .find(|(id, _)| *id == run)
-            .map(|(_, o)| o.clone())
-    }
-
-    fn put(&self, run: i64, outlines: Shears) {
-        let mut kept = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        if kept.iter().any(|(id, _)| *id == run) {
-            return;
-        }
-        if kept.len() == KEPT_RUNS {
-            kept.pop_front();
-        }
-        kept.push_back((run, outlines));
+impl Default for RunOutlines {
+    fn default() -> Self {
+        RunOutlines(Bounded::new(KEPT_RUNS, usize::MAX))
     }
 }
 
