@@ -15,6 +15,8 @@ generations.
 
     pip install ribs==0.12.0        # not a test dependency
     python crates/sylva-py/benches/varieties_cma_me.py [--seeds 1 2 3] [--generations 200]
+
+scripts/varieties-figures runs it for five seeds and writes docs/varieties.md's tables.
 """
 
 from __future__ import annotations
@@ -97,6 +99,54 @@ def run_cma_me(seed: int, generations: int, every: int, sigma: float) -> list[tu
     return curve
 
 
+RUNS = ("Sylva, the model's operators", "Sylva CMA-ME", "pyribs CMA-ME")
+
+
+def measure(seeds: list[int], generations: int, every: int, sigma: float,
+            progress=lambda line: None) -> dict[str, list[dict]]:
+    """Each run's curve for each seed, in turns, after a warm-up of pyribs (numba compiles
+    its archive on first use): {run: [{"seed", "curve": [(generation, coverage, QD-score,
+    seconds)]}]}."""
+    run_cma_me(99, 2, 1, sigma)
+    results: dict[str, list[dict]] = {name: [] for name in RUNS}
+    for seed in seeds:
+        for name, run in zip(RUNS, (lambda: run_sylva(seed, generations, every),
+                                    lambda: run_sylva(seed, generations, every, sigma),
+                                    lambda: run_cma_me(seed, generations, every, sigma))):
+            curve = run()
+            results[name].append({"seed": seed, "curve": curve})
+            progress(f"seed {seed}, {name}: {curve[-1][1]:.2f} / {curve[-1][2]:.3f}")
+    return results
+
+
+def seed_table(results: dict[str, list[dict]]) -> str:
+    """A row per seed and run: coverage / QD-score at every recorded generation, wall time."""
+    first = results[RUNS[0]][0]["curve"]
+    lines = ["| seed | run | " + " | ".join(f"gen {g}" for g, *_ in first) + " | wall |",
+             "| --- | --- |" + " --- |" * (len(first) + 1)]
+    for i in range(len(results[RUNS[0]])):
+        for name in RUNS:
+            run = results[name][i]
+            cells = " | ".join(f"{c:.2f} / {q:.3f}" for _, c, q, _ in run["curve"])
+            lines.append(f"| {run['seed']} | {name} | {cells} | {run['curve'][-1][3]:.1f} s |")
+    return "\n".join(lines)
+
+
+def mean_at(runs: list[dict], generation: int) -> tuple[float, float]:
+    """Mean coverage and QD-score over the seeds at one recorded generation."""
+    points = [next(p for p in run["curve"] if p[0] == generation) for run in runs]
+    return (float(np.mean([p[1] for p in points])), float(np.mean([p[2] for p in points])))
+
+
+def means_table(results: dict[str, list[dict]], generations: list[int]) -> str:
+    lines = ["| run | " + " | ".join(f"generation {g}" for g in generations) + " |",
+             "| --- |" + " --- |" * len(generations)]
+    for name in RUNS:
+        cells = (mean_at(results[name], g) for g in generations)
+        lines.append(f"| {name} | " + " | ".join(f"{c:.2f} / {q:.3f}" for c, q in cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
@@ -106,24 +156,13 @@ def main() -> None:
     args = parser.parse_args()
     import ribs
 
-    run_cma_me(99, 2, 1, args.sigma)  # numba compiles pyribs' archive on first use
-    print(f"PlantMaker, leaf_count x porosity 8x8, {INITIAL} random + {BATCH} x "
+    results = measure(args.seeds, args.generations, args.every, args.sigma, progress=print)
+    print(f"\nPlantMaker, leaf_count x porosity 8x8, {INITIAL} random + {BATCH} x "
           f"{args.generations} evaluations, 2 threads; pyribs {ribs.__version__}, "
           f"CMA-ME sigma0 {args.sigma} of the unit cube\n")
-    print("| seed | run | " + " | ".join(f"gen {g}" for g in range(0, args.generations + 1, args.every))
-          + " | wall |")
-    print("| --- | --- |" + " --- |" * (args.generations // args.every + 2))
-    for seed in args.seeds:
-        for name, run in (("Sylva, the model's operators",
-                           lambda: run_sylva(seed, args.generations, args.every)),
-                          ("Sylva CMA-ME", lambda: run_sylva(seed, args.generations, args.every,
-                                                             args.sigma)),
-                          ("pyribs CMA-ME", lambda: run_cma_me(seed, args.generations, args.every,
-                                                              args.sigma))):
-            curve = run()
-            cells = " | ".join(f"{c:.2f} / {q:.3f}" for _, c, q, _ in curve)
-            print(f"| {seed} | {name} | {cells} | {curve[-1][3]:.1f} s |", flush=True)
-    print("\n(each cell: coverage / QD-score)")
+    print(seed_table(results))
+    print("\n(each cell: coverage / QD-score)\n")
+    print(means_table(results, [args.every, args.generations]))
 
 
 if __name__ == "__main__":

@@ -26,6 +26,8 @@ the end.
 
     pip install ribs==0.12.0        # not a test dependency: it brings numba, scipy, pandas
     python crates/sylva-py/benches/varieties_vs_pyribs.py [--seeds 1 2 3 4 5] [--generations 100]
+
+scripts/varieties-figures runs it at three budgets and writes docs/varieties.md's tables.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 INITIAL = 200
 BATCH = 100
 CELLS = 10
+SIGMA = 0.05  # the Gaussian emitter's step, the best of --tune
 
 
 def config(seed: int, generations: int) -> sylva.Config:
@@ -127,64 +130,116 @@ def run_pyribs(seed: int, generations: int, emitter: str, sigma: float) -> dict:
     }
 
 
+NAMES = {
+    "sylva": "Sylva `varieties`",
+    "gaussian": "pyribs GaussianEmitter",
+    "isoline": "pyribs IsoLineEmitter",
+}
+
+
+def measure(seeds: list[int], generations: int, sigma: float = SIGMA,
+            progress=lambda line: None) -> dict[str, list[dict]]:
+    """Every run for each seed, in turns (Sylva, Gaussian, Iso+LineDD) so that the machine's
+    state weighs on all alike, after a warm-up of each (numba compiles pyribs' archive on
+    first use). Each run's result carries its seed."""
+    run_sylva(99, 2)
+    run_pyribs(99, 2, "gaussian", sigma)
+    run_pyribs(99, 2, "isoline", sigma)
+    results: dict[str, list[dict]] = {key: [] for key in NAMES}
+    for seed in seeds:
+        for key in results:
+            if key == "sylva":
+                r = run_sylva(seed, generations)
+            else:
+                r = run_pyribs(seed, generations, key, sigma)
+            assert r["lowest"] >= 0.0, "every elite above the QD offset"
+            assert r["evaluations"] == INITIAL + BATCH * generations, "equal work"
+            r["seed"] = seed
+            results[key].append(r)
+            progress(f"{generations} generations, seed {seed}, {NAMES[key]}: "
+                     f"{r['coverage']:.2f} / {r['qd_score']:.1f}")
+    return results
+
+
+TUNE_SIGMAS = (0.05, 0.1, 0.2, 0.3)
+
+
+def tune(seed: int, generations: int) -> dict:
+    """The Gaussian emitter at each sigma on one seed (outside the table's)."""
+    return {"seed": seed, "generations": generations,
+            "runs": {sigma: run_pyribs(seed, generations, "gaussian", sigma)
+                     for sigma in TUNE_SIGMAS}}
+
+
+def tune_sentence(tuned: dict) -> str:
+    runs = tuned["runs"]
+    best = max(runs, key=lambda sigma: runs[sigma]["qd_score"])
+    tried = ", ".join(f"{sigma}: {r['qd_score']:.0f}" for sigma, r in runs.items())
+    advice = ("" if best == SIGMA else
+              f" The tables use {SIGMA}: re-run them with `--sigma {best}`.")
+    return (f"The Gaussian emitter's sigma (`--tune`, seed {tuned['seed']}, "
+            f"{tuned['generations']} generations), QD-score by sigma: {tried}; the best is "
+            f"{best}.{advice}")
+
+
+def means(results: dict[str, list[dict]]) -> dict[str, dict[str, float]]:
+    return {key: {field: float(np.mean([r[field] for r in runs]))
+                  for field in ("coverage", "qd_score", "seconds", "pyribs")}
+            for key, runs in results.items()}
+
+
+def seed_table(results: dict[str, list[dict]]) -> str:
+    """A row per seed and run: coverage, QD-score, wall time and pyribs' own part of it."""
+    lines = ["| seed | run | coverage | QD-score | wall time | of it, pyribs' ask and tell |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for i, seed in enumerate(r["seed"] for r in results["sylva"]):
+        for key, runs in results.items():
+            r = runs[i]
+            own = f"{r['pyribs'] * 1000:.0f} ms" if key != "sylva" else ""
+            lines.append(f"| {seed} | {NAMES[key]} | {r['coverage']:.2f} | {r['qd_score']:.1f} | "
+                         f"{r['seconds'] * 1000:.0f} ms | {own} |")
+    return "\n".join(lines)
+
+
+def budget_table(budgets: dict[int, dict[str, list[dict]]]) -> str:
+    """Means over the seeds at each budget, and Sylva's against each pyribs emitter."""
+    lines = ["| generations (evaluations) | run | coverage | QD-score | wall time | "
+             "Sylva's coverage ÷ its | Sylva's QD-score ÷ its | its wall time ÷ Sylva's |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for generations, results in budgets.items():
+        m = means(results)
+        s = m["sylva"]
+        for key, row in m.items():
+            first = f"{generations} ({INITIAL + BATCH * generations:,})" if key == "sylva" else ""
+            ratios = (" | | |" if key == "sylva" else
+                      f" {s['coverage'] / row['coverage']:.2f} | "
+                      f"{s['qd_score'] / row['qd_score']:.2f} | "
+                      f"{row['seconds'] / s['seconds']:.2f} |")
+            lines.append(f"| {first} | {NAMES[key]} | {row['coverage']:.3f} | "
+                         f"{row['qd_score']:.1f} | {row['seconds'] * 1000:.0f} ms |" + ratios)
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     parser.add_argument("--generations", type=int, default=100)
-    parser.add_argument("--sigma", type=float, default=0.05)  # the best of --tune
+    parser.add_argument("--sigma", type=float, default=SIGMA)
     parser.add_argument("--tune", action="store_true")
     args = parser.parse_args()
     import ribs
 
     if args.tune:
-        seed = max(args.seeds) + 100
-        for sigma in (0.05, 0.1, 0.2, 0.3):
-            r = run_pyribs(seed, args.generations, "gaussian", sigma)
-            print(f"gaussian sigma {sigma}, seed {seed}: coverage {r['coverage']:.2f}, "
-                  f"QD-score {r['qd_score']:.1f}")
+        print(tune_sentence(tune(max(args.seeds) + 100, args.generations)))
         return
 
-    # Warm up both (numba compiles pyribs' archive on first use; pages and pools).
-    run_sylva(99, 2)
-    run_pyribs(99, 2, "gaussian", args.sigma)
-    run_pyribs(99, 2, "isoline", args.sigma)
-    print(f"binary trees, height_to_width x porosity, {CELLS}x{CELLS}, {INITIAL} + "
-          f"{BATCH} x {args.generations} evaluations, 2 threads; pyribs {ribs.__version__}\n")
-    print("| seed | run | coverage | QD-score | wall time | of it, pyribs' ask and tell | "
-          "evaluations |")
-    print("| --- | --- | --- | --- | --- | --- | --- |")
-    results: dict[str, list[dict]] = {"sylva": [], "gaussian": [], "isoline": []}
-    names = {
-        "sylva": "Sylva `varieties`",
-        "gaussian": f"pyribs GaussianEmitter (sigma {args.sigma})",
-        "isoline": "pyribs IsoLineEmitter",
-    }
-    for seed in args.seeds:
-        # In turns, so that the machine's state weighs on all alike.
-        for key in results:
-            if key == "sylva":
-                r = run_sylva(seed, args.generations)
-            else:
-                r = run_pyribs(seed, args.generations, key, args.sigma)
-            assert r["lowest"] >= 0.0, "every elite above the QD offset"
-            results[key].append(r)
-            own = f"{r['pyribs'] * 1000:.0f} ms" if key != "sylva" else ""
-            print(f"| {seed} | {names[key]} | {r['coverage']:.2f} | {r['qd_score']:.1f} | "
-                  f"{r['seconds'] * 1000:.0f} ms | {own} | {r['evaluations']} |")
+    results = measure(args.seeds, args.generations, args.sigma, progress=print)
+    print(f"\nbinary trees, height_to_width x porosity, {CELLS}x{CELLS}, {INITIAL} + "
+          f"{BATCH} x {args.generations} evaluations, 2 threads; pyribs {ribs.__version__}, "
+          f"Gaussian sigma {args.sigma}\n")
+    print(seed_table(results))
     print("\nMeans over the seeds, and Sylva's against each:\n")
-    print("| run | coverage | QD-score | wall time | Sylva's coverage / its | Sylva's QD-score / "
-          "its | its wall time / Sylva's |")
-    print("| --- | --- | --- | --- | --- | --- | --- |")
-    mean = {k: {f: float(np.mean([r[f] for r in v]))
-                for f in ("coverage", "qd_score", "seconds", "pyribs")}
-            for k, v in results.items()}
-    for key, m in mean.items():
-        s = mean["sylva"]
-        ratios = ("" if key == "sylva" else
-                  f" {s['coverage'] / m['coverage']:.2f} | {s['qd_score'] / m['qd_score']:.2f} | "
-                  f"{m['seconds'] / s['seconds']:.2f} |")
-        print(f"| {names[key]} | {m['coverage']:.3f} | {m['qd_score']:.1f} | "
-              f"{m['seconds'] * 1000:.0f} ms |" + (ratios or " | | |"))
+    print(budget_table({args.generations: results}))
 
 
 if __name__ == "__main__":

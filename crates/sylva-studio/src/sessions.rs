@@ -79,17 +79,23 @@ pub fn session_of(studio: &Studio, id: i64, mode: &str) -> Result<archive::Sessi
     Ok(row)
 }
 
-/// The example genomes shipped with Sylva, built into the binary.
+/// The examples folder shipped with Sylva (genomes, configs, pictures: 320 kB), built into the
+/// binary whole: picking files by pattern at build time would cost the build a glob and regex
+/// engine.
 #[derive(RustEmbed)]
 #[folder = "../../examples/"]
-#[include = "*/*.json"]
 struct ExampleFiles;
+
+/// An example file's text by its path in the examples folder (`bintree/varieties.toml`).
+pub fn example_text(path: &str) -> Option<String> {
+    String::from_utf8(ExampleFiles::get(path)?.data.into_owned()).ok()
+}
 
 /// An example genome by name (`plantmaker/fern`).
 pub fn example(registry: &Registry, name: &str) -> Option<Genome> {
-    let file = ExampleFiles::get(&format!("{name}.json"))?;
-    let text = std::str::from_utf8(&file.data).ok()?;
-    registry.parse_genome(text).ok()
+    registry
+        .parse_genome(&example_text(&format!("{name}.json"))?)
+        .ok()
 }
 
 /// Every example's name and model, sorted by name.

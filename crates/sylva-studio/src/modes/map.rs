@@ -17,7 +17,6 @@ use std::time::{Duration, Instant};
 
 use axum::Json;
 use axum::extract::{Path, State};
-use rust_embed::RustEmbed;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use sylva::evolution::{AxisConfig, Descriptor};
@@ -30,13 +29,7 @@ use crate::events::SessionEvent;
 use crate::http::Body;
 use crate::modes::{Mode, Route};
 use crate::runs::{self, archive_member, finite};
-use crate::sessions::{SessionView, example, session_of, view};
-
-/// The example maps, built into the binary: each model's base.
-#[derive(RustEmbed)]
-#[folder = "../../examples/"]
-#[include = "*/varieties.toml"]
-struct ExampleMaps;
+use crate::sessions::{SessionView, example, example_text, session_of, view};
 
 /// Most cells along an axis the page draws.
 const MAX_CELLS: u32 = 32;
@@ -192,12 +185,10 @@ fn config_of(
 
 /// The model's example map as a config value, or its defaults with the default map.
 fn base_config(model: &str) -> Result<serde_json::Value, ApiError> {
-    let Some(file) = ExampleMaps::get(&format!("{model}/varieties.toml")) else {
+    let Some(text) = example_text(&format!("{model}/varieties.toml")) else {
         return Ok(json!({ "model": model, "map": {} }));
     };
-    let text = std::str::from_utf8(&file.data)
-        .map_err(|e| ApiError::internal(format!("{model}'s example map: {e}")))?;
-    let mut doc: serde_json::Value = toml::from_str(text)
+    let mut doc: serde_json::Value = toml::from_str(&text)
         .map_err(|e| ApiError::internal(format!("{model}'s example map: {e}")))?;
     if doc.get("map").is_none() {
         doc["map"] = json!({});
