@@ -23,6 +23,7 @@ use sylva_core::{Plant, ranged};
 use crate::compile::{AtEnd, ElseEnd, Program, Semantics};
 use crate::sim::{ChildVariables, Detail, GrowOptions, GrowthReport, Limits, Simulator};
 use crate::tree::GpTree;
+use sylva_model::schema::{Editor, FieldSpec, Kind, Schema, StructureSpec};
 use sylva_model::{DevelopError, GenomeError};
 use sylva_model::{FormatV1, model_tag};
 
@@ -94,6 +95,144 @@ pub struct Growth {
     pub child_variables: ChildVariables,
     /// Runaway bounds; each field defaults as in [`Limits`].
     pub limits: Limits,
+}
+
+/// The genome field by field: how the program grows (the program itself is a structure,
+/// edited as a tree).
+pub fn schema() -> Schema {
+    let units = |name: &str, meaning: &'static str| {
+        FieldSpec::new(
+            name.to_owned(),
+            "growth",
+            Kind::number(0.0, 1000.0),
+            meaning,
+        )
+        .unit(" units")
+    };
+    let limit = |name: &str, max: i64, meaning: &'static str| {
+        FieldSpec::new(
+            format!("limits.{name}"),
+            "limits",
+            Kind::Integer { min: 1, max },
+            meaning,
+        )
+    };
+    let fields = vec![
+        FieldSpec::new(
+            "iterations",
+            "growth",
+            Kind::Integer {
+                min: 1,
+                max: 100_000,
+            },
+            "Steps the automata run: the plant's age.",
+        )
+        .shaping(),
+        units(
+            "root_length",
+            "The root automaton's starting length per step.",
+        )
+        .shaping(),
+        FieldSpec::new(
+            "unit",
+            "growth",
+            Kind::scale(1e-6, 1000.0),
+            "Metres per unit of the paper's space: the plant's scale.",
+        )
+        .unit(" m"),
+        FieldSpec::new(
+            "gravity",
+            "growth",
+            Kind::number(0.0, 90.0),
+            "How far a horizontal shoot bends down each step.",
+        )
+        .unit("° per step")
+        .shaping(),
+        FieldSpec::new(
+            "degrees_per_unit",
+            "growth",
+            Kind::number(0.0, 36.0),
+            "Degrees turned per unit of a rotation's value: how sharply branches turn.",
+        )
+        .unit("°")
+        .shaping(),
+        units("radius", "A stem's radius at thickness 1."),
+        units("leaf_length", "A leaf's length."),
+        units("flower_size", "A flower's diameter."),
+        FieldSpec::new(
+            "horizontal_leaves",
+            "growth",
+            Kind::Flag,
+            "Leaves held near horizontal.",
+        ),
+        FieldSpec::new(
+            "else_end",
+            "program",
+            Kind::choice_of(&[ElseEnd::Rejoin, ElseEnd::End]),
+            "Where an If's else branch goes when it ends: on with what follows the If, or to the automaton's end.",
+        ),
+        FieldSpec::new(
+            "at_end",
+            "program",
+            Kind::choice_of(&[AtEnd::Die, AtEnd::Restart]),
+            "What reaching its end does to an automaton: it dies, or starts again.",
+        ),
+        FieldSpec::new(
+            "equal_tolerance",
+            "program",
+            Kind::number(0.0, 10.0),
+            "How near two values are equal for IfEqual.",
+        ),
+        FieldSpec::new(
+            "child_variables",
+            "program",
+            Kind::choice_of(&[
+                ChildVariables::LengthThickness,
+                ChildVariables::All,
+                ChildVariables::Fresh,
+            ]),
+            "The variables a new automaton starts with: its creator's length and thickness, all its creator's, or fresh ones.",
+        ),
+        limit(
+            "states_per_step",
+            1_000_000,
+            "States one automaton may run in one step before it is killed.",
+        ),
+        limit(
+            "states",
+            1_000_000_000,
+            "States in the whole run; growth stops there.",
+        ),
+        limit(
+            "automata",
+            1_000_000,
+            "Automata in the whole run, the root included.",
+        ),
+        limit(
+            "points",
+            100_000_000,
+            "Recorded positions; growth stops there.",
+        ),
+        FieldSpec::new(
+            "limits.organs",
+            "limits",
+            Kind::Integer {
+                min: 0,
+                max: 10_000_000,
+            },
+            "Leaves and flowers.",
+        ),
+    ];
+    let program = StructureSpec {
+        path: "program",
+        meaning: "The genetic program compiled into the turtle automata: a tree of nodes.",
+        editor: Editor::Program,
+    };
+    Schema {
+        fields,
+        lists: Vec::new(),
+        structures: vec![program],
+    }
 }
 
 impl Default for Growth {

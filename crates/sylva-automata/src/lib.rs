@@ -165,6 +165,10 @@ impl Model for AutomataModel {
     /// The level sets where crossover cuts: low at operators only (the largest subtrees),
     /// medium at operators nine times in ten (Koza's, the default), high at operators half
     /// the time (more single values).
+    fn schema(&self) -> sylva_model::schema::Schema {
+        genome::schema()
+    }
+
     fn hand_settings(&self, knobs: Knobs, base: AutomataSettings) -> AutomataSettings {
         let depth = u32::from(knobs.depth.get());
         AutomataSettings {

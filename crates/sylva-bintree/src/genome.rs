@@ -38,6 +38,7 @@ use sylva_evolve::bits::{BitString, Quantized};
 
 use sylva_core::ranged;
 
+use sylva_model::schema::{FieldSpec, Kind, Schema};
 use sylva_model::{DevelopError, FormatV1, model_tag, plant_meta};
 
 /// Model name in genome files.
@@ -169,6 +170,78 @@ ranged!(min_radius: f64, "min_radius", 0.001, 1.0, " m");
 ranged!(angle: f64, "rotation angle", -360.0, 360.0, " degrees");
 
 sylva_core::ranged!(depth: u32, "depth", 1, MAX_DEPTH);
+
+/// The genome field by field, with the ranges files may hold (wider than evolution's
+/// [`LAYOUT`]).
+pub fn schema() -> Schema {
+    let metres = |path, min, max, meaning| {
+        FieldSpec::new(path, "stems", Kind::number(min, max), meaning).unit(" m")
+    };
+    let mut fields = vec![
+        FieldSpec::new(
+            "depth",
+            "shape",
+            Kind::Integer {
+                min: 1,
+                max: i64::from(MAX_DEPTH),
+            },
+            "Levels of branching: 2^depth − 1 cylinders.",
+        )
+        .shaping(),
+        metres("length", 0.01, 50.0, "The trunk's length.").shaping(),
+        FieldSpec::new(
+            "length_ratio",
+            "shape",
+            Kind::number(0.1, 1.5),
+            "Each level's length over its parent's (1 in the paper).",
+        )
+        .shaping(),
+        metres(
+            "lower_radius",
+            0.001,
+            5.0,
+            "The trunk's radius at its foot.",
+        ),
+        metres(
+            "upper_radius",
+            0.001,
+            5.0,
+            "The trunk's radius at its top: top over foot is every level's taper.",
+        ),
+        metres(
+            "min_radius",
+            0.001,
+            1.0,
+            "No cylinder is thinner than this.",
+        ),
+    ];
+    let children = [
+        ("rotation1", "the first child (it carries the axis on)"),
+        ("rotation2", "the second child (a new branch)"),
+    ];
+    for (rotation, child) in children {
+        let angle = format!("How far {child} turns from its parent.");
+        let axis = format!("The axis {child} turns about (x right, y along the branch, z up).");
+        fields.push(
+            FieldSpec::new(
+                format!("{rotation}.angle"),
+                "shape",
+                Kind::number(-360.0, 360.0),
+                angle,
+            )
+            .unit("°")
+            .shaping(),
+        );
+        fields.push(FieldSpec::new(
+            format!("{rotation}.axis"),
+            "shape",
+            Kind::Axis,
+            axis,
+        ));
+    }
+    fields.push(FieldSpec::new("geometry", "shape", Kind::choice_of(&[Geometry::Sylva, Geometry::Paper]), "Sylva's geometry (the taper carries on from level to level) or the paper's (every cylinder from the lower to the upper radius).").optional());
+    Schema::of(fields)
+}
 
 /// Reads an axis inside the array's own visitor, so an error points at the array (checks
 /// made after the array is read would point at the end of the enclosing object).

@@ -79,6 +79,10 @@ impl Model for BinTreeModel {
     /// 0.02; Depth 10 flips about six bits). The level: low and medium cut the bit string
     /// once (a tree's two halves are its largest parts), high takes each bit from either
     /// parent.
+    fn schema(&self) -> sylva_model::schema::Schema {
+        genome::schema()
+    }
+
     fn hand_settings(&self, knobs: Knobs, base: BinTreeSettings) -> BinTreeSettings {
         BinTreeSettings {
             mutation_rate: 0.01 * f64::from(knobs.depth.get()),

@@ -25,6 +25,7 @@ use rand::{Rng, RngExt};
 use serde::de::{Error, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use sylva_core::species::{BarkKind, LeafKind};
+use sylva_model::schema::{FieldSpec, Kind, Schema};
 use sylva_model::{FormatV1, model_tag};
 
 use crate::profile::Profile;
@@ -212,6 +213,85 @@ params! {
     Inset = "inset", Crown, 0.0, 0.1, 0.0, false, "",
         "How far inside its envelope the crown's space stays, as a share of the height: \
          room for the leaves the outermost twigs bear.";
+}
+
+impl Group {
+    /// Its name in panels and files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Group::Crown => "crown",
+            Group::Growth => "growth",
+            Group::Form => "form",
+        }
+    }
+}
+
+/// The parameters that move a tree's shape most, first in panels.
+const SHAPING: [&str; 7] = [
+    "height",
+    "crown_base",
+    "width",
+    "apical_control",
+    "branch_angle",
+    "gravitropism",
+    "points",
+];
+
+/// The genome field by field: the crown's shape, the leaves and bark it wears, then every
+/// parameter of [`PARAMS`] (a match's `envelope`, drawn from pictures, is not set by hand).
+pub fn schema() -> Schema {
+    let mut fields = vec![
+        FieldSpec::new(
+            "crown",
+            "crown",
+            Kind::choice_of(&CrownShape::ALL),
+            "The crown's shape: the envelope the attraction points fill.",
+        )
+        .shaping(),
+        FieldSpec::new(
+            "seed",
+            "crown",
+            Kind::Seed,
+            "Places the attraction points: another seed grows another tree of the same kind.",
+        ),
+        FieldSpec::new(
+            "foliage",
+            "form",
+            Kind::choice_of(&LeafKind::ALL),
+            "The leaves or needles it bears, at their real size, and its bark unless `bark` says otherwise.",
+        ),
+        FieldSpec::new(
+            "bark",
+            "form",
+            Kind::choice_of(&BarkKind::ALL),
+            "A bark other than the foliage's own (left out: the foliage's species' bark).",
+        )
+        .optional(),
+    ];
+    fields.extend(PARAMS.iter().map(|p| {
+        let kind = if p.whole {
+            Kind::Integer {
+                min: p.min as i64,
+                max: p.max as i64,
+            }
+        } else {
+            Kind::number(p.min, p.max)
+        };
+        let field = FieldSpec::new(
+            format!("parameters.{}", p.name),
+            p.group.name(),
+            kind,
+            p.meaning,
+        )
+        .unit(p.unit)
+        .optional();
+        if SHAPING.contains(&p.name) {
+            field.shaping()
+        } else {
+            field
+        }
+    }));
+    Schema::of(fields)
 }
 
 impl Param {

@@ -78,6 +78,10 @@ impl Model for GrownModel {
     /// is the default). The level is how often a child's parameter lies between its
     /// parents' rather than being one parent's: never (low: whole values of each), 30%
     /// (medium), 70% (high).
+    fn schema(&self) -> sylva_model::schema::Schema {
+        genome::schema()
+    }
+
     fn hand_settings(&self, knobs: Knobs, base: GrownSettings) -> GrownSettings {
         let d = f64::from(knobs.depth.get());
         GrownSettings {

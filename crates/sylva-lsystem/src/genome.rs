@@ -40,6 +40,7 @@ use crate::grammar::{
 use crate::interpret::{Angles, ModuleShape};
 use crate::mutate::{MutationRates, mutate_rules};
 use crate::physiology::Physiology;
+use sylva_model::schema::{Editor, FieldSpec, Kind, Schema, StructureSpec};
 use sylva_model::{FormatV1, model_tag};
 
 /// Model name in genome files.
@@ -302,6 +303,223 @@ impl Default for Modules {
             fine_root: shape(0.06, 0.005),
             root_branch: shape(0.1, 0.008),
         }
+    }
+}
+
+/// The genome field by field: angles, module shapes and the physiology's constants (the two
+/// L-systems are structures, edited as rules).
+pub fn schema() -> Schema {
+    let angle = |name: &str, meaning: &'static str| {
+        FieldSpec::new(
+            format!("angles.{name}"),
+            "angles",
+            Kind::number(-180.0, 180.0),
+            meaning,
+        )
+        .unit("°")
+        .shaping()
+    };
+    let mut fields = vec![
+        angle("turn", "The turn of `+` and `-`."),
+        angle("pitch", "The pitch of `>` and `<`."),
+        angle("roll", "The roll of `$` and `&`."),
+    ];
+    for (module, what) in [
+        ("leaf", "a leaf (`l`)"),
+        ("branch", "a branch (`b`)"),
+        ("fine_root", "a fine root (`r`)"),
+        ("root_branch", "a root branch (`c`)"),
+    ] {
+        let shaping = matches!(module, "leaf" | "branch");
+        let length = FieldSpec::new(
+            format!("modules.{module}.length"),
+            "modules",
+            Kind::number(0.005, 2.0),
+            format!("The length of {what}."),
+        )
+        .unit(" m");
+        fields.push(if shaping { length.shaping() } else { length });
+        fields.push(
+            FieldSpec::new(
+                format!("modules.{module}.radius"),
+                "modules",
+                Kind::number(0.001, 0.5),
+                format!("The radius of {what}."),
+            )
+            .unit(" m"),
+        );
+    }
+    let physiology: [(&str, Kind, &'static str, &'static str); 20] = [
+        (
+            "seed_biomass",
+            Kind::scale(1e-4, 10.0),
+            " g",
+            "Structural mass of the seed's embryo, half shoot, half root.",
+        ),
+        (
+            "seed_carbon",
+            Kind::number(0.0, 100.0),
+            " g",
+            "Carbon reserve of the seed.",
+        ),
+        (
+            "seed_minerals",
+            Kind::number(0.0, 100.0),
+            " g",
+            "Mineral reserve of the seed.",
+        ),
+        (
+            "carbon_content",
+            Kind::number(0.01, 1.0),
+            "",
+            "Carbon in a gram of biomass.",
+        ),
+        (
+            "mineral_content",
+            Kind::number(0.001, 1.0),
+            "",
+            "Minerals in a gram of biomass.",
+        ),
+        (
+            "photosynthesis",
+            Kind::number(0.0, 100.0),
+            " g",
+            "Carbon fixed per unit of absorbed light (a square metre of open sky for one step).",
+        ),
+        (
+            "uptake",
+            Kind::number(0.0, 100.0),
+            " m",
+            "Soil volume a square metre of fine root draws on per step.",
+        ),
+        (
+            "carbon_inhibition",
+            Kind::scale(1e-4, 1e4),
+            " g/g",
+            "Shoot carbon concentration at which photosynthesis is halved.",
+        ),
+        (
+            "mineral_inhibition",
+            Kind::scale(1e-4, 1e4),
+            " g/g",
+            "Root mineral concentration at which uptake is halved.",
+        ),
+        (
+            "growth_rate",
+            Kind::number(0.0, 1e4),
+            " per step",
+            "k of growth = k·C·N/W.",
+        ),
+        (
+            "carbon_resistance",
+            Kind::scale(1.0, 1000.0),
+            "",
+            "Resistance to carbon transport.",
+        ),
+        (
+            "mineral_resistance",
+            Kind::scale(1.0, 1000.0),
+            "",
+            "Resistance to mineral transport.",
+        ),
+        (
+            "growth_loss",
+            Kind::number(0.0, 0.9),
+            "",
+            "Share of the carbon spent on growth lost to litter.",
+        ),
+        (
+            "maintenance",
+            Kind::number(0.0, 1.0),
+            " g/g",
+            "Carbon a gram of biomass costs to keep each step.",
+        ),
+        (
+            "module_density",
+            Kind::scale(1.0, 1e6),
+            " g/m³",
+            "Biomass per cubic metre of module.",
+        ),
+        (
+            "min_cost",
+            Kind::scale(1e-5, 100.0),
+            " g",
+            "Least biomass any rewrite costs.",
+        ),
+        (
+            "apex_capacity",
+            Kind::scale(1e-4, 1e3),
+            " g",
+            "Most biomass an apex of weight 1 takes in one step.",
+        ),
+        (
+            "allocation_exponent",
+            Kind::number(0.0, 8.0),
+            "",
+            "How sharply allocation favours well-placed apexes.",
+        ),
+        (
+            "allocation_floor",
+            Kind::number(0.0, 1.0),
+            "",
+            "Added to every apex's quality, so apexes in the dark still get a little.",
+        ),
+        (
+            "life_span",
+            Kind::Integer {
+                min: 1,
+                max: 1_000_000,
+            },
+            " steps",
+            "Steps a plant lives.",
+        ),
+    ];
+    for (name, kind, unit, meaning) in physiology {
+        fields.push(
+            FieldSpec::new(format!("physiology.{name}"), "physiology", kind, meaning)
+                .unit(unit)
+                .optional(),
+        );
+    }
+    for (name, min, meaning) in [
+        (
+            "max_symbols",
+            8,
+            "Longest string of a compartment, in symbols.",
+        ),
+        ("max_modules", 1, "Most modules of a compartment."),
+    ] {
+        fields.push(
+            FieldSpec::new(
+                format!("physiology.{name}"),
+                "limits",
+                Kind::Integer {
+                    min,
+                    max: 1_000_000,
+                },
+                meaning,
+            )
+            .optional(),
+        );
+    }
+    let rules = |path, meaning| StructureSpec {
+        path,
+        meaning,
+        editor: Editor::Rules,
+    };
+    Schema {
+        fields,
+        lists: Vec::new(),
+        structures: vec![
+            rules(
+                "shoot",
+                "The above-ground L-system (`l`, `b`): its axiom and rules such as `A -> [>bA]`.",
+            ),
+            rules(
+                "root",
+                "The below-ground L-system (`r`, `c`): its axiom and rules.",
+            ),
+        ],
     }
 }
 

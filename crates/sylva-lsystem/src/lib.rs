@@ -113,6 +113,10 @@ impl Model for LSystemModel {
     /// L-systems from one parent and the angles and module shapes from the other, medium
     /// each compartment whole from either (the default), high each rule, axiom, angle and
     /// module shape from either.
+    fn schema(&self) -> sylva_model::schema::Schema {
+        genome::schema()
+    }
+
     fn hand_settings(&self, knobs: Knobs, base: LSystemSettings) -> LSystemSettings {
         LSystemSettings {
             rates: base.rates.scaled(knobs.depth.scale()),

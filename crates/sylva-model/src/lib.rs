@@ -32,6 +32,7 @@
 //! use rand::{Rng, RngExt};
 //! use sylva_core::{Plant, glam::Vec3};
 //! use sylva_model::{Bred, DevelopError, Knobs, Model, Parent, VariationError, plant_meta};
+//! use sylva_model::schema::{FieldSpec, Kind, Schema};
 //!
 //! /// A plant of one cylinder, `height` metres tall.
 //! #[derive(Clone, Copy, Debug, Default)]
@@ -64,6 +65,10 @@
 //!
 //!     fn hand_settings(&self, _: Knobs, _: ()) {}
 //!
+//!     fn schema(&self) -> Schema {
+//!         Schema::of(vec![FieldSpec::new("height", "stem", Kind::number(0.1, 10.0), "How tall.").unit(" m")])
+//!     }
+//!
 //!     fn cross<R: Rng + ?Sized>(
 //!         &self,
 //!         parents: &[Parent<'_, StickGenome>],
@@ -86,6 +91,7 @@ pub mod biomorphs;
 pub mod experiments;
 pub mod file;
 pub mod gardens;
+pub mod schema;
 mod work;
 
 use std::fmt::Debug;
@@ -160,6 +166,10 @@ pub trait Model: Clone + Debug + Send + Sync + 'static {
     /// set is kept from `base`: the model's defaults, or the settings of the run the plants
     /// come from (a match's PlantMaker plants keep to leaf colours).
     fn hand_settings(&self, knobs: Knobs, base: Self::Settings) -> Self::Settings;
+
+    /// Its genome field by field: what a person may set by hand, each value's kind, range
+    /// and meaning ([`schema`]).
+    fn schema(&self) -> schema::Schema;
 
     /// Reads a genome file's text. The default is serde's reader, which refuses unknown
     /// fields and reports the line and column of any error.

@@ -32,6 +32,7 @@
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
+use sylva_model::schema::{FieldSpec, Kind, ListSpec, Schema};
 
 /// Most branch prototypes a genome may hold.
 pub const MAX_BRANCHES: usize = 32;
@@ -626,6 +627,172 @@ pub struct Inflorescence {
     pub position: u8,
     /// 4: which fans it places, by number.
     pub fans: FanSet,
+}
+
+/// The genome field by field: the seed, then every variable of Tables 1 to 3 for each item
+/// of its list, in table order, with the values files write (options by name, factors as
+/// decimals, colours as `#rrggbb`).
+pub fn schema() -> Schema {
+    let mut fields = vec![FieldSpec::new(
+        "seed",
+        "plant",
+        Kind::Seed,
+        "The random draws within every range: another seed grows another plant of the same kind.",
+    )];
+    let tables: [(&str, &str, &[Variable]); 3] = [
+        ("branches", "branch", &BRANCH_VARIABLES),
+        ("fans", "fan", &FAN_VARIABLES),
+        ("inflorescences", "inflorescence", &INFLORESCENCE_VARIABLES),
+    ];
+    for (list, group, table) in tables {
+        for v in table {
+            let (kind, unit, meaning) = describe(v);
+            let field =
+                FieldSpec::new(format!("{list}[].{}", v.name), group, kind, meaning).unit(unit);
+            let shaping = [
+                "branch_shape",
+                "waves",
+                "min_length",
+                "max_length",
+                "count",
+                "min_angle",
+                "max_angle",
+                "position",
+            ];
+            fields.push(if shaping.contains(&v.name) {
+                field.shaping()
+            } else {
+                field
+            });
+        }
+    }
+    let list = |path, meaning, max| ListSpec {
+        path,
+        meaning,
+        min: 1,
+        max,
+    };
+    Schema {
+        fields,
+        lists: vec![
+            list(
+                "branches",
+                "A branch prototype (Table 1): a chain of cones.",
+                MAX_BRANCHES,
+            ),
+            list(
+                "fans",
+                "A fan (Table 2): copies of one branch prototype around a point of the stem.",
+                MAX_FANS,
+            ),
+            list(
+                "inflorescences",
+                "An inflorescence (Table 3): fans placed together at one point of the stem.",
+                MAX_INFLORESCENCES,
+            ),
+        ],
+        structures: Vec::new(),
+    }
+}
+
+/// A variable's kind, unit and meaning as a panel shows it.
+fn describe(v: &Variable) -> (Kind, &'static str, &'static str) {
+    let whole = |min: u32, max: u32| Kind::Integer {
+        min: i64::from(min),
+        max: i64::from(max),
+    };
+    let tenths = |max| Kind::Number {
+        min: 0.1,
+        max,
+        step: 0.1,
+        log: false,
+    };
+    let (kind, unit) = match (v.kind, v.name) {
+        (Choice, "segment_pattern") => (Kind::choice_of(SegmentPattern::ALL), ""),
+        (Choice, "branch_shape") => (Kind::choice_of(BranchShape::ALL), ""),
+        (Choice, "segment_count" | "length") => (Kind::choice_of(Amount::ALL), ""),
+        (Choice, "thickness") => (Kind::choice_of(Thickness::ALL), ""),
+        (Choice, "noise" | "expressed") => (Kind::Flag, ""),
+        (Choice, _) => (Kind::choice_of(Progression::ALL), ""),
+        (Angle, _) => (whole(v.min, v.max), "°"),
+        (Color, _) => (Kind::Colour, ""),
+        (GeneKind::Branch, _) => (
+            Kind::Item {
+                list: "branches",
+                max: MAX_BRANCHES as i64,
+            },
+            "",
+        ),
+        (GeneKind::FanSet, _) => (
+            Kind::Items {
+                list: "fans",
+                max: MAX_FANS as i64,
+            },
+            "",
+        ),
+        (Integer, "min_length_factor" | "max_length_factor") => (tenths(3.0), ""),
+        (Integer, "min_thickness_factor" | "max_thickness_factor") => (tenths(5.0), ""),
+        (Integer, name) if name.ends_with("thickness") => (whole(v.min, v.max), " mm"),
+        (Integer, "min_length" | "max_length") => (whole(v.min, v.max), " cm"),
+        (Integer, "position") => (whole(v.min, v.max), " %"),
+        (Integer, _) => (whole(v.min, v.max), ""),
+    };
+    (kind, unit, meaning(v.name))
+}
+
+/// What each variable of Tables 1 to 3 does, in a sentence.
+fn meaning(name: &str) -> &'static str {
+    match name {
+        "segment_pattern" => "The outline of each cone of the branch.",
+        "branch_shape" => "Straight, curled or curved.",
+        "min_x_angle" => {
+            "Bend about the branch's x axis (towards its up side) at the start of each wave."
+        }
+        "max_x_angle" => "Bend about the branch's x axis at the end of each wave.",
+        "min_y_angle" => "Bend about the branch's up axis (sideways) at the start of each wave.",
+        "max_y_angle" => "Sideways bend at the end of each wave.",
+        "waves" => "Waves (curved) or curls (curled) along the branch.",
+        "segment_count" => {
+            "A constant number of cones (the mean of the two bounds) or a random one."
+        }
+        "min_segments" => "Fewest cones.",
+        "max_segments" => "Most cones.",
+        "thickness" => "How thickness runs along the branch.",
+        "min_base_thickness" => "Smallest diameter at the base of a cone.",
+        "max_base_thickness" => "Largest diameter at the base of a cone.",
+        "min_apex_thickness" => "Smallest diameter at the apex of a cone.",
+        "max_apex_thickness" => "Largest diameter at the apex of a cone.",
+        "length" => "A constant length of each cone (the mean of the two bounds) or a random one.",
+        "min_length" => "Shortest cone.",
+        "max_length" => "Longest cone.",
+        "noise" => "Whether noise is added to the angles between cones.",
+        "min_noise_x_angle" => "Smallest noise on the x angle.",
+        "max_noise_x_angle" => "Largest noise on the x angle.",
+        "min_noise_y_angle" => "Smallest noise on the y angle.",
+        "max_noise_y_angle" => "Largest noise on the y angle.",
+        "branch" => "Which branch prototype the fan copies, by number.",
+        "count" => "How many branches the fan holds.",
+        "length_mode" => "How the length factor runs across the fan (constant uses the largest).",
+        "min_length_factor" => "Smallest length factor across the fan.",
+        "max_length_factor" => "Largest length factor across the fan.",
+        "angle_mode" => "How the upward slant runs across the fan (constant uses the smallest).",
+        "min_angle" => "Smallest slant above the plane across the stem (above 180° slants down).",
+        "max_angle" => "Largest slant above the plane across the stem.",
+        "thickness_mode" => {
+            "How the thickness factor runs across the fan (constant uses the largest)."
+        }
+        "min_thickness_factor" => "Smallest thickness factor across the fan.",
+        "max_thickness_factor" => "Largest thickness factor across the fan.",
+        "color_mode" => "How colour runs across the fan (constant uses the first colour).",
+        "min_color" => "The fan's first colour.",
+        "max_color" => "The fan's last colour.",
+        "texture" => "Texture: 0 none, 1 to 127 one of Sylva's textures.",
+        "start_angle" => "The angle around the stem where the first fan starts.",
+        "expressed" => "Whether the inflorescence is drawn.",
+        "position" => "Where on the stem, from its foot (0) to its top (100).",
+        "fans" => "Which fans it places, by number.",
+        _ => "",
+    }
 }
 
 /// Checks each code against its table row.

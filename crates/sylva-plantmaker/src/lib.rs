@@ -460,6 +460,10 @@ impl sylva_model::Model for PlantMakerModel {
         Some(genome.to_packed())
     }
 
+    fn schema(&self) -> sylva_model::schema::Schema {
+        genes::schema()
+    }
+
     fn hand_settings(
         &self,
         knobs: sylva_model::Knobs,

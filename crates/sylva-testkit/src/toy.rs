@@ -9,6 +9,7 @@ use sylva_core::Plant;
 use sylva_core::glam::Vec3;
 use sylva_evolve::generational::{Generational, GenerationalSettings};
 use sylva_evolve::{Crossover, Fitness, Mutate, Problem};
+use sylva_model::schema::{FieldSpec, Kind, Schema};
 use sylva_model::{
     Bred, ConfigError, DevelopError, Evolve, FormatV1, Knobs, Model, Parent, Setup, VariationError,
     model_tag, plant_meta, two_most_dominant,
@@ -98,6 +99,16 @@ impl Model for Cylinder {
 
     fn hand_settings(&self, _: Knobs, base: CylinderSettings) -> CylinderSettings {
         base
+    }
+
+    fn schema(&self) -> Schema {
+        let field = |path, meaning| FieldSpec::new(path, "stem", Kind::number(0.01, 10.0), meaning);
+        Schema::of(vec![
+            field("height", "The cylinder's height.")
+                .unit(" m")
+                .shaping(),
+            field("radius", "The cylinder's radius.").unit(" m"),
+        ])
     }
 
     fn random<R: Rng + ?Sized>(&self, _: &CylinderSettings, rng: &mut R) -> CylinderGenome {

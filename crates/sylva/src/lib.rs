@@ -150,6 +150,12 @@ pub mod core {
     }
 }
 
+/// Every model's genome field by field ([`ModelEntry::schema`](registry::ModelEntry::schema)):
+/// what a panel, Python or the docs show, and what a value is checked against.
+pub mod schema {
+    pub use sylva_model::schema::{Editor, FieldSpec, Kind, ListSpec, Schema, StructureSpec};
+}
+
 /// GLBs read back (`sylva-gltf`): a file's scene, its first node's extras, its textures.
 /// Scenes are written through [`export`].
 pub mod import {

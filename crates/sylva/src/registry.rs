@@ -23,6 +23,8 @@ use sylva_bintree::BinTreeModel;
 use sylva_grown::GrownModel;
 use sylva_lsystem::LSystemModel;
 use sylva_model::{Evolve, GenomeError, Model};
+
+use crate::schema::Schema;
 use sylva_plantmaker::PlantMakerModel;
 
 use crate::error::{FieldError, InputError};
@@ -70,6 +72,7 @@ const RANDOM_DRAWS: u32 = 100;
 trait ModelFace: Send + Sync {
     fn name(&self) -> &'static str;
     fn title(&self) -> &'static str;
+    fn schema(&self) -> Schema;
     fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError>;
     fn random(&self, settings: Settings<'_>, seed: u64) -> Result<Genome, InputError>;
     fn parse_config(&self, path: &Path, text: &str) -> Result<Config, InputError>;
@@ -85,6 +88,10 @@ impl<M: Evolve + Default> ModelFace for M {
 
     fn title(&self) -> &'static str {
         M::TITLE
+    }
+
+    fn schema(&self) -> Schema {
+        Model::schema(self)
     }
 
     fn parse_genome(&self, text: &str) -> Result<Genome, GenomeError> {
@@ -172,6 +179,12 @@ impl ModelEntry {
     /// The model's title.
     pub fn title(&self) -> &'static str {
         self.model.title()
+    }
+
+    /// Its genome field by field: each value's kind, range, unit and meaning, for panels,
+    /// Python and the docs ([`schema`](crate::schema)).
+    pub fn schema(&self) -> Schema {
+        self.model.schema()
     }
 
     /// A random genome that grows: made by the model with `settings` (its settings as JSON,

@@ -517,6 +517,9 @@ mod void {
             rng.random()
         }
         fn hand_settings(&self, _: sylva_model::Knobs, _: ()) {}
+        fn schema(&self) -> sylva_model::schema::Schema {
+            sylva_model::schema::Schema::of(Vec::new())
+        }
         fn mutate<R: Rng + ?Sized>(&self, g: &u32, _: &(), _: &mut R) -> u32 {
             *g
         }
