@@ -104,7 +104,7 @@ pub fn schema() -> Schema {
         FieldSpec::new(
             name.to_owned(),
             "growth",
-            Kind::number(0.0, 1000.0),
+            Kind::number(0.0, 1000.0).slider(0.0, 20.0),
             meaning,
         )
         .unit(" units")
@@ -113,7 +113,7 @@ pub fn schema() -> Schema {
         FieldSpec::new(
             format!("limits.{name}"),
             "limits",
-            Kind::Integer { min: 1, max },
+            Kind::integer(1, max),
             meaning,
         )
     };
@@ -121,10 +121,7 @@ pub fn schema() -> Schema {
         FieldSpec::new(
             "iterations",
             "growth",
-            Kind::Integer {
-                min: 1,
-                max: 100_000,
-            },
+            Kind::integer(1, 100_000).slider(1.0, 2000.0),
             "Steps the automata run: the plant's age.",
         )
         .shaping(),
@@ -216,10 +213,7 @@ pub fn schema() -> Schema {
         FieldSpec::new(
             "limits.organs",
             "limits",
-            Kind::Integer {
-                min: 0,
-                max: 10_000_000,
-            },
+            Kind::integer(0, 10_000_000),
             "Leaves and flowers.",
         ),
     ];

@@ -174,21 +174,20 @@ sylva_core::ranged!(depth: u32, "depth", 1, MAX_DEPTH);
 /// The genome field by field, with the ranges files may hold (wider than evolution's
 /// [`LAYOUT`]).
 pub fn schema() -> Schema {
-    let metres = |path, min, max, meaning| {
-        FieldSpec::new(path, "stems", Kind::number(min, max), meaning).unit(" m")
+    // Files may hold what the parser takes; sliders span the sizes of real trees.
+    let metres = |path, min, max, slider: f64, meaning| {
+        let kind = Kind::number(min, max).slider(min, slider);
+        FieldSpec::new(path, "stems", kind, meaning).unit(" m")
     };
     let mut fields = vec![
         FieldSpec::new(
             "depth",
             "shape",
-            Kind::Integer {
-                min: 1,
-                max: i64::from(MAX_DEPTH),
-            },
+            Kind::integer(1, i64::from(MAX_DEPTH)),
             "Levels of branching: 2^depth − 1 cylinders.",
         )
         .shaping(),
-        metres("length", 0.01, 50.0, "The trunk's length.").shaping(),
+        metres("length", 0.01, 50.0, 10.0, "The trunk's length.").shaping(),
         FieldSpec::new(
             "length_ratio",
             "shape",
@@ -200,18 +199,21 @@ pub fn schema() -> Schema {
             "lower_radius",
             0.001,
             5.0,
+            1.0,
             "The trunk's radius at its foot.",
         ),
         metres(
             "upper_radius",
             0.001,
             5.0,
+            1.0,
             "The trunk's radius at its top: top over foot is every level's taper.",
         ),
         metres(
             "min_radius",
             0.001,
             1.0,
+            0.1,
             "No cylinder is thinner than this.",
         ),
     ];
@@ -226,7 +228,7 @@ pub fn schema() -> Schema {
             FieldSpec::new(
                 format!("{rotation}.angle"),
                 "shape",
-                Kind::number(-360.0, 360.0),
+                Kind::number(-360.0, 360.0).slider(-180.0, 180.0),
                 angle,
             )
             .unit("°")

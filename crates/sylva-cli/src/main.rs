@@ -62,6 +62,9 @@ enum Command {
     /// leaf size and area, triangles and textures, each with the range real trees give;
     /// `--check` exits 1 naming each implausible figure.
     Inspect(commands::inspect::InspectArgs),
+    /// Every model's genome field by field (path, group, the values it takes, what it does):
+    /// the tables of docs/genomes.md, or JSON with `--json`.
+    Schema(commands::schema::SchemaArgs),
     /// Start the studio: a web page where you breed plants by eye (PlantMaker's grid, the
     /// biomorph garden, the binary-tree family, the GP designer), every step kept in an
     /// SQLite archive. Prints the address to open.
@@ -96,6 +99,7 @@ fn main() -> ExitCode {
             Command::Breed(args) => commands::breed::run(&models, &args),
             Command::Render(args) => commands::render::run(&models, &args),
             Command::Inspect(args) => commands::inspect::run(&models, &args),
+            Command::Schema(args) => commands::schema::run(&models, &args),
             Command::Studio(args) => commands::studio::run(models, &args),
         }
     });

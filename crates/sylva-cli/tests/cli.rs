@@ -854,3 +854,40 @@ fn lsystem_plants_breed_and_evolve() {
     validate(&[out.join("best.glb")]);
     fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn docs_genomes_is_the_output_of_sylva_schema() {
+    let out = sylva(&["schema"]);
+    ok(&out);
+    let doc = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/genomes.md");
+    let written = fs::read_to_string(&doc).unwrap_or_default();
+    assert!(
+        written == String::from_utf8(out.stdout).unwrap(),
+        "docs/genomes.md is not what `sylva schema` prints: run \
+         `cargo run -- schema > docs/genomes.md`"
+    );
+}
+
+#[test]
+fn schema_as_json_and_for_an_unknown_model() {
+    let out = sylva(&["schema", "grown", "--json"]);
+    ok(&out);
+    let schema: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let height = schema["fields"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["path"] == "parameters.height")
+        .unwrap();
+    assert_eq!(
+        (height["min"].as_f64(), height["max"].as_f64()),
+        (Some(1.0), Some(40.0))
+    );
+    let out = sylva(&["schema", "oak"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("MODEL") && err.contains("no model is named \"oak\""),
+        "{err}"
+    );
+}

@@ -270,10 +270,7 @@ pub fn schema() -> Schema {
     ];
     fields.extend(PARAMS.iter().map(|p| {
         let kind = if p.whole {
-            Kind::Integer {
-                min: p.min as i64,
-                max: p.max as i64,
-            }
+            Kind::integer(p.min as i64, p.max as i64)
         } else {
             Kind::number(p.min, p.max)
         };

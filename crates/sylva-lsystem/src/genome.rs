@@ -358,13 +358,13 @@ pub fn schema() -> Schema {
         ),
         (
             "seed_carbon",
-            Kind::number(0.0, 100.0),
+            Kind::number(0.0, 100.0).slider(0.0, 5.0),
             " g",
             "Carbon reserve of the seed.",
         ),
         (
             "seed_minerals",
-            Kind::number(0.0, 100.0),
+            Kind::number(0.0, 100.0).slider(0.0, 1.0),
             " g",
             "Mineral reserve of the seed.",
         ),
@@ -382,13 +382,13 @@ pub fn schema() -> Schema {
         ),
         (
             "photosynthesis",
-            Kind::number(0.0, 100.0),
+            Kind::number(0.0, 100.0).slider(0.0, 10.0),
             " g",
             "Carbon fixed per unit of absorbed light (a square metre of open sky for one step).",
         ),
         (
             "uptake",
-            Kind::number(0.0, 100.0),
+            Kind::number(0.0, 100.0).slider(0.0, 1.0),
             " m",
             "Soil volume a square metre of fine root draws on per step.",
         ),
@@ -406,7 +406,7 @@ pub fn schema() -> Schema {
         ),
         (
             "growth_rate",
-            Kind::number(0.0, 1e4),
+            Kind::number(0.0, 1e4).slider(0.0, 200.0),
             " per step",
             "k of growth = k·C·N/W.",
         ),
@@ -466,10 +466,7 @@ pub fn schema() -> Schema {
         ),
         (
             "life_span",
-            Kind::Integer {
-                min: 1,
-                max: 1_000_000,
-            },
+            Kind::integer(1, 1_000_000).slider(1.0, 5000.0),
             " steps",
             "Steps a plant lives.",
         ),
@@ -493,10 +490,7 @@ pub fn schema() -> Schema {
             FieldSpec::new(
                 format!("physiology.{name}"),
                 "limits",
-                Kind::Integer {
-                    min,
-                    max: 1_000_000,
-                },
+                Kind::integer(min, 1_000_000),
                 meaning,
             )
             .optional(),

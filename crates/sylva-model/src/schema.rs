@@ -48,24 +48,33 @@ pub struct FieldSpec {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Kind {
-    /// A number from `min` to `max`; a slider moves it by `step`, along a logarithmic scale
-    /// where `log` (ranges over many orders of magnitude).
+    /// A number from `min` to `max`; a slider spans `soft_min` to `soft_max` (where plants
+    /// worth growing lie; a typed value may go to the ends), moves by `step`, and along a
+    /// logarithmic scale where `log` (ranges over many orders of magnitude).
     Number {
         /// The least value.
         min: f64,
         /// The greatest value.
         max: f64,
+        /// The least value a slider offers.
+        soft_min: f64,
+        /// The greatest value a slider offers.
+        soft_max: f64,
         /// A slider's step.
         step: f64,
         /// Whether a slider moves along a logarithmic scale.
         log: bool,
     },
-    /// A whole number from `min` to `max`.
+    /// A whole number from `min` to `max`; a slider spans `soft_min` to `soft_max`.
     Integer {
         /// The least value.
         min: i64,
         /// The greatest value.
         max: i64,
+        /// The least value a slider offers.
+        soft_min: i64,
+        /// The greatest value a slider offers.
+        soft_max: i64,
     },
     /// One of a few names.
     Choice {
@@ -178,11 +187,12 @@ impl Kind {
     /// A number from `min` to `max`, its step the power of ten that cuts the range into 100
     /// to 1,000 steps.
     pub fn number(min: f64, max: f64) -> Kind {
-        let step = 10f64.powf(((max - min) / 100.0).log10().floor());
         Kind::Number {
             min,
             max,
-            step,
+            soft_min: min,
+            soft_max: max,
+            step: step_of(min, max),
             log: false,
         }
     }
@@ -193,8 +203,52 @@ impl Kind {
         Kind::Number {
             min,
             max,
+            soft_min: min,
+            soft_max: max,
             step: min,
             log: true,
+        }
+    }
+
+    /// A whole number from `min` to `max`, a slider spanning all of it.
+    pub fn integer(min: i64, max: i64) -> Kind {
+        Kind::Integer {
+            min,
+            max,
+            soft_min: min,
+            soft_max: max,
+        }
+    }
+
+    /// The same, with a slider spanning `soft_min` to `soft_max` only (and, for a number, a
+    /// step to suit that span).
+    pub fn slider(self, soft_min: f64, soft_max: f64) -> Kind {
+        match self {
+            Kind::Number {
+                min,
+                max,
+                log,
+                step,
+                ..
+            } => Kind::Number {
+                min,
+                max,
+                soft_min,
+                soft_max,
+                step: if log {
+                    step
+                } else {
+                    step_of(soft_min, soft_max)
+                },
+                log,
+            },
+            Kind::Integer { min, max, .. } => Kind::Integer {
+                min,
+                max,
+                soft_min: soft_min as i64,
+                soft_max: soft_max as i64,
+            },
+            other => other,
         }
     }
 
@@ -204,7 +258,7 @@ impl Kind {
             Kind::Number { min, max, .. } => value
                 .as_f64()
                 .is_some_and(|v| v.is_finite() && (*min..=*max).contains(&v)),
-            Kind::Integer { min, max } => {
+            Kind::Integer { min, max, .. } => {
                 value.as_i64().is_some_and(|v| (*min..=*max).contains(&v))
             }
             Kind::Choice { options } => value
@@ -236,7 +290,7 @@ impl Kind {
     pub fn expected(&self) -> String {
         match self {
             Kind::Number { min, max, .. } => format!("a number from {min} to {max}"),
-            Kind::Integer { min, max } => format!("a whole number from {min} to {max}"),
+            Kind::Integer { min, max, .. } => format!("a whole number from {min} to {max}"),
             Kind::Choice { options } => format!("one of {}", options.join(", ")),
             Kind::Flag => "true or false".into(),
             Kind::Colour => "a colour, #rrggbb".into(),
@@ -257,6 +311,11 @@ impl Kind {
             .collect();
         Kind::Choice { options }
     }
+}
+
+/// The power of ten that cuts `min..max` into 100 to 1,000 steps.
+fn step_of(min: f64, max: f64) -> f64 {
+    10f64.powf(((max - min) / 100.0).log10().floor())
 }
 
 /// Three numbers from `min` to `max`.
@@ -295,6 +354,71 @@ impl Schema {
             .kind
             .check(value)
             .map_err(|expected| format!("`{path}` takes {expected}{}, not {value}", field.unit))
+    }
+
+    /// The schema as Markdown: a table of its fields (the shape's movers in bold), then its
+    /// lists and structures. The docs' tables (docs/genomes.md) are this.
+    pub fn markdown(&self) -> String {
+        let mut out = String::from(
+            "| field | group | takes | slider | meaning |\n| --- | --- | --- | --- | --- |\n",
+        );
+        for f in &self.fields {
+            let path = if f.shapes {
+                format!("**`{}`**", f.path)
+            } else {
+                format!("`{}`", f.path)
+            };
+            let unit = match f.unit.trim() {
+                "" => String::new(),
+                unit => format!(" ({unit})"),
+            };
+            let slider = match f.kind {
+                Kind::Number {
+                    soft_min,
+                    soft_max,
+                    log: true,
+                    ..
+                } => {
+                    format!("{soft_min} to {soft_max}, logarithmic")
+                }
+                Kind::Number {
+                    soft_min,
+                    soft_max,
+                    step,
+                    ..
+                } => {
+                    format!("{soft_min} to {soft_max} by {step}")
+                }
+                Kind::Integer {
+                    soft_min, soft_max, ..
+                } => format!("{soft_min} to {soft_max}"),
+                _ => String::new(),
+            };
+            let optional = if f.optional { " Optional." } else { "" };
+            out += &format!(
+                "| {path} | {} | {}{unit} | {slider} | {}{optional} |\n",
+                f.group,
+                f.kind.expected(),
+                f.meaning.replace('|', "\\|")
+            );
+        }
+        for list in &self.lists {
+            out += &format!(
+                "\n`{}`: {} From {} to {} items; each holds the `{}[]` fields.\n",
+                list.path, list.meaning, list.min, list.max, list.path
+            );
+        }
+        for structure in &self.structures {
+            let editor = match structure.editor {
+                Editor::Rules => "edited as text, each rule checked as the model reads it",
+                Editor::Program => "edited as a tree of nodes",
+            };
+            out += &format!(
+                "\n`{}`: {} A structure, {editor}.\n",
+                structure.path, structure.meaning
+            );
+        }
+        out
     }
 
     /// Each field of the schema and its value in `genome` (a genome file as JSON), every
@@ -373,7 +497,7 @@ mod tests {
         let field = |path: &str, kind| FieldSpec::new(path, "shape", kind, "").unit("°");
         Schema::of(vec![
             field("angle", Kind::number(0.0, 360.0)),
-            field("branches[].waves", Kind::Integer { min: 1, max: 16 }),
+            field("branches[].waves", Kind::integer(1, 16)),
         ])
     }
 

@@ -697,13 +697,12 @@ pub fn schema() -> Schema {
 
 /// A variable's kind, unit and meaning as a panel shows it.
 fn describe(v: &Variable) -> (Kind, &'static str, &'static str) {
-    let whole = |min: u32, max: u32| Kind::Integer {
-        min: i64::from(min),
-        max: i64::from(max),
-    };
+    let whole = |min: u32, max: u32| Kind::integer(i64::from(min), i64::from(max));
     let tenths = |max| Kind::Number {
         min: 0.1,
         max,
+        soft_min: 0.1,
+        soft_max: max,
         step: 0.1,
         log: false,
     };

@@ -354,6 +354,27 @@ pub fn models<'py>(module: &Bound<'py, PyModule>) -> PyResult<Bound<'py, PyDict>
     Ok(dict)
 }
 
+/// A model's genome field by field: a dict of `fields` (each field's `path`, `group`,
+/// `meaning`, `kind` with its range, `unit`, `shapes`, `optional`), `lists` and
+/// `structures`. The studio's panel and docs/genomes.md show the same.
+#[pyfunction]
+#[pyo3(pass_module)]
+pub fn schema<'py>(module: &Bound<'py, PyModule>, model: &str) -> PyResult<Bound<'py, PyAny>> {
+    let models = Models::of(module.as_any())?;
+    let registry = models.get().registry();
+    let entry = registry.get(model).ok_or_else(|| {
+        let known: Vec<_> = registry.models().iter().map(|m| m.name()).collect();
+        bad_value(
+            "model",
+            format!(
+                "no model is named {model:?}; expected one of {}",
+                known.join(", ")
+            ),
+        )
+    })?;
+    to_py(module.py(), &serde_json::json!(entry.schema()))
+}
+
 /// The wind `grow` asks for: none without a strength, a period only with one.
 fn wind_options(
     strength: Option<f32>,

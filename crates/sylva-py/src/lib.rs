@@ -90,6 +90,7 @@ pub fn init(m: &Bound<'_, PyModule>, registry: Registry) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(varieties::varieties, m)?)?;
     m.add_function(wrap_pyfunction!(genome::cross, m)?)?;
     m.add_function(wrap_pyfunction!(genome::models, m)?)?;
+    m.add_function(wrap_pyfunction!(genome::schema, m)?)?;
     m.add_function(wrap_pyfunction!(evolution::match_outline, m)?)?;
     m.add_function(wrap_pyfunction!(genome::_rust_grow_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(plant::garden, m)?)?;

@@ -57,7 +57,7 @@ fn ends(kind: &Kind) -> Option<[(Value, Value); 2]> {
                 (json!(max), json!(max + past)),
             ])
         }
-        Kind::Integer { min, max } => {
+        Kind::Integer { min, max, .. } => {
             Some([(json!(min), json!(min - 1)), (json!(max), json!(max + 1))])
         }
         _ => None,
@@ -70,6 +70,31 @@ fn every_model_has_a_schema_its_examples_fill() {
     for entry in registry.models() {
         let schema: Schema = entry.schema();
         assert!(!schema.fields.is_empty(), "{} has no fields", entry.name());
+        for field in &schema.fields {
+            let within = match field.kind {
+                Kind::Number {
+                    min,
+                    max,
+                    soft_min,
+                    soft_max,
+                    step,
+                    ..
+                } => min <= soft_min && soft_min < soft_max && soft_max <= max && step > 0.0,
+                Kind::Integer {
+                    min,
+                    max,
+                    soft_min,
+                    soft_max,
+                } => min <= soft_min && soft_min < soft_max && soft_max <= max,
+                _ => true,
+            };
+            assert!(
+                within,
+                "{}: `{}`'s slider is outside its range",
+                entry.name(),
+                field.path
+            );
+        }
         let genomes = examples(entry.name());
         assert!(
             !genomes.is_empty(),

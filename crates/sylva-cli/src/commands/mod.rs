@@ -9,6 +9,7 @@ pub mod inspect;
 pub mod matching;
 pub mod render;
 mod run_files;
+pub mod schema;
 pub mod simulate;
 pub mod studio;
 pub mod varieties;

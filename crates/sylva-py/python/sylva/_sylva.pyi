@@ -531,6 +531,11 @@ def set_max_time(seconds: float) -> None:
 def models() -> dict[str, str]:
     """The models Sylva knows: name to title."""
 
+def schema(model: str) -> dict[str, Any]:
+    """A model's genome field by field: ``fields`` (each with ``path``, ``group``, ``meaning``,
+    ``kind`` and its range, ``unit``, ``shapes``, ``optional``), ``lists`` and ``structures``.
+    An unknown model raises ``InputError`` naming ``model``."""
+
 def garden(
     genomes: Sequence[Genome] = ...,
     count: int = 20,
