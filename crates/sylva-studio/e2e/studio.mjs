@@ -260,6 +260,13 @@ async function main() {
   };
   const gridIds = () =>
     page.evaluate(() => [...document.querySelectorAll('[data-testid^="grid-cell-"]')].map((c) => c.dataset.plant).filter(Boolean).map(Number));
+  // Until grid cell `i` holds a plant other than `old` (or the page shows an error).
+  const cellChanged = (i, old) =>
+    page.waitForFunction(([i, old]) => {
+      if (document.querySelector('[data-testid="message"]').dataset.kind === "error") return true;
+      const c = document.querySelector(`[data-testid="grid-cell-${i}"]`);
+      return c.dataset.plant && Number(c.dataset.plant) !== old;
+    }, [i, old], { timeout: 60_000 });
   const waitGridLoaded = () =>
     page.waitForFunction(() => {
       const cells = [...document.querySelectorAll('[data-testid^="grid-cell-"]')];
@@ -572,11 +579,7 @@ async function main() {
     }
     check(edited, "no small whole-number field to edit in the plant panel");
     await byTestId("apply-fields").click();
-    await page.waitForFunction(([i, old]) => {
-      if (document.querySelector('[data-testid="message"]').dataset.kind === "error") return true;
-      const c = document.querySelector(`[data-testid="grid-cell-${i}"]`);
-      return c.dataset.plant && Number(c.dataset.plant) !== old;
-    }, [index, child], { timeout: 60_000 });
+    await cellChanged(index, child);
     await noError(`editing ${edited.path}`);
     const editedId = (await gridIds())[index];
     const e = await api(`/api/plants/${editedId}`);
@@ -586,11 +589,7 @@ async function main() {
     await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), editedId);
     await byTestId("regrow-seed").fill("4242");
     await byTestId("regrow").click();
-    await page.waitForFunction(([i, old]) => {
-      if (document.querySelector('[data-testid="message"]').dataset.kind === "error") return true;
-      const c = document.querySelector(`[data-testid="grid-cell-${i}"]`);
-      return c.dataset.plant && Number(c.dataset.plant) !== old;
-    }, [index, editedId], { timeout: 60_000 });
+    await cellChanged(index, editedId);
     await noError("regrow");
     const regrownId = (await gridIds())[index];
     const r = await api(`/api/plants/${regrownId}`);
@@ -602,6 +601,75 @@ async function main() {
     check(shownSeed === "4242" && /^seed 4242$/m.test(packed),
       `after Regrow the panel says seed ${shownSeed}, its packed string ${(packed.match(/^seed .*$/m) || ["no seed"])[0]}`);
     await waitGridLoaded();
+  });
+
+  await step("breed: a field's slider sketches the plant as it moves and records the edit let go", async () => {
+    const shown = Number((await byTestId("plant-detail").locator("h2").innerText()).replace(/\D/g, ""));
+    const before = await gridIds();
+    const index = before.indexOf(shown);
+    check(index >= 0, `plant #${shown} is not in the grid`);
+    const slider = page.locator('[data-testid="plant-detail"] input[type=range]').first();
+    await slider.waitFor({ timeout: 30_000 });
+    const fieldPath = (await slider.getAttribute("data-testid")).replace(/^slider-/, "");
+    await slider.scrollIntoViewIfNeeded();
+    const box = await slider.boundingBox();
+    const y = box.y + box.height / 2;
+    const sketches = () => page.evaluate(() => Number(document.querySelector('[data-testid="detail-thumb"]').dataset.sketches || 0));
+    await page.mouse.move(box.x + 4, y);
+    await page.mouse.down();
+    const times = [];
+    for (let k = 1; k <= 8; k++) {
+      const had = await sketches();
+      await page.mouse.move(box.x + 4 + (box.width - 8) * (k / 8), y, { steps: 2 });
+      await page.waitForFunction((n) => Number(document.querySelector('[data-testid="detail-thumb"]').dataset.sketches || 0) > n, had, { timeout: 30_000 });
+      times.push(await page.evaluate(() => Number(document.querySelector('[data-testid="detail-thumb"]').dataset.sketchMs)));
+    }
+    await noError(`sliding ${fieldPath}`);
+    await page.screenshot({ path: path.join(out, "plant-panel-sliders.png") });
+    const value = await byTestId(`field-${fieldPath}`).inputValue();
+    await page.mouse.up();
+    times.sort((a, b) => a - b);
+    log(`slider to painted sketch (${fieldPath}): median ${times[times.length >> 1]} ms, worst ${times[times.length - 1]} ms`);
+    // Let go, the edit is recorded: the plant's cell holds an edited plant with the value.
+    await cellChanged(index, shown);
+    await noError(`recording ${fieldPath}`);
+    const edited = await api(`/api/plants/${(await gridIds())[index]}`);
+    check(edited.operator === "edit", `the slid plant's operator is ${edited.operator}, not edit`);
+    const f = edited.fields.find((x) => x.path === fieldPath);
+    check(f && Number(f.value) === Number(value), `${fieldPath} is ${f && f.value}, not the slider's ${value}`);
+    // The fields stand under their groups; Randomise draws a group's numbers and records them
+    // as one edit; a field's reset puts its value back.
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), edited.id);
+    const randomise = page.locator('[data-testid="plant-detail"] [data-testid^="randomise-"]').first();
+    await randomise.waitFor({ timeout: 30_000 });
+    const group = (await randomise.getAttribute("data-testid")).replace(/^randomise-/, "");
+    const cellBefore = (await gridIds())[index];
+    await randomise.click();
+    await cellChanged(index, cellBefore);
+    await noError(`randomising ${group}`);
+    const drawn = await api(`/api/plants/${(await gridIds())[index]}`);
+    check(drawn.operator === "edit" && drawn.parents.some((q) => q.plant === cellBefore), `Randomise ${group} recorded ${drawn.operator} from ${JSON.stringify(drawn.parents)}`);
+    const changedFields = drawn.fields.filter((f) => JSON.stringify(f.value) !== JSON.stringify(edited.fields.find((x) => x.path === f.path)?.value));
+    check(changedFields.length >= 1, `Randomise ${group} changed no field`);
+    await page.waitForFunction((id) => document.querySelector('[data-testid="plant-detail"] h2')?.textContent.includes(`#${id}`), drawn.id);
+    const reset = page.locator('[data-testid="plant-detail"] [data-testid^="reset-"]').first();
+    await reset.waitFor({ timeout: 30_000 });
+    const resetPath = (await reset.getAttribute("data-testid")).replace(/^reset-/, "");
+    const box2 = byTestId(`field-${resetPath}`);
+    const was = await box2.inputValue();
+    await box2.fill(String(Number(was) + 1));
+    await box2.dispatchEvent("change");
+    await reset.click();
+    check(await box2.inputValue() === was, `reset ${resetPath}: ${await box2.inputValue()}, not ${was}`);
+    // A value outside the field's range is refused by the schema, naming field, range, value.
+    const res = await fetch(new URL(`/api/plants/${edited.id}/sketch.png`, base), {
+      method: "POST",
+      headers: { "Content-Type": "application/json" },
+      body: JSON.stringify({ fields: [{ path: fieldPath, value: 1e9 }] }),
+    });
+    const body = await res.json();
+    check(res.status === 422 && body.field === "fields[0].value" && body.error.includes(fieldPath) && /from .* to /.test(body.error),
+      `an out-of-range sketch: ${res.status} ${JSON.stringify(body)}`);
   });
 
   await step("breed: heavy plants paint within a second (Depth-10 mutants, their cross, a random start)", async () => {

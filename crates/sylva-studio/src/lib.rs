@@ -14,6 +14,8 @@
 //! - [`runs`]: evolution runs in the archive, shared by family and design.
 //! - [`events`]: what sessions tell the pages watching them (server-sent events).
 //! - [`plants`]: plants as GLB, previews, OBJ, STL, PNG and genome files, and their lineage.
+//! - [`edits`]: field edits checked against each model's schema, the schema for the page's
+//!   controls, and sketches (a plant with fields set, drawn, recorded nowhere).
 //! - [`pruning`]: plants pruned to a match run's outlines, as breed, match and the plant
 //!   routes show them.
 //! - [`cache`]: what is kept in memory (grown plants, GLBs), bounded.
@@ -35,6 +37,7 @@
 
 pub mod archive;
 pub mod cache;
+pub mod edits;
 pub mod error;
 pub mod events;
 pub mod guard;
@@ -219,6 +222,7 @@ pub fn router(studio: Studio) -> Router {
         Route::get("/plants/{id}/plant.glb", plants::glb),
         Route::get("/plants/{id}/inspect", plants::inspect),
         Route::get("/kinds", plants::kinds),
+        Route::get("/schema/{model}", edits::schema),
         Route::get("/plants/{id}/preview.glb", plants::preview),
         Route::get("/plants/{id}/plant.obj", plants::obj),
         Route::get("/plants/{id}/plant.mtl", plants::mtl),
@@ -226,6 +230,7 @@ pub fn router(studio: Studio) -> Router {
         Route::get("/plants/{id}/plant.stl", plants::stl),
         Route::get("/plants/{id}/plant.png", plants::png),
         Route::get("/plants/{id}/genome.json", plants::genome),
+        Route::post("/plants/{id}/sketch.png", edits::sketch),
         Route::get("/plants/{id}/{file}", plants::texture),
         Route::get("/plants/{id}/lineage", plants::lineage),
         Route::post("/plants/{id}/branch", modes::branch),

@@ -570,7 +570,7 @@ fn picture_glb(studio: &Studio, id: i64, size: (u32, u32)) -> Result<Arc<Vec<u8>
 }
 
 /// `WxH`, each 16 to [`MAX_PICTURE`].
-fn parse_size(s: &str) -> Result<(u32, u32), ApiError> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), ApiError> {
     let bad = || {
         ApiError::bad(
             "size",

@@ -19,8 +19,9 @@ use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
+use crate::edits::{FieldEdit, edited};
 use crate::error::{ApiError, input_message};
-use crate::http::{Body, in_page_words};
+use crate::http::Body;
 use crate::modes::{Branch, Mode, Route};
 use crate::plants::{Form, PreviewSize, genome_of, parse_genome, plant_bytes, preview_glb};
 use crate::pruning::{PRUNED_TO, grow_shown, match_settings, pruned_run, pruned_to};
@@ -871,59 +872,6 @@ pub struct EditRequest {
     seed: Option<u64>,
 }
 
-/// One field's new value, by its path (`branches[0].waves`, as `GET /api/plants/{id}` lists).
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-pub struct FieldEdit {
-    path: String,
-    value: serde_json::Value,
-}
-
-/// `plant`'s genome with `fields` set. A value the genome refuses is named as the edit's
-/// (`fields[1].value`) with the field's path and what it takes, found by setting the edits
-/// one at a time: the genome's own message points into JSON text the person never saw.
-fn edited(registry: &Registry, plant: &PlantRow, fields: &[FieldEdit]) -> Result<Genome, ApiError> {
-    let mut value: serde_json::Value = serde_json::from_str(&plant.genome)
-        .map_err(|e| ApiError::internal(format!("plant {}'s stored genome: {e}", plant.id)))?;
-    for (i, edit) in fields.iter().enumerate() {
-        set_field(&mut value, &edit.path, edit.value.clone()).ok_or_else(|| {
-            ApiError::bad(
-                format!("fields[{i}].path"),
-                format!("the genome has no field {:?}", edit.path),
-            )
-        })?;
-        if let Err(e) = registry.parse_genome(&value.to_string()) {
-            return Err(ApiError::unprocessable(
-                format!("fields[{i}].value"),
-                in_page_words(&edit.path, &e.message),
-            ));
-        }
-    }
-    parse_genome(registry, &value.to_string(), "fields")
-}
-
-/// Sets the value at `path` (`a.b[2].c`) in a genome's JSON; the path must exist.
-fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Option<()> {
-    let mut at = genome;
-    for part in path.split('.') {
-        let (name, indices) = match part.find('[') {
-            Some(i) => (&part[..i], &part[i..]),
-            None => (part, ""),
-        };
-        if !name.is_empty() {
-            at = at.get_mut(name)?;
-        }
-        for index in indices.split(['[', ']']).filter(|s| !s.is_empty()) {
-            at = at.get_mut(index.parse::<usize>().ok()?)?;
-        }
-    }
-    if at.is_object() || at.is_array() {
-        return None;
-    }
-    *at = value;
-    Some(())
-}
-
 /// `POST /api/sessions/{id}/edit`: an edited genome or another seed.
 pub(crate) async fn edit(
     State(studio): State<Studio>,
@@ -1050,18 +998,6 @@ impl Mode for BreedMode {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fields_are_set_by_path_and_only_leaves() {
-        let mut g = serde_json::json!({"a": {"b": [1, {"c": 2}]}, "seed": 18446744073709551615u64});
-        assert!(set_field(&mut g, "a.b[1].c", json!(5)).is_some());
-        assert!(set_field(&mut g, "a.b[0]", json!(7)).is_some());
-        assert_eq!(g["a"]["b"], json!([7, {"c": 5}]));
-        assert!(set_field(&mut g, "a.b", json!(0)).is_none());
-        assert!(set_field(&mut g, "a.x", json!(0)).is_none());
-        assert!(set_field(&mut g, "a.b[9]", json!(0)).is_none());
-        assert_eq!(g["seed"].as_u64(), Some(u64::MAX));
-    }
 
     #[test]
     fn the_least_dominant_fall_off() {

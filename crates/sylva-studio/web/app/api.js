@@ -205,6 +205,7 @@ export const api = {
   branch: (id, mode) => post(`/api/plants/${enc(id)}/branch`, { mode }),
   plantUrl: (id, file) => `/api/plants/${enc(id)}/${file}`,
   kinds: () => get("/api/kinds"),
+  schema: (model) => get(`/api/schema/${enc(model)}`),
   inspect: (id, query = "") => get(`/api/plants/${enc(id)}/inspect${query ? `?${query}` : ""}`),
   pngUrl: (id, size = "256x256", view = "iso") =>
     `/api/plants/${enc(id)}/plant.png?view=${view}&size=${size}`,

@@ -1,8 +1,21 @@
 // The plant panel: an archived plant's origin, genome fields and packed string, an editable
-// genome with Regrow, exports, Branch from here and its lineage.
+// genome with Regrow, exports, Branch from here and its lineage. Each field the model's schema
+// describes has its meaning, range and unit, and a number a slider: moving it draws a sketch
+// of the plant with the new value (recorded nowhere); letting it go records the edit as a
+// step of the open breeding session, as Apply does.
 
-import { api, getBytes, seedValue, BigInteger } from "./api.js";
+import { api, getBytes, request, seedValue, BigInteger } from "./api.js";
 import { h, add, clear, fmtNum, summarize } from "./dom.js";
+
+/** Each model's schema (`GET /api/schema/{model}`), asked for once. */
+const schemas = new Map();
+function schemaOf(model) {
+  if (!schemas.has(model)) schemas.set(model, api.schema(model).catch(() => null));
+  return schemas.get(model);
+}
+
+/** A list item's path as the schema writes it: `branches[2].waves` is `branches[].waves`. */
+const general = (path) => path.replace(/\[\d+\]/g, "[]");
 
 export function createDetail(ctx, panel) {
   let current = null;
@@ -32,7 +45,8 @@ export function createDetail(ctx, panel) {
         `#${q.plant}`, q.dominance !== undefined && q.dominance !== null ? ` (dominance ${fmtNum(q.dominance)})` : ""),
     );
 
-    // genome fields, editable
+    // genome fields, editable; the schema's sliders come when it has been read
+    const inputs = new Map();
     const fieldRows = (p.fields || []).map((f) => {
       const input = h("input", {
         type: "text",
@@ -42,6 +56,7 @@ export function createDetail(ctx, panel) {
       });
       input.original = f.value;
       input.initial = input.value;
+      inputs.set(f.path, input);
       return h("tr", {}, h("th", { title: f.path }, f.path), h("td", {}, input));
     });
     const fieldsTable = h("table", { class: "fields", testid: "fields" }, h("tbody", {}, fieldRows));
@@ -98,6 +113,14 @@ export function createDetail(ctx, panel) {
       )));
     }
 
+    const thumb = h("img", { class: "thumb", src: api.pngUrl(p.id, "320x320"), alt: `plant ${p.id}`, width: 320, height: 320, testid: "detail-thumb" });
+    // The sketch a moving slider draws, kept in view above the fields while they scroll.
+    const live = h("img", { class: "thumb", alt: `plant ${p.id} as edited`, width: 320, height: 320, testid: "detail-sketch" });
+    const liveBox = h("div", { class: "sketch", hidden: true }, live);
+    schemaOf(p.model).then((schema) => {
+      if (schema && current === p) withSchema(schema, inputs, [thumb, live], liveBox, fieldsTable, seed);
+    });
+
     const title = h("div", { class: "detail-head" },
       h("h2", {}, `Plant #${p.id}`),
       h("button", { class: "close", testid: "detail-close", title: "Close", onclick: close }, "×"));
@@ -105,7 +128,7 @@ export function createDetail(ctx, panel) {
     add(panel,
       title,
       p.title ? h("div", { class: "detail-title" }, p.title) : null,
-      h("img", { class: "thumb", src: api.pngUrl(p.id, "320x320"), alt: `plant ${p.id}`, width: 320, height: 320, testid: "detail-thumb" }),
+      thumb,
       h("table", { class: "facts" }, h("tbody", {},
         h("tr", {}, h("th", {}, "model"), h("td", {}, p.model)),
         h("tr", {}, h("th", {}, "operator"), h("td", { testid: "detail-operator" }, p.operator || "–")),
@@ -139,6 +162,7 @@ export function createDetail(ctx, panel) {
       ),
       p.packed ? h("div", {}, h("h3", {}, "Packed string"), h("pre", { class: "packed", testid: "packed" }, p.packed)) : null,
       h("h3", {}, "Genome fields"),
+      liveBox,
       fieldRows.length ? fieldsTable : h("p", { class: "hint" }, "no fields"),
       fieldRows.length
         ? h("div", { class: "buttons" }, h("button", { testid: "apply-fields", onclick: () => applyFields(fieldsTable, seed) }, "Apply field edits"))
@@ -150,6 +174,153 @@ export function createDetail(ctx, panel) {
         h("button", { class: "primary", testid: "regrow", title: "Grow the edited genome (or the same one with another seed) in this plant's place", onclick: () => regrow(genomeText.value, seed) }, "Regrow"),
       ),
     );
+  }
+
+  /** Gives each field the schema describes its meaning, range and unit as a tooltip, and a
+   * number a slider beside its box (the slider spans the schema's soft range; a typed value
+   * may go to the field's ends). A slider moved draws a sketch in the panel's picture, one
+   * request at a time and always of the latest values; let go, it records the edit. */
+  function withSchema(schema, inputs, [thumb, live], liveBox, table, seedInput) {
+    const specs = new Map(schema.fields.map((f) => [f.path, f]));
+    let inFlight = false;
+    let dirty = false;
+    let waitingSince = 0; // the first move no sketch has shown yet
+    let sketches = 0;
+    let shownUrl = "";
+    const moved = () => {
+      if (!waitingSince) waitingSince = performance.now();
+      sketch();
+    };
+    async function sketch() {
+      if (inFlight) {
+        dirty = true;
+        return;
+      }
+      inFlight = true;
+      dirty = false;
+      const since = waitingSince;
+      waitingSince = 0;
+      try {
+        const fields = changed(table);
+        const bytes = await request("POST", api.plantUrl(current.id, "sketch.png"), { fields, size: "320x320" }, { raw: true });
+        const url = URL.createObjectURL(new Blob([bytes], { type: "image/png" }));
+        live.addEventListener("load", () => {
+          thumb.dataset.sketches = String(++sketches);
+          thumb.dataset.sketchMs = String(Math.round(performance.now() - since));
+        }, { once: true });
+        liveBox.hidden = false;
+        live.src = url;
+        thumb.src = url;
+        if (shownUrl) URL.revokeObjectURL(shownUrl);
+        shownUrl = url;
+      } catch (e) {
+        ctx.act(() => Promise.reject(e));
+      } finally {
+        inFlight = false;
+        if (dirty) sketch();
+      }
+    }
+    const order = new Map(schema.fields.map((f, i) => [f.path, i]));
+    const groups = [...new Set(schema.fields.map((f) => f.group))];
+    const sliders = [];
+    for (const [path, input] of inputs) {
+      const spec = specs.get(general(path));
+      if (!spec) continue;
+      const row = input.closest("tr");
+      const item = path.match(/\[(\d+)\]/);
+      row.group = item ? `${spec.group} ${Number(item[1]) + 1}` : spec.group;
+      row.order = [groups.indexOf(spec.group), item ? Number(item[1]) : -1, order.get(spec.path)];
+      const range = spec.kind === "number" || spec.kind === "integer"
+        ? ` · ${spec.min} to ${spec.max}${spec.unit}` : spec.options ? ` · ${spec.options.join(", ")}` : "";
+      input.title = `${spec.meaning}${range}${spec.optional ? " · optional" : ""}`;
+      const th = input.closest("tr").querySelector("th");
+      th.title = `${path}: ${input.title}`;
+      if (spec.shapes) th.classList.add("shapes");
+      if ((spec.kind !== "number" && spec.kind !== "integer") || typeof input.original !== "number") continue;
+      const slider = h("input", {
+        type: "range",
+        min: spec.soft_min,
+        max: spec.soft_max,
+        step: spec.kind === "integer" ? 1 : spec.log ? "any" : spec.step,
+        testid: `slider-${path}`,
+        "aria-label": `${path}: ${spec.meaning}`,
+      });
+      const toSlider = (v) => (spec.log ? Math.log(v) : v);
+      const fromSlider = (x) => (spec.log ? Number(Math.exp(x).toPrecision(4)) : Number(x));
+      if (spec.log) {
+        slider.min = Math.log(spec.soft_min);
+        slider.max = Math.log(spec.soft_max);
+      }
+      slider.value = toSlider(input.original);
+      slider.addEventListener("input", () => {
+        input.value = String(fromSlider(slider.value));
+        moved();
+      });
+      slider.addEventListener("change", () => record(table, seedInput));
+      input.addEventListener("change", () => {
+        const v = Number(input.value);
+        if (Number.isFinite(v)) slider.value = toSlider(v);
+        moved();
+      });
+      const reset = h("button", {
+        class: "reset",
+        testid: `reset-${path}`,
+        title: `Back to this plant's ${input.initial}`,
+        "aria-label": `reset ${path}`,
+        onclick: () => {
+          if (input.value === input.initial) return;
+          input.value = input.initial;
+          slider.value = toSlider(input.original);
+          moved();
+        },
+      }, "↺");
+      input.closest("td").append(h("div", { class: "slider" }, slider, reset));
+      sliders.push({ row, spec, input, slider, fromSlider });
+    }
+    // Rows in the schema's order, under a heading per group (and list item), each with a
+    // button that draws that group's numbers at random within their sliders' spans.
+    const body = table.tBodies[0];
+    const rows = [...body.rows];
+    const rank = (r) => r.order || [groups.length, 0, 0];
+    rows.sort((a, b) => rank(a)[0] - rank(b)[0] || rank(a)[1] - rank(b)[1] || rank(a)[2] - rank(b)[2]);
+    let heading = null;
+    for (const row of rows) {
+      if (row.group && row.group !== heading) {
+        heading = row.group;
+        const members = sliders.filter((s) => s.row.group === heading);
+        const randomise = members.length
+          ? h("button", {
+            class: "randomise",
+            testid: `randomise-${heading}`,
+            title: `Draw ${heading}'s numbers at random within their sliders`,
+            onclick: () => {
+              for (const s of members) {
+                const [lo, hi] = [Number(s.slider.min), Number(s.slider.max)];
+                s.slider.value = String(lo + Math.random() * (hi - lo));
+                s.input.value = String(s.fromSlider(s.slider.value));
+              }
+              moved();
+              record(table, seedInput);
+            },
+          }, "Randomise")
+          : null;
+        body.append(h("tr", { class: "group" }, h("th", { colspan: 2 }, heading, randomise)));
+      }
+      body.append(row);
+    }
+  }
+
+  /** A let-go slider's edit, recorded when a session takes edits (otherwise it waits for
+   * Apply, the sketch showing it meanwhile). Arrow keys let go at every press, so the step is
+   * recorded once they rest. */
+  let recordTimer = 0;
+  function record(table, seedInput) {
+    clearTimeout(recordTimer);
+    recordTimer = setTimeout(() => {
+      const takes = (m) => (m.routes || []).some((r) => r.method === "POST" && r.path === "/api/sessions/{id}/edit");
+      const s = ctx.session;
+      if (s && ctx.modeList.some((m) => m.name === s.mode && takes(m))) applyFields(table, seedInput);
+    }, 500);
   }
 
   /** The open session, if its mode takes the step `POST /api/sessions/{id}/${step}` (as the
@@ -181,12 +352,7 @@ export function createDetail(ctx, panel) {
     const p = current;
     const s = await ctx.act(() => {
       const session = sessionTaking("edit", "editing");
-      // the studio sets the fields on the stored genome itself, so no digit is lost
-      const fields = [];
-      for (const input of table.querySelectorAll("input[data-path]")) {
-        if (input.value === input.initial) continue;
-        fields.push({ path: input.dataset.path, value: parseValue(input.value, input.original, input.dataset.path) });
-      }
+      const fields = changed(table);
       if (fields.length === 0) {
         const e = new Error("no field was changed");
         e.field = "fields";
@@ -261,6 +427,17 @@ export function createDetail(ctx, panel) {
       return current;
     },
   };
+}
+
+/** The fields whose boxes differ from the plant's values, as edits. The studio sets them on
+ * the stored genome itself, so no digit is lost. */
+function changed(table) {
+  const fields = [];
+  for (const input of table.querySelectorAll("input[data-path]")) {
+    if (input.value === input.initial) continue;
+    fields.push({ path: input.dataset.path, value: parseValue(input.value, input.original, input.dataset.path) });
+  }
+  return fields;
 }
 
 /** A field's new value from its text, of the type its old value had. */
