@@ -189,7 +189,7 @@ for model, found in examples.items():
         check(obj["sylva_operator"] == "example" and obj["sylva_source"] == name
               and obj["sylva_generation"] == 0 and json.loads(obj["sylva_parents"]) == [],
               f"{name}: origin example, generation 0, no parents")
-        objects[name] = obj
+        objects.setdefault(name, obj)  # the first model's by a name (bintree's oak, not grown's)
 
 path = os.path.join(tmp, "my oak.json")
 oak = sylva.Genome.load(dict(examples["bintree"])["oak"]).with_field("depth", 6)
@@ -833,6 +833,50 @@ check(plants.is_plant(matched) and matched["sylva_model"] == "bintree" and len(s
       f"(IoU term {matched['sylva_fitness']:.3f}; {stats[0]['best']:.3f} in the first generation) at the cursor")
 check(facing > 0.999, f"Evolve Toward Picture: the plant's front faces the active camera (cosine {facing:.4f})")
 
+# -- The Genome panel: the genome's numbers as sliders (sylva.schema) ---------------------------
+tulip = objects["tulip"]
+bpy.context.view_layer.objects.active = tulip
+bpy.ops.sylva.load_fields()
+fields = {f.path: f for f in tulip.sylva.fields}
+check(len(fields) > 20 and "branches[0].waves" in fields and fields["branches[0].waves"].whole,
+      f"Edit Genome Fields: the tulip's {len(fields)} numbers, each list item's")
+field = fields["branches[0].max_length"]
+genome_before, size_before = tulip["sylva_genome"], tuple(tulip.dimensions)
+target = field.soft_high if field.value != field.soft_high else field.soft_low
+t = time.perf_counter()
+field.value = target
+plants.flush_regrow()  # what the timer does once changes rest
+genome_regrow_s = time.perf_counter() - t
+bpy.context.view_layer.update()  # the object's dimensions follow its new mesh
+genome = sylva.Genome.from_json(tulip["sylva_genome"])
+check(genome["branches.0.max_length"] == target and triangles(tulip) == len(genome.grow().mesh.indices)
+      and tulip["sylva_genome"] != genome_before and tuple(tulip.dimensions) != size_before,
+      f"a field's value regrows the plant: max length {target:g}, {size_before[2]:.3f} -> "
+      f"{tulip.dimensions.z:.3f} m tall")
+check(abs(field.slider - field.share_of(target)) < 1e-6, "the slider follows the typed value")
+field.slider = 0.0
+plants.flush_regrow()
+check(sylva.Genome.from_json(tulip["sylva_genome"])["branches.0.max_length"] == field.soft_low == field.value,
+      f"the slider at its left end sets the value to {field.soft_low:g}")
+kept = tulip["sylva_genome"]
+field.value = field.high + 100
+check(tulip["sylva_genome"] == kept and field.value == field.soft_low
+      and "branches[0].max_length" in tulip.sylva.error and f"to {field.high:g}" in tulip.sylva.error,
+      f"a value out of range is refused, named with its range and value: {tulip.sylva.error!r}")
+tulip.sylva.error = ""
+# The heaviest example's regrow after a change, for the figure.
+tree = objects["tree"]
+bpy.context.view_layer.objects.active = tree
+bpy.ops.sylva.load_fields()
+turn = tree.sylva.fields["angles.turn"]
+t = time.perf_counter()
+turn.value = turn.value + 5
+plants.flush_regrow()
+tree_regrow_s = time.perf_counter() - t
+check(tree.sylva.error == "" and sylva.Genome.from_json(tree["sylva_genome"])["angles.turn"] == turn.value,
+      f"the L-system tree's turn angle set to {turn.value:g}°, regrown")
+
+
 # -- Panels: drawn into a stand-in layout (headless bpy has no window to draw in) ----------
 # It checks that every property a panel shows exists, every button names a registered
 # operator, every icon is Blender's, for the states a user meets.
@@ -931,6 +975,11 @@ try:
     drawn = draw(bpy.types.SYLVA_PT_evolve, None, [])
     check({"sylva.evolve", "sylva.evolve_picture", "sylva.mark_zone", "prop target", "prop picture"} <= set(drawn),
           f"Evolve panel: {', '.join(drawn)}")
+    drawn = draw(bpy.types.SYLVA_PT_genome, objects["tulip"], [objects["tulip"]])
+    check({"prop slider", "prop value", "sylva.field_help"} <= set(drawn),
+          f"Genome panel: {len([d for d in drawn if d == 'prop slider'])} sliders, each with its box and help")
+    drawn = draw(bpy.types.SYLVA_PT_genome, objects["helix"], [objects["helix"]])
+    check(drawn == ["sylva.load_fields"], f"Genome panel before its fields are read: {', '.join(drawn)}")
     drawn = draw(bpy.types.SYLVA_PT_assets, oak_obj, [oak_obj])
     check({"sylva.wind", "sylva.lod", "sylva.forest"} <= set(drawn), f"Assets panel: {', '.join(drawn)}")
 except AssertionError as e:
@@ -987,6 +1036,11 @@ print(f"     dressed: Foliage pine {dress_times['pine'] * 1000:.0f} ms; the spec
       f"{dress_figures['preset'][1]:.2f} m)")
 print(f"     evolve: 12 generations of 300 automata toward a sphere under a forbidden box, the best "
       f"shown as it improved: {evolve_s:.2f} s")
+for what, seconds in (("the tulip's max length", genome_regrow_s), ("the L-system tree's turn angle", tree_regrow_s)):
+    after = plants.REGROW_DELAY + seconds
+    figure(after, 0.3, f"Genome panel: {what} set, regrown {after * 1000:.0f} ms after the change "
+           f"({plants.REGROW_DELAY * 1000:.0f} ms waiting for changes to rest, {seconds * 1000:.0f} ms growing; "
+           "target under 300)")
 figure(forest_s, 5.0, f"forest: 1000 conifers of 8 variants as instances on a hill: {forest_s:.2f} s (target under 5)")
 figure(rss_after / 1024, 1.0, f"forest: Blender's memory {rss_before:.0f} MB before, {rss_after:.0f} MB after "
        "(target under 1 GB)")
@@ -1005,6 +1059,7 @@ def undone(action):
 
 
 tree_name = objects["tree"].name  # Python's references to data do not outlive an undo
+tulip_name = objects["tulip"].name
 try:
     names = sorted(o.name for o in bpy.data.objects)
     undone(lambda: grown("EXAMPLE", "plantmaker", example="palm"))
@@ -1022,6 +1077,16 @@ try:
     back = bpy.data.objects[tree_name]
     check(triangles(back) == before and back.sylva.roots == roots,
           f"Undo takes a setting's change back: the L-system tree's roots and its {before} triangles")
+    before = (bpy.data.objects[tulip_name]["sylva_genome"], triangles(bpy.data.objects[tulip_name]))
+
+    def slide():
+        bpy.data.objects[tulip_name].sylva.fields["branches[0].max_length"].slider = 1.0
+        plants.flush_regrow()
+
+    undone(slide)
+    back = bpy.data.objects[tulip_name]
+    check((back["sylva_genome"], triangles(back)) == before,
+          "Undo takes a Genome slider's change back: the tulip's genome and mesh as they were")
 except RuntimeError as e:
     check(False, f"undo: {str(e).strip()}")
 settings = bpy.context.scene.sylva

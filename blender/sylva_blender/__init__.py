@@ -10,8 +10,11 @@ an extension zip by scripts/blender-extension.
 import textwrap
 
 import bpy
+import math
+
 from bpy.props import (
     BoolProperty,
+    CollectionProperty,
     EnumProperty,
     FloatProperty,
     IntProperty,
@@ -175,6 +178,66 @@ def _detail(self, context):
         plants.apply_detail(self.id_data)
 
 
+def _field_typed(self, context):
+    """A field's number typed or dragged: the genome takes it (or refuses it, and the box
+    shows the genome's value again), the slider follows."""
+    if plants.is_quiet():
+        return
+    obj = self.id_data
+    value = round(self.value) if self.whole else self.value
+    try:
+        plants.set_field(obj, self.path, value)
+    except Exception:
+        value = plants.genome_of(obj)[self.path]  # refused: kept in obj.sylva.error
+    with plants.quiet():
+        self.value = value
+        self.slider = self.share_of(value)
+
+
+def _field_slid(self, context):
+    """A field's slider moved: the value at that point of the field's span."""
+    if plants.is_quiet():
+        return
+    value = self.value_at(self.slider)
+    with plants.quiet():
+        self.value = value
+    try:
+        plants.set_field(self.id_data, self.path, value)
+    except Exception:
+        pass  # kept in obj.sylva.error, which the panel shows
+
+
+class SylvaGenomeField(bpy.types.PropertyGroup):
+    """One number of a plant's genome, as its model's schema describes it."""
+
+    path: StringProperty(name="Path", description="The field's path in the genome file")
+    group: StringProperty(name="Group")
+    meaning: StringProperty(name="Meaning")
+    unit: StringProperty(name="Unit")
+    whole: BoolProperty(name="Whole")
+    log: BoolProperty(name="Logarithmic")
+    shapes: BoolProperty(name="Moves the Shape")
+    low: FloatProperty(name="Least")
+    high: FloatProperty(name="Greatest")
+    soft_low: FloatProperty(name="Slider's Least")
+    soft_high: FloatProperty(name="Slider's Greatest")
+    value: FloatProperty(name="Value", precision=4, update=_field_typed,
+                         description="The field's value: type one anywhere in its range")
+    slider: FloatProperty(name="Slider", min=0.0, max=1.0, subtype="FACTOR", update=_field_slid,
+                          description="Where the value stands in the span plants worth growing lie in")
+
+    def share_of(self, value):
+        lo, hi, v = self.soft_low, self.soft_high, min(max(value, self.soft_low), self.soft_high)
+        if self.log:
+            lo, hi, v = math.log(lo), math.log(hi), math.log(v)
+        return (v - lo) / (hi - lo) if hi > lo else 0.0
+
+    def value_at(self, share):
+        lo, hi = self.soft_low, self.soft_high
+        v = math.exp(math.log(lo) + share * (math.log(hi) - math.log(lo))) if self.log else lo + share * (hi - lo)
+        return round(v) if self.whole else float(f"{v:.4g}")
+
+
 def _leaves(kind):
     return "needles" if kind in ("pine", "spruce", "fir") else "leaves"
 
@@ -226,6 +289,9 @@ class SylvaPlantSettings(bpy.types.PropertyGroup):
         description="Leaf cards per metre of twig, as a multiple of the kind's own",
     )
     error: StringProperty(name="Error", default="", description="Why the last growth failed")
+    fields: CollectionProperty(type=SylvaGenomeField)
+    fields_of: StringProperty(name="Fields Of", default="",
+                              description="The genome (its id) the fields were read from")
 
 
 def _wrapped(layout, text, context, icon="NONE"):
@@ -311,6 +377,40 @@ class SYLVA_PT_plant(_Panel, bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("sylva.regrow", icon="FILE_REFRESH")
         row.operator("sylva.save_genome", icon="EXPORT")
+
+
+class SYLVA_PT_genome(_Panel, bpy.types.Panel):
+    """The active plant's genome, number by number as its model's schema describes them: a
+    slider over the span plants worth growing lie in and a box for any value in range; the
+    plant regrows once changes rest, and Ctrl-Z takes a change back."""
+
+    bl_label = "Genome"
+
+    @classmethod
+    def poll(cls, context):
+        return plants.is_plant(context.active_object)
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.active_object
+        if obj.sylva.fields_of != obj.get(plants.ID):
+            layout.operator("sylva.load_fields", icon="PROPERTIES")
+            return
+        if obj.sylva.error:
+            _wrapped(layout, obj.sylva.error, context, icon="ERROR")
+        box, heading = None, None
+        for item in obj.sylva.fields:
+            index = item.path.split("]")[0].split("[")[1] if "[" in item.path else ""
+            group = f"{item.group} {int(index) + 1}" if index else item.group
+            if group != heading:
+                heading = group
+                box = layout.box()
+                box.label(text=group.capitalize())
+            row = box.row(align=True)
+            name = item.path.rsplit(".", 1)[-1].replace("_", " ")
+            row.prop(item, "slider", text=name)
+            row.prop(item, "value", text=item.unit)
+            row.operator("sylva.field_help", text="", icon="INFO").path = item.path
 
 
 class SYLVA_PT_breed(_Panel, bpy.types.Panel):
@@ -406,10 +506,12 @@ class SYLVA_PT_evolve(_Panel, bpy.types.Panel):
 
 classes = (
     SylvaSceneSettings,
+    SylvaGenomeField,
     SylvaPlantSettings,
     *operators.classes,
     SYLVA_PT_grow,
     SYLVA_PT_plant,
+    SYLVA_PT_genome,
     SYLVA_PT_breed,
     SYLVA_PT_evolve,
     SYLVA_PT_assets,

@@ -162,6 +162,45 @@ class SYLVA_OT_regrow(_OnActivePlant, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class SYLVA_OT_load_fields(_OnActivePlant, bpy.types.Operator):
+    """Show the active plant's genome number by number, as its model's schema describes it"""
+
+    bl_idname = "sylva.load_fields"
+    bl_label = "Edit Genome Fields"
+
+    def run(self, context, obj, start):
+        try:
+            plants.load_fields(obj)
+        except Exception as e:
+            return _fail(self, f"Could not read {obj.name}'s genome: {e}")
+        self.report({"INFO"}, f"{len(obj.sylva.fields)} fields of {obj.name}'s genome ({_ms(start)})")
+        return {"FINISHED"}
+
+
+class SYLVA_OT_field_help(bpy.types.Operator):
+    """What a genome field does, its range and unit"""
+
+    bl_idname = "sylva.field_help"
+    bl_label = "About This Field"
+    bl_options = {"INTERNAL"}
+
+    path: StringProperty(name="Path")
+
+    @classmethod
+    def description(cls, context, properties):
+        obj = context.active_object if context else None
+        for item in (obj.sylva.fields if plants.is_plant(obj) else []):
+            if item.path == properties.path:
+                unit = f" {item.unit}" if item.unit else ""
+                return (f"{item.path}: {item.meaning} From {item.low:g} to {item.high:g}{unit}"
+                        f"{' (moves the shape most)' if item.shapes else ''}")
+        return properties.path
+
+    def execute(self, context):
+        self.report({"INFO"}, self.description(context, self))
+        return {"FINISHED"}
+
+
 class SYLVA_OT_save_genome(bpy.types.Operator, ExportHelper):
     """Save the active plant's genome as a genome file (`sylva grow FILE` grows it again)"""
 
@@ -587,6 +626,8 @@ class SYLVA_OT_evolve_stop(bpy.types.Operator):
 classes = (
     SYLVA_OT_grow,
     SYLVA_OT_regrow,
+    SYLVA_OT_load_fields,
+    SYLVA_OT_field_help,
     SYLVA_OT_save_genome,
     SYLVA_OT_breed,
     SYLVA_OT_mutate,

@@ -432,3 +432,86 @@ def spacing(plants, at_least=0.3):
         (x0, _y0, z0), (x1, _y1, z1) = plant.bounds
         widest = max(widest, x1 - x0, z1 - z0)
     return 1.2 * widest
+
+
+# -- The genome's numbers as sliders (sylva.schema) --------------------------------------------
+# The Genome panel shows each number of a plant's genome as its model's schema describes it.
+# A change writes the genome (checked: a value out of its field's range is refused, naming
+# the field, the range and the value) and regrows the plant once the changes rest.
+
+REGROW_DELAY = 0.1  # seconds after the last change
+_waiting = set()  # names of plant objects whose genome changed and which have not regrown
+
+
+def number_fields(genome):
+    """(path, spec) of each number or whole-number field of `genome`, every list item's
+    (`branches[0].waves`, `branches[1].waves`, ...), in the schema's order."""
+    data = genome.to_dict()
+    found = []
+    for spec in sylva().schema(genome.model)["fields"]:
+        if spec["kind"] in ("number", "integer"):
+            found += [(path, spec) for path in _expand(spec["path"], data)]
+    return found
+
+
+def _expand(path, data, at=""):
+    head, _, rest = path.partition(".")
+    if head.endswith("[]"):
+        name = head[:-2]
+        for i, item in enumerate(data.get(name, []) if isinstance(data, dict) else []):
+            here = f"{at}{name}[{i}]"
+            yield from (_expand(rest, item, here + ".") if rest else [here])
+    elif isinstance(data, dict) and head in data:
+        yield from (_expand(rest, data[head], f"{at}{head}.") if rest else [f"{at}{head}"])
+
+
+def load_fields(obj):
+    """Fills obj.sylva.fields from its genome and schema (without regrowing)."""
+    genome = genome_of(obj)
+    with quiet():
+        obj.sylva.fields.clear()
+        for path, spec in number_fields(genome):
+            item = obj.sylva.fields.add()
+            item.name = item.path = path  # `name` is what obj.sylva.fields[path] finds
+            item.group = spec["group"]
+            item.meaning = spec["meaning"]
+            item.whole = spec["kind"] == "integer"
+            item.low, item.high = float(spec["min"]), float(spec["max"])
+            item.soft_low, item.soft_high = float(spec["soft_min"]), float(spec["soft_max"])
+            item.log = bool(spec.get("log"))
+            item.unit = spec["unit"].strip()
+            item.shapes = spec["shapes"]
+            item.value = float(genome[path])
+            item.slider = item.share_of(item.value)
+        obj.sylva.fields_of = obj[ID]
+
+
+def set_field(obj, path, value):
+    """Writes one field of obj's genome (checked by the package against the schema and the
+    model) and asks for a regrow once changes rest. Errors go to obj.sylva.error and are
+    raised; the genome is then unchanged."""
+    try:
+        genome = genome_of(obj).with_field(path, value)
+    except Exception as e:
+        obj.sylva.error = f"{type(e).__name__}: {e}"
+        raise
+    obj[GENOME] = genome.to_json()
+    obj.sylva.error = ""
+    _waiting.add(obj.name)
+    if not bpy.app.timers.is_registered(flush_regrow):
+        bpy.app.timers.register(flush_regrow, first_interval=REGROW_DELAY)
+
+
+def flush_regrow():
+    """Regrows every plant whose genome changed since (a timer calls it once changes rest;
+    the check calls it directly, as timers do not run without Blender's window)."""
+    for name in sorted(_waiting):
+        obj = bpy.data.objects.get(name)
+        if obj is not None and is_plant(obj):
+            try:
+                regrow(obj)
+                obj.sylva.fields_of = obj[ID]
+            except Exception:
+                pass  # kept in obj.sylva.error, which the panels show
+    _waiting.clear()
+    return None  # a timer that runs once

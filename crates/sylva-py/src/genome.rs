@@ -145,6 +145,11 @@ impl Genome {
     /// of its range raises `InputError` naming the field.
     fn with_field(&self, field: &str, value: &Bound<'_, PyAny>) -> PyResult<Genome> {
         let new = from_py(value, field)?;
+        let schema = self.inner.schema();
+        if schema.field(field).is_some() {
+            // Out of its range: named with the range and the value, before the model reads it.
+            schema.check(field, &new).map_err(|e| bad_value(field, e))?;
+        }
         let mut genome = self.value();
         let slot = genome.pointer_mut(&pointer(field)).ok_or_else(|| {
             bad_value(

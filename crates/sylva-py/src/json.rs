@@ -28,9 +28,12 @@ pub fn to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<
 }
 
 /// A JSON value at a field path: dot-separated keys, list positions as numbers
-/// (`rotation1.axis.0`).
+/// (`rotation1.axis.0`) or in brackets (`branches[2].waves`).
 pub fn pointer(field: &str) -> String {
+    // `branches[2].waves` (the schema's way) is `branches.2.waves`.
     field
+        .replace('[', ".")
+        .replace(']', "")
         .split('.')
         .map(|k| format!("/{}", k.replace('~', "~0").replace('/', "~1")))
         .collect()

@@ -36,3 +36,11 @@ def test_structures_are_named():
 def test_an_unknown_model_is_an_input_error_naming_it():
     with pytest.raises(sylva.InputError, match='model: no model is named "oak"; expected one of bintree'):
         sylva.schema("oak")
+
+
+def test_with_field_takes_the_schemas_paths_and_names_the_range():
+    genome = sylva.Genome.load(str(__import__("pathlib").Path(__file__).resolve().parents[3]
+                                   / "examples" / "plantmaker" / "tulip.json"))
+    assert genome.with_field("branches[0].waves", 3)["branches.0.waves"] == 3
+    with pytest.raises(sylva.InputError, match=r"`branches\[0\]\.waves` takes a whole number from 1 to 16, not 40"):
+        genome.with_field("branches[0].waves", 40)

@@ -44,6 +44,7 @@ trait Face: Send + Sync {
     fn default_seed(&self) -> u64;
     fn with_seed(&self, seed: u64) -> Genome;
     fn growth_seconds(&self) -> Option<f64>;
+    fn schema(&self) -> crate::schema::Schema;
     /// Whether `other` (of any model) is the same genome.
     fn same(&self, other: &Genome) -> bool;
     fn reparse(&self, text: &str) -> Result<Genome, GenomeError>;
@@ -113,6 +114,10 @@ impl<M: Model> Face for Typed<M> {
 
     fn growth_seconds(&self) -> Option<f64> {
         self.model.growth_seconds(&self.genome)
+    }
+
+    fn schema(&self) -> crate::schema::Schema {
+        self.model.schema()
     }
 
     fn same(&self, other: &Genome) -> bool {
@@ -212,6 +217,11 @@ impl Genome {
     /// The model's title.
     pub fn title(&self) -> &'static str {
         self.0.title()
+    }
+
+    /// Its model's genome field by field ([`crate::schema`]).
+    pub fn schema(&self) -> crate::schema::Schema {
+        self.0.schema()
     }
 
     /// A short text form a person can copy and paste, for a model that has one
