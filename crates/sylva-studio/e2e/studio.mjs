@@ -661,6 +661,34 @@ async function main() {
     await box2.dispatchEvent("change");
     await reset.click();
     check(await box2.inputValue() === was, `reset ${resetPath}: ${await box2.inputValue()}, not ${was}`);
+    // A locked field: every child of a Depth-10 mutation keeps the parent's value.
+    const lockPath = fieldPath;
+    await byTestId(`lock-${lockPath}`).click();
+    check(await byTestId(`lock-${lockPath}`).getAttribute("aria-pressed") === "true", "the lock button does not show it is on");
+    const mother = drawn.id;
+    const motherValue = drawn.fields.find((x) => x.path === lockPath).value;
+    for (const cell of await page.locator('[data-testid^="grid-cell-"].selected').all()) await cell.click();
+    await byTestId(`grid-cell-${(await gridIds()).indexOf(mother)}`).click();
+    await byTestId("depth").evaluate((e) => {
+      e.value = "10";
+      e.dispatchEvent(new Event("input", { bubbles: true }));
+    });
+    const known = new Set(await gridIds());
+    const painted = await page.evaluate(() => window.sylvaStudio.paintCount);
+    await byTestId("mutate").click();
+    await page.waitForFunction((n) => window.sylvaStudio.paintCount > n ||
+      document.querySelector('[data-testid="message"]').dataset.kind === "error", painted, { timeout: 60_000 });
+    await noError("mutating with a locked field");
+    const children = (await gridIds()).filter((id) => !known.has(id));
+    check(children.length >= 1, "the locked mutation made no child");
+    for (const id of children) {
+      const c = await api(`/api/plants/${id}`);
+      const v = c.fields.find((x) => x.path === lockPath);
+      check(v && JSON.stringify(v.value) === JSON.stringify(motherValue) && JSON.stringify(c.settings.locked) === JSON.stringify([lockPath]),
+        `child #${id} of a mutation with ${lockPath} locked has ${v && v.value}, not the mother's ${motherValue} (settings ${JSON.stringify(c.settings)})`);
+    }
+    const unlock = byTestId(`lock-${lockPath}`); // unlocked again for the steps after
+    if (await unlock.count()) await unlock.click();
     // A value outside the field's range is refused by the schema, naming field, range, value.
     const res = await fetch(new URL(`/api/plants/${edited.id}/sketch.png`, base), {
       method: "POST",

@@ -62,10 +62,13 @@ pub fn edited(
     parse_genome(registry, &value.to_string(), "fields")
 }
 
-/// Sets the value at `path` (`a.b[2].c`) in a genome's JSON; the path must exist and hold
-/// one value (a number, a name, or a list of numbers such as an axis), not a part of the
-/// genome made of others.
-fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Option<()> {
+/// The value at `path` (`a.b[2].c`) in a genome's JSON, if the path is there and holds one
+/// value (a number, a name, or a list of numbers such as an axis), not a part of the genome
+/// made of others.
+fn field_mut<'a>(
+    genome: &'a mut serde_json::Value,
+    path: &str,
+) -> Option<&'a mut serde_json::Value> {
     let mut at = genome;
     for part in path.split('.') {
         let (name, indices) = match part.find('[') {
@@ -81,12 +84,56 @@ fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Valu
     }
     let composite = |v: &serde_json::Value| v.is_object() || v.is_array();
     match &*at {
-        serde_json::Value::Object(_) => return None,
-        serde_json::Value::Array(items) if items.iter().any(composite) => return None,
-        _ => {}
+        serde_json::Value::Object(_) => None,
+        serde_json::Value::Array(items) if items.iter().any(composite) => None,
+        _ => Some(at),
     }
-    *at = value;
+}
+
+/// Sets the value at `path` in a genome's JSON ([`field_mut`]'s paths).
+fn set_field(genome: &mut serde_json::Value, path: &str, value: serde_json::Value) -> Option<()> {
+    *field_mut(genome, path)? = value;
     Some(())
+}
+
+/// Most fields a breeding step keeps locked.
+pub const MAX_LOCKED: usize = 4096;
+
+/// `child` with the fields at `paths` as `parent` has them: fields a person locked keep
+/// their values through mutation and crossing. A path one of them lacks (a list item the
+/// child no longer has, say) is left as the operator made it; a child the locked values
+/// make unreadable is refused, naming `locked`.
+pub fn locked(child: Genome, parent: &Genome, paths: &[String]) -> Result<Genome, ApiError> {
+    if paths.is_empty() {
+        return Ok(child);
+    }
+    let mut from = parent.to_value();
+    let mut value = child.to_value();
+    for path in paths {
+        if let Some(kept) = field_mut(&mut from, path) {
+            set_field(&mut value, path, kept.clone());
+        }
+    }
+    child
+        .reparse(&value.to_string())
+        .map_err(|e| ApiError::unprocessable("locked", in_page_words("locked", &e.message)))
+}
+
+/// Checks a step's locked paths: at most [`MAX_LOCKED`], each a path of at most 256 bytes.
+pub fn check_locked(paths: &[String]) -> Result<(), ApiError> {
+    if paths.len() > MAX_LOCKED {
+        return Err(ApiError::bad(
+            "locked",
+            format!("at most {MAX_LOCKED} fields, got {}", paths.len()),
+        ));
+    }
+    match paths.iter().position(|p| p.is_empty() || p.len() > 256) {
+        Some(i) => Err(ApiError::bad(
+            format!("locked[{i}]"),
+            "expected a field's path (1 to 256 bytes), as the plant panel lists them",
+        )),
+        None => Ok(()),
+    }
 }
 
 /// `GET /api/schema/{model}`: the model's genome field by field, for the plant panel's
@@ -145,6 +192,24 @@ pub(crate) async fn sketch(
 mod tests {
     use super::*;
     use serde_json::json;
+
+    #[test]
+    fn locked_fields_keep_the_parents_values_and_missing_ones_are_left() {
+        let registry = Registry::standard();
+        let parse = |text: &str| registry.parse_genome(text).unwrap();
+        let oak = include_str!("../../../examples/bintree/oak.json");
+        let parent = parse(oak);
+        let mut other = parent.to_value();
+        other["depth"] = json!(4);
+        other["length"] = json!(2.5);
+        let child = parse(&other.to_string());
+        let paths = ["depth".to_owned(), "branches[3].waves".to_owned()];
+        let kept = locked(child, &parent, &paths).unwrap().to_value();
+        assert_eq!(kept["depth"], parent.to_value()["depth"]);
+        assert_eq!(kept["length"], json!(2.5), "an unlocked field stays as the operator made it");
+        assert!(check_locked(&vec!["x".to_owned(); MAX_LOCKED + 1]).is_err());
+        assert!(check_locked(&[String::new()]).is_err());
+    }
 
     #[test]
     fn fields_are_set_by_path_and_only_single_values() {

@@ -19,7 +19,7 @@ use sylva::{CrossLevel, Depth, Genome, Knobs, Registry, Settings};
 
 use crate::Studio;
 use crate::archive::{self, NewPlant, Operator, ParentRow, PlantRow};
-use crate::edits::{FieldEdit, edited};
+use crate::edits::{FieldEdit, check_locked, edited, locked};
 use crate::error::{ApiError, input_message};
 use crate::http::Body;
 use crate::modes::{Branch, Mode, Route};
@@ -639,6 +639,9 @@ pub struct CrossRequest {
     level: Option<CrossLevel>,
     children: Option<u32>,
     seed: Option<u64>,
+    /// Fields every child keeps as the most dominant parent has them.
+    #[serde(default)]
+    locked: Vec<String>,
 }
 
 /// Checks a number of children, 1 to 9.
@@ -740,6 +743,13 @@ pub(crate) async fn cross(
         ..Knobs::default()
     };
     let weights: Vec<f64> = request.parents.iter().map(|p| p.dominance).collect();
+    check_locked(&request.locked)?;
+    let locked_paths = request.locked.clone();
+    // Locked fields come from the most dominant parent (the first of equals).
+    let dominant = (0..weights.len()).fold(
+        0,
+        |best, i| if weights[i] > weights[best] { i } else { best },
+    );
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
     let seed = request.seed.unwrap_or(state.seed);
     let parent_ids = ids.clone();
@@ -753,6 +763,7 @@ pub(crate) async fn cross(
             let pairs: Vec<(&Genome, f64)> = genomes.iter().zip(weights.iter().copied()).collect();
             let (child, used) = Genome::cross(&pairs, by_hand(knobs, hand.as_ref()), s)
                 .map_err(|e| ApiError::library("parents", e))?;
+            let child = locked(child, &genomes[dominant], &locked_paths)?;
             let parents = used
                 .iter()
                 .map(|&i| ParentRow {
@@ -763,7 +774,7 @@ pub(crate) async fn cross(
             Ok((child, parents))
         },
         Operator::Cross,
-        json!({ "level": level }),
+        with_locked(json!({ "level": level }), &request.locked),
     )
     .await?;
     let action = json!({
@@ -775,6 +786,14 @@ pub(crate) async fn cross(
     Ok(Json(record(&studio, id, &state, action, &ids, made, None)?))
 }
 
+/// A step's settings as the archive keeps them, with the fields it kept locked (when any).
+fn with_locked(mut settings: serde_json::Value, locked: &[String]) -> serde_json::Value {
+    if !locked.is_empty() {
+        settings["locked"] = json!(locked);
+    }
+    settings
+}
+
 /// `POST /api/sessions/{id}/mutate`.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
@@ -783,6 +802,9 @@ pub struct MutateRequest {
     depth: Option<u32>,
     children: Option<u32>,
     seed: Option<u64>,
+    /// Fields every child keeps as the parent has them.
+    #[serde(default)]
+    locked: Vec<String>,
 }
 
 /// `POST /api/sessions/{id}/mutate`.
@@ -803,6 +825,8 @@ pub(crate) async fn mutate(
         ..Knobs::default()
     };
     let count = children(request.children, GRID - 1)?;
+    check_locked(&request.locked)?;
+    let locked_paths = request.locked.clone();
     let parent = archived_one(&studio, request.plant, &row.model, "plant")?;
     let genome = genome_of(&studio.registry, &parent)?;
     let seq = studio.archive.read(|c| archive::next_seq(c, id))?;
@@ -818,6 +842,7 @@ pub(crate) async fn mutate(
             let child = genome
                 .mutate(by_hand(knobs, hand.as_ref()), s)
                 .map_err(|e| ApiError::library("plant", e))?;
+            let child = locked(child, &genome, &locked_paths)?;
             Ok((
                 child,
                 vec![ParentRow {
@@ -827,7 +852,7 @@ pub(crate) async fn mutate(
             ))
         },
         Operator::Mutate,
-        json!({ "depth": depth }),
+        with_locked(json!({ "depth": depth }), &request.locked),
     )
     .await?;
     let action = json!({ "op": "mutate", "plant": parent_id, "depth": depth, "seed": seed });

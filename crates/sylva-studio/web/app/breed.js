@@ -289,6 +289,7 @@ export default function createBreedMode(ctx, root) {
     const parents = selected.map((id, i) => ({ plant: id, dominance: read[i] }));
     return step(() => {
       const body = { parents, level: level.value };
+      if (ctx.locked.size) body.locked = [...ctx.locked];
       const c = childrenCount();
       if (c !== undefined) body.children = c;
       return api.cross(session.id, body);
@@ -299,6 +300,7 @@ export default function createBreedMode(ctx, root) {
     const plant = selected[0];
     return step(() => {
       const body = { plant, depth: Number(depth.value) };
+      if (ctx.locked.size) body.locked = [...ctx.locked];
       const c = childrenCount();
       if (c !== undefined) body.children = c;
       return api.mutate(session.id, body);

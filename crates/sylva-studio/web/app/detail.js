@@ -57,7 +57,20 @@ export function createDetail(ctx, panel) {
       input.original = f.value;
       input.initial = input.value;
       inputs.set(f.path, input);
-      return h("tr", {}, h("th", { title: f.path }, f.path), h("td", {}, input));
+      // Locked, Mutate and Cross keep the field as the parent has it.
+      const lock = h("button", {
+        class: "lock",
+        testid: `lock-${f.path}`,
+        "aria-pressed": String(ctx.locked.has(f.path)),
+        title: "Lock: Mutate and Cross keep this field as the parent has it",
+        onclick: () => {
+          if (ctx.locked.has(f.path)) ctx.locked.delete(f.path);
+          else ctx.locked.add(f.path);
+          lock.setAttribute("aria-pressed", String(ctx.locked.has(f.path)));
+          lock.textContent = ctx.locked.has(f.path) ? "locked" : "lock";
+        },
+      }, ctx.locked.has(f.path) ? "locked" : "lock");
+      return h("tr", {}, h("th", { title: f.path }, f.path), h("td", {}, h("div", { class: "value" }, input, lock)));
     });
     const fieldsTable = h("table", { class: "fields", testid: "fields" }, h("tbody", {}, fieldRows));
 

@@ -86,6 +86,8 @@ const ctx = {
   sessions: [],
   session: null,
   mode: null,
+  /** Fields (paths) the plant panel locked: Mutate and Cross keep them as the parent has them. */
+  locked: new Set(),
   showError,
   showInfo,
   /** Runs `fn`, showing any error it throws; returns its result, or undefined on error. */
