@@ -206,7 +206,11 @@ mod tests {
         let paths = ["depth".to_owned(), "branches[3].waves".to_owned()];
         let kept = locked(child, &parent, &paths).unwrap().to_value();
         assert_eq!(kept["depth"], parent.to_value()["depth"]);
-        assert_eq!(kept["length"], json!(2.5), "an unlocked field stays as the operator made it");
+        assert_eq!(
+            kept["length"],
+            json!(2.5),
+            "an unlocked field stays as the operator made it"
+        );
         assert!(check_locked(&vec!["x".to_owned(); MAX_LOCKED + 1]).is_err());
         assert!(check_locked(&[String::new()]).is_err());
     }
