@@ -3,7 +3,12 @@
 //! meshed, encoded as GLB) and stored; a random start of nine; a garden step of nine L-system
 //! plants grown for 100 steps.
 //!
-//! Run with `cargo bench -p sylva-studio --bench steps`.
+//! And the plant panel's sketch (`POST /api/plants/{id}/sketch.png`: the plant with a field
+//! set, grown, previewed and drawn at 320 × 320) of every example the studio offers, species
+//! presets' genomes included, each with its first shape-moving number set halfway along its
+//! slider: what a moving slider waits for, less the browser's decoding of the PNG.
+//!
+//! Run with `cargo bench -p sylva-studio --bench steps` (`-- sketch` for the sketches alone).
 #![allow(clippy::unwrap_used)] // Benches may panic on broken setup.
 
 use axum::body::Body;
@@ -15,18 +20,39 @@ use sylva_studio::{Archive, Studio, router};
 use tower::ServiceExt;
 
 fn call(runtime: &tokio::runtime::Runtime, studio: &Studio, path: &str, body: &Value) -> Value {
+    serde_json::from_slice(&send(runtime, studio, "POST", path, body)).unwrap()
+}
+
+fn get(runtime: &tokio::runtime::Runtime, studio: &Studio, path: &str) -> Value {
+    serde_json::from_slice(&send(runtime, studio, "GET", path, &Value::Null)).unwrap()
+}
+
+fn send(
+    runtime: &tokio::runtime::Runtime,
+    studio: &Studio,
+    method: &str,
+    path: &str,
+    body: &Value,
+) -> Vec<u8> {
     runtime.block_on(async {
-        let request = Request::post(path)
+        let body = if body.is_null() {
+            Body::empty()
+        } else {
+            Body::from(body.to_string())
+        };
+        let request = Request::builder()
+            .method(method)
+            .uri(path)
             .header("host", "127.0.0.1")
             .header("content-type", "application/json")
-            .body(Body::from(body.to_string()))
+            .body(body)
             .unwrap();
         let response = router(studio.clone()).oneshot(request).await.unwrap();
-        assert_eq!(response.status(), StatusCode::OK);
-        let bytes = axum::body::to_bytes(response.into_body(), usize::MAX)
+        assert_eq!(response.status(), StatusCode::OK, "{method} {path}");
+        axum::body::to_bytes(response.into_body(), usize::MAX)
             .await
-            .unwrap();
-        serde_json::from_slice(&bytes).unwrap()
+            .unwrap()
+            .to_vec()
     })
 }
 
@@ -118,5 +144,105 @@ fn steps(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-criterion_group!(benches, steps);
+/// The plant panel's sketch of every example, one field moved.
+fn sketches(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("sylva-studio-sketch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let studio = Studio::new(
+        Archive::open(&dir.join("bench.db")).unwrap(),
+        Guard::default(),
+    );
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let examples = get(&runtime, &studio, "/api/examples");
+    let mut by_model: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    for e in examples.as_array().unwrap() {
+        let (name, model) = (e["name"].as_str().unwrap(), e["model"].as_str().unwrap());
+        by_model
+            .entry(model.to_owned())
+            .or_default()
+            .push(name.to_owned());
+    }
+    let mut group = c.benchmark_group("sketch");
+    group.sample_size(10);
+    group.warm_up_time(std::time::Duration::from_millis(500));
+    group.measurement_time(std::time::Duration::from_secs(2));
+    for (model, names) in by_model {
+        let schema = get(&runtime, &studio, &format!("/api/schema/{model}"));
+        for chunk in names.chunks(9) {
+            let session = call(
+                &runtime,
+                &studio,
+                "/api/sessions",
+                &json!({"mode": "breed", "model": model, "start": {"examples": chunk}}),
+            );
+            let plants = get(
+                &runtime,
+                &studio,
+                &format!("/api/plants?session={}", session["id"]),
+            );
+            for listed in plants["plants"].as_array().unwrap() {
+                let plant = get(&runtime, &studio, &format!("/api/plants/{}", listed["id"]));
+                let Some(name) = plant["settings"]["example"].as_str() else {
+                    continue;
+                };
+                let Some((path, value)) = halfway(&schema, &plant) else {
+                    continue;
+                };
+                let body = json!({"fields": [{"path": path, "value": value}]});
+                let url = format!("/api/plants/{}/sketch.png", plant["id"]);
+                group.bench_function(format!("{name}: {path}"), |b| {
+                    b.iter(|| send(&runtime, &studio, "POST", &url, &body))
+                });
+            }
+        }
+    }
+    group.finish();
+    drop(studio);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The plant's first shape-moving number and the value halfway along its slider.
+fn halfway(schema: &Value, plant: &Value) -> Option<(String, Value)> {
+    plant["fields"].as_array()?.iter().find_map(|f| {
+        let path = f["path"].as_str()?;
+        let general: String = {
+            let mut out = String::new();
+            let mut inside = false;
+            for ch in path.chars() {
+                match ch {
+                    '[' => {
+                        inside = true;
+                        out.push('[');
+                    }
+                    ']' => {
+                        inside = false;
+                        out.push(']');
+                    }
+                    _ if inside => {}
+                    _ => out.push(ch),
+                }
+            }
+            out
+        };
+        let spec = schema["fields"]
+            .as_array()?
+            .iter()
+            .find(|s| s["path"] == general.as_str())?;
+        if !spec["shapes"].as_bool()? || !f["value"].is_number() {
+            return None;
+        }
+        let (lo, hi) = (spec["soft_min"].as_f64()?, spec["soft_max"].as_f64()?);
+        let middle = 0.5 * (lo + hi);
+        Some(match spec["kind"].as_str()? {
+            "integer" => (path.to_owned(), json!(middle.round() as i64)),
+            "number" => (path.to_owned(), json!(middle)),
+            _ => return None,
+        })
+    })
+}
+
+criterion_group!(benches, steps, sketches);
 criterion_main!(benches);
