@@ -15,6 +15,7 @@ use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use criterion::{Criterion, criterion_group, criterion_main};
 use serde_json::{Value, json};
+use sylva::schema::{Kind, Schema};
 use sylva_studio::guard::Guard;
 use sylva_studio::{Archive, Studio, router};
 use tower::ServiceExt;
@@ -170,7 +171,7 @@ fn sketches(c: &mut Criterion) {
     group.warm_up_time(std::time::Duration::from_millis(500));
     group.measurement_time(std::time::Duration::from_secs(2));
     for (model, names) in by_model {
-        let schema = get(&runtime, &studio, &format!("/api/schema/{model}"));
+        let schema = studio.registry.get(&model).unwrap().schema();
         for chunk in names.chunks(9) {
             let session = call(
                 &runtime,
@@ -205,42 +206,22 @@ fn sketches(c: &mut Criterion) {
 }
 
 /// The plant's first shape-moving number and the value halfway along its slider.
-fn halfway(schema: &Value, plant: &Value) -> Option<(String, Value)> {
+fn halfway(schema: &Schema, plant: &Value) -> Option<(String, Value)> {
     plant["fields"].as_array()?.iter().find_map(|f| {
         let path = f["path"].as_str()?;
-        let general: String = {
-            let mut out = String::new();
-            let mut inside = false;
-            for ch in path.chars() {
-                match ch {
-                    '[' => {
-                        inside = true;
-                        out.push('[');
-                    }
-                    ']' => {
-                        inside = false;
-                        out.push(']');
-                    }
-                    _ if inside => {}
-                    _ => out.push(ch),
-                }
-            }
-            out
-        };
-        let spec = schema["fields"]
-            .as_array()?
-            .iter()
-            .find(|s| s["path"] == general.as_str())?;
-        if !spec["shapes"].as_bool()? || !f["value"].is_number() {
-            return None;
-        }
-        let (lo, hi) = (spec["soft_min"].as_f64()?, spec["soft_max"].as_f64()?);
-        let middle = 0.5 * (lo + hi);
-        Some(match spec["kind"].as_str()? {
-            "integer" => (path.to_owned(), json!(middle.round() as i64)),
-            "number" => (path.to_owned(), json!(middle)),
+        let spec = schema
+            .field(path)
+            .filter(|spec| spec.shapes && f["value"].is_number())?;
+        let value = match spec.kind {
+            Kind::Integer {
+                soft_min, soft_max, ..
+            } => json!((soft_min + soft_max) / 2),
+            Kind::Number {
+                soft_min, soft_max, ..
+            } => json!(0.5 * (soft_min + soft_max)),
             _ => return None,
-        })
+        };
+        Some((path.to_owned(), value))
     })
 }
 
