@@ -17,7 +17,7 @@ use crate::Studio;
 use crate::archive::PlantRow;
 use crate::error::ApiError;
 use crate::http::{Body, in_page_words};
-use crate::plants::{PreviewSize, parse_genome, parse_size, plant_row, preview_glb};
+use crate::plants::{PreviewSize, imported, parse_genome, parse_size, plant_row, preview_glb};
 use crate::pruning::{grow_shown, pruned_to};
 
 /// One field's new value, by its path (`branches[0].waves`, as `GET /api/plants/{id}` lists).
@@ -180,8 +180,7 @@ pub(crate) async fn sketch(
             &plant,
             PreviewSize::of(size.0.max(size.1)),
         )?;
-        let scene = sylva::import::read_glb(&glb)
-            .map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))?;
+        let scene = imported(&glb)?;
         sylva::assets::picture(&scene.scene(), View::Iso, size).map_err(ApiError::internal)
     })
     .await??;

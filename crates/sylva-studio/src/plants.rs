@@ -412,7 +412,7 @@ pub(crate) async fn preview(
     Ok(glb_response(&glb))
 }
 
-fn imported(glb: &[u8]) -> Result<sylva::import::ImportedScene, ApiError> {
+pub(crate) fn imported(glb: &[u8]) -> Result<sylva::import::ImportedScene, ApiError> {
     sylva::import::read_glb(glb).map_err(|e| ApiError::internal(format!("reading a GLB back: {e}")))
 }
 

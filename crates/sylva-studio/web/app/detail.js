@@ -330,9 +330,12 @@ export function createDetail(ctx, panel) {
   function record(table, seedInput) {
     clearTimeout(recordTimer);
     recordTimer = setTimeout(() => {
-      const takes = (m) => (m.routes || []).some((r) => r.method === "POST" && r.path === "/api/sessions/{id}/edit");
-      const s = ctx.session;
-      if (s && ctx.modeList.some((m) => m.name === s.mode && takes(m))) applyFields(table, seedInput);
+      try {
+        sessionTaking("edit", "editing");
+      } catch {
+        return; // no session takes edits: Apply records them once one does
+      }
+      applyFields(table, seedInput);
     }, 500);
   }
 
